@@ -1,0 +1,58 @@
+// The unrotated BRDF slice table (DESIGN.md "BRDF slices"): for each of T
+// outgoing elevations θₒ, the local-frame map ρ(ωᵢ, ωₒ)·cos θᵢ with ωₒ at
+// φ = 0, Haar-coded. These are the only BRDF coefficients haarcast stores;
+// every rotation happens at run time.
+#pragma once
+
+#include <cstddef>
+#include <functional>
+#include <vector>
+
+#include "haarcast/core/brdf.h"
+#include "haarcast/core/haar.h"
+
+namespace haarcast {
+
+struct SliceTableOptions {
+  int level = 5;
+  int thetaSamples = 16;      // T
+  int supersampling = 4;      // per pixel: n×n stratified samples averaged
+};
+
+class BrdfSliceTable {
+ public:
+  int level() const { return level_; }
+  int thetaSamples() const { return static_cast<int>(thetaOut_.size()); }
+  static constexpr int kChannels = 3;
+
+  // θₒ of sample t: (t + ½)·(π/2)/T.
+  double thetaOut(int t) const { return thetaOut_[static_cast<std::size_t>(t)]; }
+  // Slice nearest to θₒ (clamped to [0, π/2]).
+  int nearestSlice(double thetaOut) const;
+
+  const HaarMap& slice(int channel, int t) const;
+  // All slices of one channel, in θₒ order (what a SliceRotator takes).
+  std::vector<HaarMap> channelSlices(int channel) const;
+
+  std::size_t storedBytes() const;
+
+  // progress(done, total) is called as slices complete (may be empty).
+  static BrdfSliceTable build(const Brdf& brdf, const SliceTableOptions& options,
+                              const std::function<void(int, int)>& progress = {});
+
+ private:
+  int level_ = 0;
+  std::vector<double> thetaOut_;
+  std::vector<HaarMap> slices_;  // [channel * T + t]
+};
+
+// The local-frame slice map of one channel at θₒ, pixel values averaged over
+// n×n stratified samples per pixel. Shared by the table builder and the
+// analytic references of the tests and the rotation report.
+SphereMap sliceMap(const Brdf& brdf, double thetaOut, int channel, int level, int supersampling);
+
+// Pixel-averaged map of any function: mean of f over n×n stratified
+// positions per pixel (uniform in θ and φ within the pixel).
+SphereMap supersampledMap(int level, int supersampling, const std::function<double(const glm::dvec3&)>& f);
+
+}  // namespace haarcast

@@ -1,0 +1,103 @@
+// Rotation of Haar-coded sphere maps: one interface, four methods
+// (DESIGN.md "Rotation methods").
+//
+// A rotation is a Y-X-Y Euler triple (α, β, γ): R = R_y(α) R_x(β) R_y(γ).
+// R_y(a) adds a to φ; R_x(b) tilts +Y toward +Z by b. Rotating a map f by R
+// gives g(ω) = f(Rᵀω): what f shows at direction d, g shows at R·d. In map
+// terms g = shift_α ∘ elevate_β ∘ shift_γ (f). For a BRDF slice tabulated in
+// the local frame (+Y = normal), R·ŷ is the shading normal in the object frame:
+// its elevation is β and its azimuth α; γ turns the slice about the normal.
+#pragma once
+
+#include <cstddef>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <glm/mat3x3.hpp>
+
+#include "haarcast/core/haar.h"
+
+namespace haarcast {
+
+struct EulerYXY {
+  double alpha = 0.0;  // final φ-shift (azimuth of the normal)
+  double beta = 0.0;   // elevation about X (elevation of the normal)
+  double gamma = 0.0;  // first φ-shift (spin about the normal)
+};
+
+glm::dmat3 rotationMatrix(const EulerYXY& r);
+
+// Euler triple of a rotation matrix, with β ∈ [0, π]. At β = 0 or π the split
+// between α and γ is arbitrary; this puts all of it in α (γ = 0).
+EulerYXY eulerFromMatrix(const glm::dmat3& m);
+
+enum class RotationMethod { Haar, Spatial, Matrix, Table };
+
+inline constexpr RotationMethod kAllRotationMethods[] = {RotationMethod::Haar, RotationMethod::Spatial,
+                                                         RotationMethod::Matrix, RotationMethod::Table};
+
+std::string_view methodName(RotationMethod m);
+// Accepts exactly the DESIGN.md names: "haar", "spatial", "matrix", "table".
+std::optional<RotationMethod> parseRotationMethod(std::string_view name);
+
+// Variants of the seed's method (see rotate_haar.h for what each does).
+enum class HaarVariant {
+  Faithful,  // the seed as written: start-level details only
+  Refined,   // default: exact block-boundary differences, finite source steps
+};
+std::string_view variantName(HaarVariant v);
+std::optional<HaarVariant> parseHaarVariant(std::string_view name);
+
+struct RotatorOptions {
+  // haar: variant and the detail level it starts from (−1 = finest, n−1).
+  // Starting k levels coarser costs O(N/4^k) and drops the finer details.
+  HaarVariant haarVariant = HaarVariant::Refined;
+  int haarStartLevel = -1;
+  // matrix (Wang et al. 2006): elevations sampled uniformly in [0, π]
+  // (inclusive), and entries below threshold·(largest entry) dropped.
+  int matrixElevations = 33;
+  double matrixThreshold = 1e-4;
+  // table (Ng et al. 2004): pre-rotated copies per slice on a grid of normal
+  // elevations β ∈ [0, π] (inclusive) × normal azimuths α × spins γ.
+  int tableElevations = 9;
+  int tableAzimuths = 16;
+  int tableSpins = 16;
+};
+
+// A rotator owns whatever its method precomputes for one set of unrotated
+// maps (a BRDF slice table) and rotates one of those maps per call. rotate()
+// is const and thread-safe.
+class SliceRotator {
+ public:
+  virtual ~SliceRotator() = default;
+  virtual RotationMethod method() const = 0;
+  virtual std::size_t sliceCount() const = 0;
+  virtual int level() const = 0;
+  // Writes the coefficients of slice `slice` rotated by r into out (resized).
+  virtual void rotate(std::size_t slice, const EulerYXY& r, HaarMap& out) const = 0;
+  // Bytes of coefficient data the method keeps: the unrotated maps plus
+  // whatever it precomputed (matrices, pre-rotated copies).
+  virtual std::size_t storedBytes() const = 0;
+};
+
+// Throws std::invalid_argument if slices is empty or mixes levels.
+std::unique_ptr<SliceRotator> makeRotator(RotationMethod method, std::vector<HaarMap> slices,
+                                          const RotatorOptions& options = {});
+
+// ---- The methods as free functions on a single map -------------------------
+
+// spatial: inverse Haar → bilinear resample at Rᵀω of every pixel centre →
+// forward Haar. The seed's ground truth.
+HaarMap rotateSpatial(const HaarMap& f, const EulerYXY& r);
+SphereMap rotateSpatialMap(const SphereMap& f, const EulerYXY& r);
+
+// A pure φ-shift by `radians`, applied to Haar coefficients: exact (a
+// permutation of pixels) when radians is a whole number of pixels, linear
+// interpolation along φ otherwise. Used by the baselines for the cheap part
+// of a Y-X-Y rotation.
+HaarMap shiftPhi(const HaarMap& f, double radians);
+
+}  // namespace haarcast

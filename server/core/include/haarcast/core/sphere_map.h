@@ -1,0 +1,97 @@
+// Square longitude-latitude maps of spherical functions (DESIGN.md "Maps").
+//
+// A map of level n has M = 2^n rows and columns. Row i holds elevation
+// θ_i = (i + ½)π/M measured from +Y, column j holds azimuth φ_j = (j + ½)2π/M
+// measured from +Z toward +X. The direction of (θ, φ) is
+// (sin θ sin φ, cos θ, sin θ cos φ) — the seed's equation for p.
+//
+// φ wraps around. θ is clamped at the poles: a sample above the first row's
+// centre takes the first row's value (no reflection across the pole), which is
+// what every resampler in haarcast does, so all rotation methods agree there.
+#pragma once
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <numbers>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+namespace haarcast {
+
+inline constexpr double kPi = std::numbers::pi;
+inline constexpr double kTwoPi = 2.0 * std::numbers::pi;
+
+// Largest map level the library accepts: level 12 is a 4096² map (64 MiB of
+// floats); anything larger is a mistake in a request, not a real use.
+inline constexpr int kMaxLevel = 12;
+
+// Throws std::invalid_argument naming the bad level unless 0 <= level <= kMaxLevel.
+void checkLevel(int level, const char* what);
+
+inline int mapSize(int level) { return 1 << level; }
+
+// Direction of spherical coordinates (θ, φ) in the haarcast convention.
+inline glm::dvec3 sphericalToDirection(double theta, double phi) {
+  const double s = std::sin(theta);
+  return {s * std::sin(phi), std::cos(theta), s * std::cos(phi)};
+}
+
+struct Spherical {
+  double theta;  // [0, π]
+  double phi;    // [0, 2π)
+};
+
+// Inverse of sphericalToDirection for a unit (or any non-zero) vector.
+Spherical directionToSpherical(const glm::dvec3& d);
+
+inline double rowTheta(int level, int row) { return (row + 0.5) * kPi / mapSize(level); }
+inline double colPhi(int level, int col) { return (col + 0.5) * kTwoPi / mapSize(level); }
+
+// Exact solid angle of a pixel in row `row`: (cos θ⁻ − cos θ⁺)·2π/M.
+double pixelSolidAngle(int level, int row);
+
+// A spherical function sampled at pixel centres, row-major (row = θ index).
+class SphereMap {
+ public:
+  SphereMap() = default;
+  explicit SphereMap(int level, float fill = 0.0f);
+
+  // Samples f(direction) at every pixel centre.
+  static SphereMap fromFunction(int level, const std::function<double(const glm::dvec3&)>& f);
+
+  int level() const { return level_; }
+  int size() const { return mapSize(level_); }
+  std::size_t pixelCount() const { return values_.size(); }
+
+  float& at(int row, int col) { return values_[index(row, col)]; }
+  float at(int row, int col) const { return values_[index(row, col)]; }
+  std::span<float> values() { return values_; }
+  std::span<const float> values() const { return values_; }
+
+  // ∫ f dω by the exact pixel solid angles.
+  double integral() const;
+
+  // Bilinear interpolation between pixel centres: φ wraps, θ clamps at the
+  // poles (see the file comment). This is the one resampler of haarcast.
+  double sampleBilinear(double theta, double phi) const;
+
+  // Copy with every pixel multiplied by its solid angle: the form in which
+  // the light enters the triple product (DESIGN.md "Solid angle").
+  SphereMap weightedBySolidAngle() const;
+
+ private:
+  std::size_t index(int row, int col) const {
+    return static_cast<std::size_t>(row) * static_cast<std::size_t>(size()) +
+           static_cast<std::size_t>(col);
+  }
+  int level_ = 0;
+  std::vector<float> values_{0.0f};
+};
+
+}  // namespace haarcast

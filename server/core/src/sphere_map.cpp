@@ -1,0 +1,88 @@
+#include "haarcast/core/sphere_map.h"
+
+#include <algorithm>
+#include <string>
+
+namespace haarcast {
+
+void checkLevel(int level, const char* what) {
+  if (level < 0 || level > kMaxLevel) {
+    throw std::invalid_argument(std::string(what) + ": map level " + std::to_string(level) +
+                                " is outside [0, " + std::to_string(kMaxLevel) + "]");
+  }
+}
+
+Spherical directionToSpherical(const glm::dvec3& d) {
+  const double len = std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+  const double y = std::clamp(d.y / len, -1.0, 1.0);
+  double phi = std::atan2(d.x, d.z);  // from +Z toward +X
+  if (phi < 0.0) phi += kTwoPi;
+  if (phi >= kTwoPi) phi -= kTwoPi;
+  return {std::acos(y), phi};
+}
+
+double pixelSolidAngle(int level, int row) {
+  const int m = mapSize(level);
+  const double t0 = row * kPi / m;
+  const double t1 = (row + 1) * kPi / m;
+  return (std::cos(t0) - std::cos(t1)) * kTwoPi / m;
+}
+
+SphereMap::SphereMap(int level, float fill) : level_(level) {
+  checkLevel(level, "SphereMap");
+  values_.assign(static_cast<std::size_t>(mapSize(level)) * static_cast<std::size_t>(mapSize(level)), fill);
+}
+
+SphereMap SphereMap::fromFunction(int level, const std::function<double(const glm::dvec3&)>& f) {
+  SphereMap map(level);
+  const int m = map.size();
+  for (int i = 0; i < m; ++i) {
+    for (int j = 0; j < m; ++j) {
+      map.at(i, j) = static_cast<float>(f(sphericalToDirection(rowTheta(level, i), colPhi(level, j))));
+    }
+  }
+  return map;
+}
+
+double SphereMap::integral() const {
+  double sum = 0.0;
+  const int m = size();
+  for (int i = 0; i < m; ++i) {
+    double row = 0.0;
+    for (int j = 0; j < m; ++j) row += at(i, j);
+    sum += row * pixelSolidAngle(level_, i);
+  }
+  return sum;
+}
+
+double SphereMap::sampleBilinear(double theta, double phi) const {
+  const int m = size();
+  // Continuous pixel coordinates: pixel centres sit at integer + 0.5.
+  double y = theta / kPi * m - 0.5;
+  double x = phi / kTwoPi * m - 0.5;
+  y = std::clamp(y, 0.0, static_cast<double>(m - 1));
+  const double fy = std::floor(y);
+  const double fx = std::floor(x);
+  const double ty = y - fy;
+  const double tx = x - fx;
+  const int i0 = static_cast<int>(fy);
+  const int i1 = std::min(i0 + 1, m - 1);
+  const int jw = static_cast<int>(fx);
+  const int j0 = ((jw % m) + m) % m;
+  const int j1 = (j0 + 1) % m;
+  const double top = (1.0 - tx) * at(i0, j0) + tx * at(i0, j1);
+  const double bottom = (1.0 - tx) * at(i1, j0) + tx * at(i1, j1);
+  return (1.0 - ty) * top + ty * bottom;
+}
+
+SphereMap SphereMap::weightedBySolidAngle() const {
+  SphereMap out = *this;
+  const int m = size();
+  for (int i = 0; i < m; ++i) {
+    const double w = pixelSolidAngle(level_, i);
+    for (int j = 0; j < m; ++j) out.at(i, j) = static_cast<float>(at(i, j) * w);
+  }
+  return out;
+}
+
+}  // namespace haarcast
