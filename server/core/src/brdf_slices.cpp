@@ -3,13 +3,11 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
-#include <condition_variable>
-#include <exception>
-#include <mutex>
 #include <stdexcept>
 #include <string>
-#include <thread>
+#include <vector>
+
+#include "parallel.h"
 
 namespace haarcast {
 namespace {
@@ -150,9 +148,9 @@ std::size_t BrdfSliceTable::storedBytes() const {
 }
 
 // Work is split by θₒ sample: each task evaluates the BRDF once per sample for
-// all three channels and Haar-codes the three maps. Workers take tasks from a
-// shared counter; progress(done, T) runs on the calling thread, in order, so a
-// callback needs no locking and an exception from it stops the build cleanly.
+// all three channels and Haar-codes the three maps, on parallelFor's threads;
+// progress(done, T) runs on the calling thread, in order, so a callback needs
+// no locking and an exception from it stops the build cleanly.
 BrdfSliceTable BrdfSliceTable::build(const Brdf& brdf, const SliceTableOptions& options,
                                      const std::function<void(int, int)>& progress) {
   checkLevel(options.level, "SliceTableOptions.level");
@@ -169,61 +167,19 @@ BrdfSliceTable BrdfSliceTable::build(const Brdf& brdf, const SliceTableOptions& 
   for (int t = 0; t < total; ++t) table.thetaOut_[static_cast<std::size_t>(t)] = (t + 0.5) * (kPi / 2.0) / total;
   table.slices_.resize(static_cast<std::size_t>(kChannels * total));
 
-  std::atomic<int> next{0};
-  std::atomic<bool> stop{false};
-  std::mutex mutex;
-  std::condition_variable cv;
-  int done = 0;                  // guarded by mutex
-  std::exception_ptr failure;    // guarded by mutex
-
-  auto worker = [&] {
-    for (int t = next.fetch_add(1); t < total && !stop.load(); t = next.fetch_add(1)) {
-      try {
+  detail::parallelFor(
+      static_cast<std::size_t>(total),
+      [&](std::size_t i) {
+        const int t = static_cast<int>(i);
         const std::array<SphereMap, 3> maps =
             sliceMapsRgb(brdf, table.thetaOut(t), options.level, options.supersampling);
         for (int c = 0; c < kChannels; ++c) {
           table.slices_[static_cast<std::size_t>(c * total + t)] = forwardHaar(maps[static_cast<std::size_t>(c)]);
         }
-        const std::lock_guard lock(mutex);
-        ++done;
-      } catch (...) {
-        const std::lock_guard lock(mutex);
-        if (!failure) failure = std::current_exception();
-        stop = true;
-      }
-      cv.notify_one();
-    }
-  };
-
-  const unsigned hardware = std::max(1u, std::thread::hardware_concurrency());
-  const int threadCount = std::min(total, static_cast<int>(hardware));
-  std::vector<std::jthread> threads;
-  threads.reserve(static_cast<std::size_t>(threadCount));
-  for (int k = 0; k < threadCount; ++k) threads.emplace_back(worker);
-
-  try {
-    int reported = 0;
-    while (reported < total) {
-      int now = 0;
-      {
-        std::unique_lock lock(mutex);
-        cv.wait(lock, [&] { return done > reported || failure; });
-        if (failure) break;
-        now = done;
-      }
-      // Report each completed slice, outside the lock.
-      while (reported < now) {
-        ++reported;
-        if (progress) progress(reported, total);
-      }
-    }
-  } catch (...) {
-    stop = true;
-    threads.clear();  // joins
-    throw;
-  }
-  threads.clear();
-  if (failure) std::rethrow_exception(failure);
+      },
+      [&](std::size_t done) {
+        if (progress) progress(static_cast<int>(done), total);
+      });
   return table;
 }
 

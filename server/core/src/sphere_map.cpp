@@ -55,24 +55,30 @@ double SphereMap::integral() const {
   return sum;
 }
 
-double SphereMap::sampleBilinear(double theta, double phi) const {
-  const int m = size();
+BilinearTaps bilinearTaps(int level, double theta, double phi) {
+  const int m = mapSize(level);
   // Continuous pixel coordinates: pixel centres sit at integer + 0.5.
   double y = theta / kPi * m - 0.5;
-  double x = phi / kTwoPi * m - 0.5;
+  const double x = phi / kTwoPi * m - 0.5;
   y = std::clamp(y, 0.0, static_cast<double>(m - 1));
   const double fy = std::floor(y);
   const double fx = std::floor(x);
-  const double ty = y - fy;
-  const double tx = x - fx;
-  const int i0 = static_cast<int>(fy);
-  const int i1 = std::min(i0 + 1, m - 1);
+  BilinearTaps t;
+  t.tRow = y - fy;
+  t.tCol = x - fx;
+  t.row[0] = static_cast<int>(fy);
+  t.row[1] = std::min(t.row[0] + 1, m - 1);
   const int jw = static_cast<int>(fx);
-  const int j0 = ((jw % m) + m) % m;
-  const int j1 = (j0 + 1) % m;
-  const double top = (1.0 - tx) * at(i0, j0) + tx * at(i0, j1);
-  const double bottom = (1.0 - tx) * at(i1, j0) + tx * at(i1, j1);
-  return (1.0 - ty) * top + ty * bottom;
+  t.col[0] = ((jw % m) + m) % m;
+  t.col[1] = (t.col[0] + 1) % m;
+  return t;
+}
+
+double SphereMap::sampleBilinear(double theta, double phi) const {
+  const BilinearTaps t = bilinearTaps(level_, theta, phi);
+  const double top = (1.0 - t.tCol) * at(t.row[0], t.col[0]) + t.tCol * at(t.row[0], t.col[1]);
+  const double bottom = (1.0 - t.tCol) * at(t.row[1], t.col[0]) + t.tCol * at(t.row[1], t.col[1]);
+  return (1.0 - t.tRow) * top + t.tRow * bottom;
 }
 
 SphereMap SphereMap::weightedBySolidAngle() const {

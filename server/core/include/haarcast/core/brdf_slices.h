@@ -51,8 +51,9 @@ class BrdfSliceTable {
 // analytic references of the tests and the rotation report.
 SphereMap sliceMap(const Brdf& brdf, double thetaOut, int channel, int level, int supersampling);
 
-// Pixel-averaged map of any function: mean of f over n×n stratified
-// positions per pixel (uniform in θ and φ within the pixel).
+// Pixel-averaged map of any function: the solid-angle mean of f over each
+// pixel, from n×n stratified positions (uniform in θ and φ within the pixel,
+// each weighted by sin θ so that SphereMap::integral stays right).
 SphereMap supersampledMap(int level, int supersampling, const std::function<double(const glm::dvec3&)>& f);
 
 }  // namespace haarcast

@@ -98,9 +98,8 @@ int supportSide(int mapLevel, std::size_t index);
 // Non-linear approximation (Ng et al. 2003): keep the k coefficients of
 // largest area-weighted magnitude |c|·side, where side is the pixel side of
 // the basis function's support — |c|·side is the L1 mass of that term, i.e. the
-// most it can add to an integral against a function bounded by 1. The scaling
-// coefficient carries side M and so is kept first whenever it is non-zero.
-// k ≥ coefficientCount keeps all non-zeros.
+// most it can add to an integral against a function bounded by 1. Ties go to
+// the lower index. k ≥ coefficientCount keeps all non-zeros.
 SparseHaar keepLargest(const HaarMap& coeffs, std::size_t k);
 
 }  // namespace haarcast

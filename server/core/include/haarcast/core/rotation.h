@@ -60,10 +60,10 @@ struct RotatorOptions {
   // (inclusive), and entries below threshold·(largest entry) dropped.
   int matrixElevations = 33;
   double matrixThreshold = 1e-4;
-  // table (Ng et al. 2004): pre-rotated copies per slice on a grid of normal
-  // elevations β ∈ [0, π] (inclusive) × normal azimuths α × spins γ.
+  // table (Ng et al. 2004): pre-rotated copies (0, β, γ) per slice on a grid
+  // of normal elevations β ∈ [0, π] (inclusive) × spins γ ∈ [0, 2π); the
+  // normal's azimuth α is not tabulated but applied as an exact φ-shift.
   int tableElevations = 9;
-  int tableAzimuths = 16;
   int tableSpins = 16;
 };
 

@@ -10,6 +10,7 @@
 // what every resampler in haarcast does, so all rotation methods agree there.
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -55,6 +56,20 @@ inline double colPhi(int level, int col) { return (col + 0.5) * kTwoPi / mapSize
 
 // Exact solid angle of a pixel in row `row`: (cos θ⁻ − cos θ⁺)·2π/M.
 double pixelSolidAngle(int level, int row);
+
+// The four pixels and weights of bilinear interpolation at (θ, φ) on a map of
+// `level`, between pixel centres: φ wraps, θ clamps at the poles (see the file
+// comment). The one definition of the taps, used by SphereMap::sampleBilinear
+// and by every resampler that needs its stencil explicitly (rotate_matrix).
+struct BilinearTaps {
+  std::array<int, 2> row;  // row[1] = row[0] + 1, or row[0] on the last row
+  std::array<int, 2> col;  // col[1] = col[0] + 1 mod M
+  double tRow;             // fraction from row[0] toward row[1], in [0, 1]
+  double tCol;             // fraction from col[0] toward col[1], in [0, 1)
+  // Weight of pixel (row[a], col[b]), a, b ∈ {0, 1}; the four sum to 1.
+  double weight(int a, int b) const { return (a ? tRow : 1.0 - tRow) * (b ? tCol : 1.0 - tCol); }
+};
+BilinearTaps bilinearTaps(int level, double theta, double phi);
 
 // A spherical function sampled at pixel centres, row-major (row = θ index).
 class SphereMap {

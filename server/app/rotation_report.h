@@ -1,0 +1,54 @@
+// `haarcast rotation-report`: every rotation method, measured side by side in
+// one run on the same lobes, rotations and light (DESIGN.md "Measurements").
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "haarcast/core/rotation.h"
+
+namespace haarcast::app {
+
+struct RotationReportOptions {
+  int level = 5;
+  int rotations = 50;
+  std::uint32_t seed = 1;
+  int supersampling = 4;        // per pixel, for the lobes and the exact references
+  int storageThetaSamples = 16;  // slice-table size for stored_bytes
+  RotatorOptions rotator;
+};
+
+struct MethodScores {
+  double psnrMapVsExact = 0.0;
+  double psnrRenderVsExact = 0.0;
+  double psnrRenderVsSpatial = 0.0;
+  double nsPerRotation = 0.0;
+  std::size_t storedBytes = 0;
+};
+
+struct RotationReport {
+  int level = 0;
+  int rotations = 0;
+  std::vector<std::string> lobes;
+  // method name → scores averaged over lobes (PSNR in dB averaged, as the
+  // seed averages its tables), and per lobe.
+  std::map<std::string, MethodScores> methods;
+  std::map<std::string, std::map<std::string, MethodScores>> perLobe;
+  // The two variants of `haar`, scored the same way.
+  std::map<std::string, MethodScores> haarVariants;
+};
+
+// Throws std::invalid_argument naming the bad option. progress(message) gets
+// one line per finished stage (may be empty).
+RotationReport runRotationReport(const RotationReportOptions& options,
+                                 const std::function<void(const std::string&)>& progress = {});
+
+nlohmann::json toJson(const RotationReport& report);
+std::string toText(const RotationReport& report);
+
+}  // namespace haarcast::app

@@ -1,0 +1,80 @@
+// The one thread pool of the core library (private header).
+#pragma once
+
+#include <algorithm>
+#include <atomic>
+#include <condition_variable>
+#include <cstddef>
+#include <exception>
+#include <functional>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+namespace haarcast::detail {
+
+// Runs body(i) for i = 0 … count−1 on up to hardware_concurrency threads (at
+// least 1), which take indices from a shared counter. The calling thread waits
+// and, if onDone is given, calls onDone(done) for done = 1, 2, … as items
+// complete — in order, on the calling thread, so it needs no locking.
+//
+// The first exception, from body or from onDone, stops the handing out of new
+// indices (items already running finish); the workers are joined and that
+// exception is rethrown on the calling thread. After a failure in body, items
+// that completed may go unreported.
+inline void parallelFor(std::size_t count, const std::function<void(std::size_t)>& body,
+                        const std::function<void(std::size_t done)>& onDone = {}) {
+  if (count == 0) return;
+  std::atomic<std::size_t> next{0};
+  std::atomic<bool> stop{false};
+  std::mutex mutex;
+  std::condition_variable cv;
+  std::size_t done = 0;        // guarded by mutex
+  std::exception_ptr failure;  // guarded by mutex
+
+  auto worker = [&] {
+    for (std::size_t i = next.fetch_add(1); i < count && !stop.load(); i = next.fetch_add(1)) {
+      try {
+        body(i);
+        const std::lock_guard lock(mutex);
+        ++done;
+      } catch (...) {
+        const std::lock_guard lock(mutex);
+        if (!failure) failure = std::current_exception();
+        stop = true;
+      }
+      cv.notify_one();
+    }
+  };
+
+  const std::size_t hardware = std::max(1u, std::thread::hardware_concurrency());
+  const std::size_t threadCount = std::min(count, hardware);
+  std::vector<std::jthread> threads;
+  threads.reserve(threadCount);
+  try {
+    for (std::size_t k = 0; k < threadCount; ++k) threads.emplace_back(worker);
+    std::size_t reported = 0;
+    while (reported < count) {
+      std::size_t now = 0;
+      {
+        std::unique_lock lock(mutex);
+        cv.wait(lock, [&] { return done > reported || failure; });
+        if (failure) break;
+        now = done;
+      }
+      // Report each completed item, outside the lock.
+      while (reported < now) {
+        ++reported;
+        if (onDone) onDone(reported);
+      }
+    }
+  } catch (...) {
+    stop = true;
+    threads.clear();  // joins
+    throw;
+  }
+  threads.clear();  // joins
+  if (failure) std::rethrow_exception(failure);
+}
+
+}  // namespace haarcast::detail
