@@ -138,15 +138,15 @@ double faithfulRenderPsnr(int level, double exponent) {
 }
 
 TEST(RotateHaar, FaithfulMeetsItsMeasuredFloors) {
-  // Measured on this code (16 rotations, seed 42): Lambert-like lobe at
-  // level 5 ≈ 55 dB, Phong-64 at level 5 ≈ 9 dB. The floors sit a few dB
-  // below, so a regression of the faithful path fails here.
+  // Measured on this code (16 rotations, seed 42): Lambert at level 5
+  // 45.5 dB, Phong-64 at level 5 7.1 dB. The floors sit ~3 dB below, so a
+  // regression of the faithful path fails here.
   const double lambert = faithfulRenderPsnr(5, 1.0);
   const double glossy = faithfulRenderPsnr(5, 64.0);
   RecordProperty("faithful_lambert_psnr_db", std::to_string(lambert));
   RecordProperty("faithful_phong64_psnr_db", std::to_string(glossy));
-  EXPECT_GT(lambert, -1000.0);
-  EXPECT_GT(glossy, -1000.0);
+  EXPECT_GT(lambert, 42.0);
+  EXPECT_GT(glossy, 4.0);
 }
 
 TEST(RotateHaar, FaithfulConvergesForSmoothMaps) {
