@@ -34,7 +34,7 @@ int main(int argc, char** argv) {
   rr->add_option("--level", report.level, "Map level n (M = 2^n), 2..7")->capture_default_str();
   rr->add_option("--rotations", report.rotations, "Random rotations per lobe")->capture_default_str();
   rr->add_option("--seed", report.seed, "Seed of the random rotations")->capture_default_str();
-  rr->add_option("--haar-variant", variant, "Variant of `haar` scored as the method: faithful|refined")
+  rr->add_option("--haar-variant", variant, "Variant of `haar` scored as the method: faithful|local|refined")
       ->capture_default_str();
   rr->add_option("--haar-start-level", report.rotator.haarStartLevel, "Detail level `haar` starts from (-1 = finest)")
       ->capture_default_str();
@@ -46,7 +46,7 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
     if (rr->parsed()) {
       const auto v = haarcast::parseHaarVariant(variant);
-      if (!v) throw std::invalid_argument("--haar-variant must be faithful or refined (got \"" + variant + "\")");
+      if (!v) throw std::invalid_argument("--haar-variant must be faithful, local or refined (got \"" + variant + "\")");
       report.rotator.haarVariant = *v;
       return runReport(report, json);
     }

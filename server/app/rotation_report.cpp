@@ -199,7 +199,7 @@ RotationReport runRotationReport(const RotationReportOptions& o, const std::func
     std::snprintf(line, sizeof line, "%-8s done (precompute %.2f s, %.0f ns per rotation)", name.c_str(), setup, ns);
     say(line);
   }
-  for (HaarVariant v : {HaarVariant::Faithful, HaarVariant::Refined}) {
+  for (HaarVariant v : {HaarVariant::Faithful, HaarVariant::Local, HaarVariant::Refined}) {
     RotatorOptions ro = o.rotator;
     ro.haarVariant = v;
     std::map<std::string, MethodScores> perLobe;

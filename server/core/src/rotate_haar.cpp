@@ -8,6 +8,9 @@
 #include "haarcast/core/rotate_haar.h"
 
 #include <algorithm>
+#include <functional>
+#include <memory>
+#include <optional>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -89,7 +92,7 @@ SourcePoint sourceWithJacobian(const glm::dmat3& rt, double theta, double phi) {
 
 struct DifferenceFields {
   Grid dTheta, dPhi, dMixed;
-  double workingScaling = 0.0;  // refined only: the working map's scaling coefficient
+  std::optional<double> workingScaling;  // when absolute values were known (refined)
   explicit DifferenceFields(int mw) : dTheta(mw - 1, mw), dPhi(mw, mw - 1), dMixed(mw - 1, mw - 1) {}
 
   // The diagonal band from the θ-difference of the φ-differences (the seed's
@@ -150,29 +153,120 @@ DifferenceFields faithfulDifferences(const StartDetails& s, const glm::dmat3& rt
   return out;
 }
 
-// Refined: exact differences of f on the working grid, then finite source
-// steps with the midpoint gradient.
-DifferenceFields refinedDifferences(const HaarMap& f, const StartDetails& s, int start, const glm::dmat3& rt) {
-  const int mw = s.mw, half = mw / 2;
-  const double dT = kPi / mw, dP = kTwoPi / mw;
-  // Scaling values of the start level (from the coarser levels), in the
-  // working map's normalisation. Only their differences are used below.
-  const std::vector<double> sv = scalingValues(f, start);
+// f's differences on the working grid: dT(t, c) = f(t+1, c) − f(t, c),
+// dP(r, c) = f(r, c+1) − f(r, c) with c+1 wrapping; and, where the variant
+// knows them, absolute values of f (for the scaling coefficient's anchor).
+struct SourceDifferences {
+  Grid dT, dP;
+  std::function<double(int, int)> pixel;  // empty when only differences are known
+  explicit SourceDifferences(int mw) : dT(mw - 1, mw), dP(mw, mw) {}
+};
+
+// Inside each 2×2 block the details give both columns' θ-differences and
+// both rows' φ-differences exactly: with corners a b / c d,
+// c − a = −v − d', d − b = −v + d', b − a = −h − d', d − c = −h + d'.
+void withinBlockDifferences(const StartDetails& s, SourceDifferences& out) {
+  for (int i = 0; i < s.mw / 2; ++i)
+    for (int j = 0; j < s.mw / 2; ++j) {
+      out.dT(2 * i, 2 * j) = -s.v(i, j) - s.d(i, j);
+      out.dT(2 * i, 2 * j + 1) = -s.v(i, j) + s.d(i, j);
+      out.dP(2 * i, 2 * j) = -s.h(i, j) - s.d(i, j);
+      out.dP(2 * i + 1, 2 * j) = -s.h(i, j) + s.d(i, j);
+    }
+}
+
+// Across a block boundary the pixel difference is the difference of the two
+// blocks' scaling values plus terms in their details: for the boundary below
+// block (i, j) in its column half σ (+1 left, −1 right),
+//   [(s' − s) + σ(h' − h) + (v' + v) + σ(d' + d)] / 2,
+// and for the boundary right of block (i, j) in its row half σ (+1 top),
+//   [(s' − s) + (h' + h) + σ(v' − v) + σ(d' + d)] / 2.
+// `sDiffTheta(i, j)` = s(i+1, j) − s(i, j); `sDiffPhi(i, j)` = s(i, j+1) − s(i, j).
+template <typename SDiffTheta, typename SDiffPhi>
+void acrossBlockDifferences(const StartDetails& s, SDiffTheta sDiffTheta, SDiffPhi sDiffPhi, SourceDifferences& out) {
+  const int half = s.mw / 2;
+  for (int i = 0; i + 1 < half; ++i)
+    for (int j = 0; j < half; ++j) {
+      const double ds = sDiffTheta(i, j);
+      for (int dj = 0; dj < 2; ++dj) {
+        const double sg = dj ? -1.0 : 1.0;
+        out.dT(2 * i + 1, 2 * j + dj) = 0.5 * (ds + sg * (s.h(i + 1, j) - s.h(i, j)) + (s.v(i + 1, j) + s.v(i, j)) +
+                                               sg * (s.d(i + 1, j) + s.d(i, j)));
+      }
+    }
+  for (int i = 0; i < half; ++i)
+    for (int j = 0; j < half; ++j) {
+      const int jn = (j + 1) % half;
+      const double ds = sDiffPhi(i, j);
+      for (int di = 0; di < 2; ++di) {
+        const double sg = di ? -1.0 : 1.0;
+        out.dP(2 * i + di, 2 * j + 1) =
+            0.5 * (ds + (s.h(i, jn) + s.h(i, j)) + sg * (s.v(i, jn) - s.v(i, j)) + sg * (s.d(i, jn) + s.d(i, j)));
+      }
+    }
+}
+
+// Refined: the start level's scaling values come from all coarser levels, so
+// every difference is exact and absolute values are known.
+SourceDifferences exactDifferences(const HaarMap& f, const StartDetails& s, int start) {
+  const int half = s.mw / 2;
   const double scale = 1.0 / static_cast<double>(1 << (f.level() - (start + 1)));
-  auto sAt = [&](int i, int j) { return sv[static_cast<std::size_t>(i) * static_cast<std::size_t>(half) + j] * scale; };
-  // Pixel p of block (i, j) relative to the block: a, b, c, d = (s ± h ± v ± d')/2.
-  auto pixel = [&](int row, int col) {
-    const int i = row / 2, j = col / 2, di = row % 2, dj = col % 2;
-    const double sh = dj ? -1.0 : 1.0, svv = di ? -1.0 : 1.0;
+  auto sv = std::make_shared<std::vector<double>>(scalingValues(f, start));
+  for (double& x : *sv) x *= scale;
+  auto sAt = [sv, half](int i, int j) { return (*sv)[static_cast<std::size_t>(i) * static_cast<std::size_t>(half) + j]; };
+  SourceDifferences out(s.mw);
+  withinBlockDifferences(s, out);
+  acrossBlockDifferences(
+      s, [&](int i, int j) { return sAt(i + 1, j) - sAt(i, j); },
+      [&](int i, int j) { return sAt(i, (j + 1) % half) - sAt(i, j); }, out);
+  // Pixel (row, col) of block (i, j): a, b, c, d = (s ± h ± v ± d')/2.
+  out.pixel = [sAt, &s](int row, int col) {
+    const int i = row / 2, j = col / 2;
+    const double sh = col % 2 ? -1.0 : 1.0, svv = row % 2 ? -1.0 : 1.0;
     return 0.5 * (sAt(i, j) + sh * s.h(i, j) + svv * s.v(i, j) + sh * svv * s.d(i, j));
   };
-  // f's differences on the working grid: dθ between rows t, t+1; dφ between
-  // columns c, c+1 (wrapping); both exact.
-  Grid fT(mw - 1, mw), fP(mw, mw);
-  for (int t = 0; t + 1 < mw; ++t)
-    for (int c = 0; c < mw; ++c) fT(t, c) = pixel(t + 1, c) - pixel(t, c);
-  for (int r = 0; r < mw; ++r)
-    for (int c = 0; c < mw; ++c) fP(r, c) = pixel(r, (c + 1) % mw) - pixel(r, c);
+  return out;
+}
+
+// Local: only the start level and the one above it. Sibling blocks' scaling
+// differences follow from their parent's details (s_TL = (S+h+v+d)/2, …);
+// across parents they are estimated by the central difference of the two
+// neighbouring sibling differences. No absolute value is known.
+SourceDifferences localDifferences(const HaarMap& f, const StartDetails& s, int start) {
+  const int half = s.mw / 2;
+  const double scale = 1.0 / static_cast<double>(1 << (f.level() - (start + 1)));
+  auto parent = [&](Band b, int i, int j) { return f.detail(b, start - 1, i / 2, j / 2) * scale; };
+  // Within one parent: s(2I+1, ·) − s(2I, ·) and s(·, 2J+1) − s(·, 2J).
+  auto siblingTheta = [&](int i, int j) {
+    const double v = parent(Band::Vertical, i, j), d = parent(Band::Diagonal, i, j);
+    return j % 2 ? -v + d : -v - d;
+  };
+  auto siblingPhi = [&](int i, int j) {
+    const double h = parent(Band::Horizontal, i, j), d = parent(Band::Diagonal, i, j);
+    return i % 2 ? -h + d : -h - d;
+  };
+  auto sDiffTheta = [&](int i, int j) {
+    if (i % 2 == 0) return siblingTheta(i, j);
+    const double before = siblingTheta(i - 1, j);
+    return i + 2 < half ? 0.5 * (before + siblingTheta(i + 1, j)) : before;
+  };
+  auto sDiffPhi = [&](int i, int j) {
+    if (half == 1) return 0.0;  // one block: the wrap joins it to itself
+    if (j % 2 == 0) return siblingPhi(i, j);
+    return 0.5 * (siblingPhi(i, j - 1) + siblingPhi(i, (j + 1) % half));
+  };
+  SourceDifferences out(s.mw);
+  withinBlockDifferences(s, out);
+  acrossBlockDifferences(s, sDiffTheta, sDiffPhi, out);
+  return out;
+}
+
+// g's differences by the finite chain rule over f's differences (shared by
+// refined and local).
+DifferenceFields finiteChainRule(const SourceDifferences& fd, int mw, const glm::dmat3& rt) {
+  const double dT = kPi / mw, dP = kTwoPi / mw;
+  const Grid& fT = fd.dT;
+  const Grid& fP = fd.dP;
 
   // Source position of every pixel centre of g, in f's pixel coordinates
   // (x along φ, y along θ; pixel centres at integers).
@@ -236,15 +330,16 @@ DifferenceFields refinedDifferences(const HaarMap& f, const StartDetails& s, int
     for (int u = 0; u + 1 < mw; ++u) out.dPhi(r, u) = difference(at(r, u), at(r, u + 1));
   out.deriveMixed();
 
-  // The scaling coefficient is the one number differences cannot give. Anchor
-  // it on one absolute value, f at the source of g's first pixel (bilinear,
-  // as everywhere), and sum the differences out to every pixel.
+  // The scaling coefficient is the one number differences cannot give. With
+  // absolute values known, anchor it on f at the source of g's first pixel
+  // (bilinear, as everywhere) and sum the differences out to every pixel.
+  if (!fd.pixel) return out;
   const Point p0 = at(0, 0);
   const double y0 = std::clamp(p0.y, 0.0, static_cast<double>(mw - 1));
   const int r0 = std::min(static_cast<int>(y0), mw - 2);
   const int c0 = ((static_cast<int>(std::floor(p0.x)) % mw) + mw) % mw;
   const double tx = p0.x - std::floor(p0.x), ty = y0 - r0;
-  const double anchor = pixel(r0, c0) + ty * fT(r0, c0) + tx * fP(r0, c0) + tx * ty * (fP(r0 + 1, c0) - fP(r0, c0));
+  const double anchor = fd.pixel(r0, c0) + ty * fT(r0, c0) + tx * fP(r0, c0) + tx * ty * (fP(r0 + 1, c0) - fP(r0, c0));
   double total = 0.0, rowStart = anchor;
   for (int r = 0; r < mw; ++r) {
     if (r > 0) rowStart += out.dTheta(r - 1, 0);
@@ -350,8 +445,12 @@ HaarMap rotateHaar(const HaarMap& f, const EulerYXY& r, const HaarRotationOption
   }
   const glm::dmat3 rt = glm::transpose(rotationMatrix(r));
   const StartDetails details(f, start);
-  const DifferenceFields g = options.variant == HaarVariant::Faithful ? faithfulDifferences(details, rt)
-                                                                      : refinedDifferences(f, details, start, rt);
+  DifferenceFields g(details.mw);
+  switch (options.variant) {
+    case HaarVariant::Faithful: g = faithfulDifferences(details, rt); break;
+    case HaarVariant::Local: g = finiteChainRule(localDifferences(f, details, start), details.mw, rt); break;
+    case HaarVariant::Refined: g = finiteChainRule(exactDifferences(f, details, start), details.mw, rt); break;
+  }
 
   // Details of g: v = −Σ/side, h = −Σ/side, d' = Σ/side, side in working
   // pixels; × 2^(n−w) back to the level-n normalisation.
@@ -369,11 +468,11 @@ HaarMap rotateHaar(const HaarMap& f, const EulerYXY& r, const HaarRotationOption
     out.detail(Band::Diagonal, l, a, b) = static_cast<float>(sum / sideOf(l) * up);
   });
 
-  if (options.variant == HaarVariant::Refined) {
-    out.scaling() = static_cast<float>(g.workingScaling * up);
+  if (g.workingScaling) {
+    out.scaling() = static_cast<float>(*g.workingScaling * up);
   } else {
-    // Faithful has no absolute value to anchor on: take the scaling
-    // coefficient from the rotation-invariant integral.
+    // No absolute value to anchor on: take the scaling coefficient from the
+    // rotation-invariant integral.
     double rest = 0.0;
     for (int l = 0; l <= start; ++l)
       for (int i = 0; i < (1 << l); ++i) {

@@ -63,6 +63,7 @@ std::optional<RotationMethod> parseRotationMethod(std::string_view name) {
 std::string_view variantName(HaarVariant v) {
   switch (v) {
     case HaarVariant::Faithful: return "faithful";
+    case HaarVariant::Local: return "local";
     case HaarVariant::Refined: return "refined";
   }
   return "?";
@@ -70,6 +71,7 @@ std::string_view variantName(HaarVariant v) {
 
 std::optional<HaarVariant> parseHaarVariant(std::string_view name) {
   if (name == "faithful") return HaarVariant::Faithful;
+  if (name == "local") return HaarVariant::Local;
   if (name == "refined") return HaarVariant::Refined;
   return std::nullopt;
 }

@@ -117,15 +117,15 @@ TEST(RotateHaar, LevelZeroMapIsRotationInvariant) {
   EXPECT_EQ(rotateHaar(f, {1, 2, 3})[0], 3.0f);
 }
 
-// Render PSNR of faithful against spatial: Σ over rotations of the integral
+// Render PSNR of a variant against spatial: Σ over rotations of the integral
 // of the rotated slice against the procedural HDR environment (sun included).
-double faithfulRenderPsnr(int level, double exponent) {
+double renderPsnrVsSpatial(HaarVariant variant, int level, double exponent) {
   const auto env = assets::proceduralEnvironment(level, 4);
   const HaarMap light = forwardHaar(env[0].weightedBySolidAngle());
   const HaarMap f = phongSlice(level, exponent, 0.6);
   std::vector<double> ref, test;
   for (const EulerYXY& r : randomRotations(16, 42)) {
-    const HaarMap s = rotateSpatial(f, r), h = rotateHaar(f, r, {HaarVariant::Faithful, -1});
+    const HaarMap s = rotateSpatial(f, r), h = rotateHaar(f, r, {variant, -1});
     double vs = 0.0, vh = 0.0;
     for (std::size_t i = 0; i < f.coefficientCount(); ++i) {
       vs += static_cast<double>(s[i]) * light[i];  // V = 1: the triple product is this inner product
@@ -137,29 +137,39 @@ double faithfulRenderPsnr(int level, double exponent) {
   return compareSignals(ref, test).psnr;
 }
 
-TEST(RotateHaar, FaithfulMeetsItsMeasuredFloors) {
-  // Measured on this code (16 rotations, seed 42): Lambert at level 5
-  // 45.5 dB, Phong-64 at level 5 7.1 dB. The floors sit ~3 dB below, so a
-  // regression of the faithful path fails here.
-  const double lambert = faithfulRenderPsnr(5, 1.0);
-  const double glossy = faithfulRenderPsnr(5, 64.0);
-  RecordProperty("faithful_lambert_psnr_db", std::to_string(lambert));
-  RecordProperty("faithful_phong64_psnr_db", std::to_string(glossy));
-  EXPECT_GT(lambert, 42.0);
-  EXPECT_GT(glossy, 4.0);
+TEST(RotateHaar, OneLevelVariantsMeetTheirMeasuredFloors) {
+  // Measured on this code (16 rotations, seed 42, level 5): faithful 45.5 dB
+  // (Lambert) and 7.1 dB (Phong-64); local 34.7 dB and −11.1 dB (worse than faithful:
+  // see rotate_haar.h and the closing note of issue 2).
+  // The floors sit ~3 dB below, so a regression of either path fails here.
+  struct Case {
+    HaarVariant variant;
+    double exponent;
+    double floor;
+  };
+  for (const Case& c : {Case{HaarVariant::Faithful, 1.0, 42.0}, Case{HaarVariant::Faithful, 64.0, 4.0},
+                        Case{HaarVariant::Local, 1.0, 31.0}, Case{HaarVariant::Local, 64.0, -14.0}}) {
+    const double psnr = renderPsnrVsSpatial(c.variant, 5, c.exponent);
+    RecordProperty(std::string(variantName(c.variant)) + "_exp" + std::to_string(static_cast<int>(c.exponent)),
+                   std::to_string(psnr));
+    EXPECT_GT(psnr, c.floor) << variantName(c.variant) << " exponent " << c.exponent;
+  }
 }
 
-TEST(RotateHaar, FaithfulConvergesForSmoothMaps) {
-  // Read as derivative samples, the details converge to the rotated map as
-  // the level grows: the error against spatial falls every level.
+TEST(RotateHaar, OneLevelVariantsConvergeForSmoothMaps) {
+  // Both estimate what one level does not say; on a smooth map the estimate
+  // improves with the level, so the error against spatial falls every level.
   const auto fn = [](const glm::dvec3& d) { return 1.0 + 0.5 * d.y + 0.3 * d.x + 0.2 * d.z * d.x; };
-  const EulerYXY r{0.3, 0.7, 0.2};
-  double previous = 1e9;
-  for (int level = 4; level <= 7; ++level) {
-    const HaarMap f = forwardHaar(SphereMap::fromFunction(level, fn));
-    const double err = maxAbsDifference(rotateHaar(f, r, {HaarVariant::Faithful, -1}), rotateSpatial(f, r)) / maxAbs(f);
-    EXPECT_LT(err, previous / 1.6) << "level " << level;
-    previous = err;
+  for (HaarVariant v : {HaarVariant::Faithful, HaarVariant::Local}) {
+    for (const EulerYXY& r : {EulerYXY{}, EulerYXY{0.3, 0.7, 0.2}}) {
+      double previous = 1e9;
+      for (int level = 4; level <= 7; ++level) {
+        const HaarMap f = forwardHaar(SphereMap::fromFunction(level, fn));
+        const double err = maxAbsDifference(rotateHaar(f, r, {v, -1}), rotateSpatial(f, r)) / maxAbs(f);
+        EXPECT_LT(err, previous / 1.6) << variantName(v) << " level " << level;
+        previous = err;
+      }
+    }
   }
 }
 

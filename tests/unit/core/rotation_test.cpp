@@ -73,6 +73,7 @@ TEST(Rotation, MethodNamesAreTheDesignNames) {
   EXPECT_FALSE(parseRotationMethod("Haar").has_value());
   EXPECT_FALSE(parseRotationMethod("").has_value());
   EXPECT_EQ(parseHaarVariant("faithful"), HaarVariant::Faithful);
+  EXPECT_EQ(parseHaarVariant("local"), HaarVariant::Local);
   EXPECT_EQ(parseHaarVariant("refined"), HaarVariant::Refined);
   EXPECT_FALSE(parseHaarVariant("best").has_value());
 }

@@ -30,6 +30,13 @@
 //    (eqs. 11–12). The scaling coefficient from the rotation-invariant
 //    integral ∫f dω = Σ c_i⟨ψ_i, ΔΩ⟩ (only the scaling and vertical basis
 //    functions have non-zero solid-angle moments).
+//  * Local — the seed's one-level idea with the best estimates it allows:
+//    the finite chain rule of Refined (2) over f's differences, of which
+//    those inside a block come exactly from the start level's details, those
+//    between sibling blocks exactly from the parent level's details (the
+//    "information from the next coarser level"), and those between blocks of
+//    different parents by central differences of the neighbouring sibling
+//    differences. The scaling coefficient from the invariant integral.
 //  * Refined (default) — the chain rule in exact finite form:
 //    (1) f's differences across every pixel boundary, exactly: inside each
 //        2×2 block from the details (v and d' separate its two columns, h and

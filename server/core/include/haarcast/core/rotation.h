@@ -45,8 +45,9 @@ std::optional<RotationMethod> parseRotationMethod(std::string_view name);
 
 // Variants of the seed's method (see rotate_haar.h for what each does).
 enum class HaarVariant {
-  Faithful,  // the seed as written: start-level details only
-  Refined,   // default: exact block-boundary differences, finite source steps
+  Faithful,  // the seed as written: start-level details as derivative samples
+  Local,     // start level + the level above, finite chain rule
+  Refined,   // default: exact differences from all coarser levels, finite chain rule
 };
 std::string_view variantName(HaarVariant v);
 std::optional<HaarVariant> parseHaarVariant(std::string_view name);
