@@ -202,11 +202,11 @@ RotationReport runRotationReport(const RotationReportOptions& o, const std::func
   for (HaarVariant v : {HaarVariant::Faithful, HaarVariant::Local, HaarVariant::Refined}) {
     RotatorOptions ro = o.rotator;
     ro.haarVariant = v;
-    std::map<std::string, MethodScores> perLobe;
+    const std::string name(variantName(v));
+    auto& perLobe = report.haarVariantsPerLobe[name];
     double ns = 0.0;
     score(*makeRotator(RotationMethod::Haar, slices, ro), perLobe, ns);
-    report.haarVariants[std::string(variantName(v))] =
-        averageOverLobes(perLobe, ns, report.methods["haar"].storedBytes);
+    report.haarVariants[name] = averageOverLobes(perLobe, ns, report.methods["haar"].storedBytes);
   }
   say("haar variants done");
   return report;
@@ -220,6 +220,8 @@ nlohmann::json toJson(const RotationReport& r) {
   for (const auto& [name, lobes] : r.perLobe)
     for (const auto& [lobe, s] : lobes) j["lobes"][lobe][name] = scoresJson(s);
   for (const auto& [name, s] : r.haarVariants) j["haar_variants"][name] = scoresJson(s);
+  for (const auto& [name, lobes] : r.haarVariantsPerLobe)
+    for (const auto& [lobe, s] : lobes) j["lobes"][lobe]["haar/" + name] = scoresJson(s);
   return j;
 }
 

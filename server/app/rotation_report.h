@@ -39,8 +39,9 @@ struct RotationReport {
   // seed averages its tables), and per lobe.
   std::map<std::string, MethodScores> methods;
   std::map<std::string, std::map<std::string, MethodScores>> perLobe;
-  // The two variants of `haar`, scored the same way.
+  // The variants of `haar`, scored the same way, and per lobe.
   std::map<std::string, MethodScores> haarVariants;
+  std::map<std::string, std::map<std::string, MethodScores>> haarVariantsPerLobe;
 };
 
 // Throws std::invalid_argument naming the bad option. progress(message) gets

@@ -35,6 +35,7 @@
 #include "haarcast/core/brdf.h"
 #include "haarcast/core/brdf_slices.h"
 #include "haarcast/core/haar.h"
+#include "haarcast/core/rotate_haar.h"
 #include "haarcast/core/rotation.h"
 #include "haarcast/core/sphere_map.h"
 #include "haarcast/core/triple_product.h"
@@ -171,6 +172,30 @@ BENCHMARK_CAPTURE(BM_Rotate, spatial, RotationMethod::Spatial)->DenseRange(4, 7)
 // grows too fast to be worth level 7 here.
 BENCHMARK_CAPTURE(BM_Rotate, matrix, RotationMethod::Matrix)->DenseRange(4, 6)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_Rotate, table, RotationMethod::Table)->DenseRange(4, 6)->Unit(benchmark::kMicrosecond);
+
+// The seed's method alone: its variants side by side (rotate_haar.h), and the
+// start-level option, which drops k finest levels for O(N/4^k) work. Args:
+// (level, start level or −1 for the finest).
+void BM_RotateHaar(benchmark::State& state, HaarVariant variant) {
+  const int level = static_cast<int>(state.range(0));
+  const int start = static_cast<int>(state.range(1));
+  const std::vector<HaarMap> slices = phongSlices(level);
+  const HaarRotationOptions options{variant, start};
+  const std::vector<EulerYXY>& rs = rotations();
+  std::size_t i = 0;
+  for (auto _ : state) {
+    const HaarMap out = rotateHaar(slices[i % slices.size()], rs[i & (kRotationCount - 1)], options);
+    benchmark::DoNotOptimize(out.coefficients().data());
+    ++i;
+  }
+  setCounters(state, level);
+}
+BENCHMARK_CAPTURE(BM_RotateHaar, faithful, HaarVariant::Faithful)
+    ->ArgsProduct({{4, 5, 6, 7}, {-1}})->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_RotateHaar, local, HaarVariant::Local)
+    ->ArgsProduct({{4, 5, 6, 7}, {-1}})->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_RotateHaar, refined, HaarVariant::Refined)
+    ->Args({7, 6})->Args({7, 5})->Args({7, 4})->Args({7, 3})->Unit(benchmark::kMicrosecond);
 
 // ---- Triple product -----------------------------------------------------
 

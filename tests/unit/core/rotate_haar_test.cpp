@@ -140,7 +140,7 @@ double renderPsnrVsSpatial(HaarVariant variant, int level, double exponent) {
 TEST(RotateHaar, OneLevelVariantsMeetTheirMeasuredFloors) {
   // Measured on this code (16 rotations, seed 42, level 5): faithful 45.5 dB
   // (Lambert) and 7.1 dB (Phong-64); local 34.7 dB and −11.1 dB (worse than faithful:
-  // see rotate_haar.h and the closing note of issue 2).
+  // see docs/design.md, "What limits the accuracy").
   // The floors sit ~3 dB below, so a regression of either path fails here.
   struct Case {
     HaarVariant variant;
