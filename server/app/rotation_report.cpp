@@ -4,7 +4,6 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
-#include <random>
 #include <sstream>
 #include <stdexcept>
 
@@ -34,15 +33,6 @@ std::vector<Lobe> reportLobes() {
   lobes.push_back({"phong64", makePhong(glm::dvec3(0.0), glm::dvec3(1.0), 64.0)});
   lobes.push_back({"phong512", makePhong(glm::dvec3(0.0), glm::dvec3(1.0), 512.0)});
   return lobes;
-}
-
-// Uniformly distributed rotations: normal uniform on the sphere, spin uniform.
-std::vector<EulerYXY> randomRotations(int count, std::uint32_t seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  std::vector<EulerYXY> out;
-  for (int k = 0; k < count; ++k) out.push_back({u(rng) * kTwoPi, std::acos(2.0 * u(rng) - 1.0), u(rng) * kTwoPi});
-  return out;
 }
 
 // The report's light: the built-in HDR environment (a small sun among

@@ -48,20 +48,8 @@ using namespace haarcast;
 // ones and the random generator stays out of the timed loop.
 constexpr std::size_t kRotationCount = 64;  // power of two: index with a mask
 
-std::vector<EulerYXY> randomRotations() {
-  std::mt19937 rng(20240611u);
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  std::vector<EulerYXY> rotations(kRotationCount);
-  for (auto& r : rotations) {
-    r.alpha = kTwoPi * unit(rng);
-    r.beta = std::acos(1.0 - 2.0 * unit(rng));  // normals uniform on the sphere
-    r.gamma = kTwoPi * unit(rng);
-  }
-  return rotations;
-}
-
 const std::vector<EulerYXY>& rotations() {
-  static const std::vector<EulerYXY> list = randomRotations();
+  static const std::vector<EulerYXY> list = randomRotations(kRotationCount, 20240611u);
   return list;
 }
 

@@ -5,6 +5,7 @@
 #include <string>
 
 #include <algorithm>
+#include <random>
 
 #include "rotators.h"
 
@@ -42,6 +43,20 @@ EulerYXY eulerFromMatrix(const glm::dmat3& m) {
     e.gamma = 0.0;
   }
   return e;
+}
+
+std::vector<EulerYXY> randomRotations(int count, std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  // Draw through generate_canonical, not a distribution object, so that the
+  // list does not depend on the standard library's distribution algorithm.
+  auto unit = [&] { return std::generate_canonical<double, 53>(rng); };
+  std::vector<EulerYXY> out(static_cast<std::size_t>(std::max(count, 0)));
+  for (EulerYXY& r : out) {
+    r.alpha = kTwoPi * unit();
+    r.beta = std::acos(1.0 - 2.0 * unit());  // cos β uniform: normals uniform on the sphere
+    r.gamma = kTwoPi * unit();
+  }
+  return out;
 }
 
 std::string_view methodName(RotationMethod m) {

@@ -7,6 +7,8 @@
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
 
+#include "test_maps.h"
+
 #include "haarcast/assets/procedural_environment.h"
 #include "haarcast/core/brdf.h"
 #include "haarcast/core/brdf_slices.h"
@@ -15,25 +17,8 @@
 namespace haarcast {
 namespace {
 
-double maxAbs(const HaarMap& a) {
-  double m = 0.0;
-  for (float v : a.coefficients()) m = std::max(m, static_cast<double>(std::abs(v)));
-  return m;
-}
-
-double maxAbsDifference(const HaarMap& a, const HaarMap& b) {
-  double m = 0.0;
-  for (std::size_t i = 0; i < a.coefficientCount(); ++i) m = std::max(m, static_cast<double>(std::abs(a[i] - b[i])));
-  return m;
-}
-
-std::vector<EulerYXY> randomRotations(int count, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  std::vector<EulerYXY> out;
-  for (int k = 0; k < count; ++k) out.push_back({u(rng) * kTwoPi, std::acos(2.0 * u(rng) - 1.0), u(rng) * kTwoPi});
-  return out;
-}
+using testing::maxAbs;
+using testing::maxAbsDifference;
 
 HaarMap phongSlice(int level, double exponent, double thetaOut) {
   const auto brdf = makePhong(glm::dvec3(0.0), glm::dvec3(1.0), exponent);
@@ -124,7 +109,7 @@ double renderPsnrVsSpatial(HaarVariant variant, int level, double exponent) {
   const HaarMap light = forwardHaar(env[0].weightedBySolidAngle());
   const HaarMap f = phongSlice(level, exponent, 0.6);
   std::vector<double> ref, test;
-  for (const EulerYXY& r : randomRotations(16, 42)) {
+  for (const EulerYXY& r : randomRotations(64, 1)) {
     const HaarMap s = rotateSpatial(f, r), h = rotateHaar(f, r, {variant, -1});
     double vs = 0.0, vh = 0.0;
     for (std::size_t i = 0; i < f.coefficientCount(); ++i) {
@@ -138,17 +123,20 @@ double renderPsnrVsSpatial(HaarVariant variant, int level, double exponent) {
 }
 
 TEST(RotateHaar, OneLevelVariantsMeetTheirMeasuredFloors) {
-  // Measured on this code (16 rotations, seed 42, level 5): faithful 45.5 dB
-  // (Lambert) and 7.1 dB (Phong-64); local 34.7 dB and −11.1 dB (worse than faithful:
-  // see docs/design.md, "What limits the accuracy").
-  // The floors sit ~3 dB below, so a regression of either path fails here.
+  // Measured on this code (64 rotations, seed 1, level 5): faithful 48.8 dB
+  // (Lambert) and 29.8 dB (Phong-64); local 39.0 and 15.9 dB. The glossy
+  // figures depend strongly on the rotation set (faithful 8.5–35 dB over
+  // seeds 1–8): the one-level variants fail badly on some rotations, and the
+  // peak depends on whether a rotation catches the sun. The floors sit ~3 dB
+  // below the values for this fixed list, so a regression of either path
+  // fails here; see docs/design.md, "What limits the accuracy".
   struct Case {
     HaarVariant variant;
     double exponent;
     double floor;
   };
-  for (const Case& c : {Case{HaarVariant::Faithful, 1.0, 42.0}, Case{HaarVariant::Faithful, 64.0, 4.0},
-                        Case{HaarVariant::Local, 1.0, 31.0}, Case{HaarVariant::Local, 64.0, -14.0}}) {
+  for (const Case& c : {Case{HaarVariant::Faithful, 1.0, 45.0}, Case{HaarVariant::Faithful, 64.0, 26.0},
+                        Case{HaarVariant::Local, 1.0, 36.0}, Case{HaarVariant::Local, 64.0, 12.0}}) {
     const double psnr = renderPsnrVsSpatial(c.variant, 5, c.exponent);
     RecordProperty(std::string(variantName(c.variant)) + "_exp" + std::to_string(static_cast<int>(c.exponent)),
                    std::to_string(psnr));

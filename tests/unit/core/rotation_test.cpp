@@ -6,22 +6,15 @@
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
 
+#include "test_maps.h"
+
 #include "haarcast/core/brdf_slices.h"
 
 namespace haarcast {
 namespace {
 
-double maxAbsDifference(const HaarMap& a, const HaarMap& b) {
-  double m = 0.0;
-  for (std::size_t i = 0; i < a.coefficientCount(); ++i) m = std::max(m, static_cast<double>(std::abs(a[i] - b[i])));
-  return m;
-}
-
-double maxAbs(const HaarMap& a) {
-  double m = 0.0;
-  for (float v : a.coefficients()) m = std::max(m, static_cast<double>(std::abs(v)));
-  return m;
-}
+using testing::maxAbs;
+using testing::maxAbsDifference;
 
 // A glossy lobe about a tilted axis: sharp enough to expose interpolation.
 HaarMap lobeMap(int level, double exponent) {

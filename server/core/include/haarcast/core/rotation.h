@@ -10,6 +10,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
@@ -87,6 +88,11 @@ class SliceRotator {
 // Throws std::invalid_argument if slices is empty or mixes levels.
 std::unique_ptr<SliceRotator> makeRotator(RotationMethod method, std::vector<HaarMap> slices,
                                           const RotatorOptions& options = {});
+
+// `count` rotations with the normal R·ŷ uniform on the sphere and the spin γ
+// uniform, from a fixed-seed generator (std::mt19937): the same list on every
+// machine, for reports, tests and benchmarks.
+std::vector<EulerYXY> randomRotations(int count, std::uint32_t seed);
 
 // ---- The methods as free functions on a single map -------------------------
 
