@@ -25,6 +25,10 @@ PACKAGES=(
   libglm-dev
   libcli11-dev
   nlohmann-json3-dev
+  libopenexr-dev
+  libembree-dev
+  libtinyobjloader-dev
+  libpng-dev
 )
 
 # Build folder, relative to the repository root (HAARCAST_BUILD_DIR overrides).
