@@ -290,35 +290,38 @@ DifferenceFields finiteChainRule(const SourceDifferences& fd, int mw, const glm:
     double dx = b.x - a.x;
     dx -= std::round(dx / mw) * mw;
     const double dy = b.y - a.y;
-    // Path parameters where x or y crosses an integer line.
-    double cuts[64];
-    int nCuts = 0;
-    cuts[nCuts++] = 0.0;
-    auto addCrossings = [&](double p0, double dp) {
-      if (dp == 0.0) return;
-      const double lo = std::min(p0, p0 + dp), hi = std::max(p0, p0 + dp);
-      for (double k = std::floor(lo) + 1.0; k < hi && nCuts < 62; k += 1.0) cuts[nCuts++] = (k - p0) / dp;
+    // Walk the path s ∈ [0, 1], stopping where x or y crosses an integer
+    // line. Each axis's crossings are evenly spaced in s, so the two streams
+    // merge without sorting or storage — a path near a source pole may cross
+    // half the map's columns.
+    constexpr double kNever = 2.0;
+    auto firstCrossing = [](double p0, double dp) {
+      if (dp > 0.0) return (std::floor(p0) + 1.0 - p0) / dp;
+      if (dp < 0.0) return (std::ceil(p0) - 1.0 - p0) / dp;
+      return kNever;
     };
-    addCrossings(a.x, dx);
-    addCrossings(a.y, dy);
-    cuts[nCuts++] = 1.0;
-    std::sort(cuts, cuts + nCuts);
-    double sum = 0.0;
-    for (int k = 0; k + 1 < nCuts; ++k) {
-      const double s0 = cuts[k], s1 = cuts[k + 1];
-      if (s1 <= s0) continue;
-      const double sm = 0.5 * (s0 + s1);
-      const double cx = std::floor(a.x + sm * dx), cy = std::floor(a.y + sm * dy);
-      const int col = ((static_cast<int>(cx) % mw) + mw) % mw;
-      const int row = static_cast<int>(cy);
-      const double x0 = a.x + s0 * dx - cx, x1 = a.x + s1 * dx - cx;
-      if (row < 0 || row >= mw - 1) {
-        sum += (x1 - x0) * fP(row < 0 ? 0 : mw - 1, col);
-        continue;
+    double nextX = firstCrossing(a.x, dx), nextY = firstCrossing(a.y, dy);
+    const double stepX = dx != 0.0 ? 1.0 / std::abs(dx) : 0.0, stepY = dy != 0.0 ? 1.0 / std::abs(dy) : 0.0;
+    double sum = 0.0, s0 = 0.0;
+    while (s0 < 1.0) {
+      const double s1 = std::min({nextX, nextY, 1.0});
+      if (s1 > s0) {
+        const double sm = 0.5 * (s0 + s1);
+        const double cx = std::floor(a.x + sm * dx), cy = std::floor(a.y + sm * dy);
+        const int col = ((static_cast<int>(cx) % mw) + mw) % mw;
+        const int row = static_cast<int>(cy);
+        const double x0 = a.x + s0 * dx - cx, x1 = a.x + s1 * dx - cx;
+        if (row < 0 || row >= mw - 1) {
+          sum += (x1 - x0) * fP(row < 0 ? 0 : mw - 1, col);
+        } else {
+          const double y0 = a.y + s0 * dy - cy, y1 = a.y + s1 * dy - cy;
+          const double mixed = fP(row + 1, col) - fP(row, col);
+          sum += (y1 - y0) * fT(row, col) + (x1 - x0) * fP(row, col) + (x1 * y1 - x0 * y0) * mixed;
+        }
       }
-      const double y0 = a.y + s0 * dy - cy, y1 = a.y + s1 * dy - cy;
-      const double mixed = fP(row + 1, col) - fP(row, col);
-      sum += (y1 - y0) * fT(row, col) + (x1 - x0) * fP(row, col) + (x1 * y1 - x0 * y0) * mixed;
+      if (nextX <= s1) nextX += stepX;
+      if (nextY <= s1) nextY += stepY;
+      s0 = s1;
     }
     return sum;
   };
