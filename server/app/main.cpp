@@ -5,6 +5,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "reference_command.h"
+#include "render_command.h"
 #include "rotation_report.h"
 
 namespace {
@@ -42,8 +44,13 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   rr->add_flag("--json", json, "Print JSON instead of a table");
 
+  const auto runRender = haarcast::app::addRenderCommand(app);
+  const auto runReference = haarcast::app::addReferenceCommand(app);
+
   try {
     app.parse(argc, argv);
+    if (const int rc = runRender(); rc >= 0) return rc;
+    if (const int rc = runReference(); rc >= 0) return rc;
     if (rr->parsed()) {
       const auto v = haarcast::parseHaarVariant(variant);
       if (!v) throw std::invalid_argument("--haar-variant must be faithful, local or refined (got \"" + variant + "\")");

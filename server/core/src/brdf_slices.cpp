@@ -3,8 +3,10 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "parallel.h"
@@ -180,6 +182,49 @@ BrdfSliceTable BrdfSliceTable::build(const Brdf& brdf, const SliceTableOptions& 
       [&](std::size_t done) {
         if (progress) progress(static_cast<int>(done), total);
       });
+  return table;
+}
+
+BrdfSliceTable BrdfSliceTable::fromSlices(std::vector<double> thetaOut, std::vector<HaarMap> slices) {
+  const std::size_t total = thetaOut.size();
+  if (total < 1 || total > static_cast<std::size_t>(kMaxThetaSamples)) {
+    throw std::invalid_argument("BrdfSliceTable::fromSlices: " + std::to_string(total) +
+                                " thetaOut samples is outside [1, " + std::to_string(kMaxThetaSamples) + "]");
+  }
+  if (slices.size() != kChannels * total) {
+    throw std::invalid_argument("BrdfSliceTable::fromSlices: " + std::to_string(slices.size()) + " slices for " +
+                                std::to_string(kChannels) + " channels × " + std::to_string(total) + " thetaOut samples");
+  }
+  for (std::size_t t = 0; t < total; ++t) {
+    // The same expression as build(), so a table that went through a file
+    // compares equal bit for bit; the tolerance only forgives a writer that
+    // computed the centres another way.
+    const double expected = (static_cast<double>(t) + 0.5) * (kPi / 2.0) / static_cast<double>(total);
+    if (!(std::abs(thetaOut[t] - expected) <= 1e-12)) {
+      throw std::invalid_argument("BrdfSliceTable::fromSlices: thetaOut[" + std::to_string(t) + "] = " +
+                                  std::to_string(thetaOut[t]) + " is not the cell centre " +
+                                  std::to_string(expected));
+    }
+  }
+  const int level = slices.front().level();
+  checkLevel(level, "BrdfSliceTable::fromSlices");
+  const std::size_t count = static_cast<std::size_t>(mapSize(level)) * static_cast<std::size_t>(mapSize(level));
+  for (std::size_t i = 0; i < slices.size(); ++i) {
+    if (slices[i].level() != level || slices[i].coefficientCount() != count) {
+      throw std::invalid_argument("BrdfSliceTable::fromSlices: slice " + std::to_string(i) + " has level " +
+                                  std::to_string(slices[i].level()) + ", slice 0 has level " + std::to_string(level));
+    }
+    for (const float c : slices[i].coefficients()) {
+      if (!std::isfinite(c)) {
+        throw std::invalid_argument("BrdfSliceTable::fromSlices: slice " + std::to_string(i) +
+                                    " has a non-finite coefficient");
+      }
+    }
+  }
+  BrdfSliceTable table;
+  table.level_ = level;
+  table.thetaOut_ = std::move(thetaOut);
+  table.slices_ = std::move(slices);
   return table;
 }
 

@@ -1,1 +1,306 @@
-// placeholder: being written (step 2)
+// RayScene on Embree 3: one child scene per distinct Mesh, placed by instance
+// geometries in a top-level scene, so that moving an object rebuilds only the
+// (tiny) top level.
+#include "haarcast/render/embree_scene.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <unordered_map>
+#include <utility>
+
+#include <embree3/rtcore.h>
+#include <glm/geometric.hpp>
+#include <glm/mat3x3.hpp>
+#include <glm/matrix.hpp>
+
+namespace haarcast {
+namespace {
+
+// Embree reports an error twice: as a code that rtcGetDeviceError returns
+// (per thread, cleared on read) and as a message passed to the error callback
+// on the thread that caused it. The callback only records the message — it
+// must not throw through Embree's C interface — and check() turns the pair
+// into an exception at the call site, which knows the call's name.
+thread_local std::string tEmbreeMessage;
+
+void recordEmbreeError(void* /*userPtr*/, RTCError /*code*/, const char* message) {
+  tEmbreeMessage = message ? message : "";
+}
+
+const char* errorName(RTCError code) {
+  switch (code) {
+    case RTC_ERROR_NONE: return "RTC_ERROR_NONE";
+    case RTC_ERROR_UNKNOWN: return "RTC_ERROR_UNKNOWN";
+    case RTC_ERROR_INVALID_ARGUMENT: return "RTC_ERROR_INVALID_ARGUMENT";
+    case RTC_ERROR_INVALID_OPERATION: return "RTC_ERROR_INVALID_OPERATION";
+    case RTC_ERROR_OUT_OF_MEMORY: return "RTC_ERROR_OUT_OF_MEMORY";
+    case RTC_ERROR_UNSUPPORTED_CPU: return "RTC_ERROR_UNSUPPORTED_CPU";
+    case RTC_ERROR_CANCELLED: return "RTC_ERROR_CANCELLED";
+  }
+  return "unknown RTCError";
+}
+
+// Throws if the last Embree call on this thread failed. `device` may be null
+// (rtcNewDevice's own failure is reported on the null device).
+void check(RTCDevice device, const char* call) {
+  const RTCError code = rtcGetDeviceError(device);
+  if (code == RTC_ERROR_NONE) return;
+  std::string what = std::string("Embree: ") + call + " failed: " + errorName(code) + " (" +
+                     std::to_string(static_cast<int>(code)) + ")";
+  if (!tEmbreeMessage.empty()) what += ": " + tEmbreeMessage;
+  tEmbreeMessage.clear();
+  throw std::runtime_error(what);
+}
+
+// A null handle from a constructor-like call is a failure even if Embree did
+// not set an error code (it always should).
+template <typename Handle>
+Handle checked(RTCDevice device, Handle handle, const char* call) {
+  check(device, call);
+  if (!handle) throw std::runtime_error(std::string("Embree: ") + call + " returned null");
+  return handle;
+}
+
+struct DeviceDeleter {
+  void operator()(RTCDeviceTy* d) const { rtcReleaseDevice(d); }
+};
+struct SceneDeleter {
+  void operator()(RTCSceneTy* s) const { rtcReleaseScene(s); }
+};
+using DeviceHandle = std::unique_ptr<RTCDeviceTy, DeviceDeleter>;
+using SceneHandle = std::unique_ptr<RTCSceneTy, SceneDeleter>;
+
+void checkTransform(const glm::mat4& m, std::size_t object) {
+  const std::string who = "RayScene: object " + std::to_string(object) + ": ";
+  for (int c = 0; c < 4; ++c) {
+    for (int r = 0; r < 4; ++r) {
+      if (!std::isfinite(m[c][r])) throw std::invalid_argument(who + "transform has a non-finite entry");
+    }
+  }
+  // Embree instances are affine; a projective row would be silently dropped.
+  if (m[0][3] != 0.0f || m[1][3] != 0.0f || m[2][3] != 0.0f || m[3][3] != 1.0f) {
+    throw std::invalid_argument(who + "transform is not affine (last row must be 0 0 0 1)");
+  }
+  // A singular linear part flattens the mesh and leaves no normal transform.
+  const double det = glm::determinant(glm::dmat3(glm::mat3(m)));
+  if (!(std::abs(det) > 0.0)) throw std::invalid_argument(who + "transform is singular");
+}
+
+// The inverse transpose of the linear part: what carries normals.
+glm::mat3 normalMatrix(const glm::mat4& m) { return glm::transpose(glm::inverse(glm::mat3(m))); }
+
+}  // namespace
+
+struct RayScene::Impl {
+  // Declared in this order so that scenes are released before the device.
+  DeviceHandle device;
+  std::vector<SceneHandle> meshScenes;  // one per distinct Mesh
+  SceneHandle top;
+  std::vector<glm::mat3> normalMatrices;  // per object
+
+  RTCScene meshScene(const Mesh& mesh) {
+    SceneHandle scene(checked(device.get(), rtcNewScene(device.get()), "rtcNewScene"));
+    // ROBUST: watertight traversal, so that a visibility ray cannot slip
+    // through the shared edge of two triangles of a closed mesh. HIGH: the
+    // meshes are static and traced by millions of rays; spatial splits pay.
+    rtcSetSceneFlags(scene.get(), RTC_SCENE_FLAG_ROBUST);
+    check(device.get(), "rtcSetSceneFlags");
+    rtcSetSceneBuildQuality(scene.get(), RTC_BUILD_QUALITY_HIGH);
+    check(device.get(), "rtcSetSceneBuildQuality");
+
+    RTCGeometry geom = checked(device.get(), rtcNewGeometry(device.get(), RTC_GEOMETRY_TYPE_TRIANGLE), "rtcNewGeometry");
+    // From here the geometry must be released on every path; the scene keeps
+    // its own reference once attached.
+    try {
+      // Embree-owned buffers (padded as its SIMD loads need): the Mesh need
+      // not outlive the scene.
+      auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
+          geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), mesh.positions.size()));
+      check(device.get(), "rtcSetNewGeometryBuffer(vertex)");
+      auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+          geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), mesh.triangles.size()));
+      check(device.get(), "rtcSetNewGeometryBuffer(index)");
+      if (!vertices || !indices) throw std::runtime_error("Embree: rtcSetNewGeometryBuffer returned null");
+      for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
+        vertices[3 * i + 0] = mesh.positions[i].x;
+        vertices[3 * i + 1] = mesh.positions[i].y;
+        vertices[3 * i + 2] = mesh.positions[i].z;
+      }
+      for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
+        indices[3 * i + 0] = mesh.triangles[i].x;
+        indices[3 * i + 1] = mesh.triangles[i].y;
+        indices[3 * i + 2] = mesh.triangles[i].z;
+      }
+      rtcCommitGeometry(geom);
+      check(device.get(), "rtcCommitGeometry(mesh)");
+      // ID 0: the only geometry, so a hit's geomID is always 0 and primID is
+      // the triangle index of the Mesh.
+      rtcAttachGeometryByID(scene.get(), geom, 0);
+      check(device.get(), "rtcAttachGeometryByID(mesh)");
+    } catch (...) {
+      rtcReleaseGeometry(geom);
+      throw;
+    }
+    rtcReleaseGeometry(geom);
+    rtcCommitScene(scene.get());
+    check(device.get(), "rtcCommitScene(mesh)");
+    meshScenes.push_back(std::move(scene));
+    return meshScenes.back().get();
+  }
+
+  void attachInstance(RTCScene child, const glm::mat4& objectToWorld, unsigned id) {
+    RTCGeometry geom = checked(device.get(), rtcNewGeometry(device.get(), RTC_GEOMETRY_TYPE_INSTANCE), "rtcNewGeometry");
+    try {
+      rtcSetGeometryInstancedScene(geom, child);
+      check(device.get(), "rtcSetGeometryInstancedScene");
+      rtcSetGeometryTransform(geom, 0, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, &objectToWorld[0][0]);
+      check(device.get(), "rtcSetGeometryTransform");
+      rtcCommitGeometry(geom);
+      check(device.get(), "rtcCommitGeometry(instance)");
+      // The instance's ID is the object index: a hit's instID[0] names it.
+      rtcAttachGeometryByID(top.get(), geom, id);
+      check(device.get(), "rtcAttachGeometryByID(instance)");
+    } catch (...) {
+      rtcReleaseGeometry(geom);
+      throw;
+    }
+    rtcReleaseGeometry(geom);
+  }
+};
+
+RayScene::RayScene(std::vector<Instance> instances) : impl_(std::make_unique<Impl>()) {
+  if (instances.empty()) throw std::invalid_argument("RayScene: no instances");
+  for (std::size_t i = 0; i < instances.size(); ++i) {
+    if (!instances[i].mesh) throw std::invalid_argument("RayScene: object " + std::to_string(i) + " has no mesh");
+    instances[i].mesh->validate();
+    checkTransform(instances[i].objectToWorld, i);
+  }
+  if (instances.size() > RTC_INVALID_GEOMETRY_ID) throw std::invalid_argument("RayScene: too many instances");
+
+  Impl& s = *impl_;
+  // A failed rtcNewDevice reports its error on the null device.
+  s.device.reset(rtcNewDevice(nullptr));
+  check(nullptr, "rtcNewDevice");
+  if (!s.device) throw std::runtime_error("Embree: rtcNewDevice returned null");
+  rtcSetDeviceErrorFunction(s.device.get(), recordEmbreeError, nullptr);
+  check(s.device.get(), "rtcSetDeviceErrorFunction");
+
+  s.top.reset(checked(s.device.get(), rtcNewScene(s.device.get()), "rtcNewScene"));
+  rtcSetSceneFlags(s.top.get(), RTC_SCENE_FLAG_ROBUST);
+  check(s.device.get(), "rtcSetSceneFlags");
+
+  std::unordered_map<const Mesh*, RTCScene> built;
+  for (std::size_t i = 0; i < instances.size(); ++i) {
+    const Mesh* mesh = instances[i].mesh;
+    auto it = built.find(mesh);
+    if (it == built.end()) it = built.emplace(mesh, s.meshScene(*mesh)).first;
+    s.attachInstance(it->second, instances[i].objectToWorld, static_cast<unsigned>(i));
+    s.normalMatrices.push_back(normalMatrix(instances[i].objectToWorld));
+  }
+  rtcCommitScene(s.top.get());
+  check(s.device.get(), "rtcCommitScene(top)");
+}
+
+RayScene::~RayScene() = default;
+RayScene::RayScene(RayScene&&) noexcept = default;
+RayScene& RayScene::operator=(RayScene&&) noexcept = default;
+
+std::size_t RayScene::objectCount() const { return impl_->normalMatrices.size(); }
+
+namespace {
+
+RTCRay toEmbree(const Ray& r) {
+  RTCRay e{};
+  e.org_x = r.origin.x;
+  e.org_y = r.origin.y;
+  e.org_z = r.origin.z;
+  e.dir_x = r.direction.x;
+  e.dir_y = r.direction.y;
+  e.dir_z = r.direction.z;
+  e.tnear = r.tnear;
+  e.tfar = r.tfar;
+  e.time = 0.0f;
+  e.mask = ~0u;
+  e.id = 0;
+  e.flags = 0;
+  return e;
+}
+
+}  // namespace
+
+std::optional<Hit> RayScene::intersect(const Ray& ray) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRayHit rh{};
+  rh.ray = toEmbree(ray);
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(impl_->top.get(), &context, &rh);
+  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
+
+  Hit hit;
+  hit.object = rh.hit.instID[0];
+  hit.triangle = rh.hit.primID;
+  hit.u = rh.hit.u;
+  hit.v = rh.hit.v;
+  hit.t = rh.ray.tfar;
+  // Embree gives Ng in the mesh's (object) frame, unnormalised.
+  const glm::vec3 n = impl_->normalMatrices[hit.object] * glm::vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z);
+  const float len = glm::length(n);
+  if (len > 0.0f) hit.geometricNormal = n / len;
+  return hit;
+}
+
+bool RayScene::occluded(const Ray& ray) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRay r = toEmbree(ray);
+  rtcOccluded1(impl_->top.get(), &context, &r);
+  // Embree marks a blocked ray by setting tfar to −∞.
+  return r.tfar == -std::numeric_limits<float>::infinity();
+}
+
+void RayScene::occludedBatch(std::span<const Ray> rays, std::span<std::uint8_t> out, bool coherent) const {
+  if (rays.size() != out.size()) {
+    throw std::invalid_argument("RayScene::occludedBatch: " + std::to_string(rays.size()) + " rays but " +
+                                std::to_string(out.size()) + " results");
+  }
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  context.flags = coherent ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+  // Streams of a fixed size on the stack: no allocation per call, and large
+  // enough for Embree to form full packets.
+  constexpr std::size_t kChunk = 256;
+  std::array<RTCRay, kChunk> chunk;
+  for (std::size_t first = 0; first < rays.size(); first += kChunk) {
+    const std::size_t n = std::min(kChunk, rays.size() - first);
+    for (std::size_t k = 0; k < n; ++k) chunk[k] = toEmbree(rays[first + k]);
+    rtcOccluded1M(impl_->top.get(), &context, chunk.data(), static_cast<unsigned>(n), sizeof(RTCRay));
+    for (std::size_t k = 0; k < n; ++k) {
+      out[first + k] = chunk[k].tfar == -std::numeric_limits<float>::infinity() ? 1 : 0;
+    }
+  }
+}
+
+void RayScene::setTransform(std::size_t object, const glm::mat4& objectToWorld) {
+  Impl& s = *impl_;
+  if (object >= s.normalMatrices.size()) {
+    throw std::out_of_range("RayScene::setTransform: object " + std::to_string(object) + " of " +
+                            std::to_string(s.normalMatrices.size()));
+  }
+  checkTransform(objectToWorld, object);
+  RTCGeometry geom = rtcGetGeometry(s.top.get(), static_cast<unsigned>(object));
+  check(s.device.get(), "rtcGetGeometry");
+  rtcSetGeometryTransform(geom, 0, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, &objectToWorld[0][0]);
+  check(s.device.get(), "rtcSetGeometryTransform");
+  rtcCommitGeometry(geom);
+  check(s.device.get(), "rtcCommitGeometry(instance)");
+  rtcCommitScene(s.top.get());
+  check(s.device.get(), "rtcCommitScene(top)");
+  s.normalMatrices[object] = normalMatrix(objectToWorld);
+}
+
+}  // namespace haarcast

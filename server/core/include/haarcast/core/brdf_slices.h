@@ -40,6 +40,13 @@ class BrdfSliceTable {
   static BrdfSliceTable build(const Brdf& brdf, const SliceTableOptions& options,
                               const std::function<void(int, int)>& progress = {});
 
+  // A table from slices computed elsewhere (the on-disk cache, haarcast_io's
+  // slice_cache.h). slices[channel * T + t], T = thetaOut.size() ≥ 1, all of
+  // one level, all finite. thetaOut must be the layout build() uses,
+  // (t + ½)·(π/2)/T, because nearestSlice() and the rotators assume it.
+  // Throws std::invalid_argument naming the first problem.
+  static BrdfSliceTable fromSlices(std::vector<double> thetaOut, std::vector<HaarMap> slices);
+
  private:
   int level_ = 0;
   std::vector<double> thetaOut_;

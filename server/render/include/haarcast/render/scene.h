@@ -1,0 +1,97 @@
+// What a frame shows: an environment, objects (mesh, material, pose) and a
+// camera — from a small JSON scene file or built in.
+//
+// Scene file (paths relative to the file's folder; every key but "objects"
+// optional):
+//   {
+//     "environment": {"file": "probes/grace_latlong.exr", "layout": "auto"},   // or {"builtin": "sky"}
+//     "camera": {"eye": [0, 0.4, 3.2], "target": [0, 0, 0], "up": [0, 1, 0], "fov_y": 35},
+//     "objects": [
+//       {"name": "bunny", "mesh": "meshes/bunny.ply",            // or {"builtin": "sphere"|"torus"|"box"|"plane"}
+//        "material": "brdfs/alum-bronze-sgd.binary",              // or "lambert", "phong:64", "blinn-phong:100", "ggx:0.25"
+//        "rotate": [0, 30, 0], "translate": [0, 0, 0], "scale": 1.0,
+//        "fit": true}                                             // centre and scale the mesh to unit radius first
+//     ]
+//   }
+// "rotate" is in degrees about X, then Y, then Z (R = R_z R_y R_x).
+#pragma once
+
+#include <array>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <glm/mat3x3.hpp>
+#include <glm/mat4x4.hpp>
+#include <glm/vec3.hpp>
+
+#include "haarcast/core/brdf.h"
+#include "haarcast/core/mesh.h"
+#include "haarcast/core/sphere_map.h"
+
+namespace haarcast::render {
+
+struct Pose {
+  glm::dvec3 rotateDegrees{0.0};
+  glm::dvec3 translate{0.0};
+  double scale = 1.0;
+
+  glm::dmat3 rotation() const;  // R = R_z R_y R_x
+  glm::dmat4 objectToWorld() const;
+};
+
+// Radiance arriving from the world, two ways: per direction (background,
+// Monte Carlo) and as area-averaged level-n maps (the Haar pipeline).
+struct Environment {
+  std::string name;
+  std::function<glm::dvec3(const glm::dvec3&)> radiance;
+  std::function<std::array<SphereMap, 3>(int level)> maps;
+};
+
+Environment builtinEnvironment();
+// A light probe file (EXR, HDR, PFM; lat-long or angular).
+Environment environmentFromFile(const std::string& path, const std::string& layout = "auto");
+
+struct Material {
+  std::string name;      // as written in the scene ("phong:64", a file path)
+  std::string cacheKey;  // identifies the BRDF for the slice-table cache
+  std::shared_ptr<const Brdf> brdf;
+  std::string warning;   // non-empty when the file needed a repair (shown to the user)
+};
+
+// "lambert", "phong:EXP", "blinn-phong:EXP", "ggx:ROUGHNESS", or a MERL
+// .binary path (relative to baseDir). Throws std::invalid_argument naming
+// the spec.
+Material materialFromSpec(const std::string& spec, const std::string& baseDir = ".");
+
+struct SceneObject {
+  std::string name;
+  std::shared_ptr<const Mesh> mesh;  // object frame
+  Material material;
+  Pose pose;
+};
+
+struct Camera {
+  glm::dvec3 eye{0.0, 0.4, 3.2};
+  glm::dvec3 target{0.0};
+  glm::dvec3 up{0.0, 1.0, 0.0};
+  double fovYDegrees = 35.0;
+};
+
+struct Scene {
+  Environment environment;
+  std::vector<SceneObject> objects;
+  Camera camera;
+};
+
+// The built-in default: the procedural sky, a glossy sphere and a torus.
+Scene defaultScene();
+// Throws std::runtime_error with the file name and the JSON path of the
+// offending key.
+Scene loadScene(const std::string& path);
+
+// Centre a mesh on the origin and scale it to unit bounding radius.
+void fitToUnitSphere(Mesh& mesh);
+
+}  // namespace haarcast::render
