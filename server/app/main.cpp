@@ -5,6 +5,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "eval.h"
 #include "reference_command.h"
 #include "render_command.h"
 #include "rotation_report.h"
@@ -46,11 +47,13 @@ int main(int argc, char** argv) {
 
   const auto runRender = haarcast::app::addRenderCommand(app);
   const auto runReference = haarcast::app::addReferenceCommand(app);
+  const auto runEval = haarcast::app::addEvalCommand(app);
 
   try {
     app.parse(argc, argv);
     if (const int rc = runRender(); rc >= 0) return rc;
     if (const int rc = runReference(); rc >= 0) return rc;
+    if (const int rc = runEval(); rc >= 0) return rc;
     if (rr->parsed()) {
       const auto v = haarcast::parseHaarVariant(variant);
       if (!v) throw std::invalid_argument("--haar-variant must be faithful, local or refined (got \"" + variant + "\")");

@@ -15,6 +15,7 @@
 #include "haarcast/io/mesh_io.h"
 #include "haarcast/render/cpu_renderer.h"
 #include "haarcast/render/scene.h"
+#include "plots.h"
 
 namespace haarcast::app {
 namespace {
@@ -100,20 +101,8 @@ int run(RenderArgs& a) {
   const render::RenderResult r = render::renderCpu(scene, a.options, showProgress);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
-  // Without --exposure: Reinhard's key — the log-average luminance of the
-  // frame maps to 0.18.
-  double exposure = 0.0;
-  if (a.exposure) {
-    exposure = *a.exposure;
-  } else {
-    double sumLog = 0.0;
-    const std::size_t n = r.image.rgb.size() / 3;
-    for (std::size_t i = 0; i < n; ++i) {
-      const double y = 0.2126 * r.image.rgb[3 * i] + 0.7152 * r.image.rgb[3 * i + 1] + 0.0722 * r.image.rgb[3 * i + 2];
-      sumLog += std::log(1e-4 + std::max(y, 0.0));
-    }
-    exposure = std::log2(0.18 / std::exp(sumLog / static_cast<double>(n)));
-  }
+  // Without --exposure: Reinhard's key (log-average luminance → 0.18).
+  const double exposure = a.exposure ? *a.exposure : reinhardKeyExposure(r.image);
 
   const fs::path out(a.out);
   const std::string ext = out.extension().string();
@@ -160,7 +149,7 @@ std::function<int()> addRenderCommand(CLI::App& app) {
   c->add_option("--backend", args->backend, "cpu (vulkan arrives with step 3)")->capture_default_str();
   c->add_option("--out", args->out, "Output .exr (a .png is written beside it) or .png")->capture_default_str();
   c->add_option("--exposure", args->exposure, "PNG exposure in stops (default: log-average luminance → 0.18)");
-  c->add_option("--cache-dir", args->cacheDir, "Slice-table cache (default $XDG_CACHE_HOME/haarcast; 'none' disables)");
+  c->add_option("--cache-dir", args->cacheDir, "Cache of slice tables and visibility (default $XDG_CACHE_HOME/haarcast; 'none' disables)");
   c->add_option("--threads", args->options.threads, "Worker threads (0 = all cores)")->capture_default_str();
   return [c, args]() { return c->parsed() ? run(*args) : -1; };
 }

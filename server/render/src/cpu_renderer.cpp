@@ -16,6 +16,7 @@
 #include "haarcast/core/triple_product.h"
 #include "haarcast/io/slice_cache.h"
 #include "haarcast/render/embree_scene.h"
+#include "haarcast/render/visibility_cache.h"
 
 namespace haarcast::render {
 namespace {
@@ -51,6 +52,7 @@ void parallelFor(std::size_t count, unsigned threads, const std::function<void(s
 // Everything precomputed for one object.
 struct PreparedObject {
   const SceneObject* object = nullptr;
+  std::shared_ptr<const Mesh> mesh;    // the object's, with normals
   BrdfSliceTable table;
   std::array<std::unique_ptr<SliceRotator>, 3> rotators;
   std::vector<SparseHaar> visibility;  // per vertex, object frame
@@ -97,7 +99,13 @@ RenderResult renderCpu(const Scene& scene, const RenderOptions& options, const R
   for (std::size_t k = 0; k < scene.objects.size(); ++k) {
     PreparedObject& p = objects[k];
     p.object = &scene.objects[k];
-    p.object->mesh->validate();
+    p.mesh = p.object->mesh;
+    p.mesh->validate();
+    if (p.mesh->normals.empty()) {  // a mesh built in code may come without them
+      auto withNormals = std::make_shared<Mesh>(*p.mesh);
+      withNormals->computeNormals();
+      p.mesh = withNormals;
+    }
     SliceTableOptions table;
     table.level = level;
     table.thetaSamples = options.thetaSamples;
@@ -112,7 +120,7 @@ RenderResult renderCpu(const Scene& scene, const RenderOptions& options, const R
     for (int c = 0; c < 3; ++c) p.rotators[static_cast<std::size_t>(c)] = makeRotator(options.method, p.table.channelSlices(c), options.rotator);
     VisibilityOptions vis = options.visibility;
     vis.level = level;
-    p.visibility = computeVertexVisibility(*p.object->mesh, vis, [&](std::size_t done, std::size_t total) {
+    p.visibility = loadOrComputeVertexVisibility(*p.mesh, vis, options.cacheDir, [&](std::size_t done, std::size_t total) {
       if (progress) progress("visibility " + p.object->name, done, total);
     });
     p.rotation = p.object->pose.rotation();
@@ -135,7 +143,7 @@ RenderResult renderCpu(const Scene& scene, const RenderOptions& options, const R
   // ---- G-buffer: primary rays ---------------------------------------------
   t0 = Clock::now();
   std::vector<Instance> instances;
-  for (const PreparedObject& p : objects) instances.push_back({p.object->mesh.get(), glm::mat4(p.object->pose.objectToWorld())});
+  for (const PreparedObject& p : objects) instances.push_back({p.mesh.get(), glm::mat4(p.object->pose.objectToWorld())});
   const RayScene rays(std::move(instances));
   const int w = options.width, h = options.height;
   const Camera& cam = scene.camera;
@@ -178,7 +186,7 @@ RenderResult renderCpu(const Scene& scene, const RenderOptions& options, const R
         result.objectMask[i] = 1;
         const Hit& hit = *hits[i];
         const PreparedObject& p = objects[hit.object];
-        const Mesh& mesh = *p.object->mesh;
+        const Mesh& mesh = *p.mesh;
         const glm::uvec3 tri = mesh.triangles[hit.triangle];
         const double b[3] = {1.0 - hit.u - hit.v, hit.u, hit.v};
         const glm::dvec3 n = glm::normalize(b[0] * glm::dvec3(mesh.normals[tri.x]) + b[1] * glm::dvec3(mesh.normals[tri.y]) +

@@ -1,1 +1,189 @@
-// placeholder: being written (step 2)
+// The visibility cache: a "visibility" cache file (io/cache_file.h) whose
+// payload is the per-vertex sparse Haar coefficients (layout in
+// visibility_cache.h).
+#include "haarcast/render/visibility_cache.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <optional>
+#include <stdexcept>
+#include <system_error>
+
+namespace haarcast {
+namespace {
+
+constexpr const char* kKind = "visibility";
+
+// FNV-1a 64 over a stream of little-endian numbers, hashed in chunks so a
+// large mesh is never copied whole.
+class ContentHasher {
+ public:
+  template <typename T>
+  void add(T value) {
+    io::appendLittleEndian(buffer_, value);
+    if (buffer_.size() >= kChunk) flush();
+  }
+  std::uint64_t finish() {
+    flush();
+    return hash_;
+  }
+
+ private:
+  static constexpr std::size_t kChunk = 1 << 16;
+  void flush() {
+    hash_ = io::fnv1a64(buffer_, hash_);
+    buffer_.clear();
+  }
+  std::string buffer_;
+  std::uint64_t hash_ = io::kFnv1a64Basis;
+};
+
+}  // namespace
+
+std::string meshContentKey(const Mesh& mesh) {
+  ContentHasher h;
+  // Each array's length goes first, so bytes cannot move from one to the next
+  // and leave the hash unchanged.
+  h.add<std::uint64_t>(mesh.positions.size());
+  for (const glm::vec3& p : mesh.positions) {
+    h.add(p.x);
+    h.add(p.y);
+    h.add(p.z);
+  }
+  h.add<std::uint64_t>(mesh.normals.size());
+  for (const glm::vec3& n : mesh.normals) {
+    h.add(n.x);
+    h.add(n.y);
+    h.add(n.z);
+  }
+  h.add<std::uint64_t>(mesh.triangles.size());
+  for (const glm::uvec3& t : mesh.triangles) {
+    h.add<std::uint32_t>(t.x);
+    h.add<std::uint32_t>(t.y);
+    h.add<std::uint32_t>(t.z);
+  }
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h.finish()));
+  return std::string("mesh-fnv1a64:") + hex + " vertices=" + std::to_string(mesh.positions.size()) +
+         " triangles=" + std::to_string(mesh.triangles.size());
+}
+
+std::string visibilityOptionsText(const VisibilityOptions& options) {
+  // The shortest decimal that reads back as the same float: exact, and
+  // readable in a hex dump.
+  char offset[32];
+  const std::to_chars_result r = std::to_chars(offset, offset + sizeof offset, options.offset);
+  const std::string offsetText = r.ec == std::errc() ? std::string(offset, r.ptr) : std::string("?");
+  return "level=" + std::to_string(options.level) + " supersampling=" + std::to_string(options.supersampling) +
+         " keep=" + std::to_string(options.keep) + " offset=" + offsetText;
+}
+
+std::string encodeVisibilityPayload(const std::vector<SparseHaar>& visibility) {
+  std::size_t bytes = 8;
+  for (const SparseHaar& v : visibility) bytes += 4 + 8 * v.size();
+  std::string out;
+  out.reserve(bytes);
+  io::appendLittleEndian<std::uint64_t>(out, visibility.size());
+  for (const SparseHaar& v : visibility) {
+    if (v.value.size() != v.index.size()) {
+      throw std::invalid_argument("encodeVisibilityPayload: " + std::to_string(v.index.size()) + " indices but " +
+                                  std::to_string(v.value.size()) + " values");
+    }
+    io::appendLittleEndian<std::uint32_t>(out, static_cast<std::uint32_t>(v.size()));
+    for (std::size_t k = 0; k < v.size(); ++k) {
+      io::appendLittleEndian<std::uint32_t>(out, v.index[k]);
+      io::appendLittleEndian<float>(out, v.value[k]);
+    }
+  }
+  return out;
+}
+
+std::vector<SparseHaar> decodeVisibilityPayload(std::string_view payload, std::size_t vertexCount,
+                                                const VisibilityOptions& options) {
+  checkVisibilityOptions(options);
+  const std::uint64_t coefficients = static_cast<std::uint64_t>(mapSize(options.level)) *
+                                     static_cast<std::uint64_t>(mapSize(options.level));
+  const std::uint64_t maxPerVertex = std::min<std::uint64_t>(options.keep, coefficients);
+  io::PayloadReader in(payload);
+  const auto count = in.take<std::uint64_t>();
+  if (count != vertexCount) {
+    throw std::runtime_error("invalid contents: " + std::to_string(count) + " vertices, the mesh has " +
+                             std::to_string(vertexCount));
+  }
+  std::vector<SparseHaar> visibility(vertexCount);
+  for (std::size_t vertex = 0; vertex < vertexCount; ++vertex) {
+    const std::string where = "invalid contents: vertex " + std::to_string(vertex) + ": ";
+    const auto n = in.take<std::uint32_t>();
+    if (n > maxPerVertex) {
+      throw std::runtime_error(where + std::to_string(n) + " coefficients, at most " + std::to_string(maxPerVertex));
+    }
+    // Known to fit in what is left before anything is allocated for it.
+    if (8ull * n > in.remaining()) {
+      throw std::runtime_error(where + std::to_string(n) + " coefficients but only " +
+                               std::to_string(in.remaining()) + " bytes left");
+    }
+    SparseHaar& v = visibility[vertex];
+    v.level = options.level;
+    v.index.resize(n);
+    v.value.resize(n);
+    for (std::uint32_t k = 0; k < n; ++k) {
+      const auto index = in.take<std::uint32_t>();
+      const auto value = in.take<float>();
+      if (index >= coefficients) {
+        throw std::runtime_error(where + "index " + std::to_string(index) + " is past the " +
+                                 std::to_string(coefficients) + " coefficients of a level-" +
+                                 std::to_string(options.level) + " map");
+      }
+      if (k > 0 && index <= v.index[k - 1]) throw std::runtime_error(where + "indices are not increasing");
+      if (!std::isfinite(value)) throw std::runtime_error(where + "a non-finite coefficient");
+      v.index[k] = index;
+      v.value[k] = value;
+    }
+  }
+  if (in.remaining() != 0) {
+    throw std::runtime_error("invalid contents: " + std::to_string(in.remaining()) + " bytes after the last vertex");
+  }
+  return visibility;
+}
+
+std::vector<SparseHaar> loadOrComputeVertexVisibility(
+    const Mesh& mesh, const VisibilityOptions& options, const std::string& cacheDir,
+    const std::function<void(std::size_t done, std::size_t total)>& progress, VisibilityCacheStatus* statusOut) {
+  VisibilityCacheStatus local;
+  VisibilityCacheStatus& status = statusOut ? *statusOut : local;
+  status = VisibilityCacheStatus{};
+  const bool warnOnStderr = statusOut == nullptr;
+
+  // Bad input is the same error whether or not the cache holds an answer.
+  checkVisibilityOptions(options);
+  mesh.validate();
+  if (cacheDir.empty()) {
+    status.reason = "no cache directory";
+    return computeVertexVisibility(mesh, options, progress);
+  }
+
+  const io::CacheHeader entry{kKind, kVisibilityCacheVersion, meshContentKey(mesh), visibilityOptionsText(options)};
+  if (const std::optional<std::string> payload = io::lookUpCacheEntry(cacheDir, entry, status)) {
+    try {
+      return decodeVisibilityPayload(*payload, mesh.positions.size(), options);
+    } catch (const std::exception& e) {
+      status.hit = false;
+      status.reason = e.what();
+    }
+  }
+
+  std::vector<SparseHaar> visibility = computeVertexVisibility(mesh, options, progress);
+  std::string payload;
+  try {
+    payload = encodeVisibilityPayload(visibility);
+  } catch (const std::exception& e) {
+    io::reportCacheError(status, warnOnStderr, kKind, e.what());
+    return visibility;
+  }
+  io::storeCacheEntry(cacheDir, entry, payload, status, warnOnStderr);
+  return visibility;
+}
+
+}  // namespace haarcast

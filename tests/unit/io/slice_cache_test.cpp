@@ -126,19 +126,27 @@ TEST(SliceCache, DamagedOrStaleFilesAreRebuiltAndRewritten) {
   const auto brdf = testBrdf();
   const SliceTableOptions options = smallOptions();
   const std::string key = "phong-30";
-  const std::size_t keyEnd = 32 + key.size();
+  // Offsets found in the file, so the cases follow cache_file.h's layout.
+  const auto offsetOf = [](const std::string& path, const std::string& text) {
+    std::ifstream in(path, std::ios::binary);
+    std::string bytes(static_cast<std::size_t>(fs::file_size(path)), '\0');
+    in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    const std::size_t at = bytes.find(text);
+    EXPECT_NE(at, std::string::npos) << text;
+    return at;
+  };
   struct Case {
     std::string label;
     std::function<void(const std::string&)> damage;
     std::string reason;
   };
   const std::vector<Case> cases = {
-      {"one payload byte", [&](const std::string& p) { flipByte(p, keyEnd + 100); }, "checksum"},
+      {"one payload byte", [&](const std::string& p) { flipByte(p, offsetOf(p, "channels=3") + 100); }, "checksum"},
       {"one checksum byte", [&](const std::string& p) { flipByte(p, fs::file_size(p) - 3); }, "checksum"},
       {"the magic", [](const std::string& p) { flipByte(p, 1); }, "magic"},
       {"the version", [](const std::string& p) { flipByte(p, 8); }, "version"},
-      {"the level", [](const std::string& p) { flipByte(p, 12); }, "options differ"},
-      {"the key", [&](const std::string& p) { flipByte(p, 33); }, "another key"},
+      {"the level", [&](const std::string& p) { flipByte(p, offsetOf(p, "level=") + 6); }, "options differ"},
+      {"the key", [&](const std::string& p) { flipByte(p, offsetOf(p, key) + 1); }, "another key"},
       {"cut short", [](const std::string& p) { fs::resize_file(p, fs::file_size(p) - 1); }, "wrong size"},
       {"grown", [](const std::string& p) { fs::resize_file(p, fs::file_size(p) + 1); }, "wrong size"},
       {"emptied", [](const std::string& p) { fs::resize_file(p, 0); }, "wrong size"},
@@ -226,8 +234,11 @@ TEST(SliceCache, EncodeDecodeRoundTripAndRefusals) {
   const SliceTableOptions options = smallOptions();
   const BrdfSliceTable table = BrdfSliceTable::build(*brdf, options);
   const std::string bytes = encodeSliceTable(table, options, "key");
-  EXPECT_EQ(bytes.size(), 32 + 3 + 8 * 4 + 4 * 3 * 4 * 256 + 8);
-  EXPECT_EQ(bytes.substr(0, 7), "HCSLICE");
+  // A cache file (cache_file.h) whose payload is 4 θₒ and 3·4 level-4 slices.
+  const std::size_t optionsBytes = std::string("level=4 thetaSamples=4 supersampling=2 channels=3").size();
+  EXPECT_EQ(bytes.size(), kCacheFileFixedBytes + std::string("slices").size() + 3 + optionsBytes + 8 * 4 +
+                              4 * 3 * 4 * 256 + kCacheFileChecksumBytes);
+  EXPECT_EQ(bytes.substr(0, 7), "HCCACHE");
   expectSameTable(decodeSliceTable(bytes, options, "key"), table);
   EXPECT_THROW(decodeSliceTable(bytes, options, "other"), std::runtime_error);
   EXPECT_THROW(decodeSliceTable(bytes.substr(0, 20), options, "key"), std::runtime_error);

@@ -65,6 +65,17 @@ TEST(CpuRenderer, EveryRotationMethodAgreesWithSpatialWhereTheyShould) {
   for (std::size_t i = 0; i < spatial.image.rgb.size(); ++i) EXPECT_NEAR(haar.image.rgb[i], spatial.image.rgb[i], 1e-4);
 }
 
+TEST(CpuRenderer, MeshesWithoutNormalsGetThemComputed) {
+  Scene scene = sphereScene("lambert", 1.0);
+  auto bare = std::make_shared<Mesh>(*scene.objects[0].mesh);
+  bare->normals.clear();
+  scene.objects[0].mesh = bare;
+  const RenderResult r = renderCpu(scene, smallOptions());
+  const std::size_t centre = static_cast<std::size_t>(12 * r.image.width + 12);
+  ASSERT_TRUE(r.objectMask[centre]);
+  EXPECT_NEAR(r.image.at(12, 12, 0), 0.8, 0.05);  // faceted normals, same answer
+}
+
 TEST(CpuRenderer, BadOptionsAreRefusedByName) {
   RenderOptions o = smallOptions();
   o.width = 100000;

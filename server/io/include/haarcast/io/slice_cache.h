@@ -2,20 +2,13 @@
 // T·M²·n² times (level 6, 16 slices, 4² samples: 1M pixels × 16); a table read
 // back from disk is bit-identical and takes milliseconds.
 //
-// File format `.hcslice`, version kSliceCacheVersion, all little-endian:
-//   offset  size
-//   0       8     magic "HCSLICE\0"
-//   8       4     u32 format version
-//   12      4     i32 level
-//   16      4     i32 thetaSamples T
-//   20      4     i32 supersampling
-//   24      4     i32 channels (3)
-//   28      4     u32 key length K (≤ kMaxSliceCacheKey)
-//   32      K     key bytes (what the table was built from; the caller's)
-//   32+K    8T    f64 θₒ of each slice
-//   …       12TM² f32 Haar coefficients, slice [channel·T + t], each in
-//                 HaarMap's quadrant layout, row-major
-//   end−8   8     u64 FNV-1a 64 of every byte before it
+// Files are haarcast cache files (cache_file.h) of kind "slices", version
+// kSliceCacheVersion. The options text is
+// "level=<n> thetaSamples=<T> supersampling=<s> channels=3"; the payload,
+// little-endian, is
+//   8T     f64 θₒ of each slice
+//   12TM²  f32 Haar coefficients, slice [channel·T + t], each in HaarMap's
+//          quadrant layout, row-major
 // Anything that does not match what the caller asks for — version, options,
 // key, size, checksum — makes the file a miss: the table is rebuilt and the
 // file rewritten.
@@ -29,20 +22,17 @@
 
 #include "haarcast/core/brdf.h"
 #include "haarcast/core/brdf_slices.h"
+#include "haarcast/io/cache_file.h"
 
 namespace haarcast::io {
 
-inline constexpr std::uint32_t kSliceCacheVersion = 1;
-inline constexpr std::size_t kMaxSliceCacheKey = 1 << 16;
+// 2: the file became a generic cache file (1 had its own header).
+inline constexpr std::uint32_t kSliceCacheVersion = 2;
+inline constexpr std::size_t kMaxSliceCacheKey = kMaxCacheText;
 
-// What loadOrBuildSliceTable did, for callers that log or test it.
-struct SliceCacheStatus {
-  bool hit = false;      // read from the cache; nothing was built
-  bool written = false;  // a built table was stored for next time
-  std::string path;      // the cache file consulted
-  std::string reason;    // why it was not a hit ("no cache file", "checksum mismatch", …); empty on a hit
-  std::string error;     // an I/O failure the user should know of (directory not creatable, write failed)
-};
+// What loadOrBuildSliceTable did, for callers that log or test it: hit means
+// nothing was built, written that a built table was stored.
+using SliceCacheStatus = CacheStatus;
 
 // Returns the table for (brdf, options), from `cacheDir` when a valid file for
 // (key, options) is there, else built (progress as in BrdfSliceTable::build)

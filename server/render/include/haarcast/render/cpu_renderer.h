@@ -37,7 +37,7 @@ struct RenderOptions {
   int sliceSupersampling = 4;
   VisibilityOptions visibility;           // its level is overridden by `level`
   bool environmentBackground = true;      // false: black where no object is
-  std::string cacheDir;                   // slice-table cache; empty = no cache
+  std::string cacheDir;                   // slice-table and visibility cache; empty = none
   unsigned threads = 0;                   // 0 = hardware concurrency
 };
 
