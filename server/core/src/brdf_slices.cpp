@@ -9,7 +9,7 @@
 #include <utility>
 #include <vector>
 
-#include "parallel.h"
+#include "haarcast/core/parallel.h"
 
 namespace haarcast {
 namespace {
@@ -169,7 +169,7 @@ BrdfSliceTable BrdfSliceTable::build(const Brdf& brdf, const SliceTableOptions& 
   for (int t = 0; t < total; ++t) table.thetaOut_[static_cast<std::size_t>(t)] = (t + 0.5) * (kPi / 2.0) / total;
   table.slices_.resize(static_cast<std::size_t>(kChannels * total));
 
-  detail::parallelFor(
+  parallelFor(
       static_cast<std::size_t>(total),
       [&](std::size_t i) {
         const int t = static_cast<int>(i);

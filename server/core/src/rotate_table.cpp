@@ -26,7 +26,7 @@
 #include <vector>
 
 #include "haarcast/core/rotation.h"
-#include "parallel.h"
+#include "haarcast/core/parallel.h"
 #include "rotators.h"
 
 namespace haarcast::detail {

@@ -13,9 +13,11 @@
 #include <glm/trigonometric.hpp>
 
 #include "haarcast/core/brdf_slices.h"
+#include "haarcast/core/parallel.h"
 #include "haarcast/core/triple_product.h"
 #include "haarcast/io/slice_cache.h"
 #include "haarcast/render/embree_scene.h"
+#include "haarcast/render/shading.h"
 #include "haarcast/render/visibility_cache.h"
 
 namespace haarcast::render {
@@ -23,31 +25,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
-
-// Runs body(i) for i in [0, count) on `threads` threads; the calling thread
-// reports progress. The first exception is rethrown after all threads stop.
-void parallelFor(std::size_t count, unsigned threads, const std::function<void(std::size_t)>& body,
-                 const std::function<void(std::size_t)>& onProgress) {
-  std::atomic<std::size_t> next{0}, done{0};
-  std::exception_ptr error;
-  std::atomic<bool> failed{false};
-  auto work = [&] {
-    for (std::size_t i; !failed && (i = next++) < count;) {
-      try {
-        body(i);
-      } catch (...) {
-        if (!failed.exchange(true)) error = std::current_exception();
-      }
-      ++done;
-    }
-  };
-  std::vector<std::thread> pool;
-  for (unsigned t = 1; t < threads; ++t) pool.emplace_back(work);
-  work();
-  for (auto& t : pool) t.join();
-  if (error) std::rethrow_exception(error);
-  if (onProgress) onProgress(done);
-}
 
 // Everything precomputed for one object.
 struct PreparedObject {
@@ -59,20 +36,6 @@ struct PreparedObject {
   std::array<SparseHaar, 3> light;     // this frame's light in the object frame
   glm::dmat3 rotation{1.0};            // object → world
 };
-
-// The local shading frame as a rotation local → object: +Y = n, the view
-// direction in the (Y, Z) half-plane at φ = 0 (DESIGN.md "BRDF slices").
-glm::dmat3 shadingFrame(const glm::dvec3& n, const glm::dvec3& wo, double& thetaOut) {
-  const double c = std::clamp(glm::dot(n, wo), -1.0, 1.0);
-  thetaOut = std::acos(std::max(c, 0.0));
-  glm::dvec3 z = wo - c * n;
-  if (glm::dot(z, z) < 1e-16) {  // view along the normal: any tangent will do
-    z = std::abs(n.x) < 0.9 ? glm::cross(n, glm::dvec3(1, 0, 0)) : glm::cross(n, glm::dvec3(0, 1, 0));
-  }
-  z = glm::normalize(z);
-  const glm::dvec3 x = glm::cross(n, z);  // right-handed: x = y × z
-  return glm::dmat3(x, n, z);
-}
 
 }  // namespace
 
@@ -89,7 +52,7 @@ void checkRenderOptions(const RenderOptions& o) {
 RenderResult renderCpu(const Scene& scene, const RenderOptions& options, const RenderProgress& progress) {
   checkRenderOptions(options);
   if (scene.objects.empty()) throw std::invalid_argument("render: the scene has no objects");
-  const unsigned threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
+  const unsigned threads = options.threads;  // 0 = all cores (parallelFor)
   const int level = options.level;
   RenderResult result;
 
@@ -146,39 +109,27 @@ RenderResult renderCpu(const Scene& scene, const RenderOptions& options, const R
   for (const PreparedObject& p : objects) instances.push_back({p.mesh.get(), glm::mat4(p.object->pose.objectToWorld())});
   const RayScene rays(std::move(instances));
   const int w = options.width, h = options.height;
-  const Camera& cam = scene.camera;
-  const glm::dvec3 forward = glm::normalize(cam.target - cam.eye);
-  const glm::dvec3 right = glm::normalize(glm::cross(forward, cam.up));
-  const glm::dvec3 up = glm::cross(right, forward);
-  const double tanHalf = std::tan(glm::radians(cam.fovYDegrees) * 0.5);
-  const double aspect = static_cast<double>(w) / h;
-  auto pixelRay = [&](int x, int y) {
-    const double sx = (2.0 * (x + 0.5) / w - 1.0) * tanHalf * aspect;
-    const double sy = (1.0 - 2.0 * (y + 0.5) / h) * tanHalf;
-    return glm::normalize(forward + sx * right + sy * up);
-  };
+  const CameraRays camera(scene.camera, w, h);
   std::vector<std::optional<Hit>> hits(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
-  parallelFor(static_cast<std::size_t>(h), threads, [&](std::size_t y) {
+  parallelFor(static_cast<std::size_t>(h), [&](std::size_t y) {
     for (int x = 0; x < w; ++x) {
       Ray r;
-      r.origin = glm::vec3(cam.eye);
-      r.direction = glm::vec3(pixelRay(x, static_cast<int>(y)));
+      r.origin = glm::vec3(camera.origin());
+      r.direction = glm::vec3(camera.direction(x, static_cast<int>(y)));
       hits[y * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)] = rays.intersect(r);
     }
-  }, {});
+  }, {}, threads);
   result.timings.gbuffer = since(t0);
 
   // ---- Per pixel: rotation and triple product ------------------------------
   t0 = Clock::now();
   result.image = io::makeImage(w, h);
   result.objectMask.assign(hits.size(), 0);
-  std::atomic<std::size_t> rowsDone{0};
-  std::mutex progressMutex;  // shading reports from the worker threads, one at a time
-  parallelFor(static_cast<std::size_t>(h), threads, [&](std::size_t y) {
+  parallelFor(static_cast<std::size_t>(h), [&](std::size_t y) {
     HaarMap rotated;
     for (int x = 0; x < w; ++x) {
       const std::size_t i = y * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
-      const glm::dvec3 dir = pixelRay(x, static_cast<int>(y));
+      const glm::dvec3 dir = camera.direction(x, static_cast<int>(y));
       glm::dvec3 radiance(0.0);
       if (!hits[i]) {
         if (options.environmentBackground) radiance = scene.environment.radiance(dir);
@@ -208,12 +159,9 @@ RenderResult renderCpu(const Scene& scene, const RenderOptions& options, const R
       }
       for (int c = 0; c < 3; ++c) result.image.at(static_cast<int>(y), x, c) = static_cast<float>(radiance[c]);
     }
-    const std::size_t done = ++rowsDone;
-    if (progress) {
-      const std::lock_guard<std::mutex> lock(progressMutex);
-      progress("shading", done, static_cast<std::size_t>(h));
-    }
-  }, {});
+  }, [&](std::size_t rows) {
+    if (progress) progress("shading", rows, static_cast<std::size_t>(h));
+  }, threads);
   result.timings.shading = since(t0);
   return result;
 }

@@ -21,7 +21,9 @@
 #include <glm/trigonometric.hpp>
 
 #include "haarcast/core/sphere_map.h"
+#include "haarcast/core/parallel.h"
 #include "haarcast/render/embree_scene.h"
+#include "haarcast/render/shading.h"
 
 namespace haarcast::render {
 namespace {
@@ -159,27 +161,9 @@ class SphereDistribution {
 
 // ---- Threads ----------------------------------------------------------------
 
-// body(i) for i in [0, count) on `threads` threads drawing from one atomic
-// counter; the first exception stops the hand-out and is rethrown.
+// haarcast's pool, with the thread count where this file's calls put it.
 void parallelFor(std::size_t count, unsigned threads, const std::function<void(std::size_t)>& body) {
-  std::atomic<std::size_t> next{0};
-  std::atomic<bool> failed{false};
-  std::exception_ptr error;
-  auto work = [&] {
-    for (std::size_t i; !failed && (i = next++) < count;) {
-      try {
-        body(i);
-      } catch (...) {
-        if (!failed.exchange(true)) error = std::current_exception();
-      }
-    }
-  };
-  std::vector<std::thread> pool;
-  const unsigned n = static_cast<unsigned>(std::min<std::size_t>(threads, std::max<std::size_t>(count, 1)));
-  for (unsigned t = 1; t < n; ++t) pool.emplace_back(work);
-  work();
-  for (auto& t : pool) t.join();
-  if (error) std::rethrow_exception(error);
+  haarcast::parallelFor(count, body, {}, threads);
 }
 
 // The largest value of f over a 3×3 grid of directions in each cell, uniform
@@ -219,21 +203,6 @@ std::vector<double> cellMaxima(int rows, int cols, double thetaMax, const std::f
 }
 
 // ---- Scene preparation ------------------------------------------------------
-
-// renderCpu's local frame, local → object: +Y = n, the view direction in
-// the (Y, Z) half-plane at φ = 0 (copied from cpu_renderer.cpp so that ρ sees
-// exactly the same arguments).
-glm::dmat3 shadingFrame(const glm::dvec3& n, const glm::dvec3& wo, double& thetaOut) {
-  const double c = std::clamp(glm::dot(n, wo), -1.0, 1.0);
-  thetaOut = std::acos(std::max(c, 0.0));
-  glm::dvec3 z = wo - c * n;
-  if (glm::dot(z, z) < 1e-16) {  // view along the normal: any tangent will do
-    z = std::abs(n.x) < 0.9 ? glm::cross(n, glm::dvec3(1, 0, 0)) : glm::cross(n, glm::dvec3(0, 1, 0));
-  }
-  z = glm::normalize(z);
-  const glm::dvec3 x = glm::cross(n, z);
-  return glm::dmat3(x, n, z);
-}
 
 struct Strategies {
   bool environment = false, brdf = false, cosine = false;
@@ -375,7 +344,7 @@ ReferenceResult renderReference(const Scene& scene, const ReferenceOptions& opti
   if (scene.objects.empty()) throw std::invalid_argument("reference: the scene has no objects");
   if (!scene.environment.radiance) throw std::invalid_argument("reference: the environment has no radiance function");
   const auto start = Clock::now();
-  const unsigned threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
+  const unsigned threads = options.threads;  // 0 = all cores (parallelFor)
   const Strategies use = strategiesOf(options.sampling);
   const Environment& env = scene.environment;
 
@@ -411,17 +380,7 @@ ReferenceResult renderReference(const Scene& scene, const ReferenceOptions& opti
   const RayScene primary(std::move(instances));
   const int w = options.width, h = options.height;
   const std::size_t pixels = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
-  const Camera& cam = scene.camera;
-  const glm::dvec3 forward = glm::normalize(cam.target - cam.eye);
-  const glm::dvec3 right = glm::normalize(glm::cross(forward, cam.up));
-  const glm::dvec3 up = glm::cross(right, forward);
-  const double tanHalf = std::tan(glm::radians(cam.fovYDegrees) * 0.5);
-  const double aspect = static_cast<double>(w) / h;
-  auto pixelRay = [&](int x, int y) {
-    const double sx = (2.0 * (x + 0.5) / w - 1.0) * tanHalf * aspect;
-    const double sy = (1.0 - 2.0 * (y + 0.5) / h) * tanHalf;
-    return glm::normalize(forward + sx * right + sy * up);
-  };
+  const CameraRays camera(scene.camera, w, h);  // the Haar renderer's rays, exactly
 
   ReferenceResult result;
   result.image = io::makeImage(w, h);
@@ -432,9 +391,9 @@ ReferenceResult renderReference(const Scene& scene, const ReferenceOptions& opti
     const int y = static_cast<int>(yy);
     for (int x = 0; x < w; ++x) {
       const std::size_t i = yy * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
-      const glm::dvec3 dir = pixelRay(x, y);
+      const glm::dvec3 dir = camera.direction(x, y);
       Ray r;
-      r.origin = glm::vec3(cam.eye);
+      r.origin = glm::vec3(camera.origin());
       r.direction = glm::vec3(dir);
       const std::optional<Hit> hit = primary.intersect(r);
       if (!hit) {

@@ -3,18 +3,14 @@
 #include "haarcast/render/visibility.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
-#include <condition_variable>
-#include <exception>
-#include <mutex>
 #include <stdexcept>
 #include <string>
-#include <thread>
 
 #include <glm/geometric.hpp>
 
 #include "haarcast/core/brdf_slices.h"
+#include "haarcast/core/parallel.h"
 
 namespace haarcast {
 namespace {
@@ -60,77 +56,6 @@ void checkMeshForVisibility(const Mesh& mesh) {
   }
 }
 
-// body(i) for i in [0, count) on up to hardware_concurrency threads taking
-// indices from a shared counter; the calling thread reports progress. (Core's
-// parallelFor is private to core, and a dependency on a thread pool library
-// would buy nothing here.) The first exception, from body or progress, stops
-// the handing out of work and is rethrown after the workers are joined.
-void parallelForWithProgress(std::size_t count, const std::function<void(std::size_t)>& body,
-                             const std::function<void(std::size_t, std::size_t)>& progress) {
-  if (count == 0) return;
-  std::atomic<std::size_t> next{0};
-  std::atomic<bool> stop{false};
-  std::mutex mutex;
-  std::condition_variable cv;
-  std::size_t done = 0;        // guarded by mutex
-  std::size_t running = 0;     // workers not yet finished; guarded by mutex
-  std::exception_ptr failure;  // guarded by mutex
-
-  auto worker = [&] {
-    for (std::size_t i = next.fetch_add(1); i < count && !stop.load(); i = next.fetch_add(1)) {
-      try {
-        body(i);
-        const std::lock_guard lock(mutex);
-        ++done;
-      } catch (...) {
-        const std::lock_guard lock(mutex);
-        if (!failure) failure = std::current_exception();
-        stop = true;
-      }
-      cv.notify_one();
-    }
-    const std::lock_guard lock(mutex);
-    --running;
-    cv.notify_one();
-  };
-
-  const std::size_t threadCount = std::min<std::size_t>(count, std::max(1u, std::thread::hardware_concurrency()));
-  std::vector<std::jthread> threads;
-  threads.reserve(threadCount);
-  try {
-    for (std::size_t k = 0; k < threadCount; ++k) {
-      {
-        const std::lock_guard lock(mutex);
-        ++running;
-      }
-      threads.emplace_back(worker);
-    }
-    std::size_t reported = 0;
-    for (;;) {
-      std::size_t now = 0;
-      bool finished = false;
-      {
-        std::unique_lock lock(mutex);
-        cv.wait(lock, [&] { return done > reported || failure || running == 0; });
-        if (failure) break;
-        now = done;
-        finished = running == 0;
-      }
-      // Report outside the lock: progress may take its time.
-      if (now > reported) {
-        reported = now;
-        if (progress) progress(reported, count);
-      }
-      if (finished) break;
-    }
-  } catch (...) {
-    stop = true;
-    threads.clear();  // joins
-    throw;
-  }
-  threads.clear();  // joins
-  if (failure) std::rethrow_exception(failure);
-}
 
 }  // namespace
 
@@ -169,15 +94,18 @@ std::vector<SparseHaar> computeVertexVisibility(
   checkMeshForVisibility(mesh);
   const float shift = shiftOf(mesh, options);
   std::vector<SparseHaar> out(mesh.positions.size());
-  parallelForWithProgress(
-      mesh.positions.size(),
+  const std::size_t total = mesh.positions.size();
+  parallelFor(
+      total,
       [&](std::size_t v) {
         const RayStart start = rayStart(mesh, v, shift);
         out[v] = keepLargest(
             forwardHaar(visibilityMap(occluders, start.origin, start.tnear, options.level, options.supersampling)),
             options.keep);
       },
-      progress);
+      [&](std::size_t done) {
+        if (progress) progress(done, total);
+      });
   return out;
 }
 

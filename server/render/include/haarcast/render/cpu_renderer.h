@@ -58,8 +58,8 @@ struct RenderResult {
   RenderTimings timings;
 };
 
-// progress(stage, done, total) for long stages; may be empty. Calls never
-// overlap, but "shading" comes from the worker threads.
+// progress(stage, done, total) for long stages, on the calling thread; may be
+// empty.
 using RenderProgress = std::function<void(const std::string& stage, std::size_t done, std::size_t total)>;
 
 RenderResult renderCpu(const Scene& scene, const RenderOptions& options, const RenderProgress& progress = {});

@@ -1,4 +1,5 @@
-// The one thread pool of the core library (private header).
+// The one thread pool of haarcast: every parallel loop (slice tables,
+// rotation matrices, visibility, both renderers) runs through it.
 #pragma once
 
 #include <algorithm>
@@ -11,10 +12,10 @@
 #include <thread>
 #include <vector>
 
-namespace haarcast::detail {
+namespace haarcast {
 
-// Runs body(i) for i = 0 … count−1 on up to hardware_concurrency threads (at
-// least 1), which take indices from a shared counter. The calling thread waits
+// Runs body(i) for i = 0 … count−1 on up to `threads` threads (0 = the
+// hardware's concurrency; at least 1), which take indices from a shared counter. The calling thread waits
 // and, if onDone is given, calls onDone(done) for done = 1, 2, … as items
 // complete — in order, on the calling thread, so it needs no locking.
 //
@@ -23,7 +24,7 @@ namespace haarcast::detail {
 // exception is rethrown on the calling thread. After a failure in body, items
 // that completed may go unreported.
 inline void parallelFor(std::size_t count, const std::function<void(std::size_t)>& body,
-                        const std::function<void(std::size_t done)>& onDone = {}) {
+                        const std::function<void(std::size_t done)>& onDone = {}, unsigned threads = 0) {
   if (count == 0) return;
   std::atomic<std::size_t> next{0};
   std::atomic<bool> stop{false};
@@ -47,12 +48,12 @@ inline void parallelFor(std::size_t count, const std::function<void(std::size_t)
     }
   };
 
-  const std::size_t hardware = std::max(1u, std::thread::hardware_concurrency());
-  const std::size_t threadCount = std::min(count, hardware);
-  std::vector<std::jthread> threads;
-  threads.reserve(threadCount);
+  const std::size_t wanted = threads ? threads : std::max(1u, std::thread::hardware_concurrency());
+  const std::size_t threadCount = std::min(count, wanted);
+  std::vector<std::jthread> pool;
+  pool.reserve(threadCount);
   try {
-    for (std::size_t k = 0; k < threadCount; ++k) threads.emplace_back(worker);
+    for (std::size_t k = 0; k < threadCount; ++k) pool.emplace_back(worker);
     std::size_t reported = 0;
     while (reported < count) {
       std::size_t now = 0;
@@ -70,11 +71,11 @@ inline void parallelFor(std::size_t count, const std::function<void(std::size_t)
     }
   } catch (...) {
     stop = true;
-    threads.clear();  // joins
+    pool.clear();  // joins
     throw;
   }
-  threads.clear();  // joins
+  pool.clear();  // joins
   if (failure) std::rethrow_exception(failure);
 }
 
-}  // namespace haarcast::detail
+}  // namespace haarcast

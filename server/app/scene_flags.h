@@ -1,0 +1,40 @@
+// The flags `render` and `reference` share: what to draw and where to write
+// it. One definition, so the two commands always draw the same scene.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "haarcast/io/image.h"
+#include "haarcast/render/scene.h"
+
+namespace haarcast::app {
+
+struct SceneFlags {
+  std::string scene, env, layout = "auto", mesh, material = "phong:64";
+  std::vector<double> rotate;
+  int width = 128, height = 128;
+  std::string background = "env";
+  std::string out;
+  std::optional<double> exposure;
+};
+
+// --scene --env --env-layout --mesh --material --rotate --width --height
+// --background --out --exposure
+void addSceneFlags(CLI::App& command, SceneFlags& flags);
+
+// --scene FILE, or one object from --mesh (with --env, --material, --rotate),
+// or the built-in default scene. Throws std::invalid_argument on a bad mix.
+render::Scene sceneFromFlags(const SceneFlags& flags);
+
+// --background env|black, validated.
+bool environmentBackground(const SceneFlags& flags);
+
+// --out .exr (and a tonemapped .png beside it) or .png; --exposure, or
+// Reinhard's key. Prints what it wrote.
+void writeOutputImages(const SceneFlags& flags, const io::RgbImage& image);
+
+}  // namespace haarcast::app

@@ -1,0 +1,30 @@
+// What the Haar renderer and the Monte Carlo reference must agree on exactly:
+// the camera's rays and each pixel's local shading frame.
+#pragma once
+
+#include <glm/mat3x3.hpp>
+#include <glm/vec3.hpp>
+
+#include "haarcast/render/scene.h"
+
+namespace haarcast::render {
+
+// A pinhole camera's rays through pixel centres (row 0 at the top).
+class CameraRays {
+ public:
+  CameraRays(const Camera& camera, int width, int height);
+  glm::dvec3 direction(int x, int y) const;  // unit, world frame
+  const glm::dvec3& origin() const { return eye_; }
+
+ private:
+  glm::dvec3 eye_, forward_, right_, up_;
+  double tanHalf_, aspect_;
+  int width_, height_;
+};
+
+// The local frame of a shaded point as a rotation local → object: +Y = the
+// shading normal n, the view direction wo in the (Y, Z) half-plane at φ = 0
+// (DESIGN.md "BRDF slices"). thetaOut gets θₒ (clamped to [0, π/2]).
+glm::dmat3 shadingFrame(const glm::dvec3& n, const glm::dvec3& wo, double& thetaOut);
+
+}  // namespace haarcast::render

@@ -1,0 +1,39 @@
+#include "haarcast/render/shading.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/geometric.hpp>
+#include <glm/trigonometric.hpp>
+
+namespace haarcast::render {
+
+CameraRays::CameraRays(const Camera& camera, int width, int height)
+    : eye_(camera.eye),
+      forward_(glm::normalize(camera.target - camera.eye)),
+      right_(glm::normalize(glm::cross(forward_, camera.up))),
+      up_(glm::cross(right_, forward_)),
+      tanHalf_(std::tan(glm::radians(camera.fovYDegrees) * 0.5)),
+      aspect_(static_cast<double>(width) / height),
+      width_(width),
+      height_(height) {}
+
+glm::dvec3 CameraRays::direction(int x, int y) const {
+  const double sx = (2.0 * (x + 0.5) / width_ - 1.0) * tanHalf_ * aspect_;
+  const double sy = (1.0 - 2.0 * (y + 0.5) / height_) * tanHalf_;
+  return glm::normalize(forward_ + sx * right_ + sy * up_);
+}
+
+glm::dmat3 shadingFrame(const glm::dvec3& n, const glm::dvec3& wo, double& thetaOut) {
+  const double c = std::clamp(glm::dot(n, wo), -1.0, 1.0);
+  thetaOut = std::acos(std::max(c, 0.0));
+  glm::dvec3 z = wo - c * n;
+  if (glm::dot(z, z) < 1e-16) {  // view along the normal: any tangent will do
+    z = std::abs(n.x) < 0.9 ? glm::cross(n, glm::dvec3(1, 0, 0)) : glm::cross(n, glm::dvec3(0, 1, 0));
+  }
+  z = glm::normalize(z);
+  const glm::dvec3 x = glm::cross(n, z);  // right-handed: x = y × z
+  return glm::dmat3(x, n, z);
+}
+
+}  // namespace haarcast::render
