@@ -2,7 +2,7 @@
 # One entry point for people and CI: installs the Debian packages haarcast
 # needs, configures (Release, Ninja) into build/, builds, then runs one job.
 #
-#   deploy/run.sh demo  [args]   haarcast rotation-report --level 5 [args]
+#   deploy/run.sh demo  [args]   render the default scene (build/demo/), then the rotation report
 #   deploy/run.sh test  [args]   ctest --test-dir build --output-on-failure [args]
 #   deploy/run.sh bench [args]   build/bin/haarcast-bench [args]
 #                                 e.g. deploy/run.sh bench -- --benchmark_filter=Rotate
@@ -100,16 +100,15 @@ configure_and_build
 
 case "$command" in
   demo)
-    # Until the server exists the demo is the rotation report. Default to
-    # level 5 unless the caller chose a level.
-    args=("$@")
-    has_level=0
-    for a in "${args[@]}"; do
-      [[ "$a" == --level || "$a" == --level=* ]] && has_level=1
-    done
-    ((has_level)) || args=(--level 5 "${args[@]}")
-    log "running haarcast rotation-report ${args[*]}"
-    exec "$BUILD_DIR/bin/haarcast" rotation-report "${args[@]}" </dev/null
+    # The main job on the built-in default scene: render it (CPU backend,
+    # EXR + PNG in build/demo/), then print the rotation report the render
+    # rests on. Extra args go to `render`.
+    mkdir -p "$BUILD_DIR/demo"
+    log "rendering the default scene into $BUILD_DIR/demo/default.exr (+ .png)"
+    "$BUILD_DIR/bin/haarcast" render --width 192 --height 128 --level 5 \
+      --cache-dir "$BUILD_DIR/cache" --out "$BUILD_DIR/demo/default.exr" "$@" </dev/null
+    log "running haarcast rotation-report --level 5"
+    exec "$BUILD_DIR/bin/haarcast" rotation-report --level 5 </dev/null
     ;;
   test)
     log "running tests"

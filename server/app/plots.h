@@ -22,8 +22,8 @@ io::RgbImage groupedLogBarChart(const std::vector<std::vector<double>>& values, 
 // Tiles images (all the same size) into rows × columns with a gap.
 io::RgbImage contactSheet(const std::vector<io::RgbImage>& tiles, int columns, int gap = 4);
 
-// Scales an image so its log-average luminance is 0.18 (Reinhard's key):
-// the exposure haarcast's PNGs use by default.
+// The exposure (stops) that puts the log-average luminance of the lit
+// pixels at 0.18 (Reinhard's key): what haarcast's PNGs use by default.
 double reinhardKeyExposure(const io::RgbImage& image);
 
 }  // namespace haarcast::app
