@@ -6,6 +6,7 @@
 
 #include <glm/geometric.hpp>
 #include <glm/gtc/matrix_transform.hpp>
+#include <glm/trigonometric.hpp>
 #include <nlohmann/json.hpp>
 
 #include "haarcast/assets/procedural_environment.h"
