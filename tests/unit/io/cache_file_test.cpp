@@ -9,7 +9,6 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
-#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -18,33 +17,17 @@
 #include <thread>
 #include <vector>
 
+#include "../test_files.h"
+
 namespace haarcast::io {
 namespace {
 
 namespace fs = std::filesystem;
+using haarcast::testing::readFile;
+using haarcast::testing::TempDir;
+using haarcast::testing::writeFile;
 
-class TempDir {
- public:
-  TempDir() {
-    static std::atomic<int> counter{0};
-    path_ = fs::temp_directory_path() /
-            ("haarcast-cache-file-test-" +
-             std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()) + "-" +
-             std::to_string(counter++));
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  fs::path operator/(const std::string& name) const { return path_ / name; }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
+constexpr const char* kTempPrefix = "haarcast-cache-file-test-";
 
 CacheHeader testHeader() { return CacheHeader{"test", 3, "some/file|123|456", "level=4 supersampling=2"}; }
 
@@ -53,18 +36,6 @@ std::string testPayload() {
   std::string p;
   for (int i = 0; i < 300; ++i) p.push_back(static_cast<char>((i * 37) & 0xff));
   return p;
-}
-
-std::string readAll(const fs::path& path) {
-  // Sized from the file, not an istreambuf_iterator (GCC 12 flags a false
-  // -Wnull-dereference inside it).
-  std::string bytes(static_cast<std::size_t>(fs::file_size(path)), '\0');
-  std::ifstream(path, std::ios::binary).read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-  return bytes;
-}
-
-void writeAll(const fs::path& path, const std::string& bytes) {
-  std::ofstream(path, std::ios::binary | std::ios::trunc).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
 }
 
 std::size_t filesIn(const fs::path& dir) {
@@ -76,7 +47,7 @@ std::size_t filesIn(const fs::path& dir) {
 // The reason readCacheFile gives for `bytes` on disk under `expected`; it
 // must be a miss.
 std::string missReason(const fs::path& path, const std::string& bytes, const CacheHeader& expected) {
-  writeAll(path, bytes);
+  writeFile(path, bytes);
   std::string why;
   const std::optional<std::string> payload = readCacheFile(path.string(), expected, &why);
   EXPECT_FALSE(payload.has_value()) << "a hit, expected a miss";
@@ -89,7 +60,7 @@ std::string missReason(const fs::path& path, const std::string& bytes, const Cac
 }
 
 TEST(CacheFile, WriteThenReadGivesThePayloadBack) {
-  TempDir tmp;
+  TempDir tmp(kTempPrefix);
   const fs::path dir = tmp / "nested" / "cache";  // created by the write
   const fs::path path = dir / cacheFileName("test", "k", "o");
   writeCacheFile(path.string(), testHeader(), testPayload());
@@ -102,7 +73,7 @@ TEST(CacheFile, WriteThenReadGivesThePayloadBack) {
   EXPECT_TRUE(why.empty());
 
   // The bytes on disk are the documented layout.
-  const std::string bytes = readAll(path);
+  const std::string bytes = readFile(path);
   const CacheHeader h = testHeader();
   EXPECT_EQ(bytes.size(), kCacheFileFixedBytes + h.kind.size() + h.key.size() + h.optionsText.size() +
                               testPayload().size() + kCacheFileChecksumBytes);
@@ -128,7 +99,7 @@ TEST(CacheFile, EmptyPayloadAndEmptyTextsRoundTrip) {
 }
 
 TEST(CacheFile, EveryMismatchIsAMissWithAReason) {
-  TempDir tmp;
+  TempDir tmp(kTempPrefix);
   const fs::path path = tmp / "entry.hccache";
   const CacheHeader h = testHeader();
   const std::string good = encodeCacheFile(h, testPayload());
@@ -264,7 +235,7 @@ TEST(CacheFile, PayloadReaderNeverReadsPastTheEnd) {
 }
 
 TEST(CacheFile, AnUnusableDirectoryIsAnErrorNotACrash) {
-  TempDir tmp;
+  TempDir tmp(kTempPrefix);
   // A regular file where the directory should be: fails even for root, which
   // permission bits would not stop.
   const fs::path blocker = tmp / "not-a-directory";
@@ -283,7 +254,7 @@ TEST(CacheFile, AnUnusableDirectoryIsAnErrorNotACrash) {
 }
 
 TEST(CacheFile, LookUpFindsWhatStoreWrote) {
-  TempDir tmp;
+  TempDir tmp(kTempPrefix);
   CacheStatus first;
   EXPECT_FALSE(lookUpCacheEntry(tmp.path().string(), testHeader(), first).has_value());
   EXPECT_EQ(first.reason, "no cache file");
@@ -304,7 +275,7 @@ TEST(CacheFile, ConcurrentWritersNeverLeaveAHalfFile) {
   // Writers race on one name with payloads of different sizes while a reader
   // polls it: every read is a miss because the file is not there yet, or one
   // writer's whole payload.
-  TempDir tmp;
+  TempDir tmp(kTempPrefix);
   const std::string path = (tmp / "race.hccache").string();
   const std::string small(1000, 'a'), large(200000, 'b');
   std::atomic<bool> done{false};

@@ -6,14 +6,12 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <functional>
 #include <iostream>
 #include <limits>
@@ -28,35 +26,20 @@
 #include "haarcast/core/sphere_map.h"
 #include "haarcast/io/merl.h"
 
+#include "../test_files.h"
+
 namespace haarcast::io {
 namespace {
 
 namespace fs = std::filesystem;
+using haarcast::testing::TempDir;
+using haarcast::testing::writeFile;
+
+constexpr const char* kTempPrefix = "haarcast-merl-test-";
 
 // The published constants, restated here on purpose rather than taken from merl.h.
 constexpr int kThetaH = 90, kThetaD = 90, kPhiD = 180;
 constexpr double kScale[3] = {1.0 / 1500.0, 1.15 / 1500.0, 1.66 / 1500.0};
-
-class TempDir {
- public:
-  TempDir() {
-    static std::atomic<int> counter{0};
-    path_ = fs::temp_directory_path() /
-            ("haarcast-merl-test-" + std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()) +
-             "-" + std::to_string(counter++));
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  fs::path operator/(const std::string& name) const { return path_ / name; }
-
- private:
-  fs::path path_;
-};
 
 // Stored value of (channel, iθh, iθd, iφd) → the bytes of a MERL file:
 // int32 dims, then red, green, blue channels of doubles, φd fastest. Written
@@ -81,11 +64,6 @@ std::string merlBytes(const std::function<double(int, int, int, int)>& stored,
   return bytes;
 }
 
-std::string writeFile(const fs::path& path, const std::string& bytes) {
-  std::ofstream(path, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-  return path.string();
-}
-
 template <typename F>
 void expectError(const F& f, const std::vector<std::string>& parts) {
   try {
@@ -105,7 +83,7 @@ glm::dvec3 randomUpper(std::mt19937& rng) {
 }
 
 TEST(MerlBrdf, LambertFileReadsBackAsAlbedoOverPi) {
-  TempDir dir;
+  TempDir dir(kTempPrefix);
   const glm::dvec3 albedo(0.8, 0.5, 0.25);
   const std::string path = writeFile(dir / "lambert-test.binary", merlBytes([&](int c, int, int, int) {
                                        return albedo[c] / kPi / kScale[c];
@@ -142,7 +120,7 @@ HalfDiff frameFreeAngles(const glm::dvec3& wi, const glm::dvec3& wo) {
 TEST(MerlBrdf, CellsAreFoundWhereTheFormatPutsThem) {
   // Each channel stores one coordinate's index, so every lookup says which
   // cell it read.
-  TempDir dir;
+  TempDir dir(kTempPrefix);
   const std::string path = writeFile(dir / "indices.binary", merlBytes([](int c, int ih, int id, int ip) {
                                        return static_cast<double>(c == 0 ? ih : c == 1 ? id : ip);
                                      }));
@@ -188,7 +166,7 @@ TEST(MerlBrdf, CellsAreFoundWhereTheFormatPutsThem) {
 }
 
 TEST(MerlBrdf, NegativeCellsAreBelowTheHorizonAndReadZero) {
-  TempDir dir;
+  TempDir dir(kTempPrefix);
   // Red has no data beyond θd index 45; green never; blue everywhere 1.
   const std::string path = writeFile(dir / "horizon.binary", merlBytes([](int c, int, int id, int) {
                                        if (c == 0) return id > 45 ? -1.0 : 1500.0;
@@ -204,7 +182,7 @@ TEST(MerlBrdf, NegativeCellsAreBelowTheHorizonAndReadZero) {
 }
 
 TEST(MerlBrdf, RefusesMalformedFiles) {
-  TempDir dir;
+  TempDir dir(kTempPrefix);
   const std::string good = merlBytes([](int, int, int, int) { return 1.0; });
   std::string nan = good;
   const double q = std::numeric_limits<double>::quiet_NaN();
@@ -230,7 +208,7 @@ TEST(MerlBrdf, RefusesMalformedFiles) {
 }
 
 TEST(MerlBrdf, RepairFillsNonFiniteCellsFromTheirRow) {
-  TempDir dir;
+  TempDir dir(kTempPrefix);
   const double nan = std::numeric_limits<double>::quiet_NaN();
   // Row (θh 0, θd 3) of red: φd index p holds p, except three NaNs and one
   // below-horizon marker that must not count in the mean.

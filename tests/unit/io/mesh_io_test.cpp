@@ -3,14 +3,12 @@
 // must refuse with a message that names the file and the problem.
 #include <gtest/gtest.h>
 
-#include <atomic>
 #include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <stdexcept>
 #include <string>
@@ -21,38 +19,20 @@
 #include "haarcast/core/mesh.h"
 #include "haarcast/io/mesh_io.h"
 
+#include "../test_files.h"
+
 namespace haarcast::io {
 namespace {
 
 namespace fs = std::filesystem;
+using haarcast::testing::TempDir;
+using haarcast::testing::writeFile;
 
-// A fresh directory per test, removed afterwards.
-class TempDir {
- public:
-  TempDir() {
-    static std::atomic<int> counter{0};
-    path_ = fs::temp_directory_path() /
-            ("haarcast-mesh-test-" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "-" +
-             std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()) + "-" +
-             std::to_string(counter++));
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-
-  std::string write(const std::string& name, const std::string& bytes) const {
-    const fs::path p = path_ / name;
-    std::ofstream(p, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    return p.string();
-  }
-
- private:
-  fs::path path_;
-};
+// A fresh directory per test, removed afterwards; the name also carries
+// GoogleTest's random seed.
+std::string tempPrefix() {
+  return "haarcast-mesh-test-" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "-";
+}
 
 // Expects `f` to throw std::runtime_error whose message has every one of `parts`.
 template <typename F>
@@ -170,23 +150,23 @@ void expectSquare(const Mesh& m) {
 }
 
 TEST(PlyLoader, AsciiQuadWithNormalsAndExtraProperties) {
-  TempDir dir;
-  const Mesh m = loadMesh(dir.write("square.ply", asciiSquarePly()));
+  TempDir dir(tempPrefix());
+  const Mesh m = loadMesh(writeFile(dir / "square.ply", asciiSquarePly()));
   EXPECT_EQ(m.name, "square");
   expectSquare(m);
 }
 
 TEST(PlyLoader, AsciiWithCrlfLineEnds) {
-  TempDir dir;
-  expectSquare(loadMesh(dir.write("square-crlf.PLY", asciiSquarePly("\r\n"))));
+  TempDir dir(tempPrefix());
+  expectSquare(loadMesh(writeFile(dir / "square-crlf.PLY", asciiSquarePly("\r\n"))));
 }
 
 TEST(PlyLoader, BinaryLittleAndBigEndianReadTheSameAsAscii) {
-  TempDir dir;
-  const Mesh ascii = loadMesh(dir.write("a.ply", asciiSquarePly()));
+  TempDir dir(tempPrefix());
+  const Mesh ascii = loadMesh(writeFile(dir / "a.ply", asciiSquarePly()));
   for (const bool big : {false, true}) {
     SCOPED_TRACE(big ? "big-endian" : "little-endian");
-    const Mesh m = loadMesh(dir.write(big ? "be.ply" : "le.ply", binarySquarePly(big)));
+    const Mesh m = loadMesh(writeFile(dir / (big ? "be.ply" : "le.ply"), binarySquarePly(big)));
     expectSquare(m);
     EXPECT_EQ(m.positions, ascii.positions);
     EXPECT_EQ(m.triangles, ascii.triangles);
@@ -215,7 +195,7 @@ TEST(PlyLoader, PentagonIsFanTriangulated) {
 }
 
 TEST(PlyLoader, RefusesCorruptFiles) {
-  TempDir dir;
+  TempDir dir(tempPrefix());
   const std::string good = binarySquarePly(false);
   struct Case {
     std::string label, bytes, expect;
@@ -255,7 +235,7 @@ TEST(PlyLoader, RefusesCorruptFiles) {
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.label);
-    const std::string path = dir.write("bad.ply", c.bytes);
+    const std::string path = writeFile(dir / "bad.ply", c.bytes);
     expectError([&] { loadMesh(path); }, {path, c.expect});
   }
 }
@@ -263,11 +243,11 @@ TEST(PlyLoader, RefusesCorruptFiles) {
 // ------------------------------------------------------------ OBJ
 
 TEST(ObjLoader, WithoutNormalsKeepsTheFileNumberingAndComputesNormals) {
-  TempDir dir;
+  TempDir dir(tempPrefix());
   // A tetrahedron with outward winding, one face written as a quad-free
   // triangle list, plus a comment, a group and a material reference that
   // must not be opened.
-  const std::string path = dir.write("tet.obj",
+  const std::string path = writeFile(dir / "tet.obj",
                                      "# tetrahedron\nmtllib missing.mtl\no tet\n"
                                      "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
                                      "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n");
@@ -328,7 +308,7 @@ TEST(ObjLoader, NegativeIndicesAreRelative) {
 }
 
 TEST(ObjLoader, RefusesCorruptFiles) {
-  TempDir dir;
+  TempDir dir(tempPrefix());
   struct Case {
     std::string label, text, expect;
   };
@@ -343,7 +323,7 @@ TEST(ObjLoader, RefusesCorruptFiles) {
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.label);
-    const std::string path = dir.write("bad.obj", c.text);
+    const std::string path = writeFile(dir / "bad.obj", c.text);
     expectError([&] { loadMesh(path); }, {path, c.expect});
   }
 }
@@ -377,8 +357,8 @@ TEST(MeshLoader, InwardWoundClosedMeshesAreTurnedOutward) {
 }
 
 TEST(MeshLoader, RefusesUnknownExtensionsAndMissingFiles) {
-  TempDir dir;
-  const std::string stl = dir.write("model.stl", "solid x\n");
+  TempDir dir(tempPrefix());
+  const std::string stl = writeFile(dir / "model.stl", "solid x\n");
   expectError([&] { loadMesh(stl); }, {stl, "unknown mesh format", ".stl"});
   const std::string missing = (fs::temp_directory_path() / "haarcast-no-such-mesh.obj").string();
   expectError([&] { loadMesh(missing); }, {missing, "cannot open"});

@@ -5,7 +5,6 @@
 // the table from being built.
 #include <gtest/gtest.h>
 
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -22,32 +21,16 @@
 #include "haarcast/core/brdf_slices.h"
 #include "haarcast/io/slice_cache.h"
 
+#include "../test_files.h"
+
 namespace haarcast::io {
 namespace {
 
 namespace fs = std::filesystem;
+using haarcast::testing::readFile;
+using haarcast::testing::TempDir;
 
-class TempDir {
- public:
-  TempDir() {
-    static std::atomic<int> counter{0};
-    path_ = fs::temp_directory_path() /
-            ("haarcast-cache-test-" + std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()) +
-             "-" + std::to_string(counter++));
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  fs::path operator/(const std::string& name) const { return path_ / name; }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
+constexpr const char* kTempPrefix = "haarcast-cache-test-";
 
 SliceTableOptions smallOptions() {
   SliceTableOptions o;
@@ -102,7 +85,7 @@ std::size_t filesIn(const fs::path& dir) {
 }
 
 TEST(SliceCache, MissBuildsAndWritesThenHitBuildsNothing) {
-  TempDir tmp;
+  TempDir tmp(kTempPrefix);
   const fs::path dir = tmp / "nested" / "cache";  // created on demand
   const auto brdf = testBrdf();
   const Call first = cached(*brdf, smallOptions(), dir, "phong-30");
@@ -128,10 +111,7 @@ TEST(SliceCache, DamagedOrStaleFilesAreRebuiltAndRewritten) {
   const std::string key = "phong-30";
   // Offsets found in the file, so the cases follow cache_file.h's layout.
   const auto offsetOf = [](const std::string& path, const std::string& text) {
-    std::ifstream in(path, std::ios::binary);
-    std::string bytes(static_cast<std::size_t>(fs::file_size(path)), '\0');
-    in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    const std::size_t at = bytes.find(text);
+    const std::size_t at = readFile(path).find(text);
     EXPECT_NE(at, std::string::npos) << text;
     return at;
   };
@@ -153,7 +133,7 @@ TEST(SliceCache, DamagedOrStaleFilesAreRebuiltAndRewritten) {
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.label);
-    TempDir dir;
+    TempDir dir(kTempPrefix);
     const Call built = cached(*brdf, options, dir.path(), key);
     ASSERT_TRUE(built.status.written);
     c.damage(built.status.path);
@@ -171,7 +151,7 @@ TEST(SliceCache, DamagedOrStaleFilesAreRebuiltAndRewritten) {
 }
 
 TEST(SliceCache, OtherOptionsOrKeysAreOtherEntries) {
-  TempDir dir;
+  TempDir dir(kTempPrefix);
   const auto brdf = testBrdf();
   SliceTableOptions options = smallOptions();
   ASSERT_TRUE(cached(*brdf, options, dir.path(), "k").status.written);
@@ -192,7 +172,7 @@ TEST(SliceCache, OtherOptionsOrKeysAreOtherEntries) {
 
 TEST(SliceCache, AFileUnderAnotherKeysNameIsAMiss) {
   // What a hash collision would look like: the right name, the wrong contents.
-  TempDir dir;
+  TempDir dir(kTempPrefix);
   const auto brdf = testBrdf();
   const Call a = cached(*brdf, smallOptions(), dir.path(), "key A");
   fs::rename(a.status.path, dir / sliceCacheFileName("key B", smallOptions()));
@@ -202,7 +182,7 @@ TEST(SliceCache, AFileUnderAnotherKeysNameIsAMiss) {
 }
 
 TEST(SliceCache, AnUnusableDirectoryStillGivesTheTable) {
-  TempDir tmp;
+  TempDir tmp(kTempPrefix);
   // A regular file where the directory should be: fails even for root, which
   // permission bits would not stop.
   const fs::path blocker = tmp / "not-a-directory";
@@ -220,7 +200,7 @@ TEST(SliceCache, AnUnusableDirectoryStillGivesTheTable) {
 }
 
 TEST(SliceCache, BadOptionsAreTheBuildersError) {
-  TempDir dir;
+  TempDir dir(kTempPrefix);
   SliceTableOptions options = smallOptions();
   options.level = -1;
   EXPECT_THROW(loadOrBuildSliceTable(*testBrdf(), options, dir.path().string(), "k"), std::invalid_argument);
@@ -249,7 +229,7 @@ TEST(SliceCache, EncodeDecodeRoundTripAndRefusals) {
 }
 
 TEST(SliceCache, FileKeyChangesWhenTheFileDoes) {
-  TempDir dir;
+  TempDir dir(kTempPrefix);
   const fs::path file = dir / "material.binary";
   std::ofstream(file) << "first";
   const std::string before = fileCacheKey(file.string());
@@ -285,7 +265,7 @@ TEST(BrdfSliceTableFromSlices, ValidatesWhatItIsGiven) {
 
 TEST(SliceCache, HitIsMuchFasterThanBuild) {
   // The figure for the report: level 6, 16 slices, 4² samples per pixel.
-  TempDir dir;
+  TempDir dir(kTempPrefix);
   const auto brdf = makeGgx({0.05, 0.05, 0.05}, {0.9, 0.6, 0.3}, 0.2);
   SliceTableOptions options;
   options.level = 6;

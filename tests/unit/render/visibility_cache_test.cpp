@@ -7,7 +7,6 @@
 
 #include <gtest/gtest.h>
 
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -23,33 +22,15 @@
 #include "haarcast/io/cache_file.h"
 #include "haarcast/io/mesh_io.h"
 
+#include "../test_files.h"
+
 namespace haarcast {
 namespace {
 
 namespace fs = std::filesystem;
+using haarcast::testing::TempDir;
 
-class TempDir {
- public:
-  TempDir() {
-    static std::atomic<int> counter{0};
-    path_ = fs::temp_directory_path() /
-            ("haarcast-visibility-cache-test-" +
-             std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()) + "-" +
-             std::to_string(counter++));
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  fs::path operator/(const std::string& name) const { return path_ / name; }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
+constexpr const char* kTempPrefix = "haarcast-visibility-cache-test-";
 
 // A torus shadows itself, so the maps are not all the same; 128 vertices at
 // level 3 keep the whole file under a second.
@@ -87,7 +68,7 @@ void expectSameVisibility(const std::vector<SparseHaar>& a, const std::vector<Sp
 }
 
 TEST(VisibilityCache, MissComputesAndWritesThenHitComputesNothing) {
-  TempDir tmp;
+  TempDir tmp(kTempPrefix);
   const fs::path dir = tmp / "nested" / "cache";  // created on demand
   const Mesh mesh = testMesh();
   const Call first = cached(mesh, testOptions(), dir);
@@ -109,7 +90,7 @@ TEST(VisibilityCache, MissComputesAndWritesThenHitComputesNothing) {
 }
 
 TEST(VisibilityCache, AMovedVertexIsAMiss) {
-  TempDir dir;
+  TempDir dir(kTempPrefix);
   Mesh mesh = testMesh();
   ASSERT_TRUE(cached(mesh, testOptions(), dir.path()).status.written);
   const std::string before = meshContentKey(mesh);
@@ -132,7 +113,7 @@ TEST(VisibilityCache, AMovedVertexIsAMiss) {
 }
 
 TEST(VisibilityCache, EveryOptionChangeIsAMiss) {
-  TempDir dir;
+  TempDir dir(kTempPrefix);
   const Mesh mesh = testMesh();
   ASSERT_TRUE(cached(mesh, testOptions(), dir.path()).status.written);
   std::vector<VisibilityOptions> others(4, testOptions());
@@ -154,7 +135,7 @@ TEST(VisibilityCache, EveryOptionChangeIsAMiss) {
 }
 
 TEST(VisibilityCache, AnUnwritableDirectoryStillGivesTheVisibility) {
-  TempDir tmp;
+  TempDir tmp(kTempPrefix);
   // A regular file where the directory should be: fails even for root.
   const fs::path blocker = tmp / "not-a-directory";
   std::ofstream(blocker) << "x";
@@ -179,7 +160,7 @@ TEST(VisibilityCache, NoDirectoryMeansNoCache) {
 }
 
 TEST(VisibilityCache, BadInputThrowsHitOrMiss) {
-  TempDir dir;
+  TempDir dir(kTempPrefix);
   VisibilityOptions bad = testOptions();
   bad.keep = 0;
   EXPECT_THROW(loadOrComputeVertexVisibility(testMesh(), bad, dir.path().string()), std::invalid_argument);
@@ -233,7 +214,7 @@ TEST(VisibilityCache, ACheckSummedButInvalidPayloadIsAMissNotACrash) {
       {"a NaN", patched(firstValue, std::numeric_limits<float>::quiet_NaN()), "non-finite"},
       {"an infinity", patched(firstValue, std::numeric_limits<float>::infinity()), "non-finite"},
   };
-  TempDir dir;
+  TempDir dir(kTempPrefix);
   const std::string path = cached(mesh, options, dir.path()).status.path;
   for (const Case& c : cases) {
     SCOPED_TRACE(c.label);
@@ -273,7 +254,7 @@ TEST(VisibilityCache, HitIsMuchFasterThanComputeOnTheBunny) {
   const Mesh mesh = io::loadMesh(file.string());
   VisibilityOptions options;
   options.level = 5;
-  TempDir dir;
+  TempDir dir(kTempPrefix);
   const auto t0 = std::chrono::steady_clock::now();
   const Call computed = cached(mesh, options, dir.path());
   const auto t1 = std::chrono::steady_clock::now();
