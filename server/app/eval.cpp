@@ -33,17 +33,15 @@ const std::map<std::string, std::map<int, std::vector<double>>> kSeedTables = {
     {"blue-metallic-paint", {{6, {104.28, 104.64, 104.97, 104.66, 104.73}}, {5, {105.49, 106.11, 106.20, 105.55, 105.49}}}}};
 const char* kSeedEnvironments = "Galileo, Grace, RNL, St. Peter's, Uffizi";
 
-struct Named {
-  template <typename T>
-  using List = std::vector<std::pair<std::string, T>>;
-};
+template <typename T>
+using NamedList = std::vector<std::pair<std::string, T>>;
 
 // What the data folder offers, with built-in stand-ins for what is missing.
 struct EvalAssets {
-  Named::List<render::Environment> environments;
-  Named::List<std::shared_ptr<Mesh>> models;
-  Named::List<render::Material> tableMaterials;  // Tables 1–4: the seed's two
-  Named::List<render::Material> glossMaterials;  // glossiness grid: steel, blue paint, aluminium bronze
+  NamedList<render::Environment> environments;
+  NamedList<std::shared_ptr<Mesh>> models;
+  NamedList<render::Material> tableMaterials;  // Tables 1–4: the seed's two
+  NamedList<render::Material> glossMaterials;  // glossiness grid: steel, blue paint, aluminium bronze
   std::vector<std::string> notes;                // what was substituted
 };
 

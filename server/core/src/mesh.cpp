@@ -48,6 +48,13 @@ void Mesh::validate() const {
   }
 }
 
+std::shared_ptr<const Mesh> withNormals(std::shared_ptr<const Mesh> mesh) {
+  if (!mesh->normals.empty()) return mesh;
+  auto copy = std::make_shared<Mesh>(*mesh);
+  copy->computeNormals();
+  return copy;
+}
+
 Bounds Mesh::bounds() const {
   Bounds b;
   if (positions.empty()) return b;

@@ -62,13 +62,8 @@ RenderResult renderCpu(const Scene& scene, const RenderOptions& options, const R
   for (std::size_t k = 0; k < scene.objects.size(); ++k) {
     PreparedObject& p = objects[k];
     p.object = &scene.objects[k];
-    p.mesh = p.object->mesh;
-    p.mesh->validate();
-    if (p.mesh->normals.empty()) {  // a mesh built in code may come without them
-      auto withNormals = std::make_shared<Mesh>(*p.mesh);
-      withNormals->computeNormals();
-      p.mesh = withNormals;
-    }
+    p.object->mesh->validate();
+    p.mesh = withNormals(p.object->mesh);  // a mesh built in code may come without them
     SliceTableOptions table;
     table.level = level;
     table.thetaSamples = options.thetaSamples;

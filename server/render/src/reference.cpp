@@ -356,13 +356,7 @@ ReferenceResult renderReference(const Scene& scene, const ReferenceOptions& opti
     if (!so.mesh) throw std::invalid_argument("reference: object \"" + so.name + "\" has no mesh");
     if (!so.material.brdf) throw std::invalid_argument("reference: object \"" + so.name + "\" has no BRDF");
     so.mesh->validate();
-    if (so.mesh->normals.size() == so.mesh->positions.size()) {
-      p.mesh = so.mesh;
-    } else {  // as visibility does: area-weighted normals on a copy
-      auto copy = std::make_shared<Mesh>(*so.mesh);
-      copy->computeNormals();
-      p.mesh = std::move(copy);
-    }
+    p.mesh = withNormals(so.mesh);
     p.brdf = so.material.brdf.get();
     p.rotation = so.pose.rotation();
     p.self = std::make_unique<RayScene>(std::vector<Instance>{Instance{p.mesh.get(), glm::mat4(1.0f)}});

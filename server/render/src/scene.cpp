@@ -41,6 +41,17 @@ Environment builtinEnvironment() {
   return e;
 }
 
+Environment constantEnvironment(double radiance) {
+  Environment e;
+  e.name = "constant";
+  e.radiance = [radiance](const glm::dvec3&) { return glm::dvec3(radiance); };
+  e.maps = [radiance](int level) {
+    const auto v = static_cast<float>(radiance);
+    return std::array<SphereMap, 3>{SphereMap(level, v), SphereMap(level, v), SphereMap(level, v)};
+  };
+  return e;
+}
+
 Environment environmentFromFile(const std::string& path, const std::string& layout) {
   auto image = std::make_shared<io::RgbImage>(io::loadEnvironment(path, io::parseProbeLayout(layout)));
   Environment e;

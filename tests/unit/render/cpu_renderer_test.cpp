@@ -8,17 +8,6 @@
 namespace haarcast::render {
 namespace {
 
-Environment constantEnvironment(double value) {
-  Environment e;
-  e.name = "constant";
-  e.radiance = [value](const glm::dvec3&) { return glm::dvec3(value); };
-  e.maps = [value](int level) {
-    return std::array<SphereMap, 3>{SphereMap(level, static_cast<float>(value)), SphereMap(level, static_cast<float>(value)),
-                                    SphereMap(level, static_cast<float>(value))};
-  };
-  return e;
-}
-
 Scene sphereScene(const std::string& material, double light) {
   Scene s;
   s.environment = constantEnvironment(light);

@@ -26,17 +26,6 @@
 namespace haarcast::render {
 namespace {
 
-Environment constantEnvironment(double value) {
-  Environment e;
-  e.name = "constant";
-  e.radiance = [value](const glm::dvec3&) { return glm::dvec3(value); };
-  e.maps = [value](int level) {
-    const auto v = static_cast<float>(value);
-    return std::array<SphereMap, 3>{SphereMap(level, v), SphereMap(level, v), SphereMap(level, v)};
-  };
-  return e;
-}
-
 // A unit sphere seen whole (angular radius 11.5° in a 35° field of view).
 Scene sphereScene(const std::string& material, Environment env, int segments = 64) {
   Scene s;

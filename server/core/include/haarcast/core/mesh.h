@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -31,5 +32,9 @@ struct Mesh {
   void validate() const;
   Bounds bounds() const;
 };
+
+// The mesh itself when it has normals, else a copy with computeNormals():
+// what every consumer of shading normals (renderers, visibility) needs.
+std::shared_ptr<const Mesh> withNormals(std::shared_ptr<const Mesh> mesh);
 
 }  // namespace haarcast

@@ -50,6 +50,8 @@ struct Environment {
 };
 
 Environment builtinEnvironment();
+// The same radiance from every direction: the furnace of analytic tests.
+Environment constantEnvironment(double radiance);
 // A light probe file (EXR, HDR, PFM; lat-long or angular).
 Environment environmentFromFile(const std::string& path, const std::string& layout = "auto");
 
