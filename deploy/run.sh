@@ -29,6 +29,21 @@ PACKAGES=(
   libembree-dev
   libtinyobjloader-dev
   libpng-dev
+  # Step 3: Vulkan on Mesa's lavapipe (a CPU device) where no GPU exists;
+  # glslang compiles the shaders at build time.
+  libvulkan-dev
+  mesa-vulkan-drivers
+  vulkan-tools
+  vulkan-validationlayers
+  glslang-tools
+  # Step 4: the wire contract, the service (Asio + Beast) and its encoders;
+  # Debian's Chromium and Node.js for the browser client's end-to-end test.
+  libprotobuf-dev
+  protobuf-compiler
+  libboost-dev
+  libturbojpeg0-dev
+  chromium
+  nodejs
 )
 
 # Build folder, relative to the repository root (HAARCAST_BUILD_DIR overrides).
@@ -49,6 +64,9 @@ install_packages() {
       missing+=("$pkg")
     fi
   done
+  # npm ships inside NodeSource's nodejs; Debian's own nodejs needs the npm
+  # package beside it (installing that over NodeSource's would conflict).
+  command -v npm >/dev/null 2>&1 || missing+=(npm)
   ((${#missing[@]} == 0)) && return 0
 
   log "installing ${missing[*]}"

@@ -5,10 +5,12 @@
 
 #include <CLI/CLI.hpp>
 
+#include "bench_frame_command.h"
 #include "eval.h"
 #include "reference_command.h"
 #include "render_command.h"
 #include "rotation_report.h"
+#include "serve_command.h"
 
 namespace {
 
@@ -48,12 +50,16 @@ int main(int argc, char** argv) {
   const auto runRender = haarcast::app::addRenderCommand(app);
   const auto runReference = haarcast::app::addReferenceCommand(app);
   const auto runEval = haarcast::app::addEvalCommand(app);
+  const auto runBenchFrame = haarcast::app::addBenchFrameCommand(app);
+  const auto runServe = haarcast::app::addServeCommand(app);
 
   try {
     app.parse(argc, argv);
     if (const int rc = runRender(); rc >= 0) return rc;
     if (const int rc = runReference(); rc >= 0) return rc;
     if (const int rc = runEval(); rc >= 0) return rc;
+    if (const int rc = runBenchFrame(); rc >= 0) return rc;
+    if (const int rc = runServe(); rc >= 0) return rc;
     if (rr->parsed()) {
       const auto v = haarcast::parseHaarVariant(variant);
       if (!v) throw std::invalid_argument("--haar-variant must be faithful, local or refined (got \"" + variant + "\")");

@@ -1,0 +1,131 @@
+// The one interface every backend implements, and that the server and the
+// `render` / `bench-frame` commands drive: prepare a scene once (slice tables,
+// rotators, visibility, GPU buffers), then render frame after frame with new
+// camera, object and light poses.
+//
+// Stage names are shared by every backend so that timings line up in tables,
+// in `bench-frame --json` and in the server's /metrics:
+//   "light"           light rotated world → each object's frame, Haar-coded, cut to k
+//   "gbuffer"         primary visibility: position, normal, object id, barycentrics
+//   "rotation-input"  per pixel: BRDF slice index (θₒ) and Y-X-Y Euler angles
+//   "rotation"        the rotated slice's coefficients, per pixel and channel
+//   "triple-product"  light × rotated BRDF × interpolated vertex visibility
+//   "tonemap"         exposure, sRGB, RGBA8 (and the linear image kept for EXR)
+#pragma once
+
+#include <cstddef>
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <glm/mat3x3.hpp>
+
+#include "haarcast/core/brdf_slices.h"
+#include "haarcast/core/haar.h"
+#include "haarcast/core/rotation.h"
+#include "haarcast/core/sphere_map.h"
+#include "haarcast/io/image.h"
+#include "haarcast/render/cpu_renderer.h"
+#include "haarcast/render/scene.h"
+
+namespace haarcast::render {
+
+struct FrameRequest {
+  int width = 128;
+  int height = 128;
+  Camera camera;
+  // One pose per scene object, in scene order; empty = the scene's own poses.
+  std::vector<Pose> poses;
+  // The environment turned by R: L'(ω) = L(Rᵀω). Identity = as loaded.
+  glm::dmat3 lightRotation{1.0};
+  // k, the light's largest coefficients kept; 0 = RenderOptions::lightCoefficients.
+  std::size_t lightCoefficients = 0;
+  double exposureStops = 0.0;  // for the RGBA8 image only
+};
+
+struct StageTime {
+  std::string name;      // one of the names above
+  double seconds = 0.0;  // device time where the backend can measure it
+};
+
+struct Frame {
+  io::RgbImage image;                 // linear radiance, for EXR and exact checks
+  std::vector<std::uint8_t> rgba8;    // tonemapped, row 0 at the top, 4 bytes per pixel
+  std::vector<std::uint8_t> objectMask;  // 1 where an object was hit
+  std::vector<StageTime> stages;      // in pipeline order
+  double seconds = 0.0;               // wall time of render()
+  std::size_t coefficientBytes = 0;   // coefficient data read this frame (slices, light, visibility, method tables)
+};
+
+class Renderer {
+ public:
+  virtual ~Renderer() = default;
+  virtual std::string backend() const = 0;     // "cpu" | "vulkan"
+  virtual std::string deviceName() const = 0;  // e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
+  virtual const RenderOptions& options() const = 0;
+  virtual std::size_t objectCount() const = 0;
+  // Not thread-safe: one frame at a time per renderer (the server serialises).
+  // Throws std::invalid_argument naming what was wrong (resolution outside
+  // 1..8192, pose count ≠ object count, …).
+  virtual Frame render(const FrameRequest& request) = 0;
+};
+
+// ---- What every backend shares: one definition of every number -----------
+
+// Once per scene: what both backends upload or use, computed by the same code.
+struct PreparedObject {
+  std::string name;
+  std::shared_ptr<const Mesh> mesh;    // with normals, object frame
+  BrdfSliceTable table;                // unrotated slices: the only BRDF data kept
+  std::vector<SparseHaar> visibility;  // per vertex, object frame, top-k
+  Pose pose;                           // the scene's pose
+};
+
+struct PreparedScene {
+  Scene scene;
+  std::vector<PreparedObject> objects;
+  std::array<SphereMap, 3> light;       // world frame, level n, radiance (no solid angle)
+  std::array<SphereMap, 3> background;  // world frame, level kBackgroundLevel, for the backdrop
+};
+
+// Level of the backdrop maps: fine enough to look like the probe (512²).
+inline constexpr int kBackgroundLevel = 9;
+
+// Slice tables (cached in options.cacheDir), visibility (cached), light and
+// backdrop maps. Validates the scene's meshes; progress per long stage.
+PreparedScene prepareScene(const Scene& scene, const RenderOptions& options, const RenderProgress& progress = {});
+
+// The frame's light in one object's frame, solid angle folded in, Haar-coded
+// and cut to its k largest coefficients (per channel):
+// L_obj(ω) = L(lightRotationᵀ · objectRotation · ω).
+std::array<SparseHaar, 3> lightInObjectFrame(const std::array<SphereMap, 3>& worldLight, const glm::dmat3& objectRotation,
+                                             const glm::dmat3& lightRotation, std::size_t k);
+
+// Per pixel, what the rotation needs: the nearest θₒ slice and the Y-X-Y
+// angles of the local shading frame (n and wo in the object frame).
+struct RotationInput {
+  int slice = 0;
+  EulerYXY euler;
+};
+RotationInput rotationInput(const glm::dvec3& normal, const glm::dvec3& towardEye, const BrdfSliceTable& table);
+
+// The backdrop seen along a world direction when the environment is turned
+// by lightRotation: bilinear (sphere_map.h's bilinearTaps) in the maps.
+glm::dvec3 backgroundRadiance(const std::array<SphereMap, 3>& background, const glm::dmat3& lightRotation,
+                              const glm::dvec3& direction);
+
+// Exposure, clamp to [0, 1], sRGB transfer, alpha 255: the same encoding as
+// io::writePng. The Vulkan tonemap pass is tested against this.
+std::vector<std::uint8_t> tonemapRgba8(const io::RgbImage& image, double exposureStops);
+
+// Throws std::invalid_argument naming the problem.
+void checkFrameRequest(const FrameRequest& request, std::size_t objectCount);
+
+// The CPU reference backend (cpu_renderer.h) behind the interface. The scene
+// is copied; precomputation (slice tables, rotators, visibility) happens here.
+std::unique_ptr<Renderer> makeCpuRenderer(const Scene& scene, const RenderOptions& options,
+                                          const RenderProgress& progress = {});
+
+}  // namespace haarcast::render
