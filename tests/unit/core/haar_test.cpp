@@ -132,7 +132,9 @@ TEST(Haar, KeepLargestTakesTheLargestAreaWeightedMagnitudes) {
       EXPECT_GE(w[s.index[n]], kth);
     }
     for (std::size_t i = 0; i < w.size(); ++i) {
-      if (!kept[i]) EXPECT_LE(w[i], kth);
+      if (!kept[i]) {
+        EXPECT_LE(w[i], kth);
+      }
     }
   }
   EXPECT_EQ(keepLargest(c, 1u << 20).size(), SparseHaar::fromDense(c).size());

@@ -1,0 +1,170 @@
+// The Renderer interface's CPU backend and the steps every backend shares.
+#include "haarcast/render/renderer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <gtest/gtest.h>
+
+#include "haarcast/assets/procedural_mesh.h"
+#include "haarcast/io/image.h"
+
+namespace haarcast::render {
+namespace {
+
+RenderOptions tinyOptions() {
+  RenderOptions o;
+  o.level = 4;
+  o.thetaSamples = 4;
+  o.sliceSupersampling = 2;
+  o.visibility.supersampling = 1;
+  o.lightCoefficients = 64;
+  return o;
+}
+
+Scene torusScene() {
+  Scene s;
+  s.environment = builtinEnvironment();
+  s.objects.push_back({"torus", std::make_shared<Mesh>(assets::makeTorus(0.6, 0.25, 24, 12)), materialFromSpec("phong:16"), {}});
+  s.objects.front().pose.rotateDegrees = {50.0, 0.0, 0.0};
+  s.camera.eye = {0.0, 0.3, 2.6};
+  return s;
+}
+
+glm::dmat3 rotationAbout(const glm::dvec3& axis, double degrees) {
+  return glm::dmat3(glm::rotate(glm::dmat4(1.0), glm::radians(degrees), axis));
+}
+
+TEST(SharedSteps, LightTurnedWithTheObjectLeavesTheObjectFrameLightUnchanged) {
+  // L_obj(ω) = L(Rₗᵀ·R_obj·ω): the same R for both is the identity, exactly.
+  const auto world = builtinEnvironment().maps(4);
+  const glm::dmat3 r = rotationAbout(glm::normalize(glm::dvec3(0.3, 1.0, -0.2)), 37.0);
+  // All coefficients kept: near-ties at the cut would otherwise swap on rounding.
+  const auto still = lightInObjectFrame(world, glm::dmat3(1.0), glm::dmat3(1.0), 1u << 20);
+  const auto turned = lightInObjectFrame(world, r, r, 1u << 20);
+  for (std::size_t c = 0; c < 3; ++c) {
+    const HaarMap a = still[c].toDense(), b = turned[c].toDense();
+    float peak = 0.0f;
+    for (float v : a.coefficients()) peak = std::max(peak, std::abs(v));
+    for (std::size_t i = 0; i < a.coefficients().size(); ++i) EXPECT_NEAR(a.coefficients()[i], b.coefficients()[i], 1e-5f * peak);
+  }
+  // …and a light turn alone changes it.
+  const auto lightOnly = lightInObjectFrame(world, glm::dmat3(1.0), r, 1u << 20);
+  EXPECT_GT(std::abs(lightOnly[0].toDense().coefficients()[1] - still[0].toDense().coefficients()[1]), 1e-3f * std::abs(still[0].toDense().coefficients()[1]));
+}
+
+TEST(SharedSteps, LightTurnByWholePixelsAboutYIsAPermutationOfThePixels) {
+  // Turning the world by 2 columns (level 4: 2·22.5°) about +Y moves the
+  // object-frame light by whole pixels: its total is unchanged exactly.
+  const auto world = builtinEnvironment().maps(4);
+  const auto a = lightInObjectFrame(world, glm::dmat3(1.0), glm::dmat3(1.0), 1u << 20);
+  const auto b = lightInObjectFrame(world, glm::dmat3(1.0), rotationAbout({0, 1, 0}, 45.0), 1u << 20);
+  // The DC coefficient is the solid-angle-weighted sum / M: a pure φ-shift keeps it.
+  EXPECT_NEAR(a[0].toDense().coefficients()[0], b[0].toDense().coefficients()[0], 1e-5 * std::abs(a[0].toDense().coefficients()[0]));
+}
+
+TEST(SharedSteps, BackgroundMatchesTheMapAtPixelCentresAndTurnsWithTheLight) {
+  const auto maps = builtinEnvironment().maps(5);
+  const int row = 9, col = 21;
+  const glm::dvec3 d = sphericalToDirection(rowTheta(5, row), colPhi(5, col));
+  const glm::dvec3 L = backgroundRadiance(maps, glm::dmat3(1.0), d);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(L[c], maps[static_cast<std::size_t>(c)].at(row, col), 1e-5 * (1.0 + L[c]));
+  // L'(ω) = L(Rᵀω): looking along R·d sees what d saw.
+  const glm::dmat3 r = rotationAbout(glm::normalize(glm::dvec3(1.0, 0.5, 0.2)), 63.0);
+  const glm::dvec3 turned = backgroundRadiance(maps, r, r * d);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(turned[c], L[c], 1e-4 * (1.0 + L[c]));
+}
+
+TEST(SharedSteps, TonemapIsExposureClampAndTheSrgbCurve) {
+  io::RgbImage image = io::makeImage(5, 2);
+  const float values[] = {0.0f, 0.002f, 0.01f, 0.18f, 0.5f, 0.99f, 1.0f, 7.0f, -1.0f, NAN};
+  for (std::size_t i = 0; i < image.rgb.size(); ++i) image.rgb[i] = values[i % 10];
+  const auto rgba = tonemapRgba8(image, -1.0);
+  ASSERT_EQ(rgba.size(), 5u * 2u * 4u);
+  for (std::size_t i = 0; i < image.rgb.size(); ++i) {
+    const std::size_t p = i / 3, c = i % 3;
+    // IEC 61966-2-1 after a gain of 2⁻¹, clamped; NaN and negatives are black.
+    const double v = std::isnan(values[i % 10]) ? 0.0 : std::clamp(values[i % 10] * 0.5, 0.0, 1.0);
+    const double s = v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055;
+    EXPECT_EQ(rgba[4 * p + c], static_cast<int>(std::lround(s * 255.0))) << "value " << values[i % 10];
+    EXPECT_EQ(rgba[4 * p + 3], 255);
+  }
+  // Spot checks: 0.18·½ → sRGB 0.3318… → 85; 7·½ clamps to 255.
+  EXPECT_EQ(rgba[4 * 1 + 0], 85);
+  EXPECT_EQ(rgba[4 * 2 + 1], 255);
+}
+
+TEST(SharedSteps, FrameRequestsAreCheckedWithClearErrors) {
+  FrameRequest r;
+  EXPECT_NO_THROW(checkFrameRequest(r, 2));
+  r.width = 0;
+  EXPECT_THROW(checkFrameRequest(r, 2), std::invalid_argument);
+  r.width = 100000;
+  try {
+    checkFrameRequest(r, 2);
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("100000"), std::string::npos);
+  }
+  r = FrameRequest{};
+  r.poses.resize(3);
+  EXPECT_THROW(checkFrameRequest(r, 2), std::invalid_argument);
+  r = FrameRequest{};
+  r.camera.target = r.camera.eye;
+  EXPECT_THROW(checkFrameRequest(r, 2), std::invalid_argument);
+  r = FrameRequest{};
+  r.camera.fovYDegrees = 180.0;
+  EXPECT_THROW(checkFrameRequest(r, 2), std::invalid_argument);
+}
+
+TEST(CpuBackend, FramesAreRepeatableAndEqualTheOneShotRender) {
+  const Scene scene = torusScene();
+  RenderOptions o = tinyOptions();
+  o.width = 32;
+  o.height = 24;
+  const auto renderer = makeCpuRenderer(scene, o);
+  EXPECT_EQ(renderer->backend(), "cpu");
+  EXPECT_EQ(renderer->objectCount(), 1u);
+  FrameRequest request;
+  request.width = 32;
+  request.height = 24;
+  request.camera = scene.camera;
+  const Frame a = renderer->render(request);
+  request.poses = {scene.objects.front().pose};  // the scene's own pose, given explicitly
+  const Frame b = renderer->render(request);
+  const RenderResult once = renderCpu(scene, o);
+  ASSERT_EQ(a.image.rgb.size(), once.image.rgb.size());
+  EXPECT_EQ(a.image.rgb, b.image.rgb);
+  EXPECT_EQ(a.image.rgb, once.image.rgb);
+  EXPECT_EQ(a.rgba8, tonemapRgba8(a.image, 0.0));
+  // Every stage is reported, in pipeline order.
+  const std::vector<std::string> names = {"light", "gbuffer", "rotation-input", "rotation", "triple-product", "tonemap"};
+  ASSERT_EQ(a.stages.size(), names.size());
+  for (std::size_t i = 0; i < names.size(); ++i) EXPECT_EQ(a.stages[i].name, names[i]);
+  EXPECT_GT(a.coefficientBytes, 0u);
+}
+
+TEST(CpuBackend, PosesAndLightChangeTheFrame) {
+  const Scene scene = torusScene();
+  RenderOptions o = tinyOptions();
+  const auto renderer = makeCpuRenderer(scene, o);
+  FrameRequest request;
+  request.width = request.height = 24;
+  request.camera = scene.camera;
+  const Frame base = renderer->render(request);
+  FrameRequest spun = request;
+  spun.poses = {scene.objects.front().pose};
+  spun.poses[0].rotateDegrees.y += 40.0;
+  FrameRequest lit = request;
+  lit.lightRotation = rotationAbout({0, 1, 0}, 90.0);
+  EXPECT_NE(renderer->render(spun).image.rgb, base.image.rgb);
+  EXPECT_NE(renderer->render(lit).image.rgb, base.image.rgb);
+  FrameRequest wrong = request;
+  wrong.poses.resize(2);
+  EXPECT_THROW(renderer->render(wrong), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace haarcast::render
