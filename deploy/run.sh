@@ -2,13 +2,19 @@
 # One entry point for people and CI: installs the Debian packages haarcast
 # needs, configures (Release, Ninja) into build/, builds, then runs one job.
 #
-#   deploy/run.sh demo  [args]   render the default scene (build/demo/), then the rotation report
+#   deploy/run.sh demo  [args]   render the default scene on both backends (build/demo/),
+#                                 then serve it: prints the browser client's URL and runs
+#                                 the CLI client against the server for a few seconds
+#                                 (on a terminal the server keeps running until Ctrl-C)
 #   deploy/run.sh test  [args]   ctest --test-dir build --output-on-failure [args]
 #   deploy/run.sh bench [args]   build/bin/haarcast-bench [args]
 #                                 e.g. deploy/run.sh bench -- --benchmark_filter=Rotate
+#   deploy/run.sh build          install and build only (the container image uses it)
 #
 # A leading "--" in [args] is dropped. Environment: HAARCAST_JOBS (build jobs,
-# default nproc), HAARCAST_BUILD_DIR (default build). Runs without a terminal
+# default nproc), HAARCAST_BUILD_DIR (default build), HAARCAST_PORT (demo's
+# server port, default 8080; 0 picks a free one), HAARCAST_BACKEND (demo's
+# server backend, default vulkan). Runs without a terminal
 # (CI): no prompts, no stdin.
 set -euo pipefail
 
@@ -101,7 +107,7 @@ command="$1"
 shift
 [[ "${1:-}" == "--" ]] && shift
 case "$command" in
-  demo | test | bench) ;;
+  demo | test | bench | build) ;;
   -h | --help | help) usage ;;
   *)
     echo "error: unknown command '$command'" >&2
@@ -113,20 +119,66 @@ esac
 cd "$(dirname "$(readlink -f "${BASH_SOURCE[0]}")")/.."
 export DEBIAN_FRONTEND=noninteractive
 
+# The browser client's npm packages (protobufjs for the page, playwright-core
+# for its end-to-end test), from the committed package-lock.json: fetched at
+# setup, never at run time. Skipped when node_modules is newer than the lock.
+vendor_web_client() {
+  local web=client/web
+  [[ -f "$web/package-lock.json" ]] || return 0
+  if [[ -d "$web/node_modules" && "$web/node_modules" -nt "$web/package-lock.json" ]]; then
+    return 0
+  fi
+  log "vendoring the browser client's npm packages (npm ci in $web)"
+  (cd "$web" && PLAYWRIGHT_SKIP_BROWSER_DOWNLOAD=1 npm ci --no-audit --no-fund </dev/null)
+  touch "$web/node_modules"
+}
+
 install_packages
 configure_and_build
+vendor_web_client
 
 case "$command" in
   demo)
-    # The main job on the built-in default scene: render it (CPU backend,
-    # EXR + PNG in build/demo/), then print the rotation report the render
-    # rests on. Extra args go to `render`.
+    # The main job on the built-in default scene: render it on both backends
+    # (EXR + PNG in build/demo/), then serve it and drive it with the CLI client.
     mkdir -p "$BUILD_DIR/demo"
-    log "rendering the default scene into $BUILD_DIR/demo/default.exr (+ .png)"
-    "$BUILD_DIR/bin/haarcast" render --width 192 --height 128 --level 5 \
-      --cache-dir "$BUILD_DIR/cache" --out "$BUILD_DIR/demo/default.exr" "$@" </dev/null
-    log "running haarcast rotation-report --level 5"
-    exec "$BUILD_DIR/bin/haarcast" rotation-report --level 5 </dev/null
+    for backend in cpu vulkan; do
+      log "rendering the default scene with --backend $backend into $BUILD_DIR/demo/default-$backend.exr (+ .png)"
+      "$BUILD_DIR/bin/haarcast" render --backend "$backend" --width 192 --height 128 --level 5 \
+        --cache-dir "$BUILD_DIR/cache" --out "$BUILD_DIR/demo/default-$backend.exr" "$@" </dev/null
+    done
+    port="${HAARCAST_PORT:-8080}"
+    log "starting haarcast serve on port $port (backend ${HAARCAST_BACKEND:-vulkan})"
+    server_log="$BUILD_DIR/demo/serve.log"
+    "$BUILD_DIR/bin/haarcast" serve --port "$port" --backend "${HAARCAST_BACKEND:-vulkan}" \
+      --cache-dir "$BUILD_DIR/cache" </dev/null >"$server_log" 2>&1 &
+    server=$!
+    trap 'kill -TERM "$server" 2>/dev/null || true' EXIT
+    url=""
+    for _ in $(seq 1 600); do
+      url="$(sed -n 's/^listening on \(http:[^ ]*\)$/\1/p' "$server_log" | head -n 1)"
+      [[ -n "$url" ]] && break
+      kill -0 "$server" 2>/dev/null || { cat "$server_log" >&2; echo "error: the server exited" >&2; exit 1; }
+      sleep 0.1
+    done
+    [[ -n "$url" ]] || { cat "$server_log" >&2; echo "error: the server did not start within 60 s" >&2; exit 1; }
+    log "browser client: $url"
+    ws="ws://${url#http://}ws"
+    log "running haarcast-client $ws for 60 frames (frames in $BUILD_DIR/demo/frames/)"
+    "$BUILD_DIR/bin/haarcast-client" "$ws" --frames 60 --size 256x256 --encoding jpeg \
+      --out "$BUILD_DIR/demo/frames" --json </dev/null
+    if [[ -t 0 ]]; then
+      log "the server keeps running at $url (log: $server_log); Ctrl-C stops it"
+      wait "$server"
+    else
+      kill -TERM "$server"
+      wait "$server"
+      trap - EXIT
+      log "server stopped cleanly"
+    fi
+    ;;
+  build)
+    log "built into $BUILD_DIR/"
     ;;
   test)
     log "running tests"

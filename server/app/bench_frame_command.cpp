@@ -1,16 +1,268 @@
-// PLACEHOLDER (step 3 replaces this file): `haarcast bench-frame`.
+// `haarcast bench-frame`: per-pass and whole-frame times of each backend
+// against resolution and level, in one run, so that CPU/Vulkan ratios come
+// from the same machine state; plus the coefficient bytes each frame reads
+// per method, and (with both backends) how closely the two images agree.
 #include "bench_frame_command.h"
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <limits>
+#include <map>
+#include <optional>
+#include <memory>
+#include <sstream>
 #include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "haarcast/gpu/vulkan_renderer.h"
+#include "haarcast/render/renderer.h"
+#include "haarcast/render/scene.h"
 
 namespace haarcast::app {
+namespace {
+
+struct BenchArgs {
+  std::string backend = "both";
+  std::string sizes = "128";
+  std::string levels = "4";
+  std::string methods = "haar";
+  std::string scene;  // scene file; empty = the built-in default
+  std::string device;
+  std::string cacheDir;
+  int frames = 3;
+  int warmup = 1;
+  bool json = false;
+};
+
+std::vector<int> parseInts(const std::string& text, const char* flag, int lo, int hi) {
+  std::vector<int> out;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    std::size_t used = 0;
+    int v = 0;
+    try {
+      v = std::stoi(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != item.size() || item.empty() || v < lo || v > hi) {
+      throw std::invalid_argument(std::string(flag) + ": \"" + item + "\" is not an integer in " + std::to_string(lo) +
+                                  ".." + std::to_string(hi));
+    }
+    out.push_back(v);
+  }
+  if (out.empty()) throw std::invalid_argument(std::string(flag) + " is empty");
+  return out;
+}
+
+std::vector<RotationMethod> parseMethods(const std::string& text) {
+  std::vector<RotationMethod> out;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    if (item == "all") {
+      out.insert(out.end(), std::begin(kAllRotationMethods), std::end(kAllRotationMethods));
+      continue;
+    }
+    const auto m = parseRotationMethod(item);
+    if (!m) throw std::invalid_argument("--method: \"" + item + "\" is not haar, spatial, matrix, table or all");
+    out.push_back(*m);
+  }
+  if (out.empty()) throw std::invalid_argument("--method is empty");
+  return out;
+}
+
+// Mean of each stage and of the frame over the timed frames.
+struct Measured {
+  std::vector<std::pair<std::string, double>> stages;
+  double frameSeconds = 0.0;
+  std::size_t coefficientBytes = 0;
+  std::size_t covered = 0;
+  render::Frame first;  // the first timed frame, for the comparison
+};
+
+Measured measure(render::Renderer& r, const render::FrameRequest& request, int frames, int warmup) {
+  // Warm-up: first-use allocation and shader variants are not the steady state.
+  for (int i = 0; i < warmup; ++i) r.render(request);
+  Measured m;
+  for (int i = 0; i < frames; ++i) {
+    render::Frame f = r.render(request);
+    if (m.stages.empty()) {
+      for (const auto& s : f.stages) m.stages.emplace_back(s.name, 0.0);
+    }
+    for (std::size_t k = 0; k < f.stages.size() && k < m.stages.size(); ++k) m.stages[k].second += f.stages[k].seconds / frames;
+    m.frameSeconds += f.seconds / frames;
+    m.coefficientBytes = f.coefficientBytes;
+    if (i == 0) m.first = std::move(f);
+  }
+  for (std::uint8_t b : m.first.objectMask) m.covered += b;
+  return m;
+}
+
+// PSNR over identically covered pixels (peak = the reference's object
+// maximum), and the coverage mismatches, as the GPU tests compute them.
+std::pair<double, std::size_t> agreement(const render::Frame& reference, const render::Frame& test) {
+  double peak = 0.0, sum = 0.0;
+  std::size_t compared = 0, mismatched = 0;
+  for (std::size_t p = 0; p < reference.objectMask.size(); ++p) {
+    if (reference.objectMask[p] != test.objectMask[p]) {
+      ++mismatched;
+      continue;
+    }
+    ++compared;
+    for (std::size_t c = 0; c < 3; ++c) {
+      const double a = reference.image.rgb[3 * p + c], b = test.image.rgb[3 * p + c];
+      if (reference.objectMask[p]) peak = std::max(peak, a);
+      sum += (a - b) * (a - b);
+    }
+  }
+  const double mse = compared ? sum / (3.0 * static_cast<double>(compared)) : 0.0;
+  return {mse > 0.0 ? 10.0 * std::log10(peak * peak / mse) : std::numeric_limits<double>::infinity(), mismatched};
+}
+
+int run(const BenchArgs& a) {
+  if (a.backend != "cpu" && a.backend != "vulkan" && a.backend != "both") {
+    throw std::invalid_argument("--backend must be cpu, vulkan or both (got \"" + a.backend + "\")");
+  }
+  if (a.frames < 1 || a.frames > 1000) throw std::invalid_argument("--frames must be in 1..1000");
+  if (a.warmup < 0 || a.warmup > 100) throw std::invalid_argument("--warmup must be in 0..100");
+  const std::vector<int> sizes = parseInts(a.sizes, "--sizes", 1, 8192);
+  const std::vector<int> levels = parseInts(a.levels, "--levels", 2, 8);
+  const std::vector<RotationMethod> methods = parseMethods(a.methods);
+  const bool cpu = a.backend != "vulkan", vulkan = a.backend != "cpu";
+  const render::Scene scene = a.scene.empty() ? render::defaultScene() : render::loadScene(a.scene);
+
+  nlohmann::json out;
+  out["scene"] = a.scene.empty() ? "default" : a.scene;
+  out["frames"] = a.frames;
+  out["warmup"] = a.warmup;
+  out["runs"] = nlohmann::json::array();
+  if (vulkan) {
+    nlohmann::json devices = nlohmann::json::array();
+    for (const auto& d : gpu::listDevices()) {
+      devices.push_back({{"index", d.index}, {"name", d.name}, {"type", d.type}, {"api", d.apiVersionText},
+                         {"rejected", d.rejected}});
+    }
+    out["vulkan_devices"] = devices;
+  }
+  std::string table;
+  auto line = [&](const std::string& s) {
+    table += s;
+    table += '\n';
+  };
+  line("| level | method | size | backend | light | gbuffer | rotation-input | rotation | triple-product | tonemap | frame (s) | coeff. bytes/frame | vs cpu |");
+  line("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+
+  for (const int level : levels) {
+    for (const RotationMethod method : methods) {
+      render::RenderOptions options;
+      options.level = level;
+      options.method = method;
+      options.cacheDir = a.cacheDir == "none" ? "" : a.cacheDir;
+      std::fprintf(stderr, "[bench-frame] level %d, %s: preparing\n", level, std::string(methodName(method)).c_str());
+      std::unique_ptr<render::Renderer> cpuRenderer, gpuRenderer;
+      if (cpu) cpuRenderer = render::makeCpuRenderer(scene, options);
+      if (vulkan) {
+        gpu::VulkanOptions v;
+        v.device = a.device;
+        v.validation = false;  // timing: validation layers would dominate
+        gpuRenderer = gpu::makeVulkanRenderer(scene, options, v);
+        out["vulkan_device"] = gpuRenderer->deviceName();
+      }
+      if (cpuRenderer) out["cpu_device"] = cpuRenderer->deviceName();
+      for (const int size : sizes) {
+        render::FrameRequest request;
+        request.width = request.height = size;
+        request.camera = scene.camera;
+        std::map<std::string, Measured> results;
+        for (render::Renderer* r : {cpuRenderer.get(), gpuRenderer.get()}) {
+          if (!r) continue;
+          std::fprintf(stderr, "[bench-frame] level %d, %s, %d², %s: %d frames + %d warm-up\n", level,
+                       std::string(methodName(method)).c_str(), size, r->backend().c_str(), a.frames, a.warmup);
+          results[r->backend()] = measure(*r, request, a.frames, a.warmup);
+        }
+        std::optional<std::pair<double, std::size_t>> agree;
+        if (results.count("cpu") && results.count("vulkan")) agree = agreement(results["cpu"].first, results["vulkan"].first);
+        for (const auto& [backend, m] : results) {
+          nlohmann::json run{{"backend", backend},       {"level", level},
+                             {"method", methodName(method)}, {"width", size},
+                             {"height", size},           {"frame_seconds", m.frameSeconds},
+                             {"coefficient_bytes", m.coefficientBytes}, {"covered_pixels", m.covered}};
+          nlohmann::json stages = nlohmann::json::object();
+          for (const auto& [name, seconds] : m.stages) stages[name] = seconds;
+          run["stages"] = stages;
+          std::string ratio = "";
+          if (backend == "vulkan" && results.count("cpu")) {
+            const double r = results["cpu"].frameSeconds / m.frameSeconds;
+            run["cpu_over_vulkan"] = r;
+            nlohmann::json perStage = nlohmann::json::object();
+            for (const auto& [name, seconds] : m.stages) {
+              for (const auto& [cname, cseconds] : results["cpu"].stages) {
+                if (cname == name && seconds > 0.0) perStage[name] = cseconds / seconds;
+              }
+            }
+            run["cpu_over_vulkan_stages"] = perStage;
+            if (agree) {
+              run["psnr_vs_cpu"] = std::isfinite(agree->first) ? nlohmann::json(agree->first) : nlohmann::json("inf");
+              run["coverage_mismatched"] = agree->second;
+            }
+            char buf[96];
+            std::snprintf(buf, sizeof buf, "×%.2f, %.1f dB, %zu px mismatched", r, agree ? agree->first : 0.0,
+                          agree ? agree->second : 0);
+            ratio = buf;
+          }
+          out["runs"].push_back(run);
+          std::string row = "| " + std::to_string(level) + " | " + std::string(methodName(method)) + " | " +
+                            std::to_string(size) + "² | " + backend + " |";
+          for (const char* name : {"light", "gbuffer", "rotation-input", "rotation", "triple-product", "tonemap"}) {
+            double seconds = 0.0;
+            for (const auto& [sname, s] : m.stages) {
+              if (sname == name) seconds = s;
+            }
+            char buf[32];
+            std::snprintf(buf, sizeof buf, " %.4f |", seconds);
+            row += buf;
+          }
+          char buf[96];
+          std::snprintf(buf, sizeof buf, " %.4f | %zu | %s |", m.frameSeconds, m.coefficientBytes, ratio.c_str());
+          line(row + buf);
+        }
+      }
+    }
+  }
+  if (a.json) {
+    std::cout << out.dump(2) << '\n';
+  } else {
+    std::cout << table;
+  }
+  return 0;
+}
+
+}  // namespace
 
 std::function<int()> addBenchFrameCommand(CLI::App& app) {
-  auto* c = app.add_subcommand("bench-frame", "Per-pass frame times of each backend (step 3)");
-  return [c]() -> int {
-    if (!c->parsed()) return -1;
-    throw std::runtime_error("bench-frame is not built yet");
-  };
+  auto args = std::make_shared<BenchArgs>();
+  auto* c = app.add_subcommand("bench-frame",
+                               "Per-pass and frame times of the CPU and Vulkan backends against resolution and level");
+  c->add_option("--backend", args->backend, "cpu|vulkan|both (both: ratios from one run)")->capture_default_str();
+  c->add_option("--sizes", args->sizes, "Square frame sizes, comma-separated (e.g. 128,256,512,1024)")
+      ->capture_default_str();
+  c->add_option("--levels", args->levels, "Map levels, comma-separated (Vulkan: 2..6)")->capture_default_str();
+  c->add_option("--method", args->methods, "Rotation methods, comma-separated, or all")->capture_default_str();
+  c->add_option("--frames", args->frames, "Timed frames per point (after one warm-up frame)")->capture_default_str();
+  c->add_option("--warmup", args->warmup, "Untimed frames first (resolution setup, first-use compilation)")
+      ->capture_default_str();
+  c->add_option("--scene", args->scene, "Scene file (default: the built-in scene)");
+  c->add_option("--device", args->device, "Vulkan device: an index or a name substring");
+  c->add_option("--cache-dir", args->cacheDir, "Cache of slice tables and visibility ('none' or empty: no cache)");
+  c->add_flag("--json", args->json, "Print JSON instead of a table");
+  return [c, args]() { return c->parsed() ? run(*args) : -1; };
 }
 
 }  // namespace haarcast::app

@@ -9,7 +9,9 @@
 
 #include <unistd.h>
 
+#include "haarcast/gpu/vulkan_renderer.h"
 #include "haarcast/render/cpu_renderer.h"
+#include "haarcast/render/renderer.h"
 #include "haarcast/render/scene.h"
 #include "scene_flags.h"
 
@@ -20,7 +22,8 @@ namespace fs = std::filesystem;
 
 struct RenderArgs {
   SceneFlags scene;
-  std::string method = "haar", variant = "refined", backend = "cpu", cacheDir;
+  std::string method = "haar", variant = "refined", backend = "cpu", device, cacheDir;
+  bool validation = gpu::kValidationByDefault;
   render::RenderOptions options;
 };
 
@@ -54,7 +57,10 @@ void showProgress(const std::string& stage, std::size_t done, std::size_t total)
 }
 
 int run(RenderArgs& a) {
-  if (a.backend != "cpu") throw std::invalid_argument("--backend " + a.backend + " is not available yet (cpu only)");
+  if (a.backend != "cpu" && a.backend != "vulkan") {
+    throw std::invalid_argument("--backend must be cpu or vulkan (got \"" + a.backend + "\")");
+  }
+  if (a.backend == "cpu" && !a.device.empty()) throw std::invalid_argument("--device applies to --backend vulkan only");
   const auto method = parseRotationMethod(a.method);
   if (!method) throw std::invalid_argument("--method must be haar, spatial, matrix or table (got \"" + a.method + "\")");
   const auto variant = parseHaarVariant(a.variant);
@@ -71,14 +77,34 @@ int run(RenderArgs& a) {
   for (const auto& object : scene.objects) {
     if (!object.material.warning.empty()) std::fprintf(stderr, "warning: %s\n", object.material.warning.c_str());
   }
+  // One renderer behind the shared interface: the same scene, request and
+  // outputs whichever backend draws them.
   const auto t0 = std::chrono::steady_clock::now();
-  const render::RenderResult r = render::renderCpu(scene, a.options, showProgress);
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  writeOutputImages(a.scene, r.image);
-  std::fprintf(stderr,
-               "%d×%d, level %d, %s, k = %zu: %.2f s (precompute %.2f, light %.3f, G-buffer %.3f, shading %.2f)\n",
-               a.options.width, a.options.height, a.options.level, a.method.c_str(), a.options.lightCoefficients,
-               seconds, r.timings.precompute, r.timings.light, r.timings.gbuffer, r.timings.shading);
+  std::unique_ptr<render::Renderer> renderer;
+  if (a.backend == "vulkan") {
+    gpu::VulkanOptions vulkan;
+    vulkan.device = a.device;
+    vulkan.validation = a.validation;
+    renderer = gpu::makeVulkanRenderer(scene, a.options, vulkan, showProgress);
+  } else {
+    renderer = render::makeCpuRenderer(scene, a.options, showProgress);
+  }
+  const double prepare = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  render::FrameRequest request;
+  request.width = a.options.width;
+  request.height = a.options.height;
+  request.camera = scene.camera;  // poses: empty = the scene's own
+  const render::Frame frame = renderer->render(request);
+  writeOutputImages(a.scene, frame.image);
+  std::string stages;
+  for (const render::StageTime& s : frame.stages) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%s%s %.3f", stages.empty() ? "" : ", ", s.name.c_str(), s.seconds);
+    stages += buf;
+  }
+  std::fprintf(stderr, "%s on %s: %d×%d, level %d, %s, k = %zu: precompute %.2f s, frame %.3f s (%s)\n",
+               renderer->backend().c_str(), renderer->deviceName().c_str(), a.options.width, a.options.height,
+               a.options.level, a.method.c_str(), a.options.lightCoefficients, prepare, frame.seconds, stages.c_str());
   return 0;
 }
 
@@ -86,7 +112,7 @@ int run(RenderArgs& a) {
 
 std::function<int()> addRenderCommand(CLI::App& app) {
   auto args = std::make_shared<RenderArgs>();
-  auto* c = app.add_subcommand("render", "Render a scene on the CPU backend (linear EXR + tonemapped PNG)");
+  auto* c = app.add_subcommand("render", "Render a scene on the CPU or Vulkan backend (linear EXR + tonemapped PNG)");
   args->scene.out = "render.exr";
   addSceneFlags(*c, args->scene);
   c->add_option("--method", args->method, "Rotation method: haar|spatial|matrix|table")->capture_default_str();
@@ -96,7 +122,10 @@ std::function<int()> addRenderCommand(CLI::App& app) {
       ->capture_default_str();
   c->add_option("--visibility-coeffs", args->options.visibility.keep, "Visibility coefficients kept per vertex")
       ->capture_default_str();
-  c->add_option("--backend", args->backend, "cpu (vulkan arrives with step 3)")->capture_default_str();
+  c->add_option("--backend", args->backend, "cpu|vulkan")->capture_default_str();
+  c->add_option("--device", args->device, "Vulkan device: an index or a name substring (default: discrete > integrated > CPU)");
+  c->add_flag("--validation,!--no-validation", args->validation, "Vulkan validation layers (when installed)")
+      ->capture_default_str();
   c->add_option("--cache-dir", args->cacheDir, "Cache of slice tables and visibility (default $XDG_CACHE_HOME/haarcast; 'none' disables)");
   c->add_option("--threads", args->options.threads, "Worker threads (0 = all cores)")->capture_default_str();
   return [c, args]() { return c->parsed() ? run(*args) : -1; };

@@ -1,16 +1,227 @@
-// PLACEHOLDER (step 4 replaces this file): `haarcast serve`.
+// `haarcast serve`: the render service on one port (server/net). This file
+// only turns flags into a catalogue of scenes and materials, a renderer
+// builder (the backend factory) and server options.
 #include "serve_command.h"
 
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <memory>
+#include <map>
+#include <set>
 #include <stdexcept>
+#include <string>
+#include <unistd.h>
+#include <vector>
+
+#include "haarcast/net/backend.h"
+#include "haarcast/net/server.h"
+#include "haarcast/render/scene.h"
 
 namespace haarcast::app {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct ServeArgs {
+  net::ServerOptions server;
+  std::string token;
+  std::string backend = "cpu", method = "haar", encoding = "jpeg";
+  int level = 4;
+  std::size_t lightCoefficients = 256;
+  std::vector<std::string> sceneFiles;
+  std::string materialsDir, webRoot, protoFile, cacheDir, vulkanDevice;
+  bool vulkanValidation = false, quiet = false;
+  unsigned renderThreads = 0;
+};
+
+// The analytic materials every server offers (MERL files come from --materials-dir).
+const std::vector<std::string> kBuiltinMaterials = {"lambert", "phong:16", "phong:64", "phong:256", "ggx:0.1", "ggx:0.3"};
+
+std::string defaultCacheDir() {
+  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg) return (fs::path(xdg) / "haarcast").string();
+  if (const char* home = std::getenv("HOME"); home && *home) return (fs::path(home) / ".cache" / "haarcast").string();
+  return ".haarcast-cache";
+}
+
+fs::path executableDir() {
+  std::error_code ec;
+  const auto exe = fs::read_symlink("/proc/self/exe", ec);
+  return ec ? fs::current_path() : exe.parent_path();
+}
+
+// The source tree's copy (a build folder's binary), else beside the
+// executable (an installed or containerised one: <prefix>/bin/haarcast with
+// <prefix>/share/haarcast/…), else next to it.
+fs::path findShipped(const fs::path& relative, const std::vector<fs::path>& installed) {
+  std::error_code ec;
+  const fs::path source = fs::path(HAARCAST_SOURCE_DIR) / relative;
+  if (fs::exists(source, ec)) return source;
+  for (const auto& candidate : installed) {
+    const fs::path p = executableDir() / candidate;
+    if (fs::exists(p, ec)) return fs::weakly_canonical(p, ec);
+  }
+  return {};
+}
+
+struct SceneSource {
+  std::string name;
+  render::Scene scene;
+};
+
+int run(ServeArgs& a) {
+  // Flags → the catalogue: scenes by name, offered materials, backends.
+  std::vector<SceneSource> scenes;
+  scenes.push_back({"default", render::defaultScene()});
+  for (const auto& file : a.sceneFiles) {
+    std::string name = fs::path(file).stem().string();
+    for (const auto& s : scenes) {
+      if (s.name == name) throw std::invalid_argument("--scene " + file + ": a scene named \"" + name + "\" is already served");
+    }
+    scenes.push_back({name, render::loadScene(file)});
+  }
+  auto materialFiles = std::make_shared<std::map<std::string, std::string>>();  // offered name → MERL path
+  net::Catalog catalog;
+  catalog.materials = kBuiltinMaterials;
+  if (!a.materialsDir.empty()) {
+    std::error_code ec;
+    if (!fs::is_directory(a.materialsDir, ec)) throw std::invalid_argument("--materials-dir " + a.materialsDir + " is not a folder");
+    std::vector<fs::path> files;
+    for (const auto& entry : fs::directory_iterator(a.materialsDir)) {
+      if (entry.is_regular_file() && entry.path().extension() == ".binary") files.push_back(entry.path());
+    }
+    std::sort(files.begin(), files.end());
+    for (const auto& f : files) {
+      const std::string name = "merl:" + f.stem().string();
+      (*materialFiles)[name] = f.string();
+      catalog.materials.push_back(name);
+    }
+  }
+  for (const auto& s : scenes) {
+    net::Catalog::SceneEntry entry{s.name, {}, s.scene.camera, {}};
+    for (const auto& o : s.scene.objects) {
+      entry.defaultMaterials.push_back(o.material.name);
+      entry.poses.push_back(o.pose);
+    }
+    catalog.scenes.push_back(std::move(entry));
+  }
+  catalog.backends = net::availableBackends();
+  if (!catalog.offersBackend(a.backend)) {
+    throw std::invalid_argument("--backend " + a.backend + " is not built into this server");
+  }
+
+  const auto method = parseRotationMethod(a.method);
+  if (!method) throw std::invalid_argument("--method must be haar, spatial, matrix or table (got \"" + a.method + "\")");
+  auto& d = a.server.defaults;
+  d.method = *method;
+  d.level = a.level;
+  d.lightCoefficients = a.lightCoefficients;
+  d.backend = a.backend;
+  if (a.encoding == "jpeg") d.encoding = net::FrameEncoding::Jpeg;
+  else if (a.encoding == "png") d.encoding = net::FrameEncoding::Png;
+  else if (a.encoding == "raw") d.encoding = net::FrameEncoding::RawRgba8;
+  else if (a.encoding == "exr") d.encoding = net::FrameEncoding::Exr;
+  else throw std::invalid_argument("--encoding must be jpeg, png, raw or exr (got \"" + a.encoding + "\")");
+  auto& limits = a.server.limits;
+  if (a.level < limits.minLevel || a.level > limits.maxLevel) {
+    throw std::invalid_argument("--level " + std::to_string(a.level) + " is outside " + std::to_string(limits.minLevel) +
+                                ".." + std::to_string(limits.maxLevel) + " (see --max-level)");
+  }
+  if (limits.maxSessions < 1) throw std::invalid_argument("--max-sessions must be at least 1");
+  if (!(limits.maxFps > 0)) throw std::invalid_argument("--max-fps must be positive");
+  limits.defaultFps = std::min(limits.defaultFps, limits.maxFps);
+
+  // The token: the flag, else the environment (keeps it out of `ps`).
+  a.server.token = !a.token.empty() ? a.token : (std::getenv("HAARCAST_TOKEN") ? std::getenv("HAARCAST_TOKEN") : "");
+  a.server.webRoot = !a.webRoot.empty() ? fs::path(a.webRoot)
+                                        : findShipped("client/web", {"../share/haarcast/web", "../client/web", "web"});
+  a.server.protoFile = !a.protoFile.empty()
+                           ? fs::path(a.protoFile)
+                           : findShipped("proto/haarcast.proto", {"../share/haarcast/haarcast.proto", "haarcast.proto"});
+  a.server.log = !a.quiet;
+  a.server.handleSignals = true;
+
+  // The renderer builder: a config's scene with its materials, through the
+  // backend factory. Runs on the render service's builder thread.
+  render::RenderOptions base;
+  base.cacheDir = a.cacheDir.empty() ? defaultCacheDir() : (a.cacheDir == "none" ? "" : a.cacheDir);
+  base.threads = a.renderThreads;
+  const net::BackendOptions backendOptions{a.vulkanDevice, a.vulkanValidation};
+  auto sharedScenes = std::make_shared<std::vector<SceneSource>>(std::move(scenes));
+  const bool quiet = a.quiet;
+  net::RendererBuilder builder = [sharedScenes, materialFiles, base, backendOptions, quiet](const net::SessionConfig& c) {
+    const auto it = std::find_if(sharedScenes->begin(), sharedScenes->end(),
+                                 [&](const SceneSource& s) { return s.name == c.scene; });
+    if (it == sharedScenes->end()) throw std::invalid_argument("unknown scene \"" + c.scene + "\"");
+    render::Scene scene = it->scene;
+    for (std::size_t i = 0; i < scene.objects.size() && i < c.materials.size(); ++i) {
+      if (c.materials[i] == scene.objects[i].material.name) continue;  // the scene's own
+      const auto file = materialFiles->find(c.materials[i]);
+      scene.objects[i].material = render::materialFromSpec(file != materialFiles->end() ? file->second : c.materials[i]);
+      scene.objects[i].material.name = c.materials[i];
+    }
+    render::RenderOptions options = base;
+    options.level = c.level;
+    options.method = c.method;
+    options.lightCoefficients = c.lightCoefficients;
+    if (!quiet) std::fprintf(stderr, "[serve] preparing renderer %s\n", c.rendererKey().c_str());
+    auto prepared = std::make_shared<net::PreparedRenderer>();
+    prepared->renderer = net::makeRenderer(c.backend, scene, options, backendOptions);
+    if (!quiet) {
+      std::fprintf(stderr, "[serve] renderer ready: %s on %s\n", prepared->renderer->backend().c_str(),
+                   prepared->renderer->deviceName().c_str());
+    }
+    return prepared;
+  };
+
+  net::Server server(a.server, std::move(catalog), std::move(builder));
+  // The line scripts and clients wait for: the bound port, flushed.
+  std::printf("listening on http://127.0.0.1:%u/\n", static_cast<unsigned>(server.port()));
+  std::fflush(stdout);
+  if (!a.quiet) {
+    std::fprintf(stderr, "[serve] browser client: http://127.0.0.1:%u/%s (web root %s)\n",
+                 static_cast<unsigned>(server.port()), a.server.token.empty() ? "" : "?token=…",
+                 a.server.webRoot.empty() ? "not found" : a.server.webRoot.c_str());
+  }
+  server.run();  // until SIGINT/SIGTERM, then drains
+  return 0;
+}
+
+}  // namespace
 
 std::function<int()> addServeCommand(CLI::App& app) {
-  auto* c = app.add_subcommand("serve", "Serve frames to CLI and browser clients (step 4)");
-  return [c]() -> int {
-    if (!c->parsed()) return -1;
-    throw std::runtime_error("serve is not built yet");
-  };
+  auto a = std::make_shared<ServeArgs>();
+  auto* c = app.add_subcommand("serve", "Serve frames over WebSocket to CLI and browser clients (HTTP on the same port)");
+  auto& o = a->server;
+  c->add_option("--port", o.port, "TCP port (0 = any free one; the bound one is printed)")->capture_default_str();
+  c->add_option("--bind", o.bindAddress, "Address to listen on")->capture_default_str();
+  c->add_option("--token", a->token, "Required token (?token=T or Authorization: Bearer T); default $HAARCAST_TOKEN");
+  c->add_option("--backend", a->backend, "Default backend: cpu|vulkan")->capture_default_str();
+  c->add_option("--level", a->level, "Default map level n (M = 2^n)")->capture_default_str();
+  c->add_option("--method", a->method, "Default rotation method: haar|spatial|matrix|table")->capture_default_str();
+  c->add_option("--light-coeffs", a->lightCoefficients, "Default light coefficients kept (k)")->capture_default_str();
+  c->add_option("--encoding", a->encoding, "Default encoding: jpeg|png|raw|exr")->capture_default_str();
+  c->add_option("--scene", a->sceneFiles, "Scene files to offer besides the built-in \"default\" (named by file stem)");
+  c->add_option("--materials-dir", a->materialsDir, "Offer the MERL .binary files of this folder (as merl:NAME)");
+  c->add_option("--web-root", a->webRoot, "The browser client's files (default: the source tree's client/web)");
+  c->add_option("--proto-file", a->protoFile, "Served at /haarcast.proto (default: the source tree's)");
+  c->add_option("--cache-dir", a->cacheDir, "Slice-table and visibility cache (default $XDG_CACHE_HOME/haarcast; 'none')");
+  c->add_option("--max-sessions", o.limits.maxSessions, "Concurrent WebSocket sessions")->capture_default_str();
+  c->add_option("--max-width", o.limits.maxWidth, "Largest frame width")->capture_default_str();
+  c->add_option("--max-height", o.limits.maxHeight, "Largest frame height")->capture_default_str();
+  c->add_option("--max-fps", o.limits.maxFps, "Largest frame rate per session")->capture_default_str();
+  c->add_option("--max-level", o.limits.maxLevel, "Largest map level a client may ask for")->capture_default_str();
+  c->add_option("--max-message-bytes", o.limits.maxMessageBytes, "Largest client message")->capture_default_str();
+  c->add_option("--handshake-timeout", o.handshakeSeconds, "Seconds for the HTTP request and the Hello")->capture_default_str();
+  c->add_option("--idle-timeout", o.idleSeconds, "Seconds without a client message before closing")->capture_default_str();
+  c->add_option("--io-threads", o.ioThreads, "Network threads")->capture_default_str();
+  c->add_option("--render-threads", a->renderThreads, "CPU backend threads (0 = all cores)")->capture_default_str();
+  c->add_option("--max-renderers", o.render.maxRenderers, "Prepared renderers kept (LRU)")->capture_default_str();
+  c->add_option("--vulkan-device", a->vulkanDevice, "Vulkan device name substring");
+  c->add_flag("--vulkan-validation", a->vulkanValidation, "Enable the Vulkan validation layers");
+  c->add_flag("--quiet", a->quiet, "No per-session log lines on stderr");
+  return [c, a]() { return c->parsed() ? run(*a) : -1; };
 }
 
 }  // namespace haarcast::app

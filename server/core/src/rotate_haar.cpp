@@ -438,6 +438,16 @@ double integralFromCoefficients(const HaarMap& f) {
   return sum;
 }
 
+double verticalDetailMoment(int mapLevel, int l, int i) { return verticalMoment(mapLevel, l, i); }
+
+PixelDifferences refinedPixelDifferences(const HaarMap& f) {
+  const int n = f.level();
+  if (n < 1) throw std::invalid_argument("refinedPixelDifferences: a level-0 map has no pixel boundaries");
+  const StartDetails details(f, n - 1);
+  const SourceDifferences d = exactDifferences(f, details, n - 1);
+  return {details.mw, d.dT.v, d.dP.v};
+}
+
 HaarMap rotateHaar(const HaarMap& f, const EulerYXY& r, const HaarRotationOptions& options) {
   const int n = f.level();
   if (n < 1) return f;  // a 1×1 map is a constant: every rotation leaves it.

@@ -309,6 +309,13 @@ class MatrixRotator final : public SliceRotator {
     out = shiftPhi(elevated, alpha);
   }
 
+  std::vector<SparseMatrixView> views() const {
+    std::vector<SparseMatrixView> out;
+    out.reserve(matrices_.size());
+    for (const CsrMatrix& a : matrices_) out.push_back({a.rowStart, a.column, a.value});
+    return out;
+  }
+
   std::size_t storedBytes() const override {
     std::size_t bytes = coefficientBytes(slices_);
     for (const CsrMatrix& a : matrices_) bytes += a.bytes();
@@ -347,3 +354,16 @@ std::unique_ptr<SliceRotator> makeMatrixRotator(std::vector<HaarMap> slices, con
 }
 
 }  // namespace haarcast::detail
+
+namespace haarcast {
+
+std::vector<SparseMatrixView> elevationMatrixViews(const SliceRotator& r) {
+  const auto* matrix = dynamic_cast<const detail::MatrixRotator*>(&r);
+  if (matrix == nullptr) {
+    throw std::invalid_argument("elevationMatrixViews: the rotator's method is " +
+                                std::string(methodName(r.method())) + ", not matrix");
+  }
+  return matrix->views();
+}
+
+}  // namespace haarcast

@@ -62,6 +62,10 @@ class TableRotator final : public SliceRotator {
     out = shiftPhi(copies_[index(slice, static_cast<int>(k), static_cast<int>(j))], e.alpha);
   }
 
+  int elevations() const { return elevations_; }
+  int spins() const { return spins_; }
+  const std::vector<HaarMap>& copies() const { return copies_; }
+
   // The copies are all it keeps: the (β_0, γ_0) copy is the unrotated slice
   // (to float rounding).
   std::size_t storedBytes() const override { return coefficientBytes(copies_); }
@@ -119,3 +123,16 @@ std::unique_ptr<SliceRotator> makeTableRotator(std::vector<HaarMap> slices, cons
 }
 
 }  // namespace haarcast::detail
+
+namespace haarcast {
+
+TableCopies tableCopies(const SliceRotator& r) {
+  const auto* table = dynamic_cast<const detail::TableRotator*>(&r);
+  if (table == nullptr) {
+    throw std::invalid_argument("tableCopies: the rotator's method is " + std::string(methodName(r.method())) +
+                                ", not table");
+  }
+  return {table->elevations(), table->spins(), table->copies()};
+}
+
+}  // namespace haarcast

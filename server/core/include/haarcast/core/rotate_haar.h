@@ -54,6 +54,8 @@
 //    exactly what the seed hoped to avoid; the report times both variants.
 #pragma once
 
+#include <vector>
+
 #include "haarcast/core/rotation.h"
 
 namespace haarcast {
@@ -68,5 +70,22 @@ HaarMap rotateHaar(const HaarMap& f, const EulerYXY& r, const HaarRotationOption
 // ∫ f dω of the map whose coefficients are `f`, from the coefficients alone
 // (the solid-angle moments of the scaling and vertical basis functions).
 double integralFromCoefficients(const HaarMap& f);
+
+// Step (1) of Refined at the finest start level, on its own: f's exact
+// differences across every pixel boundary of its level-n map, from the
+// details and the level-(n−1) scaling values. The GPU backend derives them
+// once per slice at load time (gpu/rotation_data.h) from this one definition.
+struct PixelDifferences {
+  int size = 0;               // M
+  std::vector<double> theta;  // (M−1)×M, row-major: f(t+1, c) − f(t, c)
+  std::vector<double> phi;    // M×M: f(r, c+1) − f(r, c), c+1 wrapping
+};
+// Throws std::invalid_argument for a level-0 map (it has no boundaries).
+PixelDifferences refinedPixelDifferences(const HaarMap& f);
+
+// ⟨ψ, ΔΩ⟩ of the vertical detail of detail level l, block row i, in a level-n
+// map: the weight of that coefficient in ∫f dω, with which Faithful anchors
+// its scaling coefficient (and the GPU backend packs per level and row).
+double verticalDetailMoment(int mapLevel, int l, int i);
 
 }  // namespace haarcast

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -88,6 +89,31 @@ class SliceRotator {
 // Throws std::invalid_argument if slices is empty or mixes levels.
 std::unique_ptr<SliceRotator> makeRotator(RotationMethod method, std::vector<HaarMap> slices,
                                           const RotatorOptions& options = {});
+
+// ---- The baselines' precomputations, exported --------------------------------
+// The GPU backend packs these (gpu/rotation_data.h), so that its table and
+// matrix shaders use exactly what the CPU rotators use.
+
+// A table rotator's pre-rotated copies: copies[(slice·elevations + k)·spins + j]
+// is the slice rotated by (0, β_k, γ_j), β_k = kπ/(elevations−1),
+// γ_j = 2πj/spins. Throws std::invalid_argument unless r is a table rotator.
+struct TableCopies {
+  int elevations = 0;
+  int spins = 0;
+  std::span<const HaarMap> copies;
+};
+TableCopies tableCopies(const SliceRotator& r);
+
+// A matrix rotator's elevation matrices in compressed sparse rows (row = output
+// coefficient, columns ascending): matrix k is elevate_{β_k}, β_k = kπ/(K−1),
+// acting on Haar coefficients. Throws std::invalid_argument unless r is a
+// matrix rotator.
+struct SparseMatrixView {
+  std::span<const std::uint32_t> rowStart;  // N + 1 offsets
+  std::span<const std::uint32_t> column;
+  std::span<const float> value;
+};
+std::vector<SparseMatrixView> elevationMatrixViews(const SliceRotator& r);
 
 // `count` rotations with the normal R·ŷ uniform on the sphere and the spin γ
 // uniform, from a fixed-seed generator (std::mt19937): the same list on every

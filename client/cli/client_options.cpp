@@ -1,0 +1,144 @@
+#include "client_options.h"
+
+#include <charconv>
+#include <stdexcept>
+
+namespace haarcast::client {
+
+namespace {
+
+std::uint32_t parseDimension(std::string_view text, const std::string& whole) {
+  std::uint32_t value = 0;
+  const auto* end = text.data() + text.size();
+  auto [ptr, ec] = std::from_chars(text.data(), end, value);
+  if (text.empty() || ec != std::errc() || ptr != end) {
+    throw std::invalid_argument("--size must be WIDTHxHEIGHT, e.g. 256x256 (got \"" + whole + "\")");
+  }
+  if (value == 0 || value > 8192) {
+    throw std::invalid_argument("--size: each side must be in 1..8192 (got \"" + whole + "\")");
+  }
+  return value;
+}
+
+bool isUnreserved(char c) {
+  return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '-' ||
+         c == '_' || c == '.' || c == '~';
+}
+
+}  // namespace
+
+WsUrl parseWsUrl(const std::string& url) {
+  const std::string scheme = "ws://";
+  if (url.rfind("wss://", 0) == 0) {
+    throw std::invalid_argument("URL \"" + url +
+                                "\": wss:// is not supported; haarcast speaks plain ws:// (put TLS in a proxy)");
+  }
+  if (url.rfind(scheme, 0) != 0) {
+    throw std::invalid_argument("URL \"" + url + "\" must start with ws:// (e.g. ws://127.0.0.1:8080)");
+  }
+  const std::string rest = url.substr(scheme.size());
+  const auto slash = rest.find_first_of("/?");
+  const std::string authority = rest.substr(0, slash);
+  std::string target = slash == std::string::npos ? "" : rest.substr(slash);
+  if (target.empty() || target[0] == '?') target = "/ws" + target;
+
+  WsUrl out;
+  if (!authority.empty() && authority[0] == '[') {  // [IPv6]:port
+    const auto close = authority.find(']');
+    if (close == std::string::npos) throw std::invalid_argument("URL \"" + url + "\": unterminated [IPv6] host");
+    out.host = authority.substr(1, close - 1);
+    if (close + 1 < authority.size()) {
+      if (authority[close + 1] != ':') throw std::invalid_argument("URL \"" + url + "\": junk after ]");
+      out.port = authority.substr(close + 2);
+    }
+  } else {
+    const auto colon = authority.rfind(':');
+    out.host = authority.substr(0, colon);
+    if (colon != std::string::npos) out.port = authority.substr(colon + 1);
+  }
+  if (out.host.empty()) throw std::invalid_argument("URL \"" + url + "\" has no host");
+  if (out.port.empty()) out.port = "80";
+  unsigned port = 0;
+  auto [ptr, ec] = std::from_chars(out.port.data(), out.port.data() + out.port.size(), port);
+  if (ec != std::errc() || ptr != out.port.data() + out.port.size() || port == 0 || port > 65535) {
+    throw std::invalid_argument("URL \"" + url + "\": port \"" + out.port + "\" is not in 1..65535");
+  }
+  out.target = target;
+  return out;
+}
+
+std::string withTokenQuery(const std::string& target, const std::string& token) {
+  static constexpr char kHex[] = "0123456789ABCDEF";
+  std::string encoded;
+  for (char c : token) {
+    if (isUnreserved(c)) {
+      encoded += c;
+    } else {
+      const auto byte = static_cast<unsigned char>(c);
+      encoded += '%';
+      encoded += kHex[byte >> 4];
+      encoded += kHex[byte & 15];
+    }
+  }
+  return target + (target.find('?') == std::string::npos ? "?" : "&") + "token=" + encoded;
+}
+
+Size parseSize(const std::string& text) {
+  const auto x = text.find_first_of("xX");
+  if (x == std::string::npos) {
+    throw std::invalid_argument("--size must be WIDTHxHEIGHT, e.g. 256x256 (got \"" + text + "\")");
+  }
+  const std::string_view view(text);
+  return {parseDimension(view.substr(0, x), text), parseDimension(view.substr(x + 1), text)};
+}
+
+v1::Encoding parseEncoding(const std::string& name) {
+  if (name == "jpeg" || name == "jpg") return v1::ENCODING_JPEG;
+  if (name == "png") return v1::ENCODING_PNG;
+  if (name == "raw" || name == "rgba8") return v1::ENCODING_RAW_RGBA8;
+  if (name == "exr") return v1::ENCODING_EXR;
+  throw std::invalid_argument("--encoding must be jpeg, png, raw or exr (got \"" + name + "\")");
+}
+
+std::string encodingName(v1::Encoding encoding) {
+  switch (encoding) {
+    case v1::ENCODING_JPEG: return "jpeg";
+    case v1::ENCODING_PNG: return "png";
+    case v1::ENCODING_RAW_RGBA8: return "raw";
+    case v1::ENCODING_EXR: return "exr";
+    default: return "unspecified";
+  }
+}
+
+std::string encodingFileExtension(v1::Encoding encoding) {
+  switch (encoding) {
+    case v1::ENCODING_JPEG: return ".jpg";
+    case v1::ENCODING_PNG: return ".png";
+    // Raw frames are written as PAM (netpbm P7, RGB_ALPHA): the same bytes
+    // behind a 60-byte header that records the size, so any viewer opens them.
+    case v1::ENCODING_RAW_RGBA8: return ".pam";
+    case v1::ENCODING_EXR: return ".exr";
+    default: return ".bin";
+  }
+}
+
+v1::RotationMethod parseMethod(const std::string& name) {
+  if (name.empty()) return v1::ROTATION_METHOD_UNSPECIFIED;
+  if (name == "haar") return v1::ROTATION_METHOD_HAAR;
+  if (name == "spatial") return v1::ROTATION_METHOD_SPATIAL;
+  if (name == "matrix") return v1::ROTATION_METHOD_MATRIX;
+  if (name == "table") return v1::ROTATION_METHOD_TABLE;
+  throw std::invalid_argument("--method must be haar, spatial, matrix or table (got \"" + name + "\")");
+}
+
+std::string methodName(v1::RotationMethod method) {
+  switch (method) {
+    case v1::ROTATION_METHOD_HAAR: return "haar";
+    case v1::ROTATION_METHOD_SPATIAL: return "spatial";
+    case v1::ROTATION_METHOD_MATRIX: return "matrix";
+    case v1::ROTATION_METHOD_TABLE: return "table";
+    default: return "default";
+  }
+}
+
+}  // namespace haarcast::client

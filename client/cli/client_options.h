@@ -1,0 +1,46 @@
+// What `haarcast-client` was asked to do, parsed and checked, independent of
+// sockets, so that the parsing rules are tested without a server.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "haarcast/proto/haarcast.pb.h"
+
+namespace haarcast::client {
+
+// ws://HOST:PORT[/PATH][?QUERY]. The path defaults to /ws, the server's
+// WebSocket endpoint, so `haarcast-client ws://127.0.0.1:8080` just works.
+struct WsUrl {
+  std::string host;
+  std::string port;
+  std::string target;  // path and query, e.g. "/ws?token=abc"
+};
+
+// Throws std::invalid_argument naming the URL and what is wrong with it
+// (wss:// is refused by name: TLS belongs to a proxy in front of the server).
+WsUrl parseWsUrl(const std::string& url);
+
+// The same URL with "token=T" added to its query (percent-encoded), for
+// servers behind proxies that drop the Authorization header.
+std::string withTokenQuery(const std::string& target, const std::string& token);
+
+// "256x256" → {256, 256}; throws std::invalid_argument on anything else,
+// including zero or > 8192 (the renderer's limit).
+struct Size {
+  std::uint32_t width = 0;
+  std::uint32_t height = 0;
+};
+Size parseSize(const std::string& text);
+
+// "jpeg" | "png" | "raw" | "exr" (and "rgba8" for raw).
+v1::Encoding parseEncoding(const std::string& name);
+std::string encodingName(v1::Encoding encoding);
+std::string encodingFileExtension(v1::Encoding encoding);
+
+// "haar" | "spatial" | "matrix" | "table"; "" = server default.
+v1::RotationMethod parseMethod(const std::string& name);
+std::string methodName(v1::RotationMethod method);
+
+}  // namespace haarcast::client

@@ -1,0 +1,45 @@
+// Decoding a Frame's payload back to pixels, for the not-blank check and for
+// writing raw frames as viewable files. JPEG via libjpeg-turbo, PNG via
+// libpng, RAW as is, EXR via OpenEXR (half-float RGB, tone-mapped to 8 bits
+// only for the statistics).
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "haarcast/proto/haarcast.pb.h"
+
+namespace haarcast::client {
+
+struct Rgba8Image {
+  std::uint32_t width = 0;
+  std::uint32_t height = 0;
+  std::vector<std::uint8_t> pixels;  // width·height·4, row 0 at the top
+};
+
+// Throws std::runtime_error naming the encoding and what failed (a truncated
+// JPEG, a PNG of the wrong size, a RAW payload of the wrong length, …).
+// `width`/`height` are what the Frame message claims; a decoded size that
+// differs from them is an error too.
+Rgba8Image decodeFrame(v1::Encoding encoding, std::span<const std::uint8_t> data, std::uint32_t width,
+                       std::uint32_t height);
+
+struct PixelStats {
+  double meanLuma = 0.0;    // Rec. 709 luma of the 8-bit sRGB values, 0..255
+  double stddevLuma = 0.0;  // over all pixels
+};
+PixelStats pixelStats(const Rgba8Image& image);
+
+// A frame is blank when its luma barely varies: a solid clear colour, an
+// all-black failed render. A frame that shows any object over the sky varies
+// by tens of levels. The threshold is one 8-bit level of standard deviation.
+inline constexpr double kBlankStddevLuma = 1.0;
+inline bool isBlank(const PixelStats& s) { return s.stddevLuma < kBlankStddevLuma; }
+
+// netpbm PAM (P7, RGB_ALPHA) bytes of an RGBA8 image: how raw frames are
+// written to disk.
+std::vector<std::uint8_t> encodePam(const Rgba8Image& image);
+
+}  // namespace haarcast::client

@@ -1,0 +1,354 @@
+#include "session.h"
+
+#include <cctype>
+#include <deque>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <span>
+
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/steady_timer.hpp>
+#include <boost/beast/core.hpp>
+#include <boost/beast/http.hpp>
+#include <boost/beast/websocket.hpp>
+
+#include "frame_image.h"
+
+namespace haarcast::client {
+
+namespace asio = boost::asio;
+namespace beast = boost::beast;
+namespace http = beast::http;
+namespace websocket = beast::websocket;
+using tcp = asio::ip::tcp;
+using Clock = std::chrono::steady_clock;
+
+struct Session::Impl : std::enable_shared_from_this<Session::Impl> {
+  Impl(asio::io_context& io, std::size_t clientIndex, SessionConfig sessionConfig, SessionStats& sessionStats,
+       FrameCallback frameCallback, MessageCallback messageCallback)
+      : index(clientIndex),
+        config(std::move(sessionConfig)),
+        stats(sessionStats),
+        onFrame(std::move(frameCallback)),
+        onMessage(std::move(messageCallback)),
+        resolver(io),
+        ws(io),
+        watchdog(io) {}
+
+  std::size_t index;
+  SessionConfig config;
+  SessionStats& stats;
+  FrameCallback onFrame;
+  MessageCallback onMessage;
+
+  tcp::resolver resolver;
+  websocket::stream<beast::tcp_stream> ws;
+  asio::steady_timer watchdog;
+  beast::flat_buffer readBuffer;
+  http::response<http::string_body> upgradeResponse;
+  std::deque<std::string> writes;  // serialized ClientMessages; front() is in flight
+  bool writing = false;
+
+  v1::Welcome welcome;
+  bool welcomed = false;
+  bool closing = false;  // we started the close handshake (or gave up)
+  std::uint64_t nextPose = 1;  // sequence of the next pose to send
+  bool timeUp = false;         // --duration has passed: no new poses
+  std::map<std::uint64_t, double> outstanding;  // pose sequence → sent at (ms since run start)
+  std::string phase = "connecting";
+
+  double nowMs() const {
+    return std::chrono::duration<double, std::milli>(Clock::now() - config.runStart).count();
+  }
+  std::string who() const { return "client " + std::to_string(index) + ": "; }
+
+  // The session ends here on any failure, once: the reason is kept for the
+  // summary and the exit code, and the socket is closed.
+  void fail(const std::string& why) {
+    if (stats.failure.empty()) {
+      stats.failure = why;
+      onMessage(who() + why);
+    }
+    closing = true;
+    watchdog.cancel();
+    beast::error_code ignored;
+    beast::get_lowest_layer(ws).socket().close(ignored);
+  }
+
+  void armWatchdog(const std::string& waitingFor) {
+    phase = waitingFor;
+    watchdog.expires_after(std::chrono::duration_cast<Clock::duration>(
+        std::chrono::duration<double>(config.timeoutSeconds)));
+    watchdog.async_wait([self = shared_from_this()](beast::error_code ec) {
+      if (ec || self->closing) return;  // cancelled: something arrived in time
+      self->fail("timed out after " + std::to_string(self->config.timeoutSeconds) + " s waiting for " + self->phase);
+    });
+  }
+
+  void start() {
+    armWatchdog("the connection to " + config.url.host + ":" + config.url.port);
+    resolver.async_resolve(config.url.host, config.url.port,
+                           [self = shared_from_this()](beast::error_code ec, tcp::resolver::results_type results) {
+                             self->onResolve(ec, std::move(results));
+                           });
+  }
+
+  void onResolve(beast::error_code ec, tcp::resolver::results_type results) {
+    if (closing) return;
+    if (ec) return fail("cannot resolve host \"" + config.url.host + "\": " + ec.message());
+    beast::get_lowest_layer(ws).async_connect(
+        results, [self = shared_from_this()](beast::error_code e, const tcp::endpoint&) { self->onConnect(e); });
+  }
+
+  void onConnect(beast::error_code ec) {
+    if (closing) return;
+    if (ec) {
+      return fail("cannot connect to " + config.url.host + ":" + config.url.port + ": " + ec.message() +
+                  (ec == asio::error::connection_refused ? " (is `haarcast serve` running on that port?)" : ""));
+    }
+    beast::get_lowest_layer(ws).socket().set_option(tcp::no_delay(true));
+    ws.set_option(websocket::stream_base::decorator([token = config.token](websocket::request_type& req) {
+      req.set(http::field::user_agent, "haarcast-client");
+      if (!token.empty()) req.set(http::field::authorization, "Bearer " + token);
+    }));
+    // Frames can be large (raw 1024² is 4 MiB); the default 16 MiB limit
+    // would refuse 4K raw frames with a confusing error.
+    ws.read_message_max(std::uint64_t{256} << 20);
+    ws.binary(true);
+    armWatchdog("the WebSocket upgrade");
+    ws.async_handshake(upgradeResponse, config.url.host + ":" + config.url.port, config.url.target,
+                       [self = shared_from_this()](beast::error_code e) { self->onHandshake(e); });
+  }
+
+  void onHandshake(beast::error_code ec) {
+    if (closing) return;
+    if (ec == websocket::error::upgrade_declined) {
+      const auto status = upgradeResponse.result_int();
+      std::string why = "the server refused the WebSocket upgrade at " + config.url.target + ": HTTP " +
+                        std::to_string(status) + " " + std::string(upgradeResponse.reason());
+      if (status == 401 || status == 403) why += config.token.empty() ? " (the server wants --token)" : " (wrong --token?)";
+      std::string body = upgradeResponse.body().substr(0, 200);
+      while (!body.empty() && std::isspace(static_cast<unsigned char>(body.back()))) body.pop_back();
+      if (!body.empty()) why += ": " + body;
+      return fail(why);
+    }
+    if (ec) return fail("WebSocket upgrade failed: " + ec.message());
+    // From here the watchdog times the frames (and names what was awaited);
+    // the stream's own timeout only bounds the closing handshake, so that a
+    // server that never answers our close cannot hang the client.
+    beast::get_lowest_layer(ws).expires_never();
+    websocket::stream_base::timeout timeouts{};
+    timeouts.handshake_timeout = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+        std::chrono::duration<double>(config.timeoutSeconds));
+    timeouts.idle_timeout = websocket::stream_base::none();
+    timeouts.keep_alive_pings = false;
+    ws.set_option(timeouts);
+
+    v1::ClientMessage hello;
+    *hello.mutable_hello() = config.hello;
+    hello.mutable_hello()->set_auth_token(config.token);
+    send(hello);
+    armWatchdog("Welcome");
+    doRead();
+  }
+
+  void send(const v1::ClientMessage& message) {
+    writes.push_back(message.SerializeAsString());
+    if (!writing) doWrite();
+  }
+
+  void doWrite() {
+    writing = true;
+    ws.async_write(asio::buffer(writes.front()), [self = shared_from_this()](beast::error_code ec, std::size_t) {
+      self->writing = false;
+      if (self->closing) return;
+      if (ec) return self->fail("send failed: " + ec.message());
+      self->writes.pop_front();
+      if (!self->writes.empty()) self->doWrite();
+    });
+  }
+
+  void doRead() {
+    ws.async_read(readBuffer, [self = shared_from_this()](beast::error_code ec, std::size_t bytes) {
+      self->onRead(ec, bytes);
+    });
+  }
+
+  void onRead(beast::error_code ec, std::size_t bytes) {
+    if (ec) {
+      if (closing) return;  // our own close, or a failure already reported
+      if (ec == websocket::error::closed) {
+        const auto& reason = ws.reason();
+        return fail("the server closed the session after " + std::to_string(stats.frames) + " of " +
+                    std::to_string(config.frames) + " frames (close code " + std::to_string(reason.code) +
+                    (reason.reason.empty() ? "" : ": " + std::string(reason.reason.c_str())) + ")");
+      }
+      return fail("connection lost after " + std::to_string(stats.frames) + " of " + std::to_string(config.frames) +
+                  " frames: " + ec.message());
+    }
+    v1::ServerMessage message;
+    const auto data = readBuffer.cdata();
+    if (!message.ParseFromArray(data.data(), static_cast<int>(data.size()))) {
+      return fail("the server sent " + std::to_string(bytes) + " bytes that are not a haarcast.v1.ServerMessage");
+    }
+    readBuffer.consume(readBuffer.size());
+    switch (message.body_case()) {
+      case v1::ServerMessage::kWelcome: onWelcome(message.welcome()); break;
+      case v1::ServerMessage::kFrame: onFrameMessage(message.frame(), bytes); break;
+      case v1::ServerMessage::kStats:
+        stats.serverFps = message.stats().fps();
+        stats.serverSessions = message.stats().sessions();
+        break;
+      case v1::ServerMessage::kError: onError(message.error()); break;
+      case v1::ServerMessage::kPong: break;
+      default: return fail("the server sent a ServerMessage with no body");
+    }
+    if (!closing) doRead();
+  }
+
+  void onWelcome(const v1::Welcome& w) {
+    if (welcomed) return fail("the server sent a second Welcome");
+    welcome = w;
+    welcomed = true;
+    if (w.protocol_version() != v1::PROTOCOL_VERSION_1) {
+      onMessage(who() + "the server speaks protocol version " + std::to_string(w.protocol_version()) +
+                ", this client version 1");
+    }
+    fillWindow();
+  }
+
+  // The sequence of the last pose to send: fixed by --frames, or, with
+  // --duration, whatever was sent when the time ran out.
+  std::uint64_t lastPose() const {
+    if (config.durationSeconds <= 0.0) return config.warmup + config.frames;
+    return timeUp ? nextPose - 1 : std::numeric_limits<std::uint64_t>::max();
+  }
+  bool measured(std::uint64_t sequence) const { return sequence > config.warmup; }
+
+  void fillWindow() {
+    if (config.durationSeconds > 0.0 && nextPose > config.warmup + 1 &&
+        nowMs() / 1000.0 - stats.firstPoseSeconds >= config.durationSeconds) {
+      timeUp = true;
+    }
+    while (nextPose <= lastPose() && outstanding.size() < config.inFlight) {
+      v1::ClientMessage message;
+      auto* pose = message.mutable_pose();
+      // Warm-up poses replay the start of the path; measured pose i is path pose i.
+      const std::uint64_t pathIndex = measured(nextPose) ? nextPose - 1 - config.warmup : nextPose - 1;
+      *pose = config.path->at(static_cast<std::size_t>(pathIndex % config.frames), static_cast<std::size_t>(config.frames));
+      pose->set_sequence(nextPose);
+      const double sentMs = nowMs();
+      pose->set_client_time_ms(sentMs);
+      outstanding[nextPose] = sentMs;
+      if (nextPose == config.warmup + 1) stats.firstPoseSeconds = sentMs / 1000.0;
+      ++nextPose;
+      if (measured(nextPose - 1)) ++stats.posesSent;
+      send(message);
+    }
+    armWatchdog("the frame answering pose " + std::to_string(outstanding.empty() ? 0 : outstanding.begin()->first));
+  }
+
+  void onFrameMessage(const v1::Frame& frame, std::size_t wireBytes) {
+    const auto it = outstanding.find(frame.pose_sequence());
+    if (!welcomed || it == outstanding.end()) {
+      ++stats.extraFrames;  // e.g. a first frame for pose 0, or a repeat
+      return;
+    }
+    const double latency = nowMs() - it->second;
+    // "Latest wins": the poses before this one were skipped by the server.
+    for (auto old = outstanding.begin(); old != it; old = outstanding.erase(old)) {
+      if (measured(old->first)) ++stats.dropped;
+    }
+    outstanding.erase(it);
+    if (!measured(frame.pose_sequence())) {
+      fillWindow();
+      return;
+    }
+
+    ++stats.frames;
+    stats.payloadBytes += frame.data().size();
+    stats.wireBytes += wireBytes;
+    stats.latencyMs.push_back(latency);
+    stats.serverMs.push_back(frame.server_ms());
+    for (const auto& t : frame.timings()) stats.stageMs[t.name()].push_back(t.ms());
+    stats.lastFrameSeconds = nowMs() / 1000.0;
+
+    if (!recordAndCheck(frame)) return;
+    onFrame({index, frame.pose_sequence(), latency, frame.data().size()});
+
+    fillWindow();
+    if (nextPose > lastPose() && outstanding.empty()) finish();
+  }
+
+  // Writes the frame under --out and checks it is not blank; false when the
+  // session failed doing so.
+  bool recordAndCheck(const v1::Frame& frame) {
+    const auto encoding = frame.encoding();
+    const std::span<const std::uint8_t> data(reinterpret_cast<const std::uint8_t*>(frame.data().data()),
+                                             frame.data().size());
+    const bool raw = encoding == v1::ENCODING_RAW_RGBA8;
+    if (!config.checkNotBlank && (config.outDir.empty())) return true;
+    try {
+      Rgba8Image image;
+      if (config.checkNotBlank || raw) image = decodeFrame(encoding, data, frame.width(), frame.height());
+      if (config.checkNotBlank) {
+        const PixelStats px = pixelStats(image);
+        if (isBlank(px)) {
+          ++stats.blankFrames;
+          onMessage(who() + "frame " + std::to_string(frame.sequence()) + " (pose " +
+                    std::to_string(frame.pose_sequence()) + ") is blank: luma stddev " +
+                    std::to_string(px.stddevLuma) + " < " + std::to_string(kBlankStddevLuma));
+        }
+      }
+      if (!config.outDir.empty()) {
+        char name[32];
+        std::snprintf(name, sizeof name, "frame-%06llu", static_cast<unsigned long long>(stats.frames));
+        const auto path = std::filesystem::path(config.outDir) / (name + encodingFileExtension(encoding));
+        std::ofstream out(path, std::ios::binary);
+        if (raw) {
+          const auto pam = encodePam(image);
+          out.write(reinterpret_cast<const char*>(pam.data()), static_cast<std::streamsize>(pam.size()));
+        } else {
+          out.write(frame.data().data(), static_cast<std::streamsize>(frame.data().size()));
+        }
+        if (!out) {
+          fail("cannot write " + path.string());
+          return false;
+        }
+      }
+    } catch (const std::exception& e) {
+      fail("frame " + std::to_string(frame.sequence()) + ": " + e.what());
+      return false;
+    }
+    return true;
+  }
+
+  void onError(const v1::Error& error) {
+    ++stats.errors;
+    const std::string text = "server error " + v1::ErrorCode_Name(error.code()) + ": " + error.message();
+    if (error.fatal()) return fail(text);
+    onMessage(who() + text + " (not fatal)");
+  }
+
+  void finish() {
+    closing = true;
+    watchdog.cancel();
+    ws.async_close(websocket::close_code::normal, [self = shared_from_this()](beast::error_code) {
+      // The server may already be gone after answering; the frames are in.
+      beast::error_code ignored;
+      beast::get_lowest_layer(self->ws).socket().close(ignored);
+    });
+  }
+};
+
+Session::Session(asio::io_context& io, std::size_t index, SessionConfig config, SessionStats& stats,
+                 FrameCallback onFrame, MessageCallback onMessage)
+    : impl_(std::make_shared<Impl>(io, index, std::move(config), stats, std::move(onFrame), std::move(onMessage))) {}
+
+void Session::start() { impl_->start(); }
+
+const v1::Welcome& Session::welcome() const { return impl_->welcome; }
+
+}  // namespace haarcast::client

@@ -1,0 +1,65 @@
+// A compute pipeline built from an embedded shader (shaders.h): storage
+// buffers at set 0, bindings 0 … n−1, an optional push-constant block, and
+// 32-bit specialization constants (sizes such as the map level).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <initializer_list>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <vulkan/vulkan.h>
+
+#include "haarcast/gpu/context.h"
+
+namespace haarcast::gpu {
+
+struct SpecConstant {
+  std::uint32_t id = 0;     // constant_id in the shader
+  std::uint32_t value = 0;  // int/uint value (or a float's bits)
+};
+
+// A VkShaderModule from the embedded SPIR-V of shaders/<name>; throws
+// std::invalid_argument naming the shader when it is not embedded.
+VkShaderModule createShaderModule(Context& context, std::string_view name);
+
+class ComputePipeline {
+ public:
+  // storageBuffers: bindings 0 … storageBuffers−1 of set 0, each a storage
+  // buffer. pushConstantBytes: 0 or the size of the shader's push block.
+  ComputePipeline(Context& context, std::string_view shaderName, std::uint32_t storageBuffers,
+                  std::uint32_t pushConstantBytes, std::vector<SpecConstant> specialization = {});
+  ~ComputePipeline();
+  ComputePipeline(const ComputePipeline&) = delete;
+  ComputePipeline& operator=(const ComputePipeline&) = delete;
+
+  // Points binding i at buffers[i] (whole buffer). Must not be called while a
+  // submitted command buffer that uses this pipeline is still running
+  // (Context::submit waits, so between submits is fine).
+  void bind(std::initializer_list<const Buffer*> buffers);
+  // Binds the pipeline and its descriptor set, pushes `push` and dispatches.
+  void dispatch(VkCommandBuffer cb, std::array<std::uint32_t, 3> groups, const void* push = nullptr,
+                std::uint32_t pushBytes = 0) const;
+
+  const std::string& name() const { return name_; }
+
+ private:
+  void destroy();
+  Context& context_;
+  std::string name_;
+  std::uint32_t bindings_ = 0;
+  std::uint32_t pushBytes_ = 0;
+  VkDescriptorSetLayout setLayout_ = VK_NULL_HANDLE;
+  VkPipelineLayout layout_ = VK_NULL_HANDLE;
+  VkPipeline pipeline_ = VK_NULL_HANDLE;
+  VkDescriptorPool pool_ = VK_NULL_HANDLE;
+  VkDescriptorSet set_ = VK_NULL_HANDLE;
+};
+
+// Compute writes visible to later compute reads and transfers (the
+// barrier between two passes of one command buffer).
+void computeBarrier(VkCommandBuffer cb);
+
+}  // namespace haarcast::gpu

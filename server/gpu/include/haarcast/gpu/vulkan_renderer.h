@@ -1,0 +1,77 @@
+// The Vulkan backend behind render::Renderer (docs/gpu.md): the seed's
+// passes as Vulkan work, each timed on the device with timestamp queries
+// under the shared stage names of renderer.h:
+//   light           host: render::lightInObjectFrame per object, uploaded
+//   gbuffer         graphics pipeline, offscreen: normal, ids + barycentrics, position
+//   rotation-input  compute: slice index and Y-X-Y angles per covered pixel, compacted
+//   rotation        compute: shaders/rotate_<method>.comp, in batches of covered pixels
+//   triple-product  compute: light × rotated slice × interpolated visibility
+//   tonemap         compute: backdrop, linear image kept, RGBA8
+// Scene data (slices, method data, meshes, visibility, backdrop) is uploaded
+// once; frame buffers are allocated once per resolution and reused, so a
+// frame at an unchanged resolution allocates no device memory.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <glm/vec4.hpp>
+
+#include "haarcast/gpu/context.h"
+#include "haarcast/gpu/passes.h"
+#include "haarcast/render/renderer.h"
+
+namespace haarcast::gpu {
+
+// Options of the Vulkan backend beyond the device (context.h VulkanOptions).
+struct VulkanRendererLimits {
+  // Covered pixels rotated per batch (the rotated buffer holds batch·3·N
+  // floats); 0 = as many as fit in 256 MiB and the device's storage-buffer
+  // range and dispatch limits.
+  std::size_t batchSamples = 0;
+  // Workgroup size of rotate_spatial.comp; 0 = 64 on CPU devices, 256 on GPUs.
+  std::uint32_t spatialLocalSize = 0;
+};
+
+class VulkanRenderer final : public render::Renderer {
+ public:
+  // Throws std::invalid_argument for options the GPU passes cannot take
+  // (levels outside kMinGpuLevel..kMaxGpuLevel, a method whose shader is not
+  // built) and std::runtime_error for Vulkan failures, naming the call.
+  VulkanRenderer(const render::Scene& scene, const render::RenderOptions& options, const VulkanOptions& vulkan,
+                 const render::RenderProgress& progress = {}, const VulkanRendererLimits& limits = {});
+  ~VulkanRenderer() override;
+
+  std::string backend() const override { return "vulkan"; }
+  std::string deviceName() const override;
+  const render::RenderOptions& options() const override;
+  std::size_t objectCount() const override;
+  render::Frame render(const render::FrameRequest& request) override;
+
+  // ---- For tests and diagnostics: the last frame's intermediate data -----
+  Context& context();
+  const render::PreparedScene& prepared() const;
+  // G-buffer per pixel: (object + 1 or 0, triangle, u bits, v bits), the
+  // object-frame normal and position (w unused).
+  std::vector<glm::uvec4> gbufferIds() const;
+  std::vector<glm::vec4> gbufferNormals() const;
+  std::vector<glm::vec4> gbufferPositions() const;
+  // The compacted covered pixels, in the order the GPU wrote them.
+  std::vector<RotationSample> rotationSamples() const;
+  std::vector<ShadeSample> shadeSamples() const;
+  std::size_t batchSamples() const;  // the batch size in use (0 before the first frame)
+  std::size_t batchesLastFrame() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+std::unique_ptr<render::Renderer> makeVulkanRenderer(const render::Scene& scene, const render::RenderOptions& options,
+                                                     const VulkanOptions& vulkan,
+                                                     const render::RenderProgress& progress = {});
+
+}  // namespace haarcast::gpu

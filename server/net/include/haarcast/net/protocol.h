@@ -1,0 +1,146 @@
+// The wire protocol without sockets: parsing client messages, validating a
+// Hello and later settings against the server's limits and catalogue, and
+// turning pose updates into render requests. Pure functions over bytes and
+// messages, so every rule here is tested without a network (and the session
+// code in server.cpp only moves bytes and timers).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include "haarcast/core/rotation.h"
+#include "haarcast/net/encode.h"
+#include "haarcast/proto/haarcast.pb.h"
+#include "haarcast/render/renderer.h"
+
+namespace haarcast::net {
+
+inline constexpr std::uint32_t kProtocolVersion = 1;
+inline constexpr const char* kServerVersion = "haarcast 0.1.0";
+
+// What the server allows; every limit is a clear Error when exceeded.
+struct Limits {
+  int maxWidth = 2048;
+  int maxHeight = 2048;
+  double maxFps = 60.0;
+  double defaultFps = 30.0;
+  int minLevel = 2;
+  int maxLevel = 6;
+  std::size_t maxLightCoefficients = 4096;
+  std::size_t maxMessageBytes = 64 * 1024;  // client → server; poses are ~100 bytes
+  int maxSessions = 64;
+  int maxBadMessages = 3;  // non-fatal BAD_MESSAGE errors before the server closes
+};
+
+// Server-side defaults for what a Hello leaves unset.
+struct Defaults {
+  int width = 256;
+  int height = 256;
+  FrameEncoding encoding = FrameEncoding::Jpeg;
+  int jpegQuality = 85;
+  RotationMethod method = RotationMethod::Haar;
+  int level = 5;
+  std::size_t lightCoefficients = 256;
+  std::string backend = "cpu";
+};
+
+// What the server offers: scene names (with their object counts, so that
+// per-object materials can be checked before anything is built), material
+// specs, backends.
+struct Catalog {
+  struct SceneEntry {
+    std::string name;
+    std::vector<std::string> defaultMaterials;  // per object, as the scene names them
+    render::Camera camera;                      // the scene's own view
+    std::vector<render::Pose> poses;            // per object
+  };
+  std::vector<SceneEntry> scenes;             // the first is the default
+  std::vector<std::string> materials;         // offered specs: "lambert", "phong:64", MERL names …
+  std::vector<std::string> backends;          // "cpu", "vulkan"
+
+  const SceneEntry* findScene(std::string_view name) const;  // "" = the default
+  bool offersMaterial(std::string_view spec) const;
+  bool offersBackend(std::string_view backend) const;
+};
+
+struct ProtocolError {
+  v1::ErrorCode code = v1::ERROR_CODE_UNSPECIFIED;
+  std::string message;
+  bool fatal = false;
+};
+
+// Everything a session renders with. Changing scene, materials, level,
+// method or backend selects another renderer (rendererKey()).
+struct SessionConfig {
+  int width = 0;
+  int height = 0;
+  FrameEncoding encoding = FrameEncoding::Jpeg;
+  int jpegQuality = 85;
+  double fps = 30.0;
+  std::string scene;                   // a Catalog scene name
+  std::vector<std::string> materials;  // per object, offered specs
+  RotationMethod method = RotationMethod::Haar;
+  int level = 5;
+  std::size_t lightCoefficients = 256;
+  std::string backend = "cpu";
+  double exposureStops = 0.0;
+
+  // Identifies the prepared renderer this config needs; equal keys share one.
+  std::string rendererKey() const;
+};
+
+// A binary WebSocket message → ClientMessage. Garbage, a truncated message
+// and an empty or unknown oneof are BAD_MESSAGE, naming which.
+std::variant<v1::ClientMessage, ProtocolError> parseClientMessage(std::string_view bytes);
+
+// The session's config from its Hello, or the first thing wrong with it
+// (version, resolution, fps, quality, encoding, scene, materials, settings).
+// Every error here is fatal: the session has nothing to render.
+std::variant<SessionConfig, ProtocolError> configFromHello(const v1::Hello& hello, const Limits& limits,
+                                                          const Defaults& defaults, const Catalog& catalog);
+
+// Settings or scene changes mid-session. On error the config is unchanged
+// (the errors are not fatal: the session goes on with what it had).
+std::optional<ProtocolError> applySettings(SessionConfig& config, const v1::RenderSettings& settings,
+                                           const Limits& limits, const Catalog& catalog);
+std::optional<ProtocolError> applySceneChoice(SessionConfig& config, const v1::SceneChoice& choice,
+                                              const Catalog& catalog);
+
+// The view a session has asked for so far: every PoseUpdate field it set.
+struct PoseState {
+  std::uint64_t sequence = 0;  // of the last update applied; 0 = none yet
+  render::Camera camera;
+  std::vector<render::Pose> poses;  // per object
+  glm::dvec3 lightRotateDegrees{0.0};
+  double clientTimeMs = 0.0;
+};
+
+// The scene's own view, for a session that has sent no pose yet.
+PoseState initialPose(const render::Camera& camera, const std::vector<render::Pose>& poses);
+
+// Applies an update. Returns nothing and leaves the state unchanged for an
+// update whose sequence is not newer (stale: the latest pose wins). An
+// object index out of range or a non-finite number is BAD_MESSAGE (not
+// fatal) and nothing of the update is applied.
+std::optional<ProtocolError> applyPose(PoseState& state, const v1::PoseUpdate& update);
+
+// The render request for a pose under a config.
+render::FrameRequest frameRequest(const PoseState& pose, const SessionConfig& config);
+
+// Wire enums ↔ ours.
+v1::Encoding toWire(FrameEncoding encoding);
+v1::RotationMethod toWire(RotationMethod method);
+v1::Backend backendToWire(std::string_view backend);
+v1::RenderSettings settingsToWire(const SessionConfig& config);
+
+// Serialised ServerMessages.
+std::string serialize(const v1::ServerMessage& message);
+std::string errorMessage(const ProtocolError& error);
+
+}  // namespace haarcast::net

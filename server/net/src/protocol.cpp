@@ -1,0 +1,336 @@
+#include "haarcast/net/protocol.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include <google/protobuf/unknown_field_set.h>
+
+namespace haarcast::net {
+namespace {
+
+ProtocolError error(v1::ErrorCode code, std::string message, bool fatal) {
+  return ProtocolError{code, std::move(message), fatal};
+}
+
+bool finite(const v1::Vec3& v) { return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z()); }
+glm::dvec3 toGlm(const v1::Vec3& v) { return {v.x(), v.y(), v.z()}; }
+
+std::optional<FrameEncoding> fromWire(v1::Encoding e) {
+  switch (e) {
+    case v1::ENCODING_JPEG: return FrameEncoding::Jpeg;
+    case v1::ENCODING_PNG: return FrameEncoding::Png;
+    case v1::ENCODING_RAW_RGBA8: return FrameEncoding::RawRgba8;
+    case v1::ENCODING_EXR: return FrameEncoding::Exr;
+    default: return std::nullopt;
+  }
+}
+
+std::optional<RotationMethod> methodFromWire(v1::RotationMethod m) {
+  switch (m) {
+    case v1::ROTATION_METHOD_HAAR: return RotationMethod::Haar;
+    case v1::ROTATION_METHOD_SPATIAL: return RotationMethod::Spatial;
+    case v1::ROTATION_METHOD_MATRIX: return RotationMethod::Matrix;
+    case v1::ROTATION_METHOD_TABLE: return RotationMethod::Table;
+    default: return std::nullopt;
+  }
+}
+
+// Validates settings into a copy; only a fully valid change is applied.
+std::optional<ProtocolError> mergeSettings(SessionConfig& config, const v1::RenderSettings& s, const Limits& limits,
+                                           const Catalog& catalog, bool fatal) {
+  SessionConfig next = config;
+  if (s.method() != v1::ROTATION_METHOD_UNSPECIFIED) {
+    const auto m = methodFromWire(s.method());
+    if (!m) return error(v1::ERROR_CODE_BAD_SETTINGS, "unknown rotation method " + std::to_string(s.method()), fatal);
+    next.method = *m;
+  }
+  if (s.level() != 0) {
+    if (s.level() < static_cast<std::uint32_t>(limits.minLevel) || s.level() > static_cast<std::uint32_t>(limits.maxLevel)) {
+      return error(v1::ERROR_CODE_BAD_SETTINGS,
+                   "level " + std::to_string(s.level()) + " is outside " + std::to_string(limits.minLevel) + ".." +
+                       std::to_string(limits.maxLevel),
+                   fatal);
+    }
+    next.level = static_cast<int>(s.level());
+  }
+  if (s.light_coefficients() != 0) {
+    if (s.light_coefficients() > limits.maxLightCoefficients) {
+      return error(v1::ERROR_CODE_BAD_SETTINGS,
+                   "light_coefficients " + std::to_string(s.light_coefficients()) + " is over the limit " +
+                       std::to_string(limits.maxLightCoefficients),
+                   fatal);
+    }
+    next.lightCoefficients = s.light_coefficients();
+  }
+  if (s.backend() != v1::BACKEND_UNSPECIFIED) {
+    const std::string name = s.backend() == v1::BACKEND_CPU      ? "cpu"
+                             : s.backend() == v1::BACKEND_VULKAN ? "vulkan"
+                                                                 : "";
+    if (name.empty()) return error(v1::ERROR_CODE_BAD_SETTINGS, "unknown backend " + std::to_string(s.backend()), fatal);
+    if (!catalog.offersBackend(name)) {
+      return error(v1::ERROR_CODE_BAD_SETTINGS, "backend " + name + " is not available on this server", fatal);
+    }
+    next.backend = name;
+  }
+  if (!std::isfinite(s.exposure_stops()) || std::abs(s.exposure_stops()) > 32.0) {
+    return error(v1::ERROR_CODE_BAD_SETTINGS, "exposure_stops must be finite and within ±32", fatal);
+  }
+  next.exposureStops = s.exposure_stops();
+  config = std::move(next);
+  return std::nullopt;
+}
+
+std::optional<ProtocolError> mergeScene(SessionConfig& config, const v1::SceneChoice& choice, const Catalog& catalog,
+                                        bool fatal) {
+  const Catalog::SceneEntry* scene = catalog.findScene(choice.scene());
+  if (!scene) return error(v1::ERROR_CODE_UNKNOWN_SCENE, "unknown scene \"" + choice.scene() + "\"", fatal);
+  std::vector<std::string> materials = scene->name == config.scene && !config.materials.empty()
+                                           ? config.materials
+                                           : scene->defaultMaterials;
+  // Sorted for a deterministic first error.
+  std::map<std::uint32_t, std::string> sorted(choice.object_materials().begin(), choice.object_materials().end());
+  for (const auto& [object, spec] : sorted) {
+    if (object >= materials.size()) {
+      return error(v1::ERROR_CODE_UNKNOWN_MATERIAL,
+                   "object " + std::to_string(object) + " does not exist: scene \"" + scene->name + "\" has " +
+                       std::to_string(materials.size()) + " objects",
+                   fatal);
+    }
+    // Only offered specs: a client must never make the server open a path.
+    if (!catalog.offersMaterial(spec)) {
+      return error(v1::ERROR_CODE_UNKNOWN_MATERIAL, "material \"" + spec + "\" is not offered by this server", fatal);
+    }
+    materials[object] = spec;
+  }
+  config.scene = scene->name;
+  config.materials = std::move(materials);
+  return std::nullopt;
+}
+
+}  // namespace
+
+const Catalog::SceneEntry* Catalog::findScene(std::string_view name) const {
+  if (scenes.empty()) return nullptr;
+  if (name.empty()) return &scenes.front();
+  for (const auto& s : scenes) {
+    if (s.name == name) return &s;
+  }
+  return nullptr;
+}
+
+bool Catalog::offersMaterial(std::string_view spec) const {
+  return std::find(materials.begin(), materials.end(), spec) != materials.end();
+}
+
+bool Catalog::offersBackend(std::string_view backend) const {
+  return std::find(backends.begin(), backends.end(), backend) != backends.end();
+}
+
+std::string SessionConfig::rendererKey() const {
+  std::ostringstream key;
+  key << "scene=" << scene << ";materials=";
+  for (const auto& m : materials) key << m << ',';
+  key << ";level=" << level << ";method=" << methodName(method) << ";backend=" << backend;
+  return key.str();
+}
+
+std::variant<v1::ClientMessage, ProtocolError> parseClientMessage(std::string_view bytes) {
+  v1::ClientMessage message;
+  if (bytes.size() > static_cast<std::size_t>(INT32_MAX) ||
+      !message.ParseFromArray(bytes.data(), static_cast<int>(bytes.size()))) {
+    return error(v1::ERROR_CODE_BAD_MESSAGE,
+                 "not a ClientMessage: " + std::to_string(bytes.size()) + " bytes that do not parse (garbage or truncated)",
+                 false);
+  }
+  if (message.body_case() == v1::ClientMessage::BODY_NOT_SET) {
+    // Name the unknown field, if any: a newer client's message type.
+    const auto& unknown = message.GetReflection()->GetUnknownFields(message);
+    if (unknown.field_count() > 0) {
+      return error(v1::ERROR_CODE_BAD_MESSAGE,
+                   "unknown message type: ClientMessage field " + std::to_string(unknown.field(0).number()) +
+                       " is not one this server knows",
+                   false);
+    }
+    return error(v1::ERROR_CODE_BAD_MESSAGE, "empty ClientMessage: no message type set", false);
+  }
+  return message;
+}
+
+std::variant<SessionConfig, ProtocolError> configFromHello(const v1::Hello& hello, const Limits& limits,
+                                                          const Defaults& defaults, const Catalog& catalog) {
+  if (hello.protocol_version() != kProtocolVersion) {
+    return error(v1::ERROR_CODE_UNSUPPORTED_VERSION,
+                 "protocol version " + std::to_string(hello.protocol_version()) + " is not supported (server speaks " +
+                     std::to_string(kProtocolVersion) + ")",
+                 true);
+  }
+  SessionConfig c;
+  const std::uint32_t w = hello.width() ? hello.width() : static_cast<std::uint32_t>(defaults.width);
+  const std::uint32_t h = hello.height() ? hello.height() : static_cast<std::uint32_t>(defaults.height);
+  // 0 × 0 is a mistake, not "default": both or neither must be given.
+  if ((hello.width() == 0) != (hello.height() == 0) || w > static_cast<std::uint32_t>(limits.maxWidth) ||
+      h > static_cast<std::uint32_t>(limits.maxHeight)) {
+    return error(v1::ERROR_CODE_BAD_RESOLUTION,
+                 "resolution " + std::to_string(hello.width()) + "x" + std::to_string(hello.height()) +
+                     " is outside 1x1.." + std::to_string(limits.maxWidth) + "x" + std::to_string(limits.maxHeight),
+                 true);
+  }
+  c.width = static_cast<int>(w);
+  c.height = static_cast<int>(h);
+  if (hello.encoding() == v1::ENCODING_UNSPECIFIED) {
+    c.encoding = defaults.encoding;
+  } else if (const auto e = fromWire(hello.encoding())) {
+    c.encoding = *e;
+  } else {
+    return error(v1::ERROR_CODE_BAD_SETTINGS, "unknown encoding " + std::to_string(hello.encoding()), true);
+  }
+  if (!std::isfinite(hello.fps_cap()) || hello.fps_cap() < 0.0) {
+    return error(v1::ERROR_CODE_BAD_SETTINGS, "fps_cap must be a finite number ≥ 0 (0 = server default)", true);
+  }
+  c.fps = hello.fps_cap() == 0.0 ? std::min(limits.defaultFps, limits.maxFps) : std::min(hello.fps_cap(), limits.maxFps);
+  if (hello.jpeg_quality() > 100) {
+    return error(v1::ERROR_CODE_BAD_SETTINGS,
+                 "jpeg_quality " + std::to_string(hello.jpeg_quality()) + " is outside 1..100", true);
+  }
+  c.jpegQuality = hello.jpeg_quality() ? static_cast<int>(hello.jpeg_quality()) : defaults.jpegQuality;
+  c.method = defaults.method;
+  c.level = defaults.level;
+  c.lightCoefficients = defaults.lightCoefficients;
+  c.backend = defaults.backend;
+  if (auto e = mergeScene(c, hello.scene(), catalog, true)) return *e;
+  if (auto e = mergeSettings(c, hello.settings(), limits, catalog, true)) return *e;
+  return c;
+}
+
+std::optional<ProtocolError> applySettings(SessionConfig& config, const v1::RenderSettings& settings,
+                                           const Limits& limits, const Catalog& catalog) {
+  return mergeSettings(config, settings, limits, catalog, false);
+}
+
+std::optional<ProtocolError> applySceneChoice(SessionConfig& config, const v1::SceneChoice& choice,
+                                              const Catalog& catalog) {
+  return mergeScene(config, choice, catalog, false);
+}
+
+PoseState initialPose(const render::Camera& camera, const std::vector<render::Pose>& poses) {
+  PoseState s;
+  s.camera = camera;
+  s.poses = poses;
+  return s;
+}
+
+std::optional<ProtocolError> applyPose(PoseState& state, const v1::PoseUpdate& update) {
+  if (update.sequence() <= state.sequence) return std::nullopt;  // stale
+  PoseState next = state;
+  if (update.has_camera()) {
+    const auto& c = update.camera();
+    if (!finite(c.eye()) || !finite(c.target()) || !finite(c.up()) || !std::isfinite(c.fov_y_degrees())) {
+      return error(v1::ERROR_CODE_BAD_MESSAGE, "pose " + std::to_string(update.sequence()) + ": camera has a non-finite number", false);
+    }
+    if (c.has_eye()) next.camera.eye = toGlm(c.eye());
+    if (c.has_target()) next.camera.target = toGlm(c.target());
+    if (c.has_up()) next.camera.up = toGlm(c.up());
+    if (c.fov_y_degrees() != 0.0) {
+      if (c.fov_y_degrees() <= 0.0 || c.fov_y_degrees() >= 179.0) {
+        return error(v1::ERROR_CODE_BAD_MESSAGE,
+                     "pose " + std::to_string(update.sequence()) + ": fov_y_degrees must be in (0, 179)", false);
+      }
+      next.camera.fovYDegrees = c.fov_y_degrees();
+    }
+    if (glm::length(next.camera.target - next.camera.eye) < 1e-9) {
+      return error(v1::ERROR_CODE_BAD_MESSAGE, "pose " + std::to_string(update.sequence()) + ": camera eye equals target", false);
+    }
+  }
+  for (const auto& o : update.objects()) {
+    if (o.object() >= next.poses.size()) {
+      return error(v1::ERROR_CODE_BAD_MESSAGE,
+                   "pose " + std::to_string(update.sequence()) + ": object " + std::to_string(o.object()) +
+                       " does not exist (the scene has " + std::to_string(next.poses.size()) + ")",
+                   false);
+    }
+    if (!finite(o.rotate_degrees()) || !finite(o.translate())) {
+      return error(v1::ERROR_CODE_BAD_MESSAGE, "pose " + std::to_string(update.sequence()) + ": object " +
+                                                   std::to_string(o.object()) + " has a non-finite number", false);
+    }
+    if (o.has_rotate_degrees()) next.poses[o.object()].rotateDegrees = toGlm(o.rotate_degrees());
+    if (o.has_translate()) next.poses[o.object()].translate = toGlm(o.translate());
+  }
+  if (update.has_light_rotate_degrees()) {
+    if (!finite(update.light_rotate_degrees())) {
+      return error(v1::ERROR_CODE_BAD_MESSAGE, "pose " + std::to_string(update.sequence()) + ": light rotation is not finite", false);
+    }
+    next.lightRotateDegrees = toGlm(update.light_rotate_degrees());
+  }
+  next.sequence = update.sequence();
+  next.clientTimeMs = std::isfinite(update.client_time_ms()) ? update.client_time_ms() : 0.0;
+  state = std::move(next);
+  return std::nullopt;
+}
+
+render::FrameRequest frameRequest(const PoseState& pose, const SessionConfig& config) {
+  render::FrameRequest r;
+  r.width = config.width;
+  r.height = config.height;
+  r.camera = pose.camera;
+  r.poses = pose.poses;
+  render::Pose light;
+  light.rotateDegrees = pose.lightRotateDegrees;
+  r.lightRotation = light.rotation();
+  r.lightCoefficients = config.lightCoefficients;
+  r.exposureStops = config.exposureStops;
+  return r;
+}
+
+v1::Encoding toWire(FrameEncoding encoding) {
+  switch (encoding) {
+    case FrameEncoding::Jpeg: return v1::ENCODING_JPEG;
+    case FrameEncoding::Png: return v1::ENCODING_PNG;
+    case FrameEncoding::RawRgba8: return v1::ENCODING_RAW_RGBA8;
+    case FrameEncoding::Exr: return v1::ENCODING_EXR;
+  }
+  return v1::ENCODING_UNSPECIFIED;
+}
+
+v1::RotationMethod toWire(RotationMethod method) {
+  switch (method) {
+    case RotationMethod::Haar: return v1::ROTATION_METHOD_HAAR;
+    case RotationMethod::Spatial: return v1::ROTATION_METHOD_SPATIAL;
+    case RotationMethod::Matrix: return v1::ROTATION_METHOD_MATRIX;
+    case RotationMethod::Table: return v1::ROTATION_METHOD_TABLE;
+  }
+  return v1::ROTATION_METHOD_UNSPECIFIED;
+}
+
+v1::Backend backendToWire(std::string_view backend) {
+  if (backend == "cpu") return v1::BACKEND_CPU;
+  if (backend == "vulkan") return v1::BACKEND_VULKAN;
+  return v1::BACKEND_UNSPECIFIED;
+}
+
+v1::RenderSettings settingsToWire(const SessionConfig& config) {
+  v1::RenderSettings s;
+  s.set_method(toWire(config.method));
+  s.set_level(static_cast<std::uint32_t>(config.level));
+  s.set_light_coefficients(static_cast<std::uint32_t>(config.lightCoefficients));
+  s.set_backend(backendToWire(config.backend));
+  s.set_exposure_stops(config.exposureStops);
+  return s;
+}
+
+std::string serialize(const v1::ServerMessage& message) {
+  std::string bytes;
+  message.SerializeToString(&bytes);
+  return bytes;
+}
+
+std::string errorMessage(const ProtocolError& e) {
+  v1::ServerMessage m;
+  auto* err = m.mutable_error();
+  err->set_code(e.code);
+  err->set_message(e.message);
+  err->set_fatal(e.fatal);
+  return serialize(m);
+}
+
+}  // namespace haarcast::net

@@ -1,0 +1,34 @@
+#version 450
+// The "gbuffer" pass, vertex stage. Non-indexed triangle list with no vertex
+// buffers: vertex k of the draw is corner k % 3 of triangle k / 3, fetched
+// through the object's index list, so the fragment stage gets the exact
+// barycentrics (corner one-hot, interpolated perspective-correct) and the
+// triangle id without any extension.
+layout(push_constant) uniform Push {
+  mat4 objectToClip;   // projection · view · object → world
+  uint objectId;       // scene order
+  uint triangleBase;   // the object's triangle 0 in the global numbering
+  uint pad0;
+  uint pad1;
+} pc;
+
+layout(std430, set = 0, binding = 0) readonly buffer Positions { vec4 positions[]; };  // object frame, global vertex ids
+layout(std430, set = 0, binding = 1) readonly buffer Normals { vec4 normals[]; };
+layout(std430, set = 0, binding = 2) readonly buffer Triangles { uint triangles[]; };
+
+layout(location = 0) out vec3 outNormal;
+layout(location = 1) out vec3 outPosition;
+layout(location = 2) out vec2 outBary;  // weights of corners 1 and 2 (Embree's u, v)
+layout(location = 3) flat out uint outTriangle;
+
+void main() {
+  uint triangle = uint(gl_VertexIndex) / 3u;
+  uint corner = uint(gl_VertexIndex) % 3u;
+  uint v = triangles[3u * (pc.triangleBase + triangle) + corner];
+  vec3 p = positions[v].xyz;
+  outNormal = normals[v].xyz;
+  outPosition = p;
+  outBary = vec2(corner == 1u ? 1.0 : 0.0, corner == 2u ? 1.0 : 0.0);
+  outTriangle = triangle;
+  gl_Position = pc.objectToClip * vec4(p, 1.0);
+}

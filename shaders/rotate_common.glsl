@@ -1,0 +1,82 @@
+// Shared by the rotation shaders rotate_haar/table/matrix.comp: the rotation
+// shader contract (bindings, push constants, specialisation constants) and the
+// small pieces of core math they all need, each a float port of the CPU
+// function it names. Included with GL_GOOGLE_include_directive; not compiled
+// on its own.
+//
+// Contract (shared with rotate_spatial.comp and the host dispatch):
+//   constant_id 0 = LEVEL: the map is M×M, M = 2^LEVEL, N = M² coefficients in
+//     the CPU HaarMap quadrant layout (haarcast/core/haar.h).
+//   constant_id 1 = THETA_SAMPLES: slices per channel per object.
+//   push constants: rotate samples first … first+count−1.
+//   binding 0: RotationSample per sample; binding 1: unrotated slices, slice s
+//   channel c at (s·3 + c)·N; binding 2: per-method data (rotation_data.h);
+//   binding 3: output, local sample i channel c at (i·3 + c)·N.
+//   Dispatch (count, 3, 1): one workgroup per (sample, channel).
+
+// kPi, the few-ULP transcendentals (sinCosPrecise, atan2Precise,
+// acosPrecise: Vulkan's own may be off by thousands of ULP, lavapipe's are)
+// and rotationYXY, rotX, rotY of core/rotation.cpp.
+#include "common/sphere.glsl"
+
+layout(constant_id = 0) const uint LEVEL = 5u;
+layout(constant_id = 1) const uint THETA_SAMPLES = 16u;
+
+const uint M = 1u << LEVEL;   // map side
+const uint N = M * M;         // coefficients per map
+const uint HALF = M / 2u;     // blocks per side at the finest detail level
+
+struct RotationSample {
+  uint slice;       // global slice index into binding 1
+  uint methodBase;  // the object's block in binding 2, in 32-bit words
+  float alpha;      // Y-X-Y Euler angles: R = Ry(α) Rx(β) Ry(γ) (core/rotation.h)
+  float beta;
+  float gamma;
+  uint pixel;
+  uint pad0;
+  uint pad1;
+};
+
+layout(push_constant) uniform RotationPush {
+  uint first;
+  uint count;
+  uint pad0;
+  uint pad1;
+} pushed;
+
+layout(std430, set = 0, binding = 0) readonly buffer RotationSamples { RotationSample samples[]; };
+layout(std430, set = 0, binding = 1) readonly buffer Slices { float slices[]; };
+layout(std430, set = 0, binding = 2) readonly buffer MethodData { uint methodData[]; };
+// coherent: workgroups read back what their own invocations wrote (after
+// memoryBarrierBuffer and barrier).
+layout(std430, set = 0, binding = 3) coherent buffer Rotated { float rotated[]; };
+
+float methodFloat(uint word) { return uintBitsToFloat(methodData[word]); }
+
+// Index of a detail coefficient in quadrant layout: HaarMap::detailIndexOf.
+// band 0 = horizontal, 1 = vertical, 2 = diagonal; level l, block (i, j).
+uint detailIndex(uint band, uint l, uint i, uint j) {
+  const uint blocks = 1u << l;
+  const uint row = i + (band == 0u ? 0u : blocks);
+  const uint col = j + (band == 1u ? 0u : blocks);
+  return row * M + col;
+}
+
+// Value of pixel (row, col) of the map whose coefficients start at base in
+// `slices`: the inverse Haar transform at one pixel, O(log N). Every basis
+// function is ±1/side on its support (the scaling function 1/M); h is + on
+// the left half, v on the top half, d where both or neither (haar.h).
+float slicePixel(uint base, uint row, uint col) {
+  float value = slices[base] / float(M);
+  for (uint l = 0u; l < LEVEL; ++l) {
+    const uint side = M >> l;
+    const uint i = row / side, j = col / side;
+    const float sh = (col % side) < side / 2u ? 1.0 : -1.0;
+    const float sv = (row % side) < side / 2u ? 1.0 : -1.0;
+    const float h = slices[base + detailIndex(0u, l, i, j)];
+    const float v = slices[base + detailIndex(1u, l, i, j)];
+    const float d = slices[base + detailIndex(2u, l, i, j)];
+    value += (sh * h + sv * v + sh * sv * d) / float(side);
+  }
+  return value;
+}

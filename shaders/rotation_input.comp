@@ -1,0 +1,80 @@
+#version 450
+// The "rotation-input" pass: per covered pixel, what the rotation needs (the
+// nearest θₒ slice and the Y-X-Y Euler angles of the local shading frame) and
+// what the triple product needs (object, vertices, barycentrics). The same
+// math as render::rotationInput (shading.cpp shadingFrame, rotation.cpp
+// eulerFromMatrix, brdf_slices.cpp nearestSlice), in float. Covered pixels
+// are compacted through an atomic counter, so their order is arbitrary;
+// every record carries its pixel. Local size 64, one invocation per pixel.
+#extension GL_GOOGLE_include_directive : require
+#include "common/frame.glsl"
+#include "common/sphere.glsl"
+
+layout(local_size_x = 64) in;
+
+struct RotationSample {
+  uint slice;
+  uint methodBase;
+  float alpha;
+  float beta;
+  float gamma;
+  uint pixel;
+  uint pad0;
+  uint pad1;
+};
+
+layout(std430, set = 0, binding = 0) readonly buffer Frame { FrameParams frame; };
+layout(std430, set = 0, binding = 1) readonly buffer Objects { ObjectInfo objects[]; };
+layout(std430, set = 0, binding = 2) readonly buffer Ids { uvec4 ids[]; };          // G-buffer: object+1, triangle, b1, b2
+layout(std430, set = 0, binding = 3) readonly buffer Normals { vec4 normals[]; };    // G-buffer: object-frame normal
+layout(std430, set = 0, binding = 4) readonly buffer Triangles { uint triangles[]; };  // global vertex ids, 3 per triangle
+layout(std430, set = 0, binding = 5) writeonly buffer Samples { RotationSample samples[]; };
+layout(std430, set = 0, binding = 6) writeonly buffer Shade { ShadeSample shade[]; };
+layout(std430, set = 0, binding = 7) buffer Counter { uint covered; };
+
+void main() {
+  uint p = gl_GlobalInvocationID.x;
+  if (p >= frame.width * frame.height) return;
+  uvec4 id = ids[p];
+  if (id.x == 0u) return;  // background
+  ObjectInfo o = objects[id.x - 1u];
+  uint x = p % frame.width, y = p / frame.width;
+
+  vec3 n = normalize(normals[p].xyz);
+  mat3 toWorld = mat3(o.rot0.xyz, o.rot1.xyz, o.rot2.xyz);
+  vec3 wo = transpose(toWorld) * -cameraDirection(frame, x, y);  // toward the eye, object frame
+
+  // shadingFrame: +Y = n, wo in the (Y, Z) half-plane at φ = 0.
+  float c = clamp(dot(n, wo), -1.0, 1.0);
+  float thetaOut = acosPrecise(max(c, 0.0));
+  vec3 z = wo - c * n;
+  if (dot(z, z) < 1e-16) {  // view along the normal: any tangent will do
+    z = abs(n.x) < 0.9 ? cross(n, vec3(1.0, 0.0, 0.0)) : cross(n, vec3(0.0, 1.0, 0.0));
+  }
+  z = normalize(z);
+  vec3 xAxis = cross(n, z);
+  mat3 m = mat3(xAxis, n, z);
+
+  // eulerFromMatrix: m·ŷ = n = (sin β sin α, cos β, sin β cos α).
+  float beta = acosPrecise(clamp(n.y, -1.0, 1.0));
+  float alpha, gamma;
+  if (sinPrecise(beta) > 1e-12) {
+    alpha = atan2Precise(n.x, n.z);
+    mat3 ry = transpose(rotX(beta)) * transpose(rotY(alpha)) * m;  // = R_y(γ)
+    gamma = atan2Precise(-ry[0][2], ry[0][0]);
+  } else {
+    alpha = atan2Precise(-xAxis.z, xAxis.x);  // the whole turn in α at the gimbal pole
+    gamma = 0.0;
+  }
+
+  // nearestSlice: the cell of [0, π/2] split into T that holds θₒ.
+  int t = clamp(int(floor(clamp(thetaOut, 0.0, kPi / 2.0) / (kPi / 2.0) * float(o.thetaSamples))), 0,
+                int(o.thetaSamples) - 1);
+
+  uint k = atomicAdd(covered, 1u);
+  samples[k] = RotationSample(o.sliceBase + uint(t), o.methodBase, alpha, beta, gamma, p, 0u, 0u);
+  uint tri = o.triangleBase + id.y;
+  float b1 = uintBitsToFloat(id.z), b2 = uintBitsToFloat(id.w);
+  shade[k] = ShadeSample(id.x - 1u, triangles[3u * tri], triangles[3u * tri + 1u], triangles[3u * tri + 2u],
+                         1.0 - b1 - b2, b1, b2, p);
+}

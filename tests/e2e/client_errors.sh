@@ -1,0 +1,84 @@
+#!/usr/bin/env bash
+# haarcast-client's failures, each with its exit code and a message that names
+# the cause: bad flags (2), connection refused (1), a missing or wrong token
+# (HTTP 401, 1), a server Error (1); and the good case (0). Then the server
+# must exit 0 on SIGTERM.
+#
+# usage: client_errors.sh HAARCAST HAARCAST_CLIENT
+set -uo pipefail
+server_bin="${1:?usage: client_errors.sh HAARCAST HAARCAST_CLIENT}"
+client_bin="${2:?usage: client_errors.sh HAARCAST HAARCAST_CLIENT}"
+work="$(mktemp -d -t haarcast-client-errors.XXXXXX)"
+server_pid=""
+cleanup() {
+  [[ -n "$server_pid" ]] && kill -KILL "$server_pid" 2>/dev/null
+  rm -rf "$work"
+}
+trap cleanup EXIT
+
+failures=0
+# expect NAME WANT_RC WANT_TEXT -- command...: the exit code and a piece of stderr.
+expect() {
+  local name="$1" want_rc="$2" want_text="$3"
+  shift 4
+  local rc=0
+  "$@" >"$work/out" 2>"$work/err" || rc=$?
+  if [[ "$rc" != "$want_rc" ]] || ! grep -qF -- "$want_text" "$work/err"; then
+    echo "FAIL $name: exit $rc (want $want_rc), stderr must contain \"$want_text\":"
+    sed 's/^/    /' "$work/err"
+    failures=$((failures + 1))
+  else
+    echo "ok   $name: exit $rc, \"$want_text\""
+  fi
+}
+
+expect "bad --size" 2 "--size" -- "$client_bin" ws://127.0.0.1:1 --size 0x10
+expect "bad --encoding" 2 "--encoding must be" -- "$client_bin" ws://127.0.0.1:1 --encoding webp
+expect "wss:// refused" 2 "wss://" -- "$client_bin" wss://127.0.0.1:1
+expect "connection refused" 1 "Connection refused" -- "$client_bin" ws://127.0.0.1:1 --frames 1 --quiet
+
+"$server_bin" serve --port 0 --token sekret --backend "${HAARCAST_SMOKE_BACKEND:-cpu}" \
+  >"$work/server.out" 2>"$work/server.err" </dev/null &
+server_pid=$!
+port=""
+for ((i = 0; i < 600; i++)); do
+  port="$(sed -n 's#.*listening on http://[^:]*:\([0-9]*\)/.*#\1#p' "$work/server.out" | head -1)"
+  [[ -n "$port" ]] && break
+  kill -0 "$server_pid" 2>/dev/null || break
+  sleep 0.1
+done
+if [[ -z "$port" ]]; then
+  echo "FAIL the server did not start:"
+  cat "$work/server.err"
+  exit 1
+fi
+url="ws://127.0.0.1:$port"
+common=(--frames 2 --size 64x64 --quiet --timeout 60)
+expect "no token" 1 "HTTP 401" -- "$client_bin" "$url" "${common[@]}"
+expect "wrong token" 1 "wrong --token" -- "$client_bin" "$url" "${common[@]}" --token nope
+expect "server Error (bad level)" 1 "ERROR_CODE_BAD_SETTINGS" -- "$client_bin" "$url" "${common[@]}" --token sekret --level 12
+expect "server Error (unknown material)" 1 "ERROR_CODE_UNKNOWN_MATERIAL" -- \
+  "$client_bin" "$url" "${common[@]}" --token sekret --material 0=no-such-material
+expect "good run" 0 "" -- "$client_bin" "$url" "${common[@]}" --token sekret --check-not-blank
+
+kill -TERM "$server_pid"
+rc=""
+for ((i = 0; i < 300; i++)); do
+  if ! kill -0 "$server_pid" 2>/dev/null; then
+    rc=0
+    wait "$server_pid" || rc=$?
+    break
+  fi
+  sleep 0.1
+done
+server_pid_done="$server_pid"
+server_pid=""
+if [[ "$rc" != 0 ]]; then
+  echo "FAIL the server (pid $server_pid_done) exited '${rc:-still running}' after SIGTERM, want 0"
+  kill -KILL "$server_pid_done" 2>/dev/null
+  failures=$((failures + 1))
+else
+  echo "ok   the server exited 0 on SIGTERM"
+fi
+((failures == 0)) || { echo "$failures check(s) failed"; exit 1; }
+echo "all checks passed"

@@ -1,0 +1,203 @@
+// Whole frames: the Vulkan backend against the CPU backend on the default
+// scene (level 4, 64×64) for every rotation method, plus the renderer's
+// contracts: no device allocation per frame, batching invisible in the
+// result, clear errors for what the GPU cannot do.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <memory>
+#include <string>
+
+#include "gpu_test_util.h"
+#include "haarcast/gpu/vulkan_renderer.h"
+#include "haarcast/render/renderer.h"
+
+namespace haarcast::gpu {
+namespace {
+
+// One cache in the build tree for every test process (CTest runs each test
+// in its own): slice tables and visibility are computed once and then read
+// back. The cache writes atomically and checks what it reads, so parallel
+// test processes may share it.
+const std::string& cacheDir() {
+  static const std::string path = HAARCAST_GPU_TEST_CACHE;
+  return path;
+}
+
+render::RenderOptions frameOptions(RotationMethod method, bool background) {
+  render::RenderOptions o;
+  o.width = o.height = 64;
+  o.level = 4;
+  o.method = method;
+  o.environmentBackground = background;
+  o.cacheDir = cacheDir();
+  o.threads = 0;
+  return o;
+}
+
+render::FrameRequest requestFor(const render::Scene& scene, int width, int height) {
+  render::FrameRequest r;
+  r.width = width;
+  r.height = height;
+  r.camera = scene.camera;
+  return r;
+}
+
+struct Comparison {
+  double psnr = 0.0;
+  double mse = 0.0;
+  std::size_t compared = 0;       // pixels covered identically
+  std::size_t objectPixels = 0;   // covered by either
+  std::size_t mismatched = 0;     // covered by one only
+};
+
+// PSNR over the pixels both backends cover identically (object or
+// background), peak = the reference's maximum over its object pixels
+// (DESIGN.md "Measurements"); coverage mismatches counted separately.
+Comparison compare(const render::Frame& reference, const render::Frame& test) {
+  Comparison c;
+  double peak = 0.0, sum = 0.0;
+  const std::size_t pixels = reference.objectMask.size();
+  for (std::size_t p = 0; p < pixels; ++p) {
+    const bool a = reference.objectMask[p] != 0, b = test.objectMask[p] != 0;
+    if (a || b) ++c.objectPixels;
+    if (a != b) {
+      ++c.mismatched;
+      continue;
+    }
+    ++c.compared;
+    for (std::size_t k = 0; k < 3; ++k) {
+      const double r = reference.image.rgb[3 * p + k], t = test.image.rgb[3 * p + k];
+      if (a) peak = std::max(peak, r);
+      sum += (r - t) * (r - t);
+    }
+  }
+  c.mse = c.compared ? sum / (3.0 * static_cast<double>(c.compared)) : 0.0;
+  c.psnr = c.mse > 0.0 ? 10.0 * std::log10(peak * peak / c.mse) : std::numeric_limits<double>::infinity();
+  return c;
+}
+
+// Renders one frame on each backend and checks what the comparison promises.
+void expectBackendsAgree(RotationMethod method, bool background) {
+  const render::Scene scene = render::defaultScene();
+  const render::RenderOptions o = frameOptions(method, background);
+  const auto cpu = render::makeCpuRenderer(scene, o);
+  VulkanRenderer gpu(scene, o, testing::testOptions());
+  const render::FrameRequest request = requestFor(scene, o.width, o.height);
+  const render::Frame a = cpu->render(request);
+  const render::Frame b = gpu.render(request);
+  const Comparison c = compare(a, b);
+  std::printf("%s, %s background: PSNR %.1f dB (MSE %.3g) over %zu pixels; %zu of %zu object pixels mismatched\n",
+              std::string(methodName(method)).c_str(), background ? "environment" : "black", c.psnr, c.mse, c.compared,
+              c.mismatched, c.objectPixels);
+  EXPECT_GE(c.psnr, 60.0);
+  EXPECT_LE(static_cast<double>(c.mismatched), 0.005 * static_cast<double>(c.objectPixels) + 1.0);
+  EXPECT_GT(c.objectPixels, 500u);
+  // The stages, in pipeline order, under the shared names.
+  ASSERT_EQ(b.stages.size(), 6u);
+  const char* names[] = {"light", "gbuffer", "rotation-input", "rotation", "triple-product", "tonemap"};
+  for (std::size_t i = 0; i < 6; ++i) EXPECT_EQ(b.stages[i].name, names[i]);
+  EXPECT_GT(b.coefficientBytes, 0u);
+  // RGBA8 is the CPU encoding of the frame's own linear image.
+  const auto expected = render::tonemapRgba8(b.image, request.exposureStops);
+  ASSERT_EQ(expected.size(), b.rgba8.size());
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < expected.size(); ++i) differ += expected[i] != b.rgba8[i];
+  EXPECT_LE(differ, 2u);
+  testing::expectNoValidationMessages(gpu.context());
+}
+
+// Every method, with the environment behind the objects (objects and
+// backdrop both compared).
+class WholeFrame : public ::testing::TestWithParam<RotationMethod> {};
+
+TEST_P(WholeFrame, VulkanMatchesTheCpuBackendAbove60dB) {
+  HAARCAST_REQUIRE_VULKAN();
+  expectBackendsAgree(GetParam(), true);
+}
+
+// A black background: only the objects' pixels carry light.
+TEST(WholeFrameBlack, VulkanMatchesTheCpuBackendAbove60dB) {
+  HAARCAST_REQUIRE_VULKAN();
+  expectBackendsAgree(RotationMethod::Haar, false);
+}
+
+INSTANTIATE_TEST_SUITE_P(Methods, WholeFrame,
+                         ::testing::Values(RotationMethod::Haar, RotationMethod::Spatial, RotationMethod::Matrix,
+                                           RotationMethod::Table),
+                         [](const auto& param) { return std::string(methodName(param.param)); });
+
+TEST(VulkanRenderer, AllocatesDeviceMemoryOncePerResolution) {
+  HAARCAST_REQUIRE_VULKAN();
+  const render::Scene scene = render::defaultScene();
+  const render::RenderOptions o = frameOptions(RotationMethod::Spatial, true);
+  VulkanRenderer gpu(scene, o, testing::testOptions());
+  render::FrameRequest request = requestFor(scene, 32, 32);
+  gpu.render(request);
+  const std::uint64_t afterFirst = gpu.context().allocationCount();
+  request.poses = {scene.objects[0].pose, scene.objects[1].pose};
+  request.poses[0].rotateDegrees = {0.0, 40.0, 0.0};
+  request.lightRotation = rotationMatrix({0.5, 0.2, 0.0});
+  for (int i = 0; i < 3; ++i) gpu.render(request);
+  EXPECT_EQ(gpu.context().allocationCount(), afterFirst) << "frames at one resolution allocated device memory";
+  request.width = 48;  // a new resolution reallocates once …
+  gpu.render(request);
+  const std::uint64_t afterResize = gpu.context().allocationCount();
+  EXPECT_GT(afterResize, afterFirst);
+  gpu.render(request);  // … and then not again
+  EXPECT_EQ(gpu.context().allocationCount(), afterResize);
+  testing::expectNoValidationMessages(gpu.context());
+}
+
+TEST(VulkanRenderer, BatchingTheRotationDoesNotChangeTheImage) {
+  HAARCAST_REQUIRE_VULKAN();
+  const render::Scene scene = render::defaultScene();
+  const render::RenderOptions o = frameOptions(RotationMethod::Spatial, false);
+  VulkanRenderer whole(scene, o, testing::testOptions());
+  VulkanRendererLimits small;
+  small.batchSamples = 97;
+  VulkanRenderer batched(scene, o, testing::testOptions(), {}, small);
+  const render::FrameRequest request = requestFor(scene, 40, 40);
+  const render::Frame a = whole.render(request);
+  const render::Frame b = batched.render(request);
+  EXPECT_EQ(whole.batchesLastFrame(), 1u);
+  EXPECT_GT(batched.batchesLastFrame(), 2u);
+  EXPECT_EQ(a.objectMask, b.objectMask);
+  EXPECT_EQ(a.image.rgb, b.image.rgb) << "every pixel is computed independently of its batch";
+  testing::expectNoValidationMessages(batched.context());
+}
+
+TEST(VulkanRenderer, RejectsWhatTheGpuCannotDoByName) {
+  HAARCAST_REQUIRE_VULKAN();
+  const render::Scene scene = render::defaultScene();
+  render::RenderOptions o = frameOptions(RotationMethod::Spatial, false);
+  o.level = 7;
+  try {
+    VulkanRenderer gpu(scene, o, testing::testOptions());
+    FAIL() << "level 7 accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("levels 2 to 6"), std::string::npos) << e.what();
+  }
+  o.level = 4;
+  VulkanRenderer gpu(scene, o, testing::testOptions());
+  render::FrameRequest bad = requestFor(scene, 16, 16);
+  bad.poses.resize(5);
+  EXPECT_THROW(gpu.render(bad), std::invalid_argument);
+  bad = requestFor(scene, 0, 16);
+  EXPECT_THROW(gpu.render(bad), std::invalid_argument);
+  // A device that does not exist is an error that lists the devices.
+  try {
+    VulkanOptions v = testing::testOptions();
+    v.device = "no-such-device";
+    VulkanRenderer none(scene, o, v);
+    FAIL() << "unknown device accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("no-such-device"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace haarcast::gpu

@@ -1,0 +1,212 @@
+#include "haarcast/net/protocol.h"
+
+#include <gtest/gtest.h>
+
+namespace haarcast::net {
+namespace {
+
+Catalog testCatalog() {
+  Catalog c;
+  c.scenes.push_back({"default", {"phong:64", "lambert"}, render::Camera{}, {render::Pose{}, render::Pose{}}});
+  c.scenes.push_back({"other", {"ggx:0.3"}, render::Camera{}, {render::Pose{}}});
+  c.materials = {"lambert", "phong:64", "ggx:0.3", "merl:steel"};
+  c.backends = {"cpu"};
+  return c;
+}
+
+v1::Hello goodHello() {
+  v1::Hello h;
+  h.set_protocol_version(kProtocolVersion);
+  h.set_width(64);
+  h.set_height(32);
+  h.set_encoding(v1::ENCODING_PNG);
+  h.set_fps_cap(10);
+  return h;
+}
+
+ProtocolError helloError(const v1::Hello& h, const Limits& limits = {}) {
+  auto r = configFromHello(h, limits, Defaults{}, testCatalog());
+  EXPECT_TRUE(std::holds_alternative<ProtocolError>(r)) << "accepted";
+  return std::holds_alternative<ProtocolError>(r) ? std::get<ProtocolError>(r) : ProtocolError{};
+}
+
+TEST(Protocol, ParsesAClientMessage) {
+  v1::ClientMessage m;
+  m.mutable_ping()->set_nonce(42);
+  const auto r = parseClientMessage(m.SerializeAsString());
+  ASSERT_TRUE(std::holds_alternative<v1::ClientMessage>(r));
+  EXPECT_EQ(std::get<v1::ClientMessage>(r).ping().nonce(), 42u);
+}
+
+TEST(Protocol, GarbageTruncatedEmptyAndUnknownAreBadMessages) {
+  const auto garbage = parseClientMessage(std::string("\xff\xff\xff\xff\xff\xff\xff\xff\xff\xff\xff", 11));
+  ASSERT_TRUE(std::holds_alternative<ProtocolError>(garbage));
+  EXPECT_EQ(std::get<ProtocolError>(garbage).code, v1::ERROR_CODE_BAD_MESSAGE);
+
+  v1::ClientMessage hello;
+  *hello.mutable_hello() = goodHello();
+  hello.mutable_hello()->set_client_name("a name long enough to be cut in the middle of the string");
+  const std::string bytes = hello.SerializeAsString();
+  const auto truncated = parseClientMessage(std::string_view(bytes).substr(0, bytes.size() - 10));
+  ASSERT_TRUE(std::holds_alternative<ProtocolError>(truncated));
+  EXPECT_NE(std::get<ProtocolError>(truncated).message.find("do not parse"), std::string::npos);
+
+  const auto empty = parseClientMessage("");
+  ASSERT_TRUE(std::holds_alternative<ProtocolError>(empty));
+  EXPECT_NE(std::get<ProtocolError>(empty).message.find("empty"), std::string::npos);
+
+  // Field 99, varint 1: a message type from a newer client.
+  const auto unknown = parseClientMessage(std::string("\x98\x06\x01", 3));
+  ASSERT_TRUE(std::holds_alternative<ProtocolError>(unknown));
+  EXPECT_NE(std::get<ProtocolError>(unknown).message.find("field 99"), std::string::npos)
+      << std::get<ProtocolError>(unknown).message;
+  EXPECT_FALSE(std::get<ProtocolError>(unknown).fatal);
+}
+
+TEST(Protocol, HelloGivesTheConfig) {
+  Limits limits;
+  limits.maxFps = 25;
+  auto h = goodHello();
+  h.set_fps_cap(100);
+  h.mutable_scene()->set_scene("default");
+  (*h.mutable_scene()->mutable_object_materials())[1] = "merl:steel";
+  h.mutable_settings()->set_level(3);
+  h.mutable_settings()->set_method(v1::ROTATION_METHOD_SPATIAL);
+  const auto r = configFromHello(h, limits, Defaults{}, testCatalog());
+  ASSERT_TRUE(std::holds_alternative<SessionConfig>(r)) << std::get<ProtocolError>(r).message;
+  const auto& c = std::get<SessionConfig>(r);
+  EXPECT_EQ(c.width, 64);
+  EXPECT_EQ(c.height, 32);
+  EXPECT_EQ(c.encoding, FrameEncoding::Png);
+  EXPECT_EQ(c.fps, 25.0);  // capped by the server
+  EXPECT_EQ(c.level, 3);
+  EXPECT_EQ(c.method, RotationMethod::Spatial);
+  EXPECT_EQ(c.materials, (std::vector<std::string>{"phong:64", "merl:steel"}));
+  // Same renderer iff scene, materials, level, method, backend agree.
+  SessionConfig other = c;
+  other.width = 128;
+  other.lightCoefficients = 7;
+  EXPECT_EQ(other.rendererKey(), c.rendererKey());
+  other.level = 4;
+  EXPECT_NE(other.rendererKey(), c.rendererKey());
+}
+
+TEST(Protocol, BadHellosNameWhatIsWrong) {
+  auto h = goodHello();
+  h.set_protocol_version(2);
+  EXPECT_EQ(helloError(h).code, v1::ERROR_CODE_UNSUPPORTED_VERSION);
+
+  h = goodHello();
+  h.set_width(100000);
+  h.set_height(100000);
+  auto e = helloError(h);
+  EXPECT_EQ(e.code, v1::ERROR_CODE_BAD_RESOLUTION);
+  EXPECT_NE(e.message.find("100000x100000"), std::string::npos) << e.message;
+  EXPECT_TRUE(e.fatal);
+
+  h = goodHello();
+  h.set_width(0);
+  EXPECT_EQ(helloError(h).code, v1::ERROR_CODE_BAD_RESOLUTION);
+
+  h = goodHello();
+  h.set_fps_cap(-1);
+  EXPECT_EQ(helloError(h).code, v1::ERROR_CODE_BAD_SETTINGS);
+  h.set_fps_cap(std::numeric_limits<double>::quiet_NaN());
+  EXPECT_EQ(helloError(h).code, v1::ERROR_CODE_BAD_SETTINGS);
+
+  h = goodHello();
+  h.set_jpeg_quality(101);
+  EXPECT_EQ(helloError(h).code, v1::ERROR_CODE_BAD_SETTINGS);
+
+  h = goodHello();
+  h.set_encoding(static_cast<v1::Encoding>(77));
+  EXPECT_EQ(helloError(h).code, v1::ERROR_CODE_BAD_SETTINGS);
+
+  h = goodHello();
+  h.mutable_scene()->set_scene("nope");
+  EXPECT_EQ(helloError(h).code, v1::ERROR_CODE_UNKNOWN_SCENE);
+
+  h = goodHello();
+  (*h.mutable_scene()->mutable_object_materials())[0] = "/etc/passwd";
+  e = helloError(h);
+  EXPECT_EQ(e.code, v1::ERROR_CODE_UNKNOWN_MATERIAL);
+  EXPECT_NE(e.message.find("/etc/passwd"), std::string::npos);
+
+  h = goodHello();
+  (*h.mutable_scene()->mutable_object_materials())[5] = "lambert";
+  EXPECT_EQ(helloError(h).code, v1::ERROR_CODE_UNKNOWN_MATERIAL);
+
+  h = goodHello();
+  h.mutable_settings()->set_level(9);
+  EXPECT_EQ(helloError(h).code, v1::ERROR_CODE_BAD_SETTINGS);
+
+  h = goodHello();
+  h.mutable_settings()->set_backend(v1::BACKEND_VULKAN);  // not in this catalogue
+  e = helloError(h);
+  EXPECT_EQ(e.code, v1::ERROR_CODE_BAD_SETTINGS);
+  EXPECT_NE(e.message.find("vulkan"), std::string::npos);
+}
+
+TEST(Protocol, SettingsChangeAllOrNothing) {
+  auto c = std::get<SessionConfig>(configFromHello(goodHello(), Limits{}, Defaults{}, testCatalog()));
+  const auto before = c;
+  v1::RenderSettings s;
+  s.set_level(3);
+  s.set_light_coefficients(1u << 20);  // over the limit: nothing applies
+  const auto e = applySettings(c, s, Limits{}, testCatalog());
+  ASSERT_TRUE(e);
+  EXPECT_FALSE(e->fatal);
+  EXPECT_EQ(c.level, before.level);
+  s.set_light_coefficients(32);
+  EXPECT_FALSE(applySettings(c, s, Limits{}, testCatalog()));
+  EXPECT_EQ(c.level, 3);
+  EXPECT_EQ(c.lightCoefficients, 32u);
+}
+
+TEST(Protocol, LatestPoseWinsAndBadPosesChangeNothing) {
+  PoseState state = initialPose(render::Camera{}, {render::Pose{}, render::Pose{}});
+  v1::PoseUpdate u;
+  u.set_sequence(5);
+  u.mutable_camera()->mutable_eye()->set_z(7);
+  auto* o = u.add_objects();
+  o->set_object(1);
+  o->mutable_rotate_degrees()->set_y(30);
+  u.set_client_time_ms(123);
+  EXPECT_FALSE(applyPose(state, u));
+  EXPECT_EQ(state.sequence, 5u);
+  EXPECT_EQ(state.camera.eye, glm::dvec3(0, 0, 7));
+  EXPECT_EQ(state.poses[1].rotateDegrees.y, 30);
+  EXPECT_EQ(state.clientTimeMs, 123);
+
+  v1::PoseUpdate stale;
+  stale.set_sequence(4);
+  stale.mutable_camera()->mutable_eye()->set_z(1);
+  EXPECT_FALSE(applyPose(state, stale));
+  EXPECT_EQ(state.camera.eye.z, 7);  // ignored
+
+  v1::PoseUpdate bad;
+  bad.set_sequence(6);
+  bad.mutable_camera()->mutable_eye()->set_z(2);
+  bad.add_objects()->set_object(9);
+  const auto e = applyPose(state, bad);
+  ASSERT_TRUE(e);
+  EXPECT_NE(e->message.find("object 9"), std::string::npos);
+  EXPECT_EQ(state.sequence, 5u);
+  EXPECT_EQ(state.camera.eye.z, 7);
+
+  v1::PoseUpdate nan;
+  nan.set_sequence(7);
+  nan.mutable_light_rotate_degrees()->set_x(std::numeric_limits<double>::infinity());
+  EXPECT_TRUE(applyPose(state, nan));
+
+  SessionConfig config;
+  config.width = 64;
+  config.height = 32;
+  const auto request = frameRequest(state, config);
+  EXPECT_EQ(request.width, 64);
+  EXPECT_EQ(request.poses.size(), 2u);
+  EXPECT_EQ(request.camera.eye.z, 7);
+}
+
+}  // namespace
+}  // namespace haarcast::net
