@@ -2,10 +2,10 @@
 // Faithful — a float port of rotateHaar (server/core/src/rotate_haar.cpp,
 // start level n−1), to which the tests compare it coefficient by coefficient.
 //
-// One workgroup per (sample, channel), 128 invocations (local_size_x: on
-// lavapipe 20–40% less CPU time than 256, measured; on an H100 SM, 21 such
-// workgroups fit its 228 KiB of shared memory, more than its 2,048 threads
-// take, so occupancy is not lost — computed, not measured). Steps:
+// One workgroup per (sample, channel); the local size is specialization
+// constant 2 (default 128), which the renderer sets per device: lavapipe runs
+// every barrier() over all SIMD groups of a workgroup, so small groups win
+// there (64), while a GPU wants more threads in flight (256). Steps:
 //  (1) f's exact differences across every pixel boundary, fT (θ) and fP (φ).
 //      They depend on the slice only, so the host derives them once per slice
 //      at load time (rotation_data.cpp, by rotate_haar's own formulas) and
@@ -49,7 +49,7 @@
 
 #include "rotate_common.glsl"
 
-layout(local_size_x = 128) in;  // momentSums[] has one entry per invocation
+layout(local_size_x = 128, local_size_x_id = 2) in;  // momentSums[] has one entry per invocation
 
 // Σ_{k=1}^{K−1} (2^k − 1)·2^k: where the level-K field starts in `fields`.
 uint fieldOffset(uint k) { return ((1u << (2u * k)) - 4u) / 3u - ((1u << k) - 2u); }
@@ -167,7 +167,7 @@ float jacobianDifference(mat3 rt, float row, float col, bool alongTheta, uint de
 }
 
 // Faithful's scaling coefficient: per-invocation partial sums of Σ v·moment.
-shared float momentSums[128];
+shared float momentSums[gl_WorkGroupSize.x];
 
 void main() {
   const uint local = gl_WorkGroupID.x;

@@ -3,7 +3,7 @@
 // tests compare it coefficient by coefficient: g = shift_α(blend of the two
 // nearest elevation matrices applied to shift_γ(f)).
 //
-// One workgroup per (sample, channel), 256 invocations (local_size_x).
+// One workgroup per (sample, channel), 256 invocations by default (specialization constant 2).
 // Shared memory: one map, N floats (16 KiB at level 6; LEVEL must lie in
 // [1, 6]). shift_γ(f) goes to the output region, the sparse products to
 // shared memory, and shift_α of them back to the output (rotate_shift.glsl).
@@ -18,7 +18,7 @@
 
 #include "rotate_common.glsl"
 
-layout(local_size_x = 256) in;
+layout(local_size_x = 256, local_size_x_id = 2) in;  // the renderer picks the size per device
 
 shared float buf[N];
 

@@ -3,7 +3,7 @@
 // compare it coefficient by coefficient: canonicalise the rotation, pick the
 // nearest pre-rotated copy (0, β_k, γ_j), apply α as an exact φ-shift.
 //
-// One workgroup per (sample, channel), 256 invocations (local_size_x).
+// One workgroup per (sample, channel), 256 invocations by default (specialization constant 2).
 // Shared memory: one map, N floats (16 KiB at level 6; LEVEL must lie in
 // [1, 6]). The copy is loaded into it and shifted (rotate_shift.glsl).
 //
@@ -16,7 +16,7 @@
 
 #include "rotate_common.glsl"
 
-layout(local_size_x = 256) in;
+layout(local_size_x = 256, local_size_x_id = 2) in;  // the renderer picks the size per device
 
 shared float buf[N];
 

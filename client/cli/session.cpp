@@ -35,7 +35,8 @@ struct Session::Impl : std::enable_shared_from_this<Session::Impl> {
         onMessage(std::move(messageCallback)),
         resolver(io),
         ws(io),
-        watchdog(io) {}
+        watchdog(io),
+        keepalive(io) {}
 
   std::size_t index;
   SessionConfig config;
@@ -46,6 +47,8 @@ struct Session::Impl : std::enable_shared_from_this<Session::Impl> {
   tcp::resolver resolver;
   websocket::stream<beast::tcp_stream> ws;
   asio::steady_timer watchdog;
+  asio::steady_timer keepalive;
+  std::uint64_t pingNonce = 0;
   beast::flat_buffer readBuffer;
   http::response<http::string_body> upgradeResponse;
   std::deque<std::string> writes;  // serialized ClientMessages; front() is in flight
@@ -73,8 +76,23 @@ struct Session::Impl : std::enable_shared_from_this<Session::Impl> {
     }
     closing = true;
     watchdog.cancel();
+    keepalive.cancel();
     beast::error_code ignored;
     beast::get_lowest_layer(ws).socket().close(ignored);
+  }
+
+  // The server closes sessions that send nothing for a while (its idle
+  // timeout), and a client waiting for a slow frame sends nothing: a Ping
+  // every 15 s keeps such a session open.
+  void scheduleKeepalive() {
+    keepalive.expires_after(std::chrono::seconds(15));
+    keepalive.async_wait([self = shared_from_this()](beast::error_code ec) {
+      if (ec || self->closing) return;
+      v1::ClientMessage ping;
+      ping.mutable_ping()->set_nonce(++self->pingNonce);
+      self->send(ping);
+      self->scheduleKeepalive();
+    });
   }
 
   void armWatchdog(const std::string& waitingFor) {
@@ -212,6 +230,7 @@ struct Session::Impl : std::enable_shared_from_this<Session::Impl> {
     if (welcomed) return fail("the server sent a second Welcome");
     welcome = w;
     welcomed = true;
+    scheduleKeepalive();
     if (w.protocol_version() != v1::PROTOCOL_VERSION_1) {
       onMessage(who() + "the server speaks protocol version " + std::to_string(w.protocol_version()) +
                 ", this client version 1");
@@ -335,6 +354,7 @@ struct Session::Impl : std::enable_shared_from_this<Session::Impl> {
   void finish() {
     closing = true;
     watchdog.cancel();
+    keepalive.cancel();
     ws.async_close(websocket::close_code::normal, [self = shared_from_this()](beast::error_code) {
       // The server may already be gone after answering; the frames are in.
       beast::error_code ignored;

@@ -314,6 +314,10 @@ async function main() {
   ErrorCode = root.lookupEnum('haarcast.v1.ErrorCode');
   connect();
   setInterval(updateHud, 250);
+  // The server closes sessions that send nothing for a while; a page left
+  // alone (no drags) pings to stay connected.
+  let nonce = 0;
+  setInterval(() => send({ ping: { nonce: ++nonce } }), 15000);
   requestAnimationFrame(tick);
 }
 
