@@ -61,6 +61,26 @@ expect "server Error (unknown material)" 1 "ERROR_CODE_UNKNOWN_MATERIAL" -- \
   "$client_bin" "$url" "${common[@]}" --token sekret --material 0=no-such-material
 expect "good run" 0 "" -- "$client_bin" "$url" "${common[@]}" --token sekret --check-not-blank
 
+# Two clients in one process playing a pose file: each records every pose's
+# frame in its own folder, and the frames differ (the file moves the camera).
+cat >"$work/path.json" <<'JSON'
+{"poses": [{"camera": {"eye": [0, 0.6, 3.4]}},
+           {"camera": {"eye": [2.4, 0.6, 2.4]}, "light_rotate_degrees": [0, 90, 0]},
+           {"objects": [{"object": 1, "rotate_degrees": [0, 45, 0]}]}]}
+JSON
+expect "two clients, pose file" 0 "" -- "$client_bin" "$url" --token sekret --size 32x32 --clients 2 \
+  --path "$work/path.json" --out "$work/frames" --check-not-blank --quiet --timeout 60
+for c in 0 1; do
+  n="$(find "$work/frames/client-$c" -type f -name 'frame-*.jpg' 2>/dev/null | wc -l)"
+  distinct="$(cksum "$work/frames/client-$c"/* 2>/dev/null | awk '{print $1}' | sort -u | wc -l)"
+  if [[ "$n" != 3 || "$distinct" -lt 2 ]]; then
+    echo "FAIL client-$c recorded $n frames ($distinct distinct), want 3 (the file's length), not all equal"
+    failures=$((failures + 1))
+  else
+    echo "ok   client-$c recorded the file's 3 poses ($distinct distinct frames)"
+  fi
+done
+
 kill -TERM "$server_pid"
 rc=""
 for ((i = 0; i < 300; i++)); do

@@ -542,9 +542,17 @@ TEST(ServerBadInput, OversizedMessages) {
     Client c(server.port());
     c.sendBytes(std::string(1u << 20, 'x'));  // far over: cut by the WebSocket layer
     EXPECT_FALSE(c.read(10s));
-    EXPECT_FALSE(c.timedOut);
-    EXPECT_EQ(c.closeReason.code, websocket::close_code::too_big);
+    EXPECT_FALSE(c.timedOut) << "the server did not close the session";
+    // Close code 1009 when the close frame reaches the client before the
+    // server's teardown resets the connection under the rest of the 1 MiB
+    // it is still sending; a reset otherwise. Either way the server counted it.
+    if (c.closeReason.code != websocket::close_code::none) {
+      EXPECT_EQ(c.closeReason.code, websocket::close_code::too_big);
+    }
   }
+  EXPECT_NE(server.server().metrics().prometheusText().find("haarcast_errors_total{code=\"message_too_large\"} 2"),
+            std::string::npos)
+      << server.server().metrics().prometheusText();
   EXPECT_TRUE(healthy.waitForFrames(2));
 }
 
