@@ -73,19 +73,7 @@ ComputePipeline::ComputePipeline(Context& context, std::string_view shaderName, 
     cp.layout = layout_;
     vkCheck(vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &cp, nullptr, &pipeline_), "vkCreateComputePipelines");
 
-    VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, std::max<std::uint32_t>(storageBuffers, 1)};
-    VkDescriptorPoolCreateInfo dp{};
-    dp.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
-    dp.maxSets = 1;
-    dp.poolSizeCount = 1;
-    dp.pPoolSizes = &size;
-    vkCheck(vkCreateDescriptorPool(device, &dp, nullptr, &pool_), "vkCreateDescriptorPool");
-    VkDescriptorSetAllocateInfo da{};
-    da.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
-    da.descriptorPool = pool_;
-    da.descriptorSetCount = 1;
-    da.pSetLayouts = &setLayout_;
-    vkCheck(vkAllocateDescriptorSets(device, &da, &set_), "vkAllocateDescriptorSets");
+    allocateStorageSet(device, setLayout_, storageBuffers, pool_, set_);
   } catch (...) {
     vkDestroyShaderModule(device, module, nullptr);
     destroy();  // the destructor does not run for a constructor that throws
@@ -151,6 +139,23 @@ void computeBarrier(VkCommandBuffer cb) {
   vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
                        VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_HOST_BIT,
                        0, 1, &m, 0, nullptr, 0, nullptr);
+}
+
+void allocateStorageSet(VkDevice device, VkDescriptorSetLayout layout, std::uint32_t storageBuffers,
+                        VkDescriptorPool& pool, VkDescriptorSet& set) {
+  VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, std::max<std::uint32_t>(storageBuffers, 1)};
+  VkDescriptorPoolCreateInfo dp{};
+  dp.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
+  dp.maxSets = 1;
+  dp.poolSizeCount = 1;
+  dp.pPoolSizes = &size;
+  vkCheck(vkCreateDescriptorPool(device, &dp, nullptr, &pool), "vkCreateDescriptorPool");
+  VkDescriptorSetAllocateInfo da{};
+  da.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
+  da.descriptorPool = pool;
+  da.descriptorSetCount = 1;
+  da.pSetLayouts = &layout;
+  vkCheck(vkAllocateDescriptorSets(device, &da, &set), "vkAllocateDescriptorSets");
 }
 
 }  // namespace haarcast::gpu

@@ -416,19 +416,7 @@ void VulkanRenderer::Impl::createGraphicsPipeline() {
   vkDestroyShaderModule(device, vert, nullptr);
   vkDestroyShaderModule(device, frag, nullptr);
 
-  VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 3};
-  VkDescriptorPoolCreateInfo dp{};
-  dp.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
-  dp.maxSets = 1;
-  dp.poolSizeCount = 1;
-  dp.pPoolSizes = &size;
-  vkCheck(vkCreateDescriptorPool(device, &dp, nullptr, &gbufferPool), "vkCreateDescriptorPool");
-  VkDescriptorSetAllocateInfo da{};
-  da.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
-  da.descriptorPool = gbufferPool;
-  da.descriptorSetCount = 1;
-  da.pSetLayouts = &gbufferSetLayout;
-  vkCheck(vkAllocateDescriptorSets(device, &da, &gbufferSet), "vkAllocateDescriptorSets");
+  allocateStorageSet(device, gbufferSetLayout, 3, gbufferPool, gbufferSet);
   const VkDescriptorBufferInfo infos[3] = {{positions.handle(), 0, VK_WHOLE_SIZE},
                                            {normals.handle(), 0, VK_WHOLE_SIZE},
                                            {triangles.handle(), 0, VK_WHOLE_SIZE}};

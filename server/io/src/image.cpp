@@ -203,7 +203,7 @@ bool parseInteger(const std::string& token, long long& value) {
   return endp == token.c_str() + token.size();
 }
 
-// ---------------------------------------------------------------- sRGB
+}  // namespace
 
 std::uint8_t encodeSrgb(double linear) {
   if (!(linear > 0.0)) return 0;  // also NaN
@@ -212,8 +212,6 @@ std::uint8_t encodeSrgb(double linear) {
   const double s = linear <= 0.0031308 ? 12.92 * linear : 1.055 * std::pow(linear, 1.0 / 2.4) - 0.055;
   return static_cast<std::uint8_t>(std::lround(std::clamp(s, 0.0, 1.0) * 255.0));
 }
-
-}  // namespace
 
 RgbImage makeImage(int width, int height) {
   if (width <= 0 || height <= 0 || width > kMaxImageDimension || height > kMaxImageDimension ||

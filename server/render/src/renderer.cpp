@@ -25,14 +25,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-// IEC 61966-2-1, as io::writePng encodes.
-std::uint8_t encodeSrgb(double linear) {
-  if (!(linear > 0.0)) return 0;  // also NaN
-  if (linear >= 1.0) return 255;
-  const double s = linear <= 0.0031308 ? 12.92 * linear : 1.055 * std::pow(linear, 1.0 / 2.4) - 0.055;
-  return static_cast<std::uint8_t>(std::lround(std::clamp(s, 0.0, 1.0) * 255.0));
-}
-
 }  // namespace
 
 // ---------------------------------------------------------------- shared steps
@@ -127,7 +119,7 @@ std::vector<std::uint8_t> tonemapRgba8(const io::RgbImage& image, double exposur
   const std::size_t pixels = static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height);
   std::vector<std::uint8_t> out(pixels * 4);
   for (std::size_t p = 0; p < pixels; ++p) {
-    for (std::size_t c = 0; c < 3; ++c) out[4 * p + c] = encodeSrgb(image.rgb[3 * p + c] * gain);
+    for (std::size_t c = 0; c < 3; ++c) out[4 * p + c] = io::encodeSrgb(image.rgb[3 * p + c] * gain);
     out[4 * p + 3] = 255;
   }
   return out;

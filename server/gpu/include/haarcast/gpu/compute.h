@@ -62,4 +62,9 @@ class ComputePipeline {
 // barrier between two passes of one command buffer).
 void computeBarrier(VkCommandBuffer cb);
 
+// One descriptor set of `storageBuffers` storage buffers with `layout`, from
+// a pool of its own (sized for exactly that set). The caller destroys the pool.
+void allocateStorageSet(VkDevice device, VkDescriptorSetLayout layout, std::uint32_t storageBuffers,
+                        VkDescriptorPool& pool, VkDescriptorSet& set);
+
 }  // namespace haarcast::gpu

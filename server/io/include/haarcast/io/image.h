@@ -10,6 +10,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -72,5 +73,9 @@ void writePfm(const std::string& path, const RgbImage& image);
 // 2^exposureStops, clamped to [0, 1] (NaN → 0), encoded with the sRGB transfer
 // function (IEC 61966-2-1) and rounded.
 void writePng(const std::string& path, const RgbImage& image, double exposureStops = 0.0);
+
+// One linear value to an 8-bit sRGB byte: clamped to [0, 1] (NaN → 0), the
+// IEC 61966-2-1 transfer function, rounded. writePng and every tonemap use it.
+std::uint8_t encodeSrgb(double linear);
 
 }  // namespace haarcast::io
