@@ -19,7 +19,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "haarcast/gpu/vulkan_renderer.h"
+#include "haarcast/gpu/backend.h"
 #include "haarcast/render/renderer.h"
 #include "haarcast/render/scene.h"
 
@@ -167,12 +167,12 @@ int run(const BenchArgs& a) {
       options.cacheDir = a.cacheDir == "none" ? "" : a.cacheDir;
       std::fprintf(stderr, "[bench-frame] level %d, %s: preparing\n", level, std::string(methodName(method)).c_str());
       std::unique_ptr<render::Renderer> cpuRenderer, gpuRenderer;
-      if (cpu) cpuRenderer = render::makeCpuRenderer(scene, options);
+      if (cpu) cpuRenderer = gpu::makeRenderer("cpu", scene, options);
       if (vulkan) {
         gpu::VulkanOptions v;
         v.device = a.device;
         v.validation = false;  // timing: validation layers would dominate
-        gpuRenderer = gpu::makeVulkanRenderer(scene, options, v);
+        gpuRenderer = gpu::makeRenderer("vulkan", scene, options, v);
         out["vulkan_device"] = gpuRenderer->deviceName();
       }
       if (cpuRenderer) out["cpu_device"] = cpuRenderer->deviceName();

@@ -9,8 +9,7 @@
 
 #include <unistd.h>
 
-#include "haarcast/gpu/vulkan_renderer.h"
-#include "haarcast/render/cpu_renderer.h"
+#include "haarcast/gpu/backend.h"
 #include "haarcast/render/renderer.h"
 #include "haarcast/render/scene.h"
 #include "scene_flags.h"
@@ -80,15 +79,10 @@ int run(RenderArgs& a) {
   // One renderer behind the shared interface: the same scene, request and
   // outputs whichever backend draws them.
   const auto t0 = std::chrono::steady_clock::now();
-  std::unique_ptr<render::Renderer> renderer;
-  if (a.backend == "vulkan") {
-    gpu::VulkanOptions vulkan;
-    vulkan.device = a.device;
-    vulkan.validation = a.validation;
-    renderer = gpu::makeVulkanRenderer(scene, a.options, vulkan, showProgress);
-  } else {
-    renderer = render::makeCpuRenderer(scene, a.options, showProgress);
-  }
+  gpu::VulkanOptions vulkan;
+  vulkan.device = a.device;
+  vulkan.validation = a.validation;
+  const std::unique_ptr<render::Renderer> renderer = gpu::makeRenderer(a.backend, scene, a.options, vulkan, showProgress);
   const double prepare = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   render::FrameRequest request;
   request.width = a.options.width;

@@ -15,7 +15,7 @@
 #include <unistd.h>
 #include <vector>
 
-#include "haarcast/net/backend.h"
+#include "haarcast/gpu/backend.h"
 #include "haarcast/net/server.h"
 #include "haarcast/render/scene.h"
 
@@ -106,7 +106,7 @@ int run(ServeArgs& a) {
     }
     catalog.scenes.push_back(std::move(entry));
   }
-  catalog.backends = net::availableBackends();
+  catalog.backends = gpu::availableBackends();
   if (!catalog.offersBackend(a.backend)) {
     throw std::invalid_argument("--backend " + a.backend + " is not built into this server");
   }
@@ -147,10 +147,10 @@ int run(ServeArgs& a) {
   render::RenderOptions base;
   base.cacheDir = a.cacheDir.empty() ? defaultCacheDir() : (a.cacheDir == "none" ? "" : a.cacheDir);
   base.threads = a.renderThreads;
-  const net::BackendOptions backendOptions{a.vulkanDevice, a.vulkanValidation};
+  const gpu::VulkanOptions vulkanOptions{a.vulkanDevice, a.vulkanValidation};
   auto sharedScenes = std::make_shared<std::vector<SceneSource>>(std::move(scenes));
   const bool quiet = a.quiet;
-  net::RendererBuilder builder = [sharedScenes, materialFiles, base, backendOptions, quiet](const net::SessionConfig& c) {
+  net::RendererBuilder builder = [sharedScenes, materialFiles, base, vulkanOptions, quiet](const net::SessionConfig& c) {
     const auto it = std::find_if(sharedScenes->begin(), sharedScenes->end(),
                                  [&](const SceneSource& s) { return s.name == c.scene; });
     if (it == sharedScenes->end()) throw std::invalid_argument("unknown scene \"" + c.scene + "\"");
@@ -167,7 +167,7 @@ int run(ServeArgs& a) {
     options.lightCoefficients = c.lightCoefficients;
     if (!quiet) std::fprintf(stderr, "[serve] preparing renderer %s\n", c.rendererKey().c_str());
     auto prepared = std::make_shared<net::PreparedRenderer>();
-    prepared->renderer = net::makeRenderer(c.backend, scene, options, backendOptions);
+    prepared->renderer = gpu::makeRenderer(c.backend, scene, options, vulkanOptions);
     if (!quiet) {
       std::fprintf(stderr, "[serve] renderer ready: %s on %s\n", prepared->renderer->backend().c_str(),
                    prepared->renderer->deviceName().c_str());

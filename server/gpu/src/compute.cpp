@@ -29,18 +29,7 @@ ComputePipeline::ComputePipeline(Context& context, std::string_view shaderName, 
   VkDevice device = context.device();
   VkShaderModule module = createShaderModule(context, shaderName);
   try {
-    std::vector<VkDescriptorSetLayoutBinding> bindings(storageBuffers);
-    for (std::uint32_t i = 0; i < storageBuffers; ++i) {
-      bindings[i].binding = i;
-      bindings[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-      bindings[i].descriptorCount = 1;
-      bindings[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
-    }
-    VkDescriptorSetLayoutCreateInfo sl{};
-    sl.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
-    sl.bindingCount = storageBuffers;
-    sl.pBindings = bindings.data();
-    vkCheck(vkCreateDescriptorSetLayout(device, &sl, nullptr, &setLayout_), "vkCreateDescriptorSetLayout");
+    setLayout_ = createStorageSetLayout(device, storageBuffers, VK_SHADER_STAGE_COMPUTE_BIT);
 
     VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, pushConstantBytes};
     VkPipelineLayoutCreateInfo pl{};
@@ -139,6 +128,23 @@ void computeBarrier(VkCommandBuffer cb) {
   vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
                        VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_HOST_BIT,
                        0, 1, &m, 0, nullptr, 0, nullptr);
+}
+
+VkDescriptorSetLayout createStorageSetLayout(VkDevice device, std::uint32_t storageBuffers, VkShaderStageFlags stages) {
+  std::vector<VkDescriptorSetLayoutBinding> bindings(storageBuffers);
+  for (std::uint32_t i = 0; i < storageBuffers; ++i) {
+    bindings[i].binding = i;
+    bindings[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    bindings[i].descriptorCount = 1;
+    bindings[i].stageFlags = stages;
+  }
+  VkDescriptorSetLayoutCreateInfo sl{};
+  sl.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
+  sl.bindingCount = storageBuffers;
+  sl.pBindings = bindings.data();
+  VkDescriptorSetLayout layout = VK_NULL_HANDLE;
+  vkCheck(vkCreateDescriptorSetLayout(device, &sl, nullptr, &layout), "vkCreateDescriptorSetLayout");
+  return layout;
 }
 
 void allocateStorageSet(VkDevice device, VkDescriptorSetLayout layout, std::uint32_t storageBuffers,

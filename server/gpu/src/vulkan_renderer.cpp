@@ -322,18 +322,7 @@ void VulkanRenderer::Impl::createGraphicsPipeline() {
   vkCheck(vkCreateRenderPass(device, &rp, nullptr, &renderPass), "vkCreateRenderPass");
 
   // Set 0: positions, normals, triangles (vertex stage storage buffers).
-  std::array<VkDescriptorSetLayoutBinding, 3> b{};
-  for (std::uint32_t i = 0; i < 3; ++i) {
-    b[i].binding = i;
-    b[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    b[i].descriptorCount = 1;
-    b[i].stageFlags = VK_SHADER_STAGE_VERTEX_BIT;
-  }
-  VkDescriptorSetLayoutCreateInfo sl{};
-  sl.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
-  sl.bindingCount = 3;
-  sl.pBindings = b.data();
-  vkCheck(vkCreateDescriptorSetLayout(device, &sl, nullptr, &gbufferSetLayout), "vkCreateDescriptorSetLayout");
+  gbufferSetLayout = createStorageSetLayout(device, 3, VK_SHADER_STAGE_VERTEX_BIT);
   VkPushConstantRange range{VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(GBufferPush)};
   VkPipelineLayoutCreateInfo pl{};
   pl.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;

@@ -163,6 +163,10 @@ class CpuRenderer final : public Renderer {
       for (int c = 0; c < 3; ++c) r[static_cast<std::size_t>(c)] = makeRotator(options.method, p.table.channelSlices(c), options.rotator);
       rotators_.push_back(std::move(r));
     }
+    // The meshes' ray structures are built once; frames only move them.
+    std::vector<Instance> instances;
+    for (const PreparedObject& p : prepared_.objects) instances.push_back({p.mesh.get(), glm::mat4(p.pose.objectToWorld())});
+    rays_ = std::make_unique<RayScene>(std::move(instances));
   }
 
   std::string backend() const override { return "cpu"; }
@@ -182,6 +186,7 @@ class CpuRenderer final : public Renderer {
   RenderOptions options_;
   PreparedScene prepared_;
   std::vector<std::array<std::unique_ptr<SliceRotator>, 3>> rotators_;
+  std::unique_ptr<RayScene> rays_;  // posed per frame with setTransform (top level only)
 };
 
 std::size_t CpuRenderer::rotationBytes(std::size_t object) const {
@@ -215,11 +220,8 @@ Frame CpuRenderer::render(const FrameRequest& request) {
 
   // ---- gbuffer: Embree primary rays at pixel centres ----------------------
   t0 = Clock::now();
-  std::vector<Instance> instances;
-  for (std::size_t i = 0; i < prepared_.objects.size(); ++i) {
-    instances.push_back({prepared_.objects[i].mesh.get(), glm::mat4(poseOf(i).objectToWorld())});
-  }
-  const RayScene rays(std::move(instances));
+  for (std::size_t i = 0; i < prepared_.objects.size(); ++i) rays_->setTransform(i, glm::mat4(poseOf(i).objectToWorld()));
+  const RayScene& rays = *rays_;
   const int w = request.width, h = request.height;
   const CameraRays camera(request.camera, w, h);
   const std::size_t pixels = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);

@@ -17,7 +17,7 @@
 #include <boost/beast/websocket.hpp>
 #include <gtest/gtest.h>
 
-#include "haarcast/net/backend.h"
+#include "haarcast/gpu/backend.h"
 #include "haarcast/net/encode.h"
 
 namespace haarcast::net {
@@ -58,7 +58,7 @@ RendererBuilder testBuilder() {
     options.lightCoefficients = c.lightCoefficients;
     options.cacheDir = HAARCAST_TEST_CACHE_DIR;
     auto p = std::make_shared<PreparedRenderer>();
-    p->renderer = makeRenderer(c.backend, scene, options, {});
+    p->renderer = gpu::makeRenderer(c.backend, scene, options);
     return p;
   };
 }

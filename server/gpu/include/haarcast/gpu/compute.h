@@ -62,6 +62,10 @@ class ComputePipeline {
 // barrier between two passes of one command buffer).
 void computeBarrier(VkCommandBuffer cb);
 
+// A set layout of `storageBuffers` storage buffers at bindings 0…count−1,
+// visible to `stages`. The caller destroys it.
+VkDescriptorSetLayout createStorageSetLayout(VkDevice device, std::uint32_t storageBuffers, VkShaderStageFlags stages);
+
 // One descriptor set of `storageBuffers` storage buffers with `layout`, from
 // a pool of its own (sized for exactly that set). The caller destroys the pool.
 void allocateStorageSet(VkDevice device, VkDescriptorSetLayout layout, std::uint32_t storageBuffers,

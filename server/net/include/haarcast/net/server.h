@@ -50,7 +50,7 @@ struct ServerOptions {
 class Server {
  public:
   // Binds and listens at once; throws std::runtime_error naming the address
-  // when it cannot. The renderers come from `builder` (backend.h's factory
+  // when it cannot. The renderers come from `builder` (haarcast/gpu/backend.h
   // in `haarcast serve`).
   Server(ServerOptions options, Catalog catalog, RendererBuilder builder);
   ~Server();  // stop() and wait()
