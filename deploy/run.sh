@@ -50,6 +50,8 @@ PACKAGES=(
   libturbojpeg0-dev
   chromium
   nodejs
+  # Step 5: Google Highway for the fused kernel's SIMD (runtime dispatch).
+  libhwy-dev
 )
 
 # Build folder, relative to the repository root (HAARCAST_BUILD_DIR overrides).
