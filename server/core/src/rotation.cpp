@@ -65,14 +65,21 @@ std::string_view methodName(RotationMethod m) {
     case RotationMethod::Spatial: return "spatial";
     case RotationMethod::Matrix: return "matrix";
     case RotationMethod::Table: return "table";
+    case RotationMethod::Fused: return "fused";
   }
   return "?";
 }
 
 std::optional<RotationMethod> parseRotationMethod(std::string_view name) {
-  for (RotationMethod m : kAllRotationMethods)
+  for (RotationMethod m : kAllPixelMethods)
     if (methodName(m) == name) return m;
   return std::nullopt;
+}
+
+std::string pixelMethodNames() {
+  std::string out;
+  for (RotationMethod m : kAllPixelMethods) out += (out.empty() ? "" : ", ") + std::string(methodName(m));
+  return out;
 }
 
 std::string_view variantName(HaarVariant v) {
@@ -111,6 +118,8 @@ std::unique_ptr<SliceRotator> makeRotator(RotationMethod method, std::vector<Haa
     case RotationMethod::Spatial: return detail::makeSpatialRotator(std::move(slices), options);
     case RotationMethod::Matrix: return detail::makeMatrixRotator(std::move(slices), options);
     case RotationMethod::Table: return detail::makeTableRotator(std::move(slices), options);
+    case RotationMethod::Fused:
+      throw std::invalid_argument("makeRotator: fused rotates no coefficients (it samples the slice per pixel, core/fused.h)");
   }
   throw std::invalid_argument("makeRotator: unknown method");
 }

@@ -36,14 +36,26 @@ glm::dmat3 rotationMatrix(const EulerYXY& r);
 // between α and γ is arbitrary; this puts all of it in α (γ = 0).
 EulerYXY eulerFromMatrix(const glm::dmat3& m);
 
-enum class RotationMethod { Haar, Spatial, Matrix, Table };
+// The per-pixel methods (DESIGN.md "Per-pixel methods"). Four of them rotate
+// a slice's coefficients (a SliceRotator each); `fused` never forms rotated
+// coefficients: it sums the rotated slice against light × visibility in the
+// pixel basis (fused.h), the same integral as `spatial` + the triple product.
+enum class RotationMethod { Haar, Spatial, Matrix, Table, Fused };
 
+// The methods that make rotated coefficients (makeRotator accepts these).
 inline constexpr RotationMethod kAllRotationMethods[] = {RotationMethod::Haar, RotationMethod::Spatial,
                                                          RotationMethod::Matrix, RotationMethod::Table};
+// Every per-pixel method a renderer accepts, the default first.
+inline constexpr RotationMethod kAllPixelMethods[] = {RotationMethod::Fused, RotationMethod::Haar,
+                                                      RotationMethod::Spatial, RotationMethod::Matrix,
+                                                      RotationMethod::Table};
+inline constexpr RotationMethod kDefaultPixelMethod = RotationMethod::Fused;
 
 std::string_view methodName(RotationMethod m);
-// Accepts exactly the DESIGN.md names: "haar", "spatial", "matrix", "table".
+// Accepts exactly the DESIGN.md names: "fused", "haar", "spatial", "matrix", "table".
 std::optional<RotationMethod> parseRotationMethod(std::string_view name);
+// "fused, haar, spatial, matrix, table": for error messages that list the choices.
+std::string pixelMethodNames();
 
 // Variants of the seed's method (see rotate_haar.h for what each does).
 enum class HaarVariant {
@@ -86,7 +98,8 @@ class SliceRotator {
   virtual std::size_t storedBytes() const = 0;
 };
 
-// Throws std::invalid_argument if slices is empty or mixes levels.
+// Throws std::invalid_argument if slices is empty or mixes levels, or for
+// `fused`, which rotates no coefficients.
 std::unique_ptr<SliceRotator> makeRotator(RotationMethod method, std::vector<HaarMap> slices,
                                           const RotatorOptions& options = {});
 

@@ -1,0 +1,108 @@
+// `fused`: the rotation and the triple product in one per-pixel sum
+// (DESIGN.md "Per-pixel methods").
+//
+// A pixel needs I_c = Σ_ω L_c(ω)·V(ω)·ρ_c(Rᵀω)·ΔΩ(ω): the light (cut to its
+// k largest Haar coefficients), the visibility (the barycentric blend of the
+// hit triangle's three vertex lists) and the BRDF slice turned by the pixel's
+// Y-X-Y rotation R. `spatial` forms ρ(Rᵀω) at every pixel centre by bilinear
+// lookup and Haar-codes it, and the triple product then sums the three in the
+// Haar basis. The Haar basis is orthonormal, so by Parseval that sum is the
+// same number in the pixel basis — and there the rotated slice never has to be
+// stored or transformed: each map direction ω looks up ρ at Rᵀω and is
+// weighted by W_c(ω) = (L_c·ΔΩ)(ω)·V(ω) at once.
+//
+// What is shared, and when:
+//   prepare   PixelSlices: the slices synthesised from their Haar
+//             coefficients to pixel form (R, G, B texels), once per table;
+//   per frame FusedLight: the truncated light L·ΔΩ of one object, synthesised
+//             once per object;
+//   per pixel the three vertex lists merged into one weighted coefficient
+//             list and synthesised once; then one pass over the M² directions
+//             computes the geometry of Rᵀω once for the three channels.
+// The pass runs in float with SIMD through Google Highway (runtime dispatch:
+// the best of SSE4/AVX2/AVX-512 or NEON the machine has).
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "haarcast/core/brdf_slices.h"
+#include "haarcast/core/haar.h"
+#include "haarcast/core/rotation.h"
+#include "haarcast/core/shared_layout.h"
+
+namespace haarcast {
+
+// Throws std::invalid_argument naming the level unless it is one `fused` takes
+// (shared::kMinLevel … shared::kFusedMaxLevel).
+void checkFusedLevel(int level);
+
+// The slice table in pixel form: texel (t, row, col) at
+// ((t·M + row)·M + col)·4 = R, G, B, 0 (shared::kTexelFloats).
+class PixelSlices {
+ public:
+  PixelSlices() = default;
+  // Synthesises every slice of the table (inverse Haar per channel).
+  static PixelSlices synthesize(const BrdfSliceTable& table);
+
+  int level() const { return level_; }
+  int thetaSamples() const { return thetaSamples_; }
+  std::span<const float> texels() const { return texels_; }
+  const float* slice(int t) const;
+  // The last map row with a non-zero texel in any slice: below it every
+  // lookup reads zeros (a slice is ρ·max(cos θᵢ, 0), so this is about the
+  // equator), which lets the pass skip directions that cannot contribute.
+  int lastNonZeroRow() const { return lastNonZeroRow_; }
+  std::size_t storedBytes() const { return texels_.size() * sizeof(float); }
+
+ private:
+  int level_ = 0;
+  int thetaSamples_ = 0;
+  int lastNonZeroRow_ = -1;
+  std::vector<float> texels_;
+};
+
+// One object's light for one frame in pixel form, three planes of M² floats
+// (channel c at c·M²): the synthesis of L·ΔΩ as lightInObjectFrame cut it.
+struct FusedLight {
+  int level = 0;
+  std::vector<float> planes;
+  static FusedLight synthesize(const std::array<SparseHaar, 3>& light);
+};
+
+// One of the hit triangle's vertices: its visibility list and barycentric weight.
+struct WeightedVisibility {
+  const SparseHaar* list = nullptr;
+  float weight = 0.0f;
+};
+
+// Per-thread working memory: sized on first use, reused after (no allocation
+// per pixel).
+struct FusedScratch {
+  std::vector<float> visibility;  // merged coefficients, then V in pixel form
+  std::vector<float> synthesis;   // one inverse-Haar step
+  std::vector<float> weight;      // W_c = (L_c·ΔΩ)·V, three planes
+  std::vector<float> blended;     // the θₒ-blended slice, when the blend weight is not 0
+};
+
+// One pixel of `fused`: Σ_ω W_c(ω)·ρ_c(Rᵀω) for c = R, G, B, with
+// ρ = (1 − w)·slice[first] + w·slice[second] (shared::sliceBlendAt) looked up
+// bilinearly exactly as rotateSpatialMap does (θ clamped at the poles, φ
+// wrapped). Equal, to float rounding, to Σ_v weight_v·tripleProduct(light_c,
+// rotateSpatial(slice), V_v). The lists and maps must share the slices' level
+// (checked: std::invalid_argument).
+std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBlend& blend, const EulerYXY& r,
+                                const FusedLight& light, std::span<const WeightedVisibility> visibility,
+                                FusedScratch& scratch);
+
+// The SIMD target the pass dispatches to on this machine ("AVX3", "AVX2", …).
+std::string fusedTargetName();
+
+// The bytes one pixel reads in the pass: one slice (two when blending), the
+// light planes and the merged visibility list.
+std::size_t fusedPixelBytes(int level, bool blended, std::size_t visibilityEntries);
+
+}  // namespace haarcast

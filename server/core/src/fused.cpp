@@ -1,0 +1,201 @@
+// `fused` (fused.h): what is prepared once, per frame and per pixel, around
+// the SIMD pass of fused_kernel.cpp.
+#include "haarcast/core/fused.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "fused_kernel.h"
+
+namespace haarcast {
+namespace {
+
+// One synthesis step of the inverse Haar transform (haar.cpp's, in float):
+// the top-left n×n block of `a` (row stride `stride`) from s, h, v, d quadrants
+// to the n×n values one level finer.
+void synthesisStep(float* a, int stride, int n, float* scratch) {
+  const int half = n / 2;
+  for (int i = 0; i < half; ++i) {
+    for (int j = 0; j < half; ++j) {
+      const float s = a[i * stride + j], h = a[i * stride + j + half];
+      const float v = a[(i + half) * stride + j], d = a[(i + half) * stride + j + half];
+      scratch[(2 * i) * n + 2 * j] = 0.5f * (s + h + v + d);
+      scratch[(2 * i) * n + 2 * j + 1] = 0.5f * (s - h + v - d);
+      scratch[(2 * i + 1) * n + 2 * j] = 0.5f * (s + h - v - d);
+      scratch[(2 * i + 1) * n + 2 * j + 1] = 0.5f * (s - h - v + d);
+    }
+  }
+  for (int r = 0; r < n; ++r) std::copy_n(scratch + r * n, n, a + r * stride);
+}
+
+// Dense coefficients (quadrant layout) → pixel values, in place.
+void synthesizeInPlace(std::span<float> coefficients, int level, std::vector<float>& scratch) {
+  const int m = mapSize(level);
+  scratch.resize(coefficients.size());
+  for (int n = 2; n <= m; n *= 2) synthesisStep(coefficients.data(), m, n, scratch.data());
+}
+
+void checkSameLevel(int level, int expected, const char* what) {
+  if (level != expected) {
+    throw std::invalid_argument(std::string("fused: ") + what + " is at level " + std::to_string(level) +
+                                ", the slices at level " + std::to_string(expected));
+  }
+}
+
+}  // namespace
+
+void checkFusedLevel(int level) {
+  if (level < static_cast<int>(shared::kMinLevel) || level > static_cast<int>(shared::kFusedMaxLevel)) {
+    throw std::invalid_argument("fused: level " + std::to_string(level) + " is outside " +
+                                std::to_string(shared::kMinLevel) + ".." + std::to_string(shared::kFusedMaxLevel));
+  }
+}
+
+namespace detail {
+const PixelDirections& pixelDirections(int level) {
+  struct Table {
+    std::vector<float> x, y, z;
+    PixelDirections view;
+  };
+  // Built once for every level `fused` takes (thread-safe static initialisation).
+  static const std::array<Table, shared::kFusedMaxLevel + 1> tables = [] {
+    std::array<Table, shared::kFusedMaxLevel + 1> t;
+    for (int l = 0; l <= static_cast<int>(shared::kFusedMaxLevel); ++l) {
+      const int m = mapSize(l);
+      Table& table = t[static_cast<std::size_t>(l)];
+      for (int i = 0; i < m; ++i) {
+        for (int j = 0; j < m; ++j) {
+          const glm::dvec3 dir = sphericalToDirection(rowTheta(l, i), colPhi(l, j));
+          table.x.push_back(static_cast<float>(dir.x));
+          table.y.push_back(static_cast<float>(dir.y));
+          table.z.push_back(static_cast<float>(dir.z));
+        }
+      }
+      table.view = {table.x.data(), table.y.data(), table.z.data()};
+    }
+    return t;
+  }();
+  return tables.at(static_cast<std::size_t>(level)).view;
+}
+}  // namespace detail
+
+PixelSlices PixelSlices::synthesize(const BrdfSliceTable& table) {
+  checkFusedLevel(table.level());
+  PixelSlices out;
+  out.level_ = table.level();
+  out.thetaSamples_ = table.thetaSamples();
+  const std::size_t n = static_cast<std::size_t>(mapSize(out.level_)) * static_cast<std::size_t>(mapSize(out.level_));
+  out.texels_.assign(static_cast<std::size_t>(out.thetaSamples_) * n * shared::kTexelFloats, 0.0f);
+  const int m = mapSize(out.level_);
+  for (int t = 0; t < out.thetaSamples_; ++t) {
+    for (int c = 0; c < BrdfSliceTable::kChannels; ++c) {
+      const SphereMap pixels = inverseHaar(table.slice(c, t));
+      const std::span<const float> values = pixels.values();
+      float* dst = out.texels_.data() + static_cast<std::size_t>(t) * n * shared::kTexelFloats;
+      for (std::size_t p = 0; p < n; ++p) {
+        dst[p * shared::kTexelFloats + static_cast<std::size_t>(c)] = values[p];
+        if (values[p] != 0.0f) out.lastNonZeroRow_ = std::max(out.lastNonZeroRow_, static_cast<int>(p) / m);
+      }
+    }
+  }
+  return out;
+}
+
+const float* PixelSlices::slice(int t) const {
+  if (t < 0 || t >= thetaSamples_) {
+    throw std::out_of_range("PixelSlices: slice " + std::to_string(t) + " of " + std::to_string(thetaSamples_));
+  }
+  const std::size_t n = static_cast<std::size_t>(mapSize(level_)) * static_cast<std::size_t>(mapSize(level_));
+  return texels_.data() + static_cast<std::size_t>(t) * n * shared::kTexelFloats;
+}
+
+FusedLight FusedLight::synthesize(const std::array<SparseHaar, 3>& light) {
+  FusedLight out;
+  out.level = light[0].level;
+  checkFusedLevel(out.level);
+  const std::size_t n = static_cast<std::size_t>(mapSize(out.level)) * static_cast<std::size_t>(mapSize(out.level));
+  out.planes.assign(3 * n, 0.0f);
+  std::vector<float> scratch;
+  for (std::size_t c = 0; c < 3; ++c) {
+    checkSameLevel(light[c].level, out.level, "a light channel");
+    const std::span<float> plane(out.planes.data() + c * n, n);
+    for (std::size_t e = 0; e < light[c].size(); ++e) plane[light[c].index[e]] = light[c].value[e];
+    synthesizeInPlace(plane, out.level, scratch);
+  }
+  return out;
+}
+
+std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBlend& blend, const EulerYXY& r,
+                                const FusedLight& light, std::span<const WeightedVisibility> visibility,
+                                FusedScratch& scratch) {
+  const int level = slices.level();
+  checkSameLevel(light.level, level, "the light");
+  const std::size_t n = static_cast<std::size_t>(mapSize(level)) * static_cast<std::size_t>(mapSize(level));
+
+  // V: the vertices' lists merged into one weighted coefficient list (the
+  // product is linear in V), then synthesised once.
+  scratch.visibility.assign(n, 0.0f);
+  for (const WeightedVisibility& v : visibility) {
+    checkSameLevel(v.list->level, level, "a visibility list");
+    for (std::size_t e = 0; e < v.list->size(); ++e) scratch.visibility[v.list->index[e]] += v.weight * v.list->value[e];
+  }
+  synthesizeInPlace(scratch.visibility, level, scratch.synthesis);
+
+  // W_c = (L_c·ΔΩ)·V.
+  scratch.weight.resize(3 * n);
+  for (std::size_t c = 0; c < 3; ++c) {
+    const float* l = light.planes.data() + c * n;
+    float* w = scratch.weight.data() + c * n;
+    for (std::size_t p = 0; p < n; ++p) w[p] = l[p] * scratch.visibility[p];
+  }
+
+  // ρ: one slice, or the blend of two (linear, so blending the texels once
+  // equals blending the two sums).
+  const float* slice = slices.slice(static_cast<int>(blend.first));
+  if (blend.weight != 0.0f && blend.second != blend.first) {
+    const float* other = slices.slice(static_cast<int>(blend.second));
+    scratch.blended.resize(n * shared::kTexelFloats);
+    const float w = blend.weight;
+    for (std::size_t k = 0; k < n * shared::kTexelFloats; ++k) scratch.blended[k] = slice[k] + w * (other[k] - slice[k]);
+    slice = scratch.blended.data();
+  }
+
+  detail::FusedPass pass;
+  pass.level = level;
+  pass.slice = slice;
+  pass.weight = scratch.weight.data();
+  pass.directions = detail::pixelDirections(level);
+  pass.cosAlpha = static_cast<float>(std::cos(r.alpha));
+  pass.sinAlpha = static_cast<float>(std::sin(r.alpha));
+  pass.cosBeta = static_cast<float>(std::cos(r.beta));
+  pass.sinBeta = static_cast<float>(std::sin(r.beta));
+  // Source column = φ'·M/2π − (γ·M/2π + ½); the offset's whole part is
+  // applied to the integer column, its fraction to the float coordinate.
+  const int m = mapSize(level);
+  double offset = r.gamma / kTwoPi * m + 0.5;
+  offset -= std::floor(offset / m) * m;  // [0, M): whole turns change nothing
+  const double whole = std::floor(offset);
+  pass.columnShift = static_cast<int>(whole);
+  pass.columnFraction = static_cast<float>(offset - whole);
+  // A direction whose source row is beyond lastNonZeroRow + 1 reads only zero
+  // texels (both bilinear rows are zero); one more row of margin absorbs the
+  // float rounding of θ'.
+  const int cutRow = slices.lastNonZeroRow() + 2;
+  pass.skipBelowY = cutRow < m ? static_cast<float>(std::cos(cutRow * kPi / m)) : -2.0f;
+
+  std::array<float, 3> out{};
+  detail::fusedSample(pass, out.data());
+  return out;
+}
+
+std::string fusedTargetName() { return detail::fusedTarget(); }
+
+std::size_t fusedPixelBytes(int level, bool blended, std::size_t visibilityEntries) {
+  const std::size_t n = static_cast<std::size_t>(mapSize(level)) * static_cast<std::size_t>(mapSize(level));
+  const std::size_t slice = n * shared::kTexelFloats * sizeof(float);
+  return slice * (blended ? 2 : 1) + 3 * n * sizeof(float) + visibilityEntries * (sizeof(std::uint32_t) + sizeof(float));
+}
+
+}  // namespace haarcast

@@ -1,0 +1,34 @@
+// The SIMD pass of `fused` (fused_kernel.cpp, one copy per Highway target,
+// dispatched at run time). fused.cpp prepares its inputs.
+#pragma once
+
+#include <cstddef>
+
+namespace haarcast::detail {
+
+// Unit directions of the pixel centres of a level's map, planar (N each).
+struct PixelDirections {
+  const float* x = nullptr;
+  const float* y = nullptr;
+  const float* z = nullptr;
+};
+const PixelDirections& pixelDirections(int level);
+
+struct FusedPass {
+  int level = 0;
+  const float* slice = nullptr;   // R, G, B, 0 texels (shared::kTexelFloats)
+  const float* weight = nullptr;  // W_c, three planes of N
+  PixelDirections directions;
+  // Rᵀ = R_y(−γ) R_x(−β) R_y(−α): α turns the directions, β tilts them,
+  // and γ is an offset of the source column, split into a whole number of
+  // columns and a fraction so the float coordinate stays small.
+  float cosAlpha = 1.0f, sinAlpha = 0.0f, cosBeta = 1.0f, sinBeta = 0.0f;
+  int columnShift = 0;        // whole columns of γ·M/2π + ½
+  float columnFraction = 0.0f;
+  float skipBelowY = -2.0f;   // directions with cos θ' below this read only zero texels
+};
+
+void fusedSample(const FusedPass& pass, float out[3]);
+const char* fusedTarget();
+
+}  // namespace haarcast::detail
