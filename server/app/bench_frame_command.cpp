@@ -30,7 +30,8 @@ struct BenchArgs {
   std::string backend = "both";
   std::string sizes = "128";
   std::string levels = "4";
-  std::string methods = "haar";
+  std::string methods{methodName(kDefaultPixelMethod)};
+  std::string slices = "blend";  // fused: blend | nearest
   std::string scene;  // scene file; empty = the built-in default
   std::string device;
   std::string cacheDir;
@@ -61,17 +62,33 @@ std::vector<int> parseInts(const std::string& text, const char* flag, int lo, in
   return out;
 }
 
+// "256" (square) or "1920x1080", comma-separated.
+std::vector<std::pair<int, int>> parseSizes(const std::string& text) {
+  std::vector<std::pair<int, int>> out;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    const std::size_t x = item.find('x');
+    const std::string w = item.substr(0, x), h = x == std::string::npos ? w : item.substr(x + 1);
+    const std::vector<int> wv = parseInts(w, "--sizes", 1, render::kMaxFrameSide);
+    const std::vector<int> hv = parseInts(h, "--sizes", 1, render::kMaxFrameSide);
+    out.emplace_back(wv[0], hv[0]);
+  }
+  if (out.empty()) throw std::invalid_argument("--sizes is empty");
+  return out;
+}
+
 std::vector<RotationMethod> parseMethods(const std::string& text) {
   std::vector<RotationMethod> out;
   std::stringstream in(text);
   std::string item;
   while (std::getline(in, item, ',')) {
     if (item == "all") {
-      out.insert(out.end(), std::begin(kAllRotationMethods), std::end(kAllRotationMethods));
+      out.insert(out.end(), std::begin(kAllPixelMethods), std::end(kAllPixelMethods));
       continue;
     }
     const auto m = parseRotationMethod(item);
-    if (!m) throw std::invalid_argument("--method: \"" + item + "\" is not haar, spatial, matrix, table or all");
+    if (!m) throw std::invalid_argument("--method: \"" + item + "\" is not one of " + pixelMethodNames() + " or all");
     out.push_back(*m);
   }
   if (out.empty()) throw std::invalid_argument("--method is empty");
@@ -132,7 +149,10 @@ int run(const BenchArgs& a) {
   }
   if (a.frames < 1 || a.frames > 1000) throw std::invalid_argument("--frames must be in 1..1000");
   if (a.warmup < 0 || a.warmup > 100) throw std::invalid_argument("--warmup must be in 0..100");
-  const std::vector<int> sizes = parseInts(a.sizes, "--sizes", 1, 8192);
+  const std::vector<std::pair<int, int>> sizes = parseSizes(a.sizes);
+  if (a.slices != "blend" && a.slices != "nearest") {
+    throw std::invalid_argument("--slices must be blend or nearest (got \"" + a.slices + "\")");
+  }
   const std::vector<int> levels = parseInts(a.levels, "--levels", 2, 8);
   const std::vector<RotationMethod> methods = parseMethods(a.methods);
   const bool cpu = a.backend != "vulkan", vulkan = a.backend != "cpu";
@@ -156,14 +176,15 @@ int run(const BenchArgs& a) {
     table += s;
     table += '\n';
   };
-  line("| level | method | size | backend | light | gbuffer | rotation-input | rotation | triple-product | tonemap | frame (s) | coeff. bytes/frame | vs cpu |");
-  line("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+  line("| level | method | size | backend | light | gbuffer | rotation-input | rotation | triple-product | fused | tonemap | frame (s) | fps | coeff. bytes/frame | vs cpu |");
+  line("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
 
   for (const int level : levels) {
     for (const RotationMethod method : methods) {
       render::RenderOptions options;
       options.level = level;
       options.method = method;
+      options.interpolateSlices = a.slices == "blend";
       options.cacheDir = a.cacheDir == "none" ? "" : a.cacheDir;
       std::fprintf(stderr, "[bench-frame] level %d, %s: preparing\n", level, std::string(methodName(method)).c_str());
       std::unique_ptr<render::Renderer> cpuRenderer, gpuRenderer;
@@ -176,23 +197,25 @@ int run(const BenchArgs& a) {
         out["vulkan_device"] = gpuRenderer->deviceName();
       }
       if (cpuRenderer) out["cpu_device"] = cpuRenderer->deviceName();
-      for (const int size : sizes) {
+      for (const auto& [width, height] : sizes) {
         render::FrameRequest request;
-        request.width = request.height = size;
+        request.width = width;
+        request.height = height;
         request.camera = scene.camera;
         std::map<std::string, Measured> results;
         for (render::Renderer* r : {cpuRenderer.get(), gpuRenderer.get()}) {
           if (!r) continue;
-          std::fprintf(stderr, "[bench-frame] level %d, %s, %d², %s: %d frames + %d warm-up\n", level,
-                       std::string(methodName(method)).c_str(), size, r->backend().c_str(), a.frames, a.warmup);
+          std::fprintf(stderr, "[bench-frame] level %d, %s, %d×%d, %s: %d frames + %d warm-up\n", level,
+                       std::string(methodName(method)).c_str(), width, height, r->backend().c_str(), a.frames, a.warmup);
           results[r->backend()] = measure(*r, request, a.frames, a.warmup);
         }
         std::optional<std::pair<double, std::size_t>> agree;
         if (results.count("cpu") && results.count("vulkan")) agree = agreement(results["cpu"].first, results["vulkan"].first);
         for (const auto& [backend, m] : results) {
           nlohmann::json run{{"backend", backend},       {"level", level},
-                             {"method", methodName(method)}, {"width", size},
-                             {"height", size},           {"frame_seconds", m.frameSeconds},
+                             {"method", methodName(method)}, {"width", width},
+                             {"height", height},         {"frame_seconds", m.frameSeconds},
+                             {"fps", m.frameSeconds > 0.0 ? 1.0 / m.frameSeconds : 0.0},
                              {"coefficient_bytes", m.coefficientBytes}, {"covered_pixels", m.covered}};
           nlohmann::json stages = nlohmann::json::object();
           for (const auto& [name, seconds] : m.stages) stages[name] = seconds;
@@ -218,9 +241,10 @@ int run(const BenchArgs& a) {
             ratio = buf;
           }
           out["runs"].push_back(run);
+          if (method == RotationMethod::Fused) run["slices"] = a.slices;
           std::string row = "| " + std::to_string(level) + " | " + std::string(methodName(method)) + " | " +
-                            std::to_string(size) + "² | " + backend + " |";
-          for (const char* name : {"light", "gbuffer", "rotation-input", "rotation", "triple-product", "tonemap"}) {
+                            std::to_string(width) + "×" + std::to_string(height) + " | " + backend + " |";
+          for (const char* name : {"light", "gbuffer", "rotation-input", "rotation", "triple-product", "fused", "tonemap"}) {
             double seconds = 0.0;
             for (const auto& [sname, s] : m.stages) {
               if (sname == name) seconds = s;
@@ -230,7 +254,8 @@ int run(const BenchArgs& a) {
             row += buf;
           }
           char buf[96];
-          std::snprintf(buf, sizeof buf, " %.4f | %zu | %s |", m.frameSeconds, m.coefficientBytes, ratio.c_str());
+          std::snprintf(buf, sizeof buf, " %.4f | %.2f | %zu | %s |", m.frameSeconds,
+                        m.frameSeconds > 0.0 ? 1.0 / m.frameSeconds : 0.0, m.coefficientBytes, ratio.c_str());
           line(row + buf);
         }
       }
@@ -251,10 +276,14 @@ std::function<int()> addBenchFrameCommand(CLI::App& app) {
   auto* c = app.add_subcommand("bench-frame",
                                "Per-pass and frame times of the CPU and Vulkan backends against resolution and level");
   c->add_option("--backend", args->backend, "cpu|vulkan|both (both: ratios from one run)")->capture_default_str();
-  c->add_option("--sizes", args->sizes, "Square frame sizes, comma-separated (e.g. 128,256,512,1024)")
+  c->add_option("--sizes", args->sizes, "Frame sizes, comma-separated: N for N×N, or WxH (e.g. 128,256,1920x1080)")
       ->capture_default_str();
-  c->add_option("--levels", args->levels, "Map levels, comma-separated (Vulkan: 2..6)")->capture_default_str();
-  c->add_option("--method", args->methods, "Rotation methods, comma-separated, or all")->capture_default_str();
+  c->add_option("--levels", args->levels, "Map levels, comma-separated (2..8; fused 2..7; the other methods on Vulkan 2..6)")
+      ->capture_default_str();
+  c->add_option("--method", args->methods, "Per-pixel methods, comma-separated (" + pixelMethodNames() + "), or all")
+      ->capture_default_str();
+  c->add_option("--slices", args->slices, "fused: blend the two nearest θo slices (blend) or take the nearest (nearest)")
+      ->capture_default_str();
   c->add_option("--frames", args->frames, "Timed frames per point (after one warm-up frame)")->capture_default_str();
   c->add_option("--warmup", args->warmup, "Untimed frames first (resolution setup, first-use compilation)")
       ->capture_default_str();

@@ -35,6 +35,10 @@ void checkRenderOptions(const RenderOptions& o) {
     bad("resolution " + std::to_string(o.width) + "×" + std::to_string(o.height) + " is outside 1..8192");
   }
   if (o.level < 2 || o.level > 8) bad("level " + std::to_string(o.level) + " is outside 2..8");
+  if (o.method == RotationMethod::Fused && o.level > static_cast<int>(shared::kFusedMaxLevel)) {
+    bad("level " + std::to_string(o.level) + " is outside " + std::to_string(shared::kMinLevel) + ".." +
+        std::to_string(shared::kFusedMaxLevel) + " for fused");
+  }
   if (o.lightCoefficients == 0) bad("light coefficients must be at least 1");
   if (o.thetaSamples < 1 || o.thetaSamples > 256) bad("theta samples must be in 1..256");
 }
@@ -92,6 +96,7 @@ RotationInput rotationInput(const glm::dvec3& normal, const glm::dvec3& towardEy
   RotationInput in;
   in.euler = eulerFromMatrix(shadingFrame(normal, towardEye, thetaOut));
   in.slice = table.nearestSlice(thetaOut);
+  in.thetaOut = thetaOut;
   return in;
 }
 
@@ -127,18 +132,25 @@ std::vector<std::uint8_t> tonemapRgba8(const io::RgbImage& image, double exposur
 
 void checkFrameRequest(const FrameRequest& r, std::size_t objectCount) {
   auto bad = [](const std::string& what) { throw std::invalid_argument("frame request: " + what); };
-  if (r.width < 1 || r.height < 1 || r.width > 8192 || r.height > 8192) {
-    bad("resolution " + std::to_string(r.width) + "×" + std::to_string(r.height) + " is outside 1..8192");
+  if (r.width < 1 || r.height < 1 || r.width > kMaxFrameSide || r.height > kMaxFrameSide) {
+    bad("resolution " + std::to_string(r.width) + "×" + std::to_string(r.height) + " is outside 1.." +
+        std::to_string(kMaxFrameSide));
   }
   if (!r.poses.empty() && r.poses.size() != objectCount) {
     bad(std::to_string(r.poses.size()) + " poses for " + std::to_string(objectCount) + " objects");
   }
-  if (!(r.camera.fovYDegrees > 0.0 && r.camera.fovYDegrees < 180.0)) {
-    bad("camera fov " + std::to_string(r.camera.fovYDegrees) + "° is outside (0, 180)");
+  if (!(r.camera.fovYDegrees >= kMinFovDegrees && r.camera.fovYDegrees <= kMaxFovDegrees)) {
+    bad("camera fov " + std::to_string(r.camera.fovYDegrees) + "° is outside " + std::to_string(kMinFovDegrees) +
+        ".." + std::to_string(kMaxFovDegrees) + "°");
   }
   const glm::dvec3 view = r.camera.target - r.camera.eye;
-  if (!(glm::length(view) > 1e-12) || !(glm::length(glm::cross(view, r.camera.up)) > 1e-12 * glm::length(view))) {
-    bad("camera eye, target and up must be finite, distinct and not collinear");
+  const double distance = glm::length(view);
+  if (!(distance >= kMinEyeDistance && distance <= kMaxEyeDistance)) {
+    bad("camera eye-to-target distance " + std::to_string(distance) + " is outside " + std::to_string(kMinEyeDistance) +
+        ".." + std::to_string(kMaxEyeDistance));
+  }
+  if (!(glm::length(glm::cross(view, r.camera.up)) > 1e-9 * distance)) {
+    bad("camera up must be finite, non-zero and not along the view direction");
   }
   for (const Pose& p : r.poses) {
     if (!std::isfinite(p.rotateDegrees.x + p.rotateDegrees.y + p.rotateDegrees.z + p.translate.x + p.translate.y +
@@ -150,6 +162,24 @@ void checkFrameRequest(const FrameRequest& r, std::size_t objectCount) {
   if (!std::isfinite(r.exposureStops)) bad("exposure is not finite");
 }
 
+ResolvedFrame resolveFrame(const PreparedScene& prepared, const RenderOptions& options, const FrameRequest& request) {
+  checkFrameRequest(request, prepared.objects.size());
+  ResolvedFrame out;
+  out.lightCoefficients = request.lightCoefficients ? request.lightCoefficients : options.lightCoefficients;
+  out.objects.resize(prepared.objects.size());
+  for (std::size_t i = 0; i < out.objects.size(); ++i) {
+    const Pose& pose = request.poses.empty() ? prepared.objects[i].pose : request.poses[i];
+    ResolvedObject& o = out.objects[i];
+    o.rotation = pose.rotation();
+    o.objectToWorld = pose.objectToWorld();
+    o.scale = pose.scale;
+    o.light = lightInObjectFrame(prepared.light, o.rotation, request.lightRotation, out.lightCoefficients);
+    for (const SparseHaar& l : o.light) out.lightBytes += l.size() * (sizeof(std::uint32_t) + sizeof(float));
+    if (options.method == RotationMethod::Fused) o.fusedLight = FusedLight::synthesize(o.light);
+  }
+  return out;
+}
+
 // ---------------------------------------------------------------- CPU backend
 
 namespace {
@@ -159,6 +189,11 @@ class CpuRenderer final : public Renderer {
   CpuRenderer(const Scene& scene, const RenderOptions& options, const RenderProgress& progress)
       : options_(options), prepared_(prepareScene(scene, options, progress)) {
     for (const PreparedObject& p : prepared_.objects) {
+      if (options.method == RotationMethod::Fused) {
+        // The only per-object data fused keeps: the unrotated slices in pixel form.
+        pixelSlices_.push_back(PixelSlices::synthesize(p.table));
+        continue;
+      }
       std::array<std::unique_ptr<SliceRotator>, 3> r;
       for (int c = 0; c < 3; ++c) r[static_cast<std::size_t>(c)] = makeRotator(options.method, p.table.channelSlices(c), options.rotator);
       rotators_.push_back(std::move(r));
@@ -183,9 +218,23 @@ class CpuRenderer final : public Renderer {
   // (which replaces the slice).
   std::size_t rotationBytes(std::size_t object) const;
 
+  struct PixelInput {
+    RotationInput rotation;
+    double b[3];
+    unsigned vertex[3];
+  };
+  // The per-pixel passes: rotation + triple product (the rotating methods),
+  // or one fused pass. Each fills frame.image and objectMask, adds its stages
+  // and returns the coefficient bytes it read.
+  std::size_t shadeRotating(const ResolvedFrame& resolved, const std::vector<std::optional<Hit>>& hits,
+                            const std::vector<PixelInput>& inputs, Frame& frame, int w, int h);
+  std::size_t shadeFused(const ResolvedFrame& resolved, const std::vector<std::optional<Hit>>& hits,
+                         const std::vector<PixelInput>& inputs, Frame& frame, int w, int h);
+
   RenderOptions options_;
   PreparedScene prepared_;
-  std::vector<std::array<std::unique_ptr<SliceRotator>, 3>> rotators_;
+  std::vector<std::array<std::unique_ptr<SliceRotator>, 3>> rotators_;  // rotating methods
+  std::vector<PixelSlices> pixelSlices_;                                 // fused
   std::unique_ptr<RayScene> rays_;  // posed per frame with setTransform (top level only)
 };
 
@@ -198,29 +247,19 @@ std::size_t CpuRenderer::rotationBytes(std::size_t object) const {
 }
 
 Frame CpuRenderer::render(const FrameRequest& request) {
-  checkFrameRequest(request, prepared_.objects.size());
   const auto start = Clock::now();
   const unsigned threads = options_.threads;
-  const std::size_t k = request.lightCoefficients ? request.lightCoefficients : options_.lightCoefficients;
-  const std::vector<Pose>& poses = request.poses;
-  auto poseOf = [&](std::size_t i) -> const Pose& { return poses.empty() ? prepared_.objects[i].pose : poses[i]; };
   Frame frame;
-  std::size_t bytes = 0;
 
   // ---- light: world → each object's frame, once per frame -----------------
   auto t0 = Clock::now();
-  std::vector<std::array<SparseHaar, 3>> light(prepared_.objects.size());
-  std::vector<glm::dmat3> rotation(prepared_.objects.size());
-  for (std::size_t i = 0; i < light.size(); ++i) {
-    rotation[i] = poseOf(i).rotation();
-    light[i] = lightInObjectFrame(prepared_.light, rotation[i], request.lightRotation, k);
-    for (const SparseHaar& s : light[i]) bytes += s.size() * (sizeof(std::uint32_t) + sizeof(float));
-  }
+  const ResolvedFrame resolved = resolveFrame(prepared_, options_, request);
+  std::size_t bytes = resolved.lightBytes;
   frame.stages.push_back({"light", since(t0)});
 
   // ---- gbuffer: Embree primary rays at pixel centres ----------------------
   t0 = Clock::now();
-  for (std::size_t i = 0; i < prepared_.objects.size(); ++i) rays_->setTransform(i, glm::mat4(poseOf(i).objectToWorld()));
+  for (std::size_t i = 0; i < resolved.objects.size(); ++i) rays_->setTransform(i, glm::mat4(resolved.objects[i].objectToWorld));
   const RayScene& rays = *rays_;
   const int w = request.width, h = request.height;
   const CameraRays camera(request.camera, w, h);
@@ -238,11 +277,6 @@ Frame CpuRenderer::render(const FrameRequest& request) {
 
   // ---- rotation-input: slice and Euler angles per covered pixel -----------
   t0 = Clock::now();
-  struct PixelInput {
-    RotationInput rotation;
-    double b[3];
-    unsigned vertex[3];
-  };
   std::vector<PixelInput> inputs(pixels);
   parallelFor(static_cast<std::size_t>(h), [&](std::size_t y) {
     for (int x = 0; x < w; ++x) {
@@ -261,19 +295,41 @@ Frame CpuRenderer::render(const FrameRequest& request) {
       in.vertex[2] = tri.z;
       const glm::dvec3 n = glm::normalize(in.b[0] * glm::dvec3(mesh.normals[tri.x]) + in.b[1] * glm::dvec3(mesh.normals[tri.y]) +
                                           in.b[2] * glm::dvec3(mesh.normals[tri.z]));
-      const glm::dvec3 wo = glm::transpose(rotation[hit.object]) * -camera.direction(x, static_cast<int>(y));  // object frame
+      const glm::dvec3 wo = glm::transpose(resolved.objects[hit.object].rotation) * -camera.direction(x, static_cast<int>(y));
       in.rotation = rotationInput(n, wo, p.table);
     }
   }, {}, threads);
   frame.stages.push_back({"rotation-input", since(t0)});
 
-  // ---- rotation + triple product, fused per pixel -------------------------
+  frame.image = io::makeImage(w, h);
+  frame.objectMask.assign(pixels, 0);
+  bytes += options_.method == RotationMethod::Fused ? shadeFused(resolved, hits, inputs, frame, w, h)
+                                                    : shadeRotating(resolved, hits, inputs, frame, w, h);
+
+  // ---- tonemap: backdrop, RGBA8 --------------------------------------------
+  t0 = Clock::now();
+  if (options_.environmentBackground) {
+    parallelFor(static_cast<std::size_t>(h), [&](std::size_t y) {
+      for (int x = 0; x < w; ++x) {
+        if (frame.objectMask[y * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)]) continue;
+        const glm::dvec3 L = backgroundRadiance(prepared_.background, request.lightRotation, camera.direction(x, static_cast<int>(y)));
+        for (int c = 0; c < 3; ++c) frame.image.at(static_cast<int>(y), x, c) = static_cast<float>(L[c]);
+      }
+    }, {}, threads);
+  }
+  frame.rgba8 = tonemapRgba8(frame.image, request.exposureStops);
+  frame.stages.push_back({"tonemap", since(t0)});
+  frame.coefficientBytes = bytes;
+  frame.seconds = since(start);
+  return frame;
+}
+
+std::size_t CpuRenderer::shadeRotating(const ResolvedFrame& resolved, const std::vector<std::optional<Hit>>& hits,
+                                       const std::vector<PixelInput>& inputs, Frame& frame, int w, int h) {
   // The CPU keeps one rotated map per thread instead of a frame's worth, so
   // the two stages run interleaved; their wall time is split in proportion
   // to the thread time each took.
-  t0 = Clock::now();
-  frame.image = io::makeImage(w, h);
-  frame.objectMask.assign(pixels, 0);
+  const auto t0 = Clock::now();
   std::atomic<std::int64_t> rotationNs{0}, productNs{0};
   std::atomic<std::size_t> shadingBytes{0};
   parallelFor(static_cast<std::size_t>(h), [&](std::size_t y) {
@@ -295,7 +351,7 @@ Frame CpuRenderer::render(const FrameRequest& request) {
         // The visibility blend is linear, so it distributes over the product.
         for (int v = 0; v < 3; ++v) {
           const SparseHaar& vis = p.visibility[in.vertex[v]];
-          sum += in.b[v] * tripleProduct(light[object][c], rotated, vis);
+          sum += in.b[v] * tripleProduct(resolved.objects[object].light[c], rotated, vis);
           rowBytes += vis.size() * (sizeof(std::uint32_t) + sizeof(float));
         }
         rot += std::chrono::duration_cast<std::chrono::nanoseconds>(b - a).count();
@@ -307,30 +363,48 @@ Frame CpuRenderer::render(const FrameRequest& request) {
     rotationNs += rot;
     productNs += prod;
     shadingBytes += rowBytes;
-  }, {}, threads);
+  }, {}, options_.threads);
   const double shading = since(t0);
   const double busy = static_cast<double>(rotationNs.load() + productNs.load());
   const double rotationShare = busy > 0.0 ? static_cast<double>(rotationNs.load()) / busy : 0.5;
   frame.stages.push_back({"rotation", shading * rotationShare});
   frame.stages.push_back({"triple-product", shading * (1.0 - rotationShare)});
-  bytes += shadingBytes.load();
+  return shadingBytes.load();
+}
 
-  // ---- tonemap: backdrop, RGBA8 --------------------------------------------
-  t0 = Clock::now();
-  if (options_.environmentBackground) {
-    parallelFor(static_cast<std::size_t>(h), [&](std::size_t y) {
-      for (int x = 0; x < w; ++x) {
-        if (frame.objectMask[y * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)]) continue;
-        const glm::dvec3 L = backgroundRadiance(prepared_.background, request.lightRotation, camera.direction(x, static_cast<int>(y)));
-        for (int c = 0; c < 3; ++c) frame.image.at(static_cast<int>(y), x, c) = static_cast<float>(L[c]);
+std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const std::vector<std::optional<Hit>>& hits,
+                                    const std::vector<PixelInput>& inputs, Frame& frame, int w, int h) {
+  const auto t0 = Clock::now();
+  std::atomic<std::size_t> shadingBytes{0};
+  parallelFor(static_cast<std::size_t>(h), [&](std::size_t y) {
+    // Per worker thread, kept across rows: no allocation per pixel.
+    thread_local FusedScratch scratch;
+    std::size_t rowBytes = 0;
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = y * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
+      if (!hits[i]) continue;
+      frame.objectMask[i] = 1;
+      const std::size_t object = hits[i]->object;
+      const PreparedObject& p = prepared_.objects[object];
+      const PixelInput& in = inputs[i];
+      std::array<WeightedVisibility, 3> vis;
+      std::size_t entries = 0;
+      for (std::size_t v = 0; v < 3; ++v) {
+        vis[v] = {&p.visibility[in.vertex[v]], static_cast<float>(in.b[v])};
+        entries += vis[v].list->size();
       }
-    }, {}, threads);
-  }
-  frame.rgba8 = tonemapRgba8(frame.image, request.exposureStops);
-  frame.stages.push_back({"tonemap", since(t0)});
-  frame.coefficientBytes = bytes;
-  frame.seconds = since(start);
-  return frame;
+      const PixelSlices& slices = pixelSlices_[object];
+      const shared::SliceBlend blend = shared::sliceBlendAt(static_cast<float>(in.rotation.thetaOut),
+                                                            static_cast<shared::uint>(slices.thetaSamples()),
+                                                            options_.interpolateSlices ? 1u : 0u);
+      const std::array<float, 3> rgb = fusedShade(slices, blend, in.rotation.euler, resolved.objects[object].fusedLight, vis, scratch);
+      for (int c = 0; c < 3; ++c) frame.image.at(static_cast<int>(y), x, c) = rgb[static_cast<std::size_t>(c)];
+      rowBytes += fusedPixelBytes(slices.level(), blend.weight != 0.0f, entries);
+    }
+    shadingBytes += rowBytes;
+  }, {}, options_.threads);
+  frame.stages.push_back({"fused", since(t0)});
+  return shadingBytes.load();
 }
 
 }  // namespace

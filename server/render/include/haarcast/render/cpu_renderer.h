@@ -30,7 +30,10 @@ struct RenderOptions {
   int width = 128;
   int height = 128;
   int level = 5;                          // map level of light, slices and visibility
-  RotationMethod method = RotationMethod::Haar;
+  RotationMethod method = kDefaultPixelMethod;
+  // fused: blend the two nearest θₒ slices (false: the nearest alone, as the
+  // rotating methods do).
+  bool interpolateSlices = true;
   RotatorOptions rotator;
   std::size_t lightCoefficients = 256;    // k: the light's largest coefficients kept
   int thetaSamples = 16;                  // BRDF slices per channel
@@ -42,7 +45,7 @@ struct RenderOptions {
 };
 
 // Throws std::invalid_argument naming the bad option (sizes over 8192², level
-// outside 2..8, k = 0, …).
+// outside 2..8 — 2..7 for fused —, k = 0, …).
 void checkRenderOptions(const RenderOptions& options);
 
 struct RenderTimings {

@@ -10,6 +10,8 @@
 //   "rotation-input"  per pixel: BRDF slice index (θₒ) and Y-X-Y Euler angles
 //   "rotation"        the rotated slice's coefficients, per pixel and channel
 //   "triple-product"  light × rotated BRDF × interpolated vertex visibility
+//   "fused"           `fused` only: rotation and triple product in one pass
+//                     over the map directions (core/fused.h), in place of the two above
 //   "tonemap"         exposure, sRGB, RGBA8 (and the linear image kept for EXR)
 #pragma once
 
@@ -23,6 +25,7 @@
 #include <glm/mat3x3.hpp>
 
 #include "haarcast/core/brdf_slices.h"
+#include "haarcast/core/fused.h"
 #include "haarcast/core/haar.h"
 #include "haarcast/core/rotation.h"
 #include "haarcast/core/sphere_map.h"
@@ -43,6 +46,9 @@ struct FrameRequest {
   // k, the light's largest coefficients kept; 0 = RenderOptions::lightCoefficients.
   std::size_t lightCoefficients = 0;
   double exposureStops = 0.0;  // for the RGBA8 image only
+  // false: the caller needs only rgba8 (an encoder), so a backend may skip
+  // reading the linear image back (Frame::image is then empty).
+  bool linearImage = true;
 };
 
 struct StageTime {
@@ -104,10 +110,12 @@ std::array<SparseHaar, 3> lightInObjectFrame(const std::array<SphereMap, 3>& wor
                                              const glm::dmat3& lightRotation, std::size_t k);
 
 // Per pixel, what the rotation needs: the nearest θₒ slice and the Y-X-Y
-// angles of the local shading frame (n and wo in the object frame).
+// angles of the local shading frame (n and wo in the object frame); θₒ itself
+// for `fused`, which may blend the two nearest slices (shared::sliceBlendAt).
 struct RotationInput {
   int slice = 0;
   EulerYXY euler;
+  double thetaOut = 0.0;
 };
 RotationInput rotationInput(const glm::dvec3& normal, const glm::dvec3& towardEye, const BrdfSliceTable& table);
 
@@ -122,6 +130,31 @@ std::vector<std::uint8_t> tonemapRgba8(const io::RgbImage& image, double exposur
 
 // Throws std::invalid_argument naming the problem.
 void checkFrameRequest(const FrameRequest& request, std::size_t objectCount);
+
+// The bounds a frame request must keep (checkFrameRequest), one set for every
+// backend, the service and the clients.
+inline constexpr int kMaxFrameSide = 8192;
+inline constexpr double kMinFovDegrees = 1.0;
+inline constexpr double kMaxFovDegrees = 170.0;
+inline constexpr double kMinEyeDistance = 1e-3;  // eye to target, scene units
+inline constexpr double kMaxEyeDistance = 1e4;
+
+// One frame resolved once, for every backend: the request checked, and per
+// object its pose in effect, the light in its frame (cut to k) and, for
+// `fused`, that light in pixel form (synthesised once per object per frame).
+struct ResolvedObject {
+  glm::dmat3 rotation{1.0};        // object → world
+  glm::dmat4 objectToWorld{1.0};
+  double scale = 1.0;
+  std::array<SparseHaar, 3> light;
+  FusedLight fusedLight;           // empty unless the method is fused
+};
+struct ResolvedFrame {
+  std::size_t lightCoefficients = 0;  // k in effect
+  std::vector<ResolvedObject> objects;
+  std::size_t lightBytes = 0;         // the light lists, index + value per entry
+};
+ResolvedFrame resolveFrame(const PreparedScene& prepared, const RenderOptions& options, const FrameRequest& request);
 
 // The CPU reference backend (cpu_renderer.h) behind the interface. The scene
 // is copied; precomputation (slice tables, rotators, visibility) happens here.
