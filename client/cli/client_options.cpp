@@ -128,7 +128,8 @@ v1::RotationMethod parseMethod(const std::string& name) {
   if (name == "spatial") return v1::ROTATION_METHOD_SPATIAL;
   if (name == "matrix") return v1::ROTATION_METHOD_MATRIX;
   if (name == "table") return v1::ROTATION_METHOD_TABLE;
-  throw std::invalid_argument("--method must be haar, spatial, matrix or table (got \"" + name + "\")");
+  if (name == "fused") return v1::ROTATION_METHOD_FUSED;
+  throw std::invalid_argument("--method must be fused, haar, spatial, matrix or table (got \"" + name + "\")");
 }
 
 std::string methodName(v1::RotationMethod method) {
@@ -137,6 +138,7 @@ std::string methodName(v1::RotationMethod method) {
     case v1::ROTATION_METHOD_SPATIAL: return "spatial";
     case v1::ROTATION_METHOD_MATRIX: return "matrix";
     case v1::ROTATION_METHOD_TABLE: return "table";
+    case v1::ROTATION_METHOD_FUSED: return "fused";
     default: return "default";
   }
 }

@@ -153,7 +153,7 @@ int run(int argc, char** argv) {
   app.add_option("--fps-cap", fpsCap, "Ask the server for at most this many frames per second (0 = its default)")
       ->check(CLI::Range(0.0, 1000.0));
   app.add_option("--quality", quality, "JPEG quality 1..100 (0 = the server's default)")->check(CLI::Range(0u, 100u));
-  app.add_option("--method", method, "Rotation method: haar | spatial | matrix | table (default: the server's)");
+  app.add_option("--method", method, "Per-pixel method: fused | haar | spatial | matrix | table (default: the server's)");
   app.add_option("--level", level, "Map level n, 2^n x 2^n (0 = the server's default)")->check(CLI::Range(0u, 12u));
   app.add_option("--coefficients,-k", coefficients, "Light coefficients kept (0 = the server's default)");
   app.add_option("--scene", scene, "Scene name offered by the server (default: the server's)");

@@ -7,7 +7,7 @@
 //   alt-drag      rotate the light (the environment) about +Y
 //
 // Page parameters: ?size=256x256&encoding=jpeg|png|raw&token=T&fps=30
-//                  &method=haar&level=5&k=64 (the initial settings)
+//                  &method=fused&level=5&k=64 (the initial settings)
 /* global protobuf */
 
 const params = new URLSearchParams(location.search);
@@ -72,7 +72,7 @@ function sizeFromParam(text) {
 function settingsFromParams() {
   const method = params.get('method');
   const value = method ? RotationMethod.values[`ROTATION_METHOD_${method.toUpperCase()}`] : 0;
-  if (value === undefined) throw new Error(`?method must be haar, spatial, matrix or table (got "${method}")`);
+  if (value === undefined) throw new Error(`?method must be fused, haar, spatial, matrix or table (got "${method}")`);
   return { method: value, level: Number(params.get('level') || 0), lightCoefficients: Number(params.get('k') || 0) };
 }
 

@@ -21,7 +21,7 @@ namespace fs = std::filesystem;
 
 struct RenderArgs {
   SceneFlags scene;
-  std::string method = "haar", variant = "refined", backend = "cpu", device, cacheDir;
+  std::string method = "fused", variant = "refined", backend = "cpu", device, cacheDir;
   bool validation = gpu::kValidationByDefault;
   render::RenderOptions options;
 };
@@ -61,7 +61,7 @@ int run(RenderArgs& a) {
   }
   if (a.backend == "cpu" && !a.device.empty()) throw std::invalid_argument("--device applies to --backend vulkan only");
   const auto method = parseRotationMethod(a.method);
-  if (!method) throw std::invalid_argument("--method must be haar, spatial, matrix or table (got \"" + a.method + "\")");
+  if (!method) throw std::invalid_argument("--method must be one of " + pixelMethodNames() + " (got \"" + a.method + "\")");
   const auto variant = parseHaarVariant(a.variant);
   if (!variant) throw std::invalid_argument("--haar-variant must be faithful, local or refined (got \"" + a.variant + "\")");
   a.options.method = *method;
@@ -109,7 +109,7 @@ std::function<int()> addRenderCommand(CLI::App& app) {
   auto* c = app.add_subcommand("render", "Render a scene on the CPU or Vulkan backend (linear EXR + tonemapped PNG)");
   args->scene.out = "render.exr";
   addSceneFlags(*c, args->scene);
-  c->add_option("--method", args->method, "Rotation method: haar|spatial|matrix|table")->capture_default_str();
+  c->add_option("--method", args->method, "Per-pixel method: " + pixelMethodNames())->capture_default_str();
   c->add_option("--haar-variant", args->variant, "faithful|local|refined")->capture_default_str();
   c->add_option("--level", args->options.level, "Map level n (M = 2^n)")->capture_default_str();
   c->add_option("--light-coeffs", args->options.lightCoefficients, "Light coefficients kept (k)")

@@ -27,7 +27,7 @@ namespace fs = std::filesystem;
 struct ServeArgs {
   net::ServerOptions server;
   std::string token;
-  std::string backend = "cpu", method = "haar", encoding = "jpeg";
+  std::string backend = "cpu", method = "fused", encoding = "jpeg";
   int level = 4;
   std::size_t lightCoefficients = 256;
   std::vector<std::string> sceneFiles;
@@ -112,7 +112,7 @@ int run(ServeArgs& a) {
   }
 
   const auto method = parseRotationMethod(a.method);
-  if (!method) throw std::invalid_argument("--method must be haar, spatial, matrix or table (got \"" + a.method + "\")");
+  if (!method) throw std::invalid_argument("--method must be one of " + pixelMethodNames() + " (got \"" + a.method + "\")");
   auto& d = a.server.defaults;
   d.method = *method;
   d.level = a.level;
@@ -199,7 +199,7 @@ std::function<int()> addServeCommand(CLI::App& app) {
   c->add_option("--token", a->token, "Required token (?token=T or Authorization: Bearer T); default $HAARCAST_TOKEN");
   c->add_option("--backend", a->backend, "Default backend: cpu|vulkan")->capture_default_str();
   c->add_option("--level", a->level, "Default map level n (M = 2^n)")->capture_default_str();
-  c->add_option("--method", a->method, "Default rotation method: haar|spatial|matrix|table")->capture_default_str();
+  c->add_option("--method", a->method, "Default per-pixel method: " + pixelMethodNames())->capture_default_str();
   c->add_option("--light-coeffs", a->lightCoefficients, "Default light coefficients kept (k)")->capture_default_str();
   c->add_option("--encoding", a->encoding, "Default encoding: jpeg|png|raw|exr")->capture_default_str();
   c->add_option("--scene", a->sceneFiles, "Scene files to offer besides the built-in \"default\" (named by file stem)");

@@ -231,7 +231,7 @@ try {
   check(Number(h1.fps) > 0, `HUD fps is a positive number ("${h1.fps}")`);
   check(Number(h1.latency) > 0, `HUD latency is a positive number of ms ("${h1.latency}")`);
   check(Number(h1.kbps) > 0, `HUD kbit/s is a positive number ("${h1.kbps}")`);
-  check(['haar', 'spatial', 'matrix', 'table'].includes(h1.method), `HUD method names a method ("${h1.method}")`);
+  check(['fused', 'haar', 'spatial', 'matrix', 'table'].includes(h1.method), `HUD method names a method ("${h1.method}")`);
   await page.waitForTimeout(600);
   const h2 = await hud();
   check(h2.updates > h1.updates, `the HUD keeps updating (${h1.updates} → ${h2.updates} redraws)`);
@@ -242,7 +242,7 @@ try {
 
   // 5. A control reaches the server: switch the method, drag, and the next
   // frame must come back rendered with it.
-  const target = h1.method === 'spatial' ? 'haar' : 'spatial';
+  const target = h1.method === 'fused' ? 'haar' : 'fused';
   await page.selectOption('#method', target);
   await dragAndWait(`drag after choosing ${target}`);
   await page.waitForFunction((m) => window.haarcast.lastFrame.method === m, target, { timeout: 60000 })

@@ -32,6 +32,7 @@ std::optional<RotationMethod> methodFromWire(v1::RotationMethod m) {
     case v1::ROTATION_METHOD_SPATIAL: return RotationMethod::Spatial;
     case v1::ROTATION_METHOD_MATRIX: return RotationMethod::Matrix;
     case v1::ROTATION_METHOD_TABLE: return RotationMethod::Table;
+    case v1::ROTATION_METHOD_FUSED: return RotationMethod::Fused;
     default: return std::nullopt;
   }
 }
@@ -298,6 +299,7 @@ v1::RotationMethod toWire(RotationMethod method) {
     case RotationMethod::Spatial: return v1::ROTATION_METHOD_SPATIAL;
     case RotationMethod::Matrix: return v1::ROTATION_METHOD_MATRIX;
     case RotationMethod::Table: return v1::ROTATION_METHOD_TABLE;
+    case RotationMethod::Fused: return v1::ROTATION_METHOD_FUSED;
   }
   return v1::ROTATION_METHOD_UNSPECIFIED;
 }

@@ -54,6 +54,37 @@ TEST(CpuRenderer, EveryRotationMethodAgreesWithSpatialWhereTheyShould) {
   for (std::size_t i = 0; i < spatial.image.rgb.size(); ++i) EXPECT_NEAR(haar.image.rgb[i], spatial.image.rgb[i], 1e-4);
 }
 
+TEST(CpuRenderer, FusedEqualsSpatialRotationAndTheTripleProduct) {
+  // Parseval: the pixel-basis sum of fused is the Haar-basis triple product
+  // of the spatially rotated slice. With the nearest θₒ slice (as spatial
+  // takes it) the frames agree to float rounding, at each level fused takes.
+  const Scene scene = sphereScene("phong:32", 1.0);
+  for (int level : {3, 4, 5}) {
+    RenderOptions o = smallOptions();
+    o.level = level;
+    o.lightCoefficients = 64;  // a truncated light, as in a frame
+    o.method = RotationMethod::Spatial;
+    const RenderResult spatial = renderCpu(scene, o);
+    o.method = RotationMethod::Fused;
+    o.interpolateSlices = false;
+    const RenderResult fused = renderCpu(scene, o);
+    ASSERT_EQ(fused.objectMask, spatial.objectMask);
+    float peak = 0.0f;
+    for (float v : spatial.image.rgb) peak = std::max(peak, v);
+    ASSERT_GT(peak, 0.0f);
+    for (std::size_t i = 0; i < spatial.image.rgb.size(); ++i) {
+      EXPECT_NEAR(fused.image.rgb[i], spatial.image.rgb[i], 2e-5 * peak) << "level " << level << ", value " << i;
+    }
+    // Blending neighbouring θₒ slices changes the picture a little, not a lot.
+    o.interpolateSlices = true;
+    const RenderResult blended = renderCpu(scene, o);
+    double diff = 0.0;
+    for (std::size_t i = 0; i < spatial.image.rgb.size(); ++i) diff = std::max(diff, double(std::abs(blended.image.rgb[i] - fused.image.rgb[i])));
+    EXPECT_GT(diff, 1e-6 * peak);
+    EXPECT_LT(diff, 0.25 * peak);
+  }
+}
+
 TEST(CpuRenderer, MeshesWithoutNormalsGetThemComputed) {
   Scene scene = sphereScene("lambert", 1.0);
   auto bare = std::make_shared<Mesh>(*scene.objects[0].mesh);
@@ -75,6 +106,12 @@ TEST(CpuRenderer, BadOptionsAreRefusedByName) {
   o = smallOptions();
   o.lightCoefficients = 0;
   EXPECT_THROW(checkRenderOptions(o), std::invalid_argument);
+  o = smallOptions();
+  o.method = RotationMethod::Fused;
+  o.level = 8;  // fused stops at 7
+  EXPECT_THROW(checkRenderOptions(o), std::invalid_argument);
+  o.method = RotationMethod::Haar;
+  EXPECT_NO_THROW(checkRenderOptions(o));
   EXPECT_THROW(materialFromSpec("phong:"), std::invalid_argument);
   EXPECT_THROW(materialFromSpec("velvet"), std::invalid_argument);
 }

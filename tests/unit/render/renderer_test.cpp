@@ -117,6 +117,14 @@ TEST(SharedSteps, FrameRequestsAreCheckedWithClearErrors) {
   r = FrameRequest{};
   r.camera.fovYDegrees = 180.0;
   EXPECT_THROW(checkFrameRequest(r, 2), std::invalid_argument);
+  r = FrameRequest{};
+  r.camera.eye = r.camera.target + glm::dvec3(0.0, 0.0, 2.0 * kMaxEyeDistance);
+  try {
+    checkFrameRequest(r, 2);
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("distance"), std::string::npos) << e.what();
+  }
 }
 
 TEST(CpuBackend, FramesAreRepeatableAndEqualTheOneShotRender) {
@@ -139,11 +147,17 @@ TEST(CpuBackend, FramesAreRepeatableAndEqualTheOneShotRender) {
   EXPECT_EQ(a.image.rgb, b.image.rgb);
   EXPECT_EQ(a.image.rgb, once.image.rgb);
   EXPECT_EQ(a.rgba8, tonemapRgba8(a.image, 0.0));
-  // Every stage is reported, in pipeline order.
-  const std::vector<std::string> names = {"light", "gbuffer", "rotation-input", "rotation", "triple-product", "tonemap"};
+  // Every stage is reported, in pipeline order (fused, the default, has one
+  // pass where the rotating methods have two).
+  const std::vector<std::string> names = {"light", "gbuffer", "rotation-input", "fused", "tonemap"};
   ASSERT_EQ(a.stages.size(), names.size());
   for (std::size_t i = 0; i < names.size(); ++i) EXPECT_EQ(a.stages[i].name, names[i]);
   EXPECT_GT(a.coefficientBytes, 0u);
+  o.method = RotationMethod::Haar;
+  const Frame rotating = makeCpuRenderer(scene, o)->render(request);
+  const std::vector<std::string> rotatingNames = {"light", "gbuffer", "rotation-input", "rotation", "triple-product", "tonemap"};
+  ASSERT_EQ(rotating.stages.size(), rotatingNames.size());
+  for (std::size_t i = 0; i < rotatingNames.size(); ++i) EXPECT_EQ(rotating.stages[i].name, rotatingNames[i]);
 }
 
 TEST(CpuBackend, PosesAndLightChangeTheFrame) {
