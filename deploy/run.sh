@@ -7,14 +7,16 @@
 #                                 the CLI client against the server for a few seconds
 #                                 (on a terminal the server keeps running until Ctrl-C)
 #   deploy/run.sh test  [args]   ctest --test-dir build --output-on-failure [args]
-#   deploy/run.sh bench [args]   build/bin/haarcast-bench [args]
+#   deploy/run.sh bench [args]   the speed table (bench-frame, fused: 128², 256², 512² at
+#                                 levels 4-6, fps per backend), then build/bin/haarcast-bench [args]
 #                                 e.g. deploy/run.sh bench -- --benchmark_filter=Rotate
 #   deploy/run.sh build          install and build only (the container image uses it)
 #
 # A leading "--" in [args] is dropped. Environment: HAARCAST_JOBS (build jobs,
 # default nproc), HAARCAST_BUILD_DIR (default build), HAARCAST_PORT (demo's
 # server port, default 8080; 0 picks a free one), HAARCAST_BACKEND (demo's
-# server backend, default vulkan). Runs without a terminal
+# server backend, default vulkan), HAARCAST_BENCH_BACKEND (the speed table's
+# backends: cpu, vulkan or both, default both; none skips it). Runs without a terminal
 # (CI): no prompts, no stdin.
 set -euo pipefail
 
@@ -166,10 +168,10 @@ case "$command" in
     [[ -n "$url" ]] || { cat "$server_log" >&2; echo "error: the server did not start within 60 s" >&2; exit 1; }
     log "browser client: $url"
     ws="ws://${url#http://}ws"
-    # A frame costs seconds without a GPU (every pixel rotates its own BRDF
-    # slice), so the client plays a 36-pose orbit for 10 s at 128².
+    # The client plays a 36-pose orbit for at most 10 s at 256² with the
+    # server's default method (fused).
     log "running haarcast-client $ws for 10 s (frames in $BUILD_DIR/demo/frames/)"
-    "$BUILD_DIR/bin/haarcast-client" "$ws" --duration 10 --frames 36 --size 128x128 --encoding jpeg \
+    "$BUILD_DIR/bin/haarcast-client" "$ws" --duration 10 --frames 36 --size 256x256 --encoding jpeg \
       --out "$BUILD_DIR/demo/frames" --json </dev/null
     if [[ -t 0 ]]; then
       log "the server keeps running at $url (log: $server_log); Ctrl-C stops it"
@@ -189,6 +191,12 @@ case "$command" in
     exec ctest --test-dir "$BUILD_DIR" --output-on-failure "$@" </dev/null
     ;;
   bench)
+    bench_backend="${HAARCAST_BENCH_BACKEND:-both}"
+    if [[ "$bench_backend" != none ]]; then
+      log "speed table: fused, 128² 256² 512², levels 4-6, backend $bench_backend"
+      "$BUILD_DIR/bin/haarcast" bench-frame --backend "$bench_backend" --method fused --sizes 128,256,512 \
+        --levels 4,5,6 --frames 3 --cache-dir "$BUILD_DIR/cache" </dev/null
+    fi
     log "running benchmarks"
     exec "$BUILD_DIR/bin/haarcast-bench" "$@" </dev/null
     ;;

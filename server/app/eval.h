@@ -23,6 +23,7 @@ struct EvalOptions {
   std::string dataDir;  // ../shared/data layout: probes/, meshes/, brdfs/
   std::string outDir = "eval";
   bool quick = false;   // the small version the test suite runs
+  bool truthOnly = false;  // only the truth section (Monte Carlo and every method)
   unsigned threads = 0;
 };
 
