@@ -203,12 +203,14 @@ TEST(MergeVisibility, ZeroWeightsAndSharedVertices) {
 }
 
 TEST(MergeVisibility, BadListsAreRefused) {
-  const SparseHaar a{3, {0, 5}, {1.0f, 0.5f}}, b{4, {0}, {1.0f}}, unsorted{3, {5, 0}, {1.0f, 1.0f}}, ragged{3, {0, 1}, {1.0f}};
+  const SparseHaar a{3, {0, 5}, {1.0f, 0.5f}}, b{4, {0}, {1.0f}}, unsorted{3, {5, 0}, {1.0f, 1.0f}}, ragged{3, {0, 1}, {1.0f}},
+                   repeated{3, {0, 5, 5}, {1.0f, 1.0f, 1.0f}};
   SparseHaar out;
   EXPECT_THROW(mergeVisibility({&a, &a, &b}, {0.3, 0.3, 0.4}, out), std::invalid_argument);
   EXPECT_THROW(mergeVisibility({&a, nullptr, &a}, {0.3, 0.3, 0.4}, out), std::invalid_argument);
   EXPECT_THROW(mergeVisibility({&a, &unsorted, &a}, {0.3, 0.3, 0.4}, out), std::invalid_argument);
   EXPECT_THROW(mergeVisibility({&a, &ragged, &a}, {0.3, 0.3, 0.4}, out), std::invalid_argument);
+  EXPECT_THROW(mergeVisibility({&a, &a, &repeated}, {0.3, 0.3, 0.4}, out), std::invalid_argument);
 }
 
 // The counter the warm-call tests rely on sees an allocation at all.
