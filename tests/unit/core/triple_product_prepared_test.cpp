@@ -91,7 +91,8 @@ TEST(PreparedTripleProduct, EqualsTripleProductAndBruteForce) {
     const double scale = magnitude(c.light, c.brdf, c.visibility) + 1e-30;
     const double old = tripleProduct(c.light, c.brdf, c.visibility);
     const double prepared = tripleProduct(light, c.brdf, visibility);
-    // Same terms summed in the same order: equal up to double rounding.
+    // tripleProduct prepares both operands per call and walks the same way;
+    // the brute force is the independent reference.
     EXPECT_NEAR(prepared, old, 1e-12 * scale);
     EXPECT_NEAR(tripleProduct(light, c.brdf, c.visibility, scratch), old, 1e-12 * scale);
     EXPECT_NEAR(prepared, tripleProductBruteForce(c.light.toDense(), c.brdf, c.visibility.toDense()), 1e-5 * scale);

@@ -32,13 +32,15 @@ double tripleProduct(const SparseHaar& light, const HaarMap& brdf, const SparseH
 
 // ---- The per-pixel path: operands prepared once ------------------------------
 //
-// tripleProduct above validates both sparse operands, works out where each
-// coefficient sits, and sorts them into the walk's order on every call. Per
-// frame the light of an object and channel is one list; per pixel the
-// visibility is one list shared by the three channels. Both are prepared once
-// into the walk's own order, and the walk then only merges two sorted block
-// lists: no allocation, validation or sort per call. Same terms, same order
-// of summation: the result equals tripleProduct's up to rounding.
+// The walk visits the blocks where the light or the visibility has a detail
+// in pre-order of the block quadtree, so that one root-to-block path, updated
+// incrementally, gives every block's scaling values. tripleProduct above
+// validates both sparse operands, works out where each coefficient sits and
+// sorts them into that order on every call. Per frame the light of an object
+// and channel is one list; per pixel the visibility is one list shared by the
+// three channels. Prepared once each, the walk only merges two sorted block
+// lists: no allocation, validation or sort per call, and the same number
+// (tripleProduct is this walk with both operands prepared per call).
 
 // A sparse Haar function in the order the walk visits it: validated, its
 // detail coefficients grouped per block (h, v, d' together) and the blocks in
@@ -52,7 +54,7 @@ class PreparedSparseHaar {
   };
 
   PreparedSparseHaar() = default;
-  explicit PreparedSparseHaar(const SparseHaar& x) { assign(x); }
+  explicit PreparedSparseHaar(const SparseHaar& x, const char* what = "sparse operand") { assign(x, what); }
 
   // Replaces the contents with x, reusing this object's buffers (no
   // allocation once they are large enough). Throws std::invalid_argument for
