@@ -1,6 +1,7 @@
 // rotateHaar3 and RgbHaarRotator: the three-channel path must give what
 // three single-channel rotateHaar calls give, and allocate nothing once warm.
 #include <array>
+#include <cmath>
 #include <memory>
 #include <random>
 #include <stdexcept>
@@ -15,6 +16,7 @@
 #include "haarcast/core/brdf.h"
 #include "haarcast/core/brdf_slices.h"
 #include "haarcast/core/rotate_haar.h"
+#include "haarcast/core/triple_product.h"
 
 namespace haarcast {
 namespace {
@@ -187,6 +189,54 @@ TEST(RgbHaarRotator, BadTablesAreRefused) {
   RotatorOptions o;
   o.haarStartLevel = 3;
   EXPECT_THROW(RgbHaarRotator({std::vector<HaarMap>{a}, {a}, {a}}, o), std::invalid_argument);
+}
+
+// One pixel's shading, end to end: the renderer's loop (per channel one
+// rotation and three products blended with the barycentrics) against the
+// lean calls (one three-channel rotation, the visibility merged, one product
+// per channel with the prepared light).
+TEST(HaarPixel, LeanPathEqualsTheOldLoop) {
+  std::mt19937 rng(31);
+  std::bernoulli_distribution visible(0.7);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int level : {4, 5}) {
+    std::array<std::vector<HaarMap>, 3> slices;
+    std::array<SparseHaar, 3> light;
+    std::array<PreparedLight, 3> prepared;
+    for (std::size_t c = 0; c < 3; ++c) {
+      for (int t = 0; t < 2; ++t) slices[c].push_back(glossySlice(level, static_cast<int>(c)));
+      SphereMap env(level);
+      for (float& v : env.values()) v = static_cast<float>(4.0 * u(rng) * u(rng));
+      light[c] = keepLargest(forwardHaar(env.weightedBySolidAngle()), 256);
+      prepared[c].assign(light[c]);
+    }
+    const RgbHaarRotator rgb(slices);
+    HaarRotationScratch scratch;
+    std::array<HaarMap, 3> rotated;
+    SparseHaar merged;
+    PreparedVisibility visibility;
+    for (const EulerYXY& r : randomRotations(6, 40u + static_cast<unsigned>(level))) {
+      std::array<SparseHaar, 3> vertex;
+      for (SparseHaar& v : vertex) {
+        SphereMap map(level);
+        for (float& x : map.values()) x = visible(rng) ? 1.0f : 0.0f;
+        v = keepLargest(forwardHaar(map), 64);
+      }
+      const double a = u(rng), b = (1.0 - a) * u(rng);
+      const std::array<double, 3> w{a, b, 1.0 - a - b};
+
+      rgb.rotate(1, r, rotated, scratch);
+      mergeVisibility({&vertex[0], &vertex[1], &vertex[2]}, w, merged);
+      visibility.assign(merged);
+      for (std::size_t c = 0; c < 3; ++c) {
+        const HaarMap old = rotateHaar(slices[c][1], r);
+        double expected = 0.0;
+        for (std::size_t k = 0; k < 3; ++k) expected += w[k] * tripleProduct(light[c], old, vertex[k]);
+        EXPECT_NEAR(tripleProduct(prepared[c], rotated[c], visibility), expected, 1e-5 * std::abs(expected) + 1e-9)
+            << "level " << level << " channel " << c;
+      }
+    }
+  }
 }
 
 }  // namespace
