@@ -351,7 +351,8 @@ void BM_HaarPixel(benchmark::State& state, bool lean) {
 BENCHMARK_CAPTURE(BM_HaarPixel, old, false)->DenseRange(4, 5)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_HaarPixel, lean, true)->DenseRange(4, 5)->Unit(benchmark::kMicrosecond);
 
-// The lean pixel's parts on their own (level 5): where its time goes.
+// The lean pixel's parts on their own: where its time goes (merge_visibility
+// includes preparing the merged list, once per pixel).
 void BM_HaarPixelPart(benchmark::State& state, int part) {
   const int level = static_cast<int>(state.range(0));
   const PixelInputs& in = pixelInputs(level);
