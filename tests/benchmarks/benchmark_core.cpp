@@ -1,5 +1,6 @@
 // Benchmarks of the core math: the Haar transform, the four rotation methods
-// (DESIGN.md "Rotation methods") and the triple product.
+// (DESIGN.md "Rotation methods"), the triple product, and one pixel's `haar`
+// shading (the renderer's per-pixel work, old and lean paths side by side).
 //
 // Run:   deploy/run.sh bench -- --benchmark_filter=Rotate
 //        (or build/bin/haarcast-bench --benchmark_filter=... directly)
@@ -20,6 +21,7 @@
 // reported as skipped with the reason rather than aborting the run.
 #include <benchmark/benchmark.h>
 
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <exception>
@@ -243,6 +245,149 @@ void BM_TripleProduct(benchmark::State& state) {
   state.counters["k_visibility"] = static_cast<double>(in.visibility.size());
 }
 BENCHMARK(BM_TripleProduct)->RangeMultiplier(4)->Range(16, 4096)->Unit(benchmark::kNanosecond);
+
+// ---- One pixel's haar shading ----------------------------------------------
+//
+// What CpuRenderer does per covered pixel with the `haar` method, side by side
+// with the lean path of the same library (DESIGN.md "Speed": one run):
+//  * old:  per channel, SliceRotator::rotate (rotateHaar) and three
+//          tripleProduct calls, one per vertex of the triangle, blended with
+//          the barycentrics — 3 rotations, 9 triple products;
+//  * lean: RgbHaarRotator::rotate (rotateHaar3: the geometry once for the
+//          three channels, no allocation), mergeVisibility (the blend before
+//          the product, which is linear in V), the merged visibility prepared
+//          once, and one tripleProduct per channel with the frame's
+//          PreparedLight — 1 rotation of three channels, 3 triple products.
+// Inputs as the renderer has them: Phong-64 slices of the three channels,
+// the light's k = 256 largest coefficients per channel, each vertex's 64
+// largest visibility coefficients. Arg: the map level. Compare the two on the
+// same line; the time is per pixel.
+struct PixelInputs {
+  int level = -1;
+  std::array<std::unique_ptr<SliceRotator>, 3> rotators;  // old
+  std::unique_ptr<RgbHaarRotator> rgb;                     // lean
+  std::array<SparseHaar, 3> light;
+  std::array<PreparedLight, 3> preparedLight;
+  std::vector<std::array<SparseHaar, 3>> triangles;  // per-vertex visibility
+  std::vector<std::array<double, 3>> barycentrics;
+};
+
+constexpr std::size_t kTriangleCount = 16;  // power of two: index with a mask
+
+const PixelInputs& pixelInputs(int level) {
+  static PixelInputs in;
+  if (in.level == level) return in;
+  in = PixelInputs{};
+  in.level = level;
+  const auto phong = makePhong(glm::dvec3(0.1, 0.2, 0.3), glm::dvec3(0.9, 0.6, 0.4), 64.0);
+  std::array<std::vector<HaarMap>, 3> slices;
+  for (int c = 0; c < 3; ++c)
+    for (const double thetaOut : {0.15, 0.55, 0.95, 1.35})
+      slices[static_cast<std::size_t>(c)].push_back(forwardHaar(sliceMap(*phong, thetaOut, c, level, 2)));
+  for (std::size_t c = 0; c < 3; ++c) in.rotators[c] = makeRotator(RotationMethod::Haar, slices[c]);
+  in.rgb = std::make_unique<RgbHaarRotator>(slices);
+  const std::array<SphereMap, 3> env = assets::proceduralEnvironment(level, 4);
+  for (std::size_t c = 0; c < 3; ++c) {
+    in.light[c] = keepLargest(forwardHaar(env[c].weightedBySolidAngle()), 256);
+    in.preparedLight[c].assign(in.light[c]);
+  }
+  // Each vertex near a wall: a slanted horizon and a cone-shaped occluder
+  // whose direction and size vary from vertex to vertex.
+  std::mt19937 rng(77);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (std::size_t t = 0; t < kTriangleCount; ++t) {
+    std::array<SparseHaar, 3> vertices;
+    for (SparseHaar& v : vertices) {
+      const glm::dvec3 blocker = glm::normalize(glm::dvec3(1.0, 0.3 * u(rng), 0.5 * u(rng)));
+      const double cone = 0.8 + 0.1 * u(rng), tilt = 0.2 * u(rng);
+      const SphereMap map = supersampledMap(level, 2, [&](const glm::dvec3& d) {
+        if (d.y < -0.1 + tilt * d.z) return 0.0;
+        return glm::dot(d, blocker) > cone ? 0.0 : 1.0;
+      });
+      v = keepLargest(forwardHaar(map), 64);
+    }
+    in.triangles.push_back(std::move(vertices));
+    const double a = 0.5 * (u(rng) + 1.0), b = 0.5 * (1.0 - a) * (u(rng) + 1.0);
+    in.barycentrics.push_back({a, b, 1.0 - a - b});
+  }
+  return in;
+}
+
+void BM_HaarPixel(benchmark::State& state, bool lean) {
+  const int level = static_cast<int>(state.range(0));
+  const PixelInputs& in = pixelInputs(level);
+  const std::vector<EulerYXY>& rs = rotations();
+  const std::size_t slices = in.rgb->sliceCount();
+  HaarMap rotated;
+  std::array<HaarMap, 3> rotated3;
+  HaarRotationScratch scratch;
+  SparseHaar merged;
+  PreparedVisibility visibility;
+  double radiance = 0.0;
+  std::size_t i = 0;
+  for (auto _ : state) {
+    const std::size_t slice = i % slices;
+    const EulerYXY& r = rs[i & (kRotationCount - 1)];
+    const std::array<SparseHaar, 3>& v = in.triangles[i & (kTriangleCount - 1)];
+    const std::array<double, 3>& b = in.barycentrics[i & (kTriangleCount - 1)];
+    if (lean) {
+      in.rgb->rotate(slice, r, rotated3, scratch);
+      mergeVisibility({&v[0], &v[1], &v[2]}, b, merged);
+      visibility.assign(merged, "visibility");
+      for (std::size_t c = 0; c < 3; ++c) radiance += tripleProduct(in.preparedLight[c], rotated3[c], visibility);
+    } else {
+      for (std::size_t c = 0; c < 3; ++c) {
+        in.rotators[c]->rotate(slice, r, rotated);
+        for (std::size_t k = 0; k < 3; ++k) radiance += b[k] * tripleProduct(in.light[c], rotated, v[k]);
+      }
+    }
+    benchmark::DoNotOptimize(radiance);
+    ++i;
+  }
+  setCounters(state, level);
+  state.counters["k_light"] = static_cast<double>(in.light[0].size());
+  state.counters["k_visibility"] = static_cast<double>(in.triangles[0][0].size());
+}
+BENCHMARK_CAPTURE(BM_HaarPixel, old, false)->DenseRange(4, 5)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_HaarPixel, lean, true)->DenseRange(4, 5)->Unit(benchmark::kMicrosecond);
+
+// The lean pixel's parts on their own: where its time goes (merge_visibility
+// includes preparing the merged list, once per pixel).
+void BM_HaarPixelPart(benchmark::State& state, int part) {
+  const int level = static_cast<int>(state.range(0));
+  const PixelInputs& in = pixelInputs(level);
+  const std::vector<EulerYXY>& rs = rotations();
+  std::array<HaarMap, 3> rotated3;
+  HaarRotationScratch scratch;
+  in.rgb->rotate(0, rs[0], rotated3, scratch);
+  SparseHaar merged;
+  PreparedVisibility visibility;
+  double radiance = 0.0;
+  std::size_t i = 0;
+  for (auto _ : state) {
+    const std::array<SparseHaar, 3>& v = in.triangles[i & (kTriangleCount - 1)];
+    switch (part) {
+      case 0: in.rgb->rotate(i % in.rgb->sliceCount(), rs[i & (kRotationCount - 1)], rotated3, scratch); break;
+      case 1:
+        mergeVisibility({&v[0], &v[1], &v[2]}, in.barycentrics[i & (kTriangleCount - 1)], merged);
+        visibility.assign(merged, "visibility");
+        break;
+      default:
+        if (i == 0) {
+          mergeVisibility({&v[0], &v[1], &v[2]}, in.barycentrics[0], merged);
+          visibility.assign(merged, "visibility");
+        }
+        for (std::size_t c = 0; c < 3; ++c) radiance += tripleProduct(in.preparedLight[c], rotated3[c], visibility);
+    }
+    benchmark::DoNotOptimize(radiance);
+    benchmark::ClobberMemory();
+    ++i;
+  }
+  setCounters(state, level);
+}
+BENCHMARK_CAPTURE(BM_HaarPixelPart, rotate3, 0)->DenseRange(4, 5)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_HaarPixelPart, merge_visibility, 1)->DenseRange(4, 5)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_HaarPixelPart, triple_products, 2)->DenseRange(4, 5)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 

@@ -118,17 +118,21 @@ SphereMap inverseHaar(const HaarMap& coeffs) {
 }
 
 std::vector<double> scalingValues(const HaarMap& coeffs, int l) {
+  std::vector<double> a, scratch;
+  scalingValues(coeffs, l, a, scratch);
+  return a;
+}
+
+void scalingValues(const HaarMap& coeffs, int l, std::vector<double>& a, std::vector<double>& scratch) {
   if (l < 0 || l > coeffs.level()) throw std::invalid_argument("scalingValues: level out of range");
   const int m = coeffs.size();
   const int side = 1 << l;
   // Synthesise only the top-left side×side corner: levels 0 .. l−1.
-  std::vector<double> a(static_cast<std::size_t>(side) * static_cast<std::size_t>(side));
+  a.resize(static_cast<std::size_t>(side) * static_cast<std::size_t>(side));
   for (int r = 0; r < side; ++r)
     for (int c = 0; c < side; ++c)
       a[static_cast<std::size_t>(r) * side + c] = coeffs[static_cast<std::size_t>(r) * m + c];
-  std::vector<double> scratch;
   for (int n = 2; n <= side; n *= 2) synthesisStep(a, side, n, scratch);
-  return a;
 }
 
 HaarMap SparseHaar::toDense() const {

@@ -1,114 +1,146 @@
-#include "haarcast/core/triple_product.h"
-
+// The triple product in the Haar basis (triple_product.h): the sparse
+// operands prepared into the walk's order, the walk itself, the per-call form
+// that prepares both operands on every call, the brute-force reference, and
+// the barycentric merge of per-vertex visibility.
 #include <algorithm>
-#include <array>
+#include <bit>
+#include <stdexcept>
 #include <string>
+
+#include "haarcast/core/triple_product.h"
 
 namespace haarcast {
 namespace {
 
-// (h, v, d) details of one block.
 using Details = std::array<double, 3>;
 
 // Signs of (h, v, d) in the synthesis of child quadrant 2·rowBit + colBit
 // (haar.cpp, synthesisStep): top-left, top-right, bottom-left, bottom-right.
 constexpr std::array<Details, 4> kChildSign{{{1, 1, 1}, {-1, 1, -1}, {1, -1, -1}, {-1, -1, 1}}};
 
-// Scaling value of a child block from its parent's: one synthesis step,
-// S_child = (S_parent ± h ± v ± d) / 2.
+// S_child = (S_parent ± h ± v ± d) / 2: one synthesis step.
 double childScaling(double parent, const Details& details, int quadrant) {
   const Details& sign = kChildSign[static_cast<std::size_t>(quadrant)];
   return 0.5 * (parent + sign[0] * details[0] + sign[1] * details[1] + sign[2] * details[2]);
 }
 
-Details denseDetails(const HaarMap& map, int l, int i, int j) {
-  return {map.detail(Band::Horizontal, l, i, j), map.detail(Band::Vertical, l, i, j),
-          map.detail(Band::Diagonal, l, i, j)};
+// Spreads the low 16 bits of x to the even bits.
+std::uint64_t spreadBits(std::uint64_t x) {
+  x &= 0xFFFFu;
+  x = (x | (x << 8)) & 0x00FF00FFu;
+  x = (x | (x << 4)) & 0x0F0F0F0Fu;
+  x = (x | (x << 2)) & 0x33333333u;
+  x = (x | (x << 1)) & 0x55555555u;
+  return x;
 }
 
-// Position of block (l, i, j) in a pre-order walk of the block quadtree:
-// the Morton code of its top-left finest block, ties (a block and its
-// top-left descendants) broken coarser first. A block's descendants then
-// follow it contiguously, so its ancestors are always visited before it.
+// Position of block (l, i, j) in a pre-order walk of the block quadtree: the
+// Morton code of its top-left finest block (row bits odd, column bits even),
+// ties (a block and its top-left descendants) broken coarser first. A block's
+// descendants then follow it contiguously, so its ancestors are always
+// visited before it.
 std::uint64_t preorderKey(int finestLevel, int l, int i, int j) {
   const int shift = finestLevel - l;
-  const auto row = static_cast<std::uint64_t>(i) << shift;
-  const auto col = static_cast<std::uint64_t>(j) << shift;
-  std::uint64_t morton = 0;
-  for (int b = 0; b <= finestLevel; ++b) {
-    morton |= ((row >> b) & 1u) << (2 * b + 1);
-    morton |= ((col >> b) & 1u) << (2 * b);
-  }
-  return (morton << 4) | static_cast<std::uint64_t>(l);  // l ≤ kMaxLevel < 16
+  const std::uint64_t morton = (spreadBits(static_cast<std::uint64_t>(i) << shift) << 1) |
+                               spreadBits(static_cast<std::uint64_t>(j) << shift);
+  return (morton << 4) | static_cast<std::uint64_t>(l);
 }
 
-// A non-zero detail coefficient of the light or of the visibility.
-struct DetailEntry {
-  std::uint64_t key;
-  CoefficientPosition position;
-  bool isLight;
-  double value;
+// coefficientPosition of a detail index (index ≥ 1) without a loop: the
+// detail level is that of the larger of row and column, the band which of
+// them lies in the upper half.
+struct DetailPosition {
+  std::uint32_t band;
+  int level, i, j;
 };
-
-void checkOperand(const SparseHaar& x, const char* name, const HaarMap& brdf) {
-  if (x.level != brdf.level()) {
-    throw std::invalid_argument(std::string("tripleProduct: ") + name + " level " + std::to_string(x.level) +
-                                " differs from brdf level " + std::to_string(brdf.level()));
-  }
-  if (x.index.size() != x.value.size()) {
-    throw std::invalid_argument(std::string("tripleProduct: ") + name + " has " + std::to_string(x.index.size()) +
-                                " indices but " + std::to_string(x.value.size()) + " values");
-  }
-  for (const std::uint32_t index : x.index) {
-    if (index >= brdf.coefficientCount()) {
-      throw std::invalid_argument(std::string("tripleProduct: ") + name + " index " + std::to_string(index) +
-                                  " is outside a level-" + std::to_string(x.level) + " map");
-    }
-  }
+DetailPosition detailPosition(int n, std::uint32_t index) {
+  const std::uint32_t row = index >> n, col = index & ((1u << n) - 1u);
+  const int l = std::bit_width(std::max(row, col)) - 1;
+  const auto half = static_cast<std::uint32_t>(1u << l);
+  if (row < half) return {0u, l, static_cast<int>(row), static_cast<int>(col - half)};
+  if (col < half) return {1u, l, static_cast<int>(row - half), static_cast<int>(col)};
+  return {2u, l, static_cast<int>(row - half), static_cast<int>(col - half)};
 }
 
-void checkLevels(const HaarMap& light, const HaarMap& brdf, const HaarMap& visibility) {
-  if (light.level() != brdf.level() || visibility.level() != brdf.level()) {
-    throw std::invalid_argument("tripleProductBruteForce: levels differ (light " + std::to_string(light.level()) +
-                                ", brdf " + std::to_string(brdf.level()) + ", visibility " +
-                                std::to_string(visibility.level()) + ")");
-  }
-}
+// Sort word of one detail coefficient: key, then band, then its position in
+// the input list (so that the last of duplicate indices comes last).
+constexpr int kListBits = 2 * kMaxLevel;  // an index of a level-kMaxLevel map
+constexpr int kBandShift = kListBits;
+constexpr int kKeyShift = kListBits + 2;
+static_assert(kKeyShift + 2 * kMaxLevel + 4 <= 64, "sort word overflows");
 
 }  // namespace
 
-double tripleProduct(const SparseHaar& light, const HaarMap& brdf, const SparseHaar& visibility) {
-  checkOperand(light, "light", brdf);
-  checkOperand(visibility, "visibility", brdf);
+void PreparedSparseHaar::assign(const SparseHaar& x, const char* what) {
+  if (x.level < 0 || x.level > kMaxLevel) {
+    throw std::invalid_argument(std::string("tripleProduct: ") + what + " level " + std::to_string(x.level) +
+                                " is outside [0, " + std::to_string(kMaxLevel) + "]");
+  }
+  if (x.index.size() != x.value.size()) {
+    throw std::invalid_argument(std::string("tripleProduct: ") + what + " has " + std::to_string(x.index.size()) +
+                                " indices but " + std::to_string(x.value.size()) + " values");
+  }
+  const int n = x.level;
+  const std::uint64_t count = std::uint64_t{1} << (2 * n);
+  if (x.index.size() > (std::uint64_t{1} << kListBits)) {
+    throw std::invalid_argument(std::string("tripleProduct: ") + what + " has " + std::to_string(x.index.size()) +
+                                " entries, more than a level-" + std::to_string(kMaxLevel) + " map has coefficients");
+  }
+  level_ = n;
+  scaling_ = 0.0;
+  order_.clear();
+  for (std::size_t k = 0; k < x.index.size(); ++k) {
+    const std::uint32_t index = x.index[k];
+    if (index >= count) {
+      throw std::invalid_argument(std::string("tripleProduct: ") + what + " index " + std::to_string(index) +
+                                  " is outside a level-" + std::to_string(n) + " map");
+    }
+    if (index == 0) {
+      scaling_ = x.value[k];
+      continue;
+    }
+    const DetailPosition p = detailPosition(n, index);
+    const std::uint64_t key = preorderKey(n - 1, p.level, p.i, p.j);
+    order_.push_back((key << kKeyShift) | (std::uint64_t{p.band} << kBandShift) | k);
+  }
+  std::sort(order_.begin(), order_.end());
+
+  blocks_.clear();
+  constexpr std::uint64_t kListMask = (std::uint64_t{1} << kListBits) - 1;
+  for (const std::uint64_t word : order_) {
+    const std::uint64_t key = word >> kKeyShift;
+    const auto band = static_cast<std::size_t>((word >> kBandShift) & 3u);
+    const auto k = static_cast<std::size_t>(word & kListMask);
+    if (blocks_.empty() || blocks_.back().key != key) {
+      const DetailPosition p = detailPosition(n, x.index[k]);
+      blocks_.push_back({key, p.level, p.i, p.j, {}});
+    }
+    blocks_.back().details[band] = x.value[k];
+  }
+}
+
+double tripleProduct(const PreparedLight& light, const HaarMap& brdf, const PreparedVisibility& visibility) {
   const int n = brdf.level();
-  const int finest = n - 1;  // finest detail level
+  if (light.level() != n || visibility.level() != n) {
+    throw std::invalid_argument("tripleProduct: light level " + std::to_string(light.level()) + ", visibility level " +
+                                std::to_string(visibility.level()) + ", brdf level " + std::to_string(n));
+  }
+  const std::span<const float> b = brdf.coefficients();
+  const int m = mapSize(n);
+  auto brdfDetails = [&](int l, int i, int j) -> Details {
+    return {b[HaarMap::detailIndexOf(m, Band::Horizontal, l, i, j)], b[HaarMap::detailIndexOf(m, Band::Vertical, l, i, j)],
+            b[HaarMap::detailIndexOf(m, Band::Diagonal, l, i, j)]};
+  };
 
   // Term 1 of triple_product.h: all three scaling, C = 1/M.
-  const double a0 = !light.index.empty() && light.index[0] == 0 ? light.value[0] : 0.0;
-  const double b0 = brdf.scaling();
-  const double c0 = !visibility.index.empty() && visibility.index[0] == 0 ? visibility.value[0] : 0.0;
-  double sum = a0 * b0 * c0 / mapSize(n);
-
-  // The blocks where the light or the visibility has a detail, in pre-order,
-  // so that one root-to-block path, updated incrementally, gives every
-  // block's scaling values: O((k_L + k_V) log N) after the sort.
-  std::vector<DetailEntry> entries;
-  entries.reserve(light.size() + visibility.size());
-  auto collect = [&](const SparseHaar& x, bool isLight) {
-    for (std::size_t k = 0; k < x.size(); ++k) {
-      const CoefficientPosition p = coefficientPosition(n, x.index[k]);
-      if (p.isScaling) continue;
-      entries.push_back({preorderKey(finest, p.level, p.i, p.j), p, isLight, x.value[k]});
-    }
-  };
-  collect(light, true);
-  collect(visibility, false);
-  std::sort(entries.begin(), entries.end(),
-            [](const DetailEntry& x, const DetailEntry& y) { return x.key < y.key; });
+  const double a0 = light.scaling(), b0 = brdf.scaling(), c0 = visibility.scaling();
+  double sum = a0 * b0 * c0 / m;
 
   // The current root-to-block path, one entry per detail level: block
-  // coordinates, the scaling values S_a, S_b, S_c of that block, and the
-  // light's and visibility's details there (zero for a block not visited).
+  // coordinates, the scaling values S_a, S_b, S_c of that block (S_c built
+  // from the visibility's coarser coefficients, term 3 of triple_product.h),
+  // and the light's and visibility's details there (zero for a block not
+  // visited).
   std::array<int, kMaxLevel> pathI{}, pathJ{};
   std::array<double, kMaxLevel> sA{}, sB{}, sC{};
   std::array<Details, kMaxLevel> detA{}, detC{};
@@ -120,8 +152,13 @@ double tripleProduct(const SparseHaar& light, const HaarMap& brdf, const SparseH
     depth = 1;
   }
 
-  for (std::size_t first = 0; first < entries.size();) {
-    const CoefficientPosition& block = entries[first].position;
+  // Merge the two block lists, both in pre-order: O((k_L + k_V) log N).
+  const std::span<const PreparedSparseHaar::Block> la = light.blocks(), lc = visibility.blocks();
+  std::size_t ia = 0, ic = 0;
+  while (ia < la.size() || ic < lc.size()) {
+    const bool takeA = ic == lc.size() || (ia < la.size() && la[ia].key <= lc[ic].key);
+    const bool takeC = ia == la.size() || (ic < lc.size() && lc[ic].key <= la[ia].key);
+    const PreparedSparseHaar::Block& block = takeA ? la[ia] : lc[ic];
     const int l = block.level;
 
     // Deepest level shared with the current path; the root always is.
@@ -130,17 +167,16 @@ double tripleProduct(const SparseHaar& light, const HaarMap& brdf, const SparseH
            pathJ[static_cast<std::size_t>(common)] != block.j >> (l - common)) {
       --common;
     }
-    // Descend to the block. Blocks strictly between `common` and `l` hold no
-    // light or visibility detail: pre-order would have visited them already.
+    // Descend to the block; blocks strictly between hold no light or
+    // visibility detail (pre-order would have visited them).
     for (int d = common + 1; d <= l; ++d) {
       const auto parent = static_cast<std::size_t>(d - 1);
       const auto child = static_cast<std::size_t>(d);
       const int ci = block.i >> (l - d);
       const int cj = block.j >> (l - d);
       const int quadrant = 2 * (ci & 1) + (cj & 1);
-      const Details detB = denseDetails(brdf, d - 1, pathI[parent], pathJ[parent]);
       sA[child] = childScaling(sA[parent], detA[parent], quadrant);
-      sB[child] = childScaling(sB[parent], detB, quadrant);
+      sB[child] = childScaling(sB[parent], brdfDetails(d - 1, pathI[parent], pathJ[parent]), quadrant);
       sC[child] = childScaling(sC[parent], detC[parent], quadrant);
       pathI[child] = ci;
       pathJ[child] = cj;
@@ -149,32 +185,36 @@ double tripleProduct(const SparseHaar& light, const HaarMap& brdf, const SparseH
     }
     depth = l + 1;
 
-    // Gather this block's light and visibility details.
     const auto at = static_cast<std::size_t>(l);
-    std::size_t last = first;
-    for (; last < entries.size() && entries[last].key == entries[first].key; ++last) {
-      Details& det = entries[last].isLight ? detA[at] : detC[at];
-      det[static_cast<std::size_t>(entries[last].position.band)] = entries[last].value;
-    }
-    first = last;
+    if (takeA) detA[at] = la[ia++].details;
+    if (takeC) detC[at] = lc[ic++].details;
 
     // Terms 2 and 3 of triple_product.h for this block, C = ±1/s.
     const Details& a = detA[at];
     const Details& c = detC[at];
-    const Details b = denseDetails(brdf, l, block.i, block.j);
+    const Details bd = brdfDetails(l, block.i, block.j);
     double sameType = 0.0;
-    for (std::size_t t = 0; t < 3; ++t) {
-      sameType += a[t] * b[t] * sC[at] + a[t] * c[t] * sB[at] + b[t] * c[t] * sA[at];
-    }
-    const double allTypes = a[0] * (b[1] * c[2] + b[2] * c[1]) + a[1] * (b[0] * c[2] + b[2] * c[0]) +
-                            a[2] * (b[0] * c[1] + b[1] * c[0]);
+    for (std::size_t t = 0; t < 3; ++t) sameType += a[t] * bd[t] * sC[at] + a[t] * c[t] * sB[at] + bd[t] * c[t] * sA[at];
+    const double allTypes = a[0] * (bd[1] * c[2] + bd[2] * c[1]) + a[1] * (bd[0] * c[2] + bd[2] * c[0]) +
+                            a[2] * (bd[0] * c[1] + bd[1] * c[0]);
     sum += (sameType + allTypes) / mapSize(n - l);
   }
   return sum;
 }
 
+double tripleProduct(const SparseHaar& light, const HaarMap& brdf, const SparseHaar& visibility) {
+  const PreparedLight preparedLight(light, "light");
+  PreparedVisibility preparedVisibility;
+  preparedVisibility.assign(visibility, "visibility");
+  return tripleProduct(preparedLight, brdf, preparedVisibility);
+}
+
 double tripleProductBruteForce(const HaarMap& light, const HaarMap& brdf, const HaarMap& visibility) {
-  checkLevels(light, brdf, visibility);
+  if (light.level() != brdf.level() || visibility.level() != brdf.level()) {
+    throw std::invalid_argument("tripleProductBruteForce: levels differ (light " + std::to_string(light.level()) +
+                                ", brdf " + std::to_string(brdf.level()) + ", visibility " +
+                                std::to_string(visibility.level()) + ")");
+  }
   const SphereMap l = inverseHaar(light);
   const SphereMap b = inverseHaar(brdf);
   const SphereMap v = inverseHaar(visibility);
@@ -183,6 +223,53 @@ double tripleProductBruteForce(const HaarMap& light, const HaarMap& brdf, const 
     sum += static_cast<double>(l.values()[p]) * b.values()[p] * v.values()[p];
   }
   return sum;
+}
+
+double tripleProduct(const PreparedLight& light, const HaarMap& brdf, const SparseHaar& visibility,
+                     TripleProductScratch& scratch) {
+  scratch.visibility.assign(visibility, "visibility");
+  return tripleProduct(light, brdf, scratch.visibility);
+}
+
+void mergeVisibility(const std::array<const SparseHaar*, 3>& vertices, const std::array<double, 3>& weights,
+                     SparseHaar& out) {
+  for (std::size_t v = 0; v < 3; ++v) {
+    if (!vertices[v]) throw std::invalid_argument("mergeVisibility: vertex " + std::to_string(v) + " list is null");
+    if (vertices[v]->level != vertices[0]->level) {
+      throw std::invalid_argument("mergeVisibility: vertex " + std::to_string(v) + " has level " +
+                                  std::to_string(vertices[v]->level) + ", vertex 0 level " +
+                                  std::to_string(vertices[0]->level));
+    }
+    if (vertices[v]->index.size() != vertices[v]->value.size()) {
+      throw std::invalid_argument("mergeVisibility: vertex " + std::to_string(v) + " has " +
+                                  std::to_string(vertices[v]->index.size()) + " indices but " +
+                                  std::to_string(vertices[v]->value.size()) + " values");
+    }
+  }
+  out.level = vertices[0]->level;
+  out.index.clear();
+  out.value.clear();
+  // A three-way merge of lists sorted by index; a list of weight 0 is empty.
+  std::array<std::size_t, 3> next{}, end{};
+  for (std::size_t v = 0; v < 3; ++v) end[v] = weights[v] != 0.0 ? vertices[v]->size() : 0;
+  constexpr std::uint64_t kDone = std::uint64_t{1} << 32;
+  auto head = [&](std::size_t v) -> std::uint64_t { return next[v] < end[v] ? vertices[v]->index[next[v]] : kDone; };
+  for (;;) {
+    const std::uint64_t index = std::min({head(0), head(1), head(2)});
+    if (index == kDone) break;
+    double value = 0.0;
+    for (std::size_t v = 0; v < 3; ++v) {
+      if (head(v) != index) continue;
+      value += weights[v] * static_cast<double>(vertices[v]->value[next[v]]);
+      ++next[v];
+      if (next[v] < end[v] && vertices[v]->index[next[v]] <= index) {
+        throw std::invalid_argument("mergeVisibility: vertex " + std::to_string(v) +
+                                    " indices are not strictly increasing at position " + std::to_string(next[v]));
+      }
+    }
+    out.index.push_back(static_cast<std::uint32_t>(index));
+    out.value.push_back(static_cast<float>(value));
+  }
 }
 
 }  // namespace haarcast

@@ -80,6 +80,9 @@ SphereMap inverseHaar(const HaarMap& coeffs);
 // reconstructed from the scaling coefficient and the details of levels < l.
 // s at level l of a block is (sum of the block's pixels) / (block side).
 std::vector<double> scalingValues(const HaarMap& coeffs, int l);
+// The same into caller-owned buffers (resized; no allocation once they are
+// large enough): out gets the 2^l × 2^l values, scratch is work space.
+void scalingValues(const HaarMap& coeffs, int l, std::vector<double>& out, std::vector<double>& scratch);
 
 // Non-zero coefficients of a map, sorted by index.
 struct SparseHaar {

@@ -54,6 +54,8 @@
 //    exactly what the seed hoped to avoid; the report times both variants.
 #pragma once
 
+#include <array>
+#include <cstddef>
 #include <vector>
 
 #include "haarcast/core/rotation.h"
@@ -66,6 +68,72 @@ struct HaarRotationOptions {
 };
 
 HaarMap rotateHaar(const HaarMap& f, const EulerYXY& r, const HaarRotationOptions& options = {});
+
+// ---- Three colour channels at once: the per-pixel path ----------------------
+//
+// A pixel rotates the same slice of its R, G and B tables by one rotation.
+// Everything in Refined that depends on the rotation alone is computed once
+// and applied to the three channels together:
+//  * the source position S(p) = (Φ, Θ) of every working pixel centre, Rᵀp in
+//    spherical coordinates (seed eqs. 8–10), from per-level tables of the
+//    pixel centres' sines and cosines: one acos and one atan2 per pixel;
+//  * step (2)'s walk of each path S(p₁) → S(p₂) over the source cells it
+//    crosses (the finite chain rule, seed eqs. 11–13): which cells, and each
+//    cell's bilinear weights y₁−y₀, x₁−x₀, x₁y₁−x₀y₀. The three channels'
+//    difference fields are read at the same cells in the same pass.
+// Per channel remain only the linear parts: step (1) (f's exact differences
+// from the details and the start level's scaling values), step (3) (the
+// scaling anchor) and the recursive h_t / h_s sums (seed eqs. 14–16), each
+// done for the three channels in one loop.
+//
+// The result is the same as three rotateHaar calls up to double rounding
+// (the coefficients are stored as float either way). Faithful and Local take
+// the single-channel path, one channel after another.
+
+// Work buffers for rotateHaar3, owned by the caller and kept between calls
+// (one per thread): once they have grown to a level's size, a call allocates
+// nothing. What they hold between calls means nothing.
+struct HaarRotationScratch {
+  std::vector<double> scaling, synthesis;  // start-level scaling values of one channel, and work space
+  std::vector<double> cells;               // f's differences per source cell, 3 channels
+  std::vector<double> points;              // source position of every working pixel centre
+  std::vector<double> dTheta, dPhi, dMixed;  // g's difference fields, 3 channels
+  std::vector<double> sumsA, sumsB;        // the h_t / h_s recursion, ping-pong
+};
+
+// Rotates the three maps f[0..2] (one slice, three channels; all one level) by
+// r into out[0..2] (resized to f's level). Throws std::invalid_argument on a
+// null map, mixed levels, or a start level finer than the maps' finest.
+void rotateHaar3(const std::array<const HaarMap*, 3>& f, const EulerYXY& r, std::array<HaarMap, 3>& out,
+                 HaarRotationScratch& scratch, const HaarRotationOptions& options = {});
+
+// The `haar` method for an RGB slice table: owns the three channels' unrotated
+// slices (BrdfSliceTable::channelSlices(c)) and rotates one slice of all
+// three per call with rotateHaar3. rotate() is const and thread-safe as long
+// as each thread passes its own scratch.
+class RgbHaarRotator {
+ public:
+  // Throws std::invalid_argument if a channel is empty, the channels differ in
+  // slice count, the slices mix levels, or the start level is too fine.
+  explicit RgbHaarRotator(std::array<std::vector<HaarMap>, 3> channelSlices, const HaarRotationOptions& options = {});
+  // The haar fields of RotatorOptions (variant, start level).
+  RgbHaarRotator(std::array<std::vector<HaarMap>, 3> channelSlices, const RotatorOptions& options);
+
+  std::size_t sliceCount() const { return slices_[0].size(); }
+  int level() const { return slices_[0].front().level(); }
+  const HaarRotationOptions& options() const { return options_; }
+
+  // out[c] = slice `slice` of channel c rotated by r. Throws std::out_of_range
+  // for a slice index ≥ sliceCount().
+  void rotate(std::size_t slice, const EulerYXY& r, std::array<HaarMap, 3>& out, HaarRotationScratch& scratch) const;
+
+  // Only the unrotated slices of the three channels, as for SliceRotator.
+  std::size_t storedBytes() const;
+
+ private:
+  std::array<std::vector<HaarMap>, 3> slices_;
+  HaarRotationOptions options_;
+};
 
 // ∫ f dω of the map whose coefficients are `f`, from the coefficients alone
 // (the solid-angle moments of the scaling and vertical basis functions).
