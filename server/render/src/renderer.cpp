@@ -13,6 +13,7 @@
 #include <glm/geometric.hpp>
 
 #include "haarcast/core/parallel.h"
+#include "haarcast/core/rotate_haar.h"
 #include "haarcast/core/triple_product.h"
 #include "haarcast/io/slice_cache.h"
 #include "haarcast/render/embree_scene.h"
@@ -197,6 +198,15 @@ class CpuRenderer final : public Renderer {
       std::array<std::unique_ptr<SliceRotator>, 3> r;
       for (int c = 0; c < 3; ++c) r[static_cast<std::size_t>(c)] = makeRotator(options.method, p.table.channelSlices(c), options.rotator);
       rotators_.push_back(std::move(r));
+      // haar refined rotates the three channels together, sharing the
+      // geometry and the cell walk (rotate_haar.h).
+      if (options.method == RotationMethod::Haar && options.rotator.haarVariant == HaarVariant::Refined) {
+        rgbHaar_.push_back(std::make_unique<RgbHaarRotator>(
+            std::array<std::vector<HaarMap>, 3>{p.table.channelSlices(0), p.table.channelSlices(1), p.table.channelSlices(2)},
+            options.rotator));
+      } else {
+        rgbHaar_.push_back(nullptr);
+      }
     }
     // The meshes' ray structures are built once; frames only move them.
     std::vector<Instance> instances;
@@ -234,6 +244,7 @@ class CpuRenderer final : public Renderer {
   RenderOptions options_;
   PreparedScene prepared_;
   std::vector<std::array<std::unique_ptr<SliceRotator>, 3>> rotators_;  // rotating methods
+  std::vector<std::unique_ptr<RgbHaarRotator>> rgbHaar_;                 // haar refined, else null
   std::vector<PixelSlices> pixelSlices_;                                 // fused
   std::unique_ptr<RayScene> rays_;  // posed per frame with setTransform (top level only)
 };
@@ -326,6 +337,10 @@ Frame CpuRenderer::render(const FrameRequest& request) {
 
 std::size_t CpuRenderer::shadeRotating(const ResolvedFrame& resolved, const std::vector<std::optional<Hit>>& hits,
                                        const std::vector<PixelInput>& inputs, Frame& frame, int w, int h) {
+  // The light's lists are validated and put in the walk's order once per frame.
+  std::vector<std::array<PreparedLight, 3>> light(resolved.objects.size());
+  for (std::size_t i = 0; i < light.size(); ++i)
+    for (std::size_t c = 0; c < 3; ++c) light[i][c].assign(resolved.objects[i].light[c]);
   // The CPU keeps one rotated map per thread instead of a frame's worth, so
   // the two stages run interleaved; their wall time is split in proportion
   // to the thread time each took.
@@ -333,7 +348,14 @@ std::size_t CpuRenderer::shadeRotating(const ResolvedFrame& resolved, const std:
   std::atomic<std::int64_t> rotationNs{0}, productNs{0};
   std::atomic<std::size_t> shadingBytes{0};
   parallelFor(static_cast<std::size_t>(h), [&](std::size_t y) {
-    HaarMap rotated;
+    // Per worker thread, kept across rows: no allocation per pixel once warm.
+    struct Scratch {
+      std::array<HaarMap, 3> rotated;
+      HaarRotationScratch haar;
+      SparseHaar merged;
+      PreparedVisibility visibility;
+    };
+    thread_local Scratch s;
     std::int64_t rot = 0, prod = 0;
     std::size_t rowBytes = 0;
     for (int x = 0; x < w; ++x) {
@@ -343,22 +365,28 @@ std::size_t CpuRenderer::shadeRotating(const ResolvedFrame& resolved, const std:
       const std::size_t object = hits[i]->object;
       const PreparedObject& p = prepared_.objects[object];
       const PixelInput& in = inputs[i];
-      for (std::size_t c = 0; c < 3; ++c) {
-        const auto a = Clock::now();
-        rotators_[object][c]->rotate(static_cast<std::size_t>(in.rotation.slice), in.rotation.euler, rotated);
-        const auto b = Clock::now();
-        double sum = 0.0;
-        // The visibility blend is linear, so it distributes over the product.
-        for (int v = 0; v < 3; ++v) {
-          const SparseHaar& vis = p.visibility[in.vertex[v]];
-          sum += in.b[v] * tripleProduct(resolved.objects[object].light[c], rotated, vis);
-          rowBytes += vis.size() * (sizeof(std::uint32_t) + sizeof(float));
-        }
-        rot += std::chrono::duration_cast<std::chrono::nanoseconds>(b - a).count();
-        prod += std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - b).count();
-        rowBytes += rotationBytes(object);
-        frame.image.at(static_cast<int>(y), x, static_cast<int>(c)) = static_cast<float>(sum);
+      const auto a = Clock::now();
+      const std::size_t slice = static_cast<std::size_t>(in.rotation.slice);
+      if (rgbHaar_[object]) {
+        rgbHaar_[object]->rotate(slice, in.rotation.euler, s.rotated, s.haar);
+      } else {
+        for (std::size_t c = 0; c < 3; ++c) rotators_[object][c]->rotate(slice, in.rotation.euler, s.rotated[c]);
       }
+      const auto b = Clock::now();
+      // The product is linear in V: the three vertices' lists merged with
+      // their barycentric weights, then one product per channel.
+      const std::array<const SparseHaar*, 3> vertices{&p.visibility[in.vertex[0]], &p.visibility[in.vertex[1]],
+                                                      &p.visibility[in.vertex[2]]};
+      mergeVisibility(vertices, {in.b[0], in.b[1], in.b[2]}, s.merged);
+      s.visibility.assign(s.merged);
+      for (std::size_t c = 0; c < 3; ++c) {
+        frame.image.at(static_cast<int>(y), x, static_cast<int>(c)) =
+            static_cast<float>(tripleProduct(light[object][c], s.rotated[c], s.visibility));
+      }
+      rot += std::chrono::duration_cast<std::chrono::nanoseconds>(b - a).count();
+      prod += std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - b).count();
+      for (const SparseHaar* v : vertices) rowBytes += v->size() * (sizeof(std::uint32_t) + sizeof(float));
+      rowBytes += 3 * rotationBytes(object);
     }
     rotationNs += rot;
     productNs += prod;
