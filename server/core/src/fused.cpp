@@ -143,29 +143,34 @@ std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBl
   }
   synthesizeInPlace(scratch.visibility, level, scratch.synthesis);
 
-  // W_c = (L_c·ΔΩ)·V.
-  scratch.weight.resize(3 * n);
-  for (std::size_t c = 0; c < 3; ++c) {
-    const float* l = light.planes.data() + c * n;
-    float* w = scratch.weight.data() + c * n;
-    for (std::size_t p = 0; p < n; ++p) w[p] = l[p] * scratch.visibility[p];
-  }
-
   // ρ: one slice, or the blend of two (linear, so blending the texels once
-  // equals blending the two sums).
+  // equals blending the two sums). Rows past lastNonZeroRow are zero in every
+  // slice, so only the rows above are blended; the buffer's rows below are
+  // kept zero (they may hold another object's rows from an earlier pixel).
   const float* slice = slices.slice(static_cast<int>(blend.first));
   if (blend.weight != 0.0f && blend.second != blend.first) {
     const float* other = slices.slice(static_cast<int>(blend.second));
-    scratch.blended.resize(n * shared::kTexelFloats);
+    const std::size_t rowFloats = static_cast<std::size_t>(mapSize(level)) * shared::kTexelFloats;
+    const std::size_t rows = static_cast<std::size_t>(slices.lastNonZeroRow() + 1);
+    if (scratch.blended.size() != n * shared::kTexelFloats) {
+      scratch.blended.assign(n * shared::kTexelFloats, 0.0f);
+      scratch.blendedRows = 0;
+    }
+    if (scratch.blendedRows > rows) {
+      std::fill(scratch.blended.begin() + static_cast<std::ptrdiff_t>(rows * rowFloats),
+                scratch.blended.begin() + static_cast<std::ptrdiff_t>(scratch.blendedRows * rowFloats), 0.0f);
+    }
+    scratch.blendedRows = rows;
     const float w = blend.weight;
-    for (std::size_t k = 0; k < n * shared::kTexelFloats; ++k) scratch.blended[k] = slice[k] + w * (other[k] - slice[k]);
+    for (std::size_t k = 0; k < rows * rowFloats; ++k) scratch.blended[k] = slice[k] + w * (other[k] - slice[k]);
     slice = scratch.blended.data();
   }
 
   detail::FusedPass pass;
   pass.level = level;
   pass.slice = slice;
-  pass.weight = scratch.weight.data();
+  pass.light = light.planes.data();
+  pass.visibility = scratch.visibility.data();
   pass.directions = detail::pixelDirections(level);
   pass.cosAlpha = static_cast<float>(std::cos(r.alpha));
   pass.sinAlpha = static_cast<float>(std::sin(r.alpha));

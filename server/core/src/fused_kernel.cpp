@@ -6,7 +6,7 @@
 //   Rᵀω = R_y(−γ) R_x(−β) R_y(−α) ω        (core/rotation.h; seed eq. for p)
 //   θ' = atan2(|(x, z)|, y),  φ' = atan2(x, z) − γ
 //   ρ_c = bilinear lookup of the slice at (θ', φ')   (sphere_map.h bilinearTaps)
-//   acc_c += W_c(ω) · ρ_c
+//   acc_c += (L_c·ΔΩ)(ω) · V(ω) · ρ_c
 // γ never needs trigonometry: it only offsets the source column.
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "fused_kernel.cpp"
@@ -63,9 +63,10 @@ void FusedSample(const FusedPass& p, float* HWY_RESTRICT out) {
   const float* HWY_RESTRICT red = p.slice;
   const float* HWY_RESTRICT green = p.slice + 1;
   const float* HWY_RESTRICT blue = p.slice + 2;
-  const float* HWY_RESTRICT w0 = p.weight;
-  const float* HWY_RESTRICT w1 = p.weight + n;
-  const float* HWY_RESTRICT w2 = p.weight + 2 * n;
+  const float* HWY_RESTRICT l0 = p.light;
+  const float* HWY_RESTRICT l1 = p.light + n;
+  const float* HWY_RESTRICT l2 = p.light + 2 * n;
+  const float* HWY_RESTRICT vis = p.visibility;
 
   VF accR = zero, accG = zero, accB = zero;
   // n ≥ 16 ≥ lanes on every target for level ≥ 2, and both are powers of two.
@@ -107,9 +108,11 @@ void FusedSample(const FusedPass& p, float* HWY_RESTRICT out) {
       const VF bottom = hn::MulAdd(tCol, hn::Sub(e, c), c);
       return hn::MulAdd(tRow, hn::Sub(bottom, top), top);
     };
-    accR = hn::MulAdd(hn::LoadU(d, w0 + i), lookup(red), accR);
-    accG = hn::MulAdd(hn::LoadU(d, w1 + i), lookup(green), accG);
-    accB = hn::MulAdd(hn::LoadU(d, w2 + i), lookup(blue), accB);
+    // W_c = (L_c·ΔΩ)·V, formed only for the directions that are not skipped.
+    const VF v = hn::LoadU(d, vis + i);
+    accR = hn::MulAdd(hn::Mul(hn::LoadU(d, l0 + i), v), lookup(red), accR);
+    accG = hn::MulAdd(hn::Mul(hn::LoadU(d, l1 + i), v), lookup(green), accG);
+    accB = hn::MulAdd(hn::Mul(hn::LoadU(d, l2 + i), v), lookup(blue), accB);
   }
   out[0] = hn::GetLane(hn::SumOfLanes(d, accR));
   out[1] = hn::GetLane(hn::SumOfLanes(d, accG));

@@ -17,7 +17,8 @@ const PixelDirections& pixelDirections(int level);
 struct FusedPass {
   int level = 0;
   const float* slice = nullptr;   // R, G, B, 0 texels (shared::kTexelFloats)
-  const float* weight = nullptr;  // W_c, three planes of N
+  const float* light = nullptr;       // L_c·ΔΩ, three planes of N
+  const float* visibility = nullptr;  // V, N
   PixelDirections directions;
   // Rᵀ = R_y(−γ) R_x(−β) R_y(−α): α turns the directions, β tilts them,
   // and γ is an offset of the source column, split into a whole number of

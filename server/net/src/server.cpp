@@ -884,6 +884,11 @@ void Server::Impl::doAccept() {
     if (ec) {
       log("accept: %s", ec.message().c_str());
     } else {
+      // Frames are small writes answered by small pose messages: without
+      // this, Nagle's algorithm holds a frame's last segment until the
+      // client's delayed ACK (40 ms on Linux), a stall on every frame.
+      beast::error_code ignored;
+      socket.set_option(tcp::no_delay(true), ignored);
       std::make_shared<HttpSession>(*this, std::move(socket))->run();
     }
     doAccept();

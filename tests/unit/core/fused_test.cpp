@@ -156,6 +156,24 @@ TEST(Fused, BlendOfTwoSlicesIsTheBlendOfTheirResults) {
   }
 }
 
+TEST(Fused, ScratchSharedAcrossTablesGivesFreshAnswers) {
+  // One thread's scratch serves every object: a blend into it for a table
+  // whose slices reach the south pole must not leak into the next table's.
+  std::mt19937 rng(10u);
+  const Case full = randomCase(4, false, rng);
+  const Case upper = randomCase(4, true, rng);
+  const PixelSlices fullSlices = PixelSlices::synthesize(full.table), upperSlices = PixelSlices::synthesize(upper.table);
+  ASSERT_GT(fullSlices.lastNonZeroRow(), upperSlices.lastNonZeroRow());
+  const FusedLight light = FusedLight::synthesize(upper.light);
+  const EulerYXY r{0.3, 2.6, 1.0};  // a tilt that looks at the lower rows
+  const shared::SliceBlend blend{0u, 1u, 0.5f};
+  FusedScratch fresh, shared;
+  const auto want = fusedShade(upperSlices, blend, r, light, weighted(upper), fresh);
+  (void)fusedShade(fullSlices, blend, r, FusedLight::synthesize(full.light), weighted(full), shared);
+  const auto got = fusedShade(upperSlices, blend, r, light, weighted(upper), shared);
+  for (std::size_t ch = 0; ch < 3; ++ch) EXPECT_EQ(got[ch], want[ch]) << "channel " << ch;
+}
+
 TEST(SliceBlend, AtASampleItIsThatSliceAlone) {
   const int samples = 16;
   for (int t = 0; t < samples; ++t) {

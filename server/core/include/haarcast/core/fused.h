@@ -84,8 +84,8 @@ struct WeightedVisibility {
 struct FusedScratch {
   std::vector<float> visibility;  // merged coefficients, then V in pixel form
   std::vector<float> synthesis;   // one inverse-Haar step
-  std::vector<float> weight;      // W_c = (L_c·ΔΩ)·V, three planes
   std::vector<float> blended;     // the θₒ-blended slice, when the blend weight is not 0
+  std::size_t blendedRows = 0;    // rows of `blended` that may be non-zero
 };
 
 // One pixel of `fused`: Σ_ω W_c(ω)·ρ_c(Rᵀω) for c = R, G, B, with
