@@ -36,6 +36,7 @@
 #include "haarcast/assets/procedural_environment.h"
 #include "haarcast/core/brdf.h"
 #include "haarcast/core/brdf_slices.h"
+#include "haarcast/core/fused.h"
 #include "haarcast/core/haar.h"
 #include "haarcast/core/rotate_haar.h"
 #include "haarcast/core/rotation.h"
@@ -266,6 +267,8 @@ struct PixelInputs {
   int level = -1;
   std::array<std::unique_ptr<SliceRotator>, 3> rotators;  // old
   std::unique_ptr<RgbHaarRotator> rgb;                     // lean
+  PixelSlices pixelSlices;                                 // fused
+  FusedLight fusedLight;
   std::array<SparseHaar, 3> light;
   std::array<PreparedLight, 3> preparedLight;
   std::vector<std::array<SparseHaar, 3>> triangles;  // per-vertex visibility
@@ -286,11 +289,19 @@ const PixelInputs& pixelInputs(int level) {
       slices[static_cast<std::size_t>(c)].push_back(forwardHaar(sliceMap(*phong, thetaOut, c, level, 2)));
   for (std::size_t c = 0; c < 3; ++c) in.rotators[c] = makeRotator(RotationMethod::Haar, slices[c]);
   in.rgb = std::make_unique<RgbHaarRotator>(slices);
+  {
+    std::vector<double> thetaOut;
+    std::vector<HaarMap> all;
+    for (std::size_t t = 0; t < slices[0].size(); ++t) thetaOut.push_back((static_cast<double>(t) + 0.5) * (kPi / 2.0) / static_cast<double>(slices[0].size()));
+    for (const auto& channel : slices) all.insert(all.end(), channel.begin(), channel.end());
+    in.pixelSlices = PixelSlices::synthesize(BrdfSliceTable::fromSlices(thetaOut, std::move(all)));
+  }
   const std::array<SphereMap, 3> env = assets::proceduralEnvironment(level, 4);
   for (std::size_t c = 0; c < 3; ++c) {
     in.light[c] = keepLargest(forwardHaar(env[c].weightedBySolidAngle()), 256);
     in.preparedLight[c].assign(in.light[c]);
   }
+  in.fusedLight = FusedLight::synthesize(in.light);
   // Each vertex near a wall: a slanted horizon and a cone-shaped occluder
   // whose direction and size vary from vertex to vertex.
   std::mt19937 rng(77);
@@ -350,6 +361,36 @@ void BM_HaarPixel(benchmark::State& state, bool lean) {
 }
 BENCHMARK_CAPTURE(BM_HaarPixel, old, false)->DenseRange(4, 5)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_HaarPixel, lean, true)->DenseRange(4, 5)->Unit(benchmark::kMicrosecond);
+
+// The same pixel by `fused` (fused.h): one pass over the map directions for
+// the three channels, θₒ blend of two slices, the same inputs. Compare with
+// BM_HaarPixel on the same run.
+void BM_FusedPixel(benchmark::State& state) {
+  const int level = static_cast<int>(state.range(0));
+  const PixelInputs& in = pixelInputs(level);
+  const std::vector<EulerYXY>& rs = rotations();
+  const auto slices = static_cast<shared::uint>(in.pixelSlices.thetaSamples());
+  FusedScratch scratch;
+  float radiance = 0.0f;
+  std::size_t i = 0;
+  for (auto _ : state) {
+    const EulerYXY& r = rs[i & (kRotationCount - 1)];
+    const std::array<SparseHaar, 3>& v = in.triangles[i & (kTriangleCount - 1)];
+    const std::array<double, 3>& b = in.barycentrics[i & (kTriangleCount - 1)];
+    const std::array<WeightedVisibility, 3> vis{WeightedVisibility{&v[0], static_cast<float>(b[0])},
+                                                WeightedVisibility{&v[1], static_cast<float>(b[1])},
+                                                WeightedVisibility{&v[2], static_cast<float>(b[2])}};
+    const auto first = static_cast<shared::uint>(i % slices);
+    const shared::SliceBlend blend{first, std::min(first + 1u, slices - 1u), 0.5f};
+    const std::array<float, 3> rgb = fusedShade(in.pixelSlices, blend, r, in.fusedLight, vis, scratch);
+    radiance += rgb[0] + rgb[1] + rgb[2];
+    benchmark::DoNotOptimize(radiance);
+    ++i;
+  }
+  setCounters(state, level);
+  state.SetLabel(fusedTargetName());
+}
+BENCHMARK(BM_FusedPixel)->DenseRange(4, 7)->Unit(benchmark::kMicrosecond);
 
 // The lean pixel's parts on their own: where its time goes (merge_visibility
 // includes preparing the merged list, once per pixel).
