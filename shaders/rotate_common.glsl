@@ -18,6 +18,8 @@
 // acosPrecise: Vulkan's own may be off by thousands of ULP, lavapipe's are)
 // and rotationYXY, rotX, rotY of core/rotation.cpp.
 #include "common/sphere.glsl"
+// RotationSample (core/shared_layout.h, shared with the host).
+#include "haarcast/core/shared_layout.h"
 
 layout(constant_id = 0) const uint LEVEL = 5u;
 layout(constant_id = 1) const uint THETA_SAMPLES = 16u;
@@ -25,17 +27,6 @@ layout(constant_id = 1) const uint THETA_SAMPLES = 16u;
 const uint M = 1u << LEVEL;   // map side
 const uint N = M * M;         // coefficients per map
 const uint HALF = M / 2u;     // blocks per side at the finest detail level
-
-struct RotationSample {
-  uint slice;       // global slice index into binding 1
-  uint methodBase;  // the object's block in binding 2, in 32-bit words
-  float alpha;      // Y-X-Y Euler angles: R = Ry(α) Rx(β) Ry(γ) (core/rotation.h)
-  float beta;
-  float gamma;
-  uint pixel;
-  uint pad0;
-  uint pad1;
-};
 
 layout(push_constant) uniform RotationPush {
   uint first;

@@ -17,7 +17,7 @@ FrameParams makeFrameParams(const render::Camera& camera, int width, int height,
   const glm::dvec3 forward = glm::normalize(camera.target - camera.eye);
   const glm::dvec3 right = glm::normalize(glm::cross(forward, camera.up));
   const glm::dvec3 up = glm::cross(right, forward);
-  FrameParams f;
+  FrameParams f{};
   f.forward = glm::vec4(glm::vec3(forward), 0.0f);
   f.right = glm::vec4(glm::vec3(right), 0.0f);
   f.up = glm::vec4(glm::vec3(up), 0.0f);
@@ -44,6 +44,30 @@ std::array<float, 256> srgbThresholds(double exposureStops) {
     t[static_cast<std::size_t>(k)] = static_cast<float>(linear / gain);
   }
   return t;
+}
+
+std::vector<std::uint32_t> packVisibilityEntries(std::span<const SparseHaar> lists, int level) {
+  const std::size_t count = static_cast<std::size_t>(mapSize(level)) * static_cast<std::size_t>(mapSize(level));
+  std::vector<std::uint32_t> out(2 * lists.size());
+  for (std::size_t n = 0; n < lists.size(); ++n) {
+    const SparseHaar& list = lists[n];
+    if (list.level != level || list.index.size() != list.value.size()) {
+      throw std::invalid_argument("packVisibilityEntries: list " + std::to_string(n) + " has level " +
+                                  std::to_string(list.level) + " (expected " + std::to_string(level) + ") or " +
+                                  "unequal index and value counts");
+    }
+    out[2 * n] = static_cast<std::uint32_t>(out.size() / 2);
+    out[2 * n + 1] = static_cast<std::uint32_t>(list.size());
+    for (std::size_t k = 0; k < list.size(); ++k) {
+      if (list.index[k] >= count) {
+        throw std::invalid_argument("packVisibilityEntries: list " + std::to_string(n) + " index " +
+                                    std::to_string(list.index[k]) + " is outside a level-" + std::to_string(level) + " map");
+      }
+      out.push_back(list.index[k]);
+      out.push_back(std::bit_cast<std::uint32_t>(list.value[k]));
+    }
+  }
+  return out;
 }
 
 std::uint32_t preorderKey(int mapLevel, int l, int i, int j) {

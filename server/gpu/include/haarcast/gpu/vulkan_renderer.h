@@ -34,6 +34,12 @@ struct VulkanRendererLimits {
   std::size_t batchSamples = 0;
   // Workgroup size of rotate_spatial.comp; 0 = 64 on CPU devices, 256 on GPUs.
   std::uint32_t spatialLocalSize = 0;
+  // `fused`: workgroup size (0 = 64 on CPU devices, 256 on GPUs), the most
+  // workgroups in flight (0 = as the scratch allows), and its scratch forced
+  // into global memory even where shared memory would hold it (tests).
+  std::uint32_t fusedLocalSize = 0;
+  std::uint32_t fusedGroups = 0;
+  bool fusedGlobalScratch = false;
 };
 
 class VulkanRenderer final : public render::Renderer {
