@@ -1,5 +1,7 @@
 #include "haarcast/gpu/passes.h"
 
+#include "haarcast/core/sphere_map.h"
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -44,6 +46,16 @@ std::array<float, 256> srgbThresholds(double exposureStops) {
     t[static_cast<std::size_t>(k)] = static_cast<float>(linear / gain);
   }
   return t;
+}
+
+std::vector<glm::vec4> pixelCentreDirections(int level) {
+  const int m = mapSize(level);
+  std::vector<glm::vec4> out;
+  out.reserve(static_cast<std::size_t>(m) * static_cast<std::size_t>(m));
+  for (int i = 0; i < m; ++i) {
+    for (int j = 0; j < m; ++j) out.emplace_back(glm::vec3(sphericalToDirection(rowTheta(level, i), colPhi(level, j))), 0.0f);
+  }
+  return out;
 }
 
 std::vector<std::uint32_t> packVisibilityEntries(std::span<const SparseHaar> lists, int level) {

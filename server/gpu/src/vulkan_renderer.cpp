@@ -309,12 +309,7 @@ void VulkanRenderer::Impl::uploadScene() {
 
 void VulkanRenderer::Impl::createFusedPipeline(std::uint32_t local) {
   // The pixel-centre directions, as core fused builds them (double → float).
-  const int m = mapSize(level);
-  std::vector<glm::vec4> dirs;
-  dirs.reserve(coefficients);
-  for (int i = 0; i < m; ++i) {
-    for (int j = 0; j < m; ++j) dirs.emplace_back(glm::vec3(sphericalToDirection(rowTheta(level, i), colPhi(level, j))), 0.0f);
-  }
+  const std::vector<glm::vec4> dirs = pixelCentreDirections(level);
   directions = Buffer(context, dirs.size() * sizeof(glm::vec4));
   directions.write(dirs.data(), dirs.size() * sizeof(glm::vec4));
 

@@ -175,6 +175,39 @@ TEST_P(FusedFrame, VulkanMatchesTheCpuBackend) {
 
 INSTANTIATE_TEST_SUITE_P(Levels, FusedFrame, ::testing::Values(4, 5, 6, 7));
 
+// The fused dispatch's shape does not change a bit of the image: scratch
+// in shared or in global memory, as many workgroups as pixels or 3 that
+// loop over them all. A frame asked for RGBA8 only reads back no linear
+// image and encodes the same bytes; frames allocate no device memory.
+TEST(VulkanRenderer, FusedDispatchShapeAndReadback) {
+  HAARCAST_REQUIRE_VULKAN();
+  const render::Scene scene = render::defaultScene();
+  const render::RenderOptions o = frameOptions(RotationMethod::Fused, true);
+  VulkanRenderer whole(scene, o, testing::testOptions());
+  VulkanRendererLimits few;
+  few.fusedGroups = 3;
+  few.fusedGlobalScratch = true;
+  VulkanRenderer looped(scene, o, testing::testOptions(), {}, few);
+  render::FrameRequest request = requestFor(scene, 40, 40);
+  const render::Frame a = whole.render(request);
+  const render::Frame b = looped.render(request);
+  EXPECT_EQ(a.objectMask, b.objectMask);
+  EXPECT_EQ(a.image.rgb, b.image.rgb) << "every pixel is computed alone, whichever workgroup takes it";
+  const std::uint64_t allocations = whole.context().allocationCount();
+  request.linearImage = false;
+  const render::Frame c = whole.render(request);
+  EXPECT_TRUE(c.image.rgb.empty());
+  EXPECT_EQ(c.rgba8, a.rgba8);
+  EXPECT_EQ(c.objectMask, a.objectMask);
+  EXPECT_EQ(whole.context().allocationCount(), allocations) << "a fused frame allocated device memory";
+  // An empty frame (the camera looks away): the indirect dispatch has no groups.
+  request.camera.target = request.camera.eye + (request.camera.eye - scene.camera.target);
+  const render::Frame d = whole.render(request);
+  EXPECT_EQ(std::count(d.objectMask.begin(), d.objectMask.end(), 1), 0);
+  testing::expectNoValidationMessages(whole.context());
+  testing::expectNoValidationMessages(looped.context());
+}
+
 TEST(VulkanRenderer, AllocatesDeviceMemoryOncePerResolution) {
   HAARCAST_REQUIRE_VULKAN();
   const render::Scene scene = render::defaultScene();

@@ -56,6 +56,10 @@ std::uint32_t preorderKey(int mapLevel, int l, int i, int j);
 // std::invalid_argument when a list's level differs from `level`.
 std::vector<std::uint32_t> packVisibilityEntries(std::span<const SparseHaar> lists, int level);
 
+// fused.comp's directions: the unit vectors of a level's pixel centres, row
+// by row (w unused), computed in double as core fused's and rounded to float.
+std::vector<glm::vec4> pixelCentreDirections(int level);
+
 // Floats of fused.comp's scratch per workgroup: the N merged coefficients,
 // the finest synthesis step's N values and the previous step's N/4.
 inline std::size_t fusedScratchFloats(int level) {
