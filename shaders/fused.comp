@@ -137,8 +137,22 @@ void shadePixel(uint s) {
   const uint lightBase = 3u * sh.object * N;
   const int mask = int(M) - 1;
 
+  // Only rows that can reach the slice's non-zero cap: y2 = ω·a with
+  // a = (sin β sin α, cos β, sin β cos α) at angle β from +Y, so y2 ≥
+  // skipBelowY needs ω within δ = acos(skipBelowY) of a, and a pixel centre
+  // at θᵢ is at least |θᵢ − β| from it. The margin covers float rounding.
+  // The range is uniform over the workgroup, so every device skips the rows
+  // outside it for real (the test below only masks lanes).
+  uint firstRow = 0u, endRow = M;
+  if (skipBelowY > -1.0) {
+    const float axis = acosPrecise(clamp(cosB, -1.0, 1.0));
+    const float reach = acosPrecise(min(skipBelowY, 1.0)) + 2e-3;
+    firstRow = uint(clamp(floor((axis - reach) * rowScale - 0.5), 0.0, float(M)));
+    endRow = uint(clamp(ceil((axis + reach) * rowScale - 0.5) + 1.0, 0.0, float(M)));
+  }
+
   vec3 acc = vec3(0.0);
-  for (uint i = lid; i < N; i += LOCAL) {
+  for (uint i = firstRow * M + lid; i < endRow * M; i += LOCAL) {
     const vec3 w0 = directions[i].xyz;
     const float x1 = cosA * w0.x - sinA * w0.z;  // R_y(−α)
     const float z1 = sinA * w0.x + cosA * w0.z;
