@@ -30,6 +30,7 @@ constexpr VkFormat kPositionFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
 constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
 constexpr std::size_t kRotatedBudget = 256u << 20;  // bytes of rotated coefficients per batch, at most
 constexpr std::size_t kFusedScratchBudget = 256u << 20;  // bytes of `fused` scratch in global memory, at most
+constexpr std::size_t kFusedPlanesBudget = 256u << 20;   // bytes of vertex visibility in pixel form, at most
 
 std::uint32_t groupsOf(std::size_t items, std::uint32_t local) {
   return static_cast<std::uint32_t>((items + local - 1) / local);
@@ -73,6 +74,7 @@ struct VulkanRenderer::Impl {
   std::uint32_t fusedGroups = 0;     // the most workgroups of the fused dispatch
   std::uint32_t fusedLocal = 0;      // its local size
   bool fusedShared = false;          // scratch in shared memory (else in `scratch`)
+  bool fusedVertexPlanes = false;    // visibility uploaded per vertex in pixel form (else as lists)
 
   // ---- Pipelines ---------------------------------------------------------------
   std::unique_ptr<ComputePipeline> rotate, rotationInput, tripleProduct, tonemap, fusedPass;
@@ -193,9 +195,7 @@ void VulkanRenderer::Impl::uploadScene() {
       const PixelSlices pixelSlices = PixelSlices::synthesize(p.table);
       info.sliceBase = static_cast<std::uint32_t>(sliceData.size() / (shared::kTexelFloats * n));
       sliceData.insert(sliceData.end(), pixelSlices.texels().begin(), pixelSlices.texels().end());
-      // As fusedShade: beyond the last non-zero row + 1 every lookup reads zeros.
-      const int m = mapSize(level), cutRow = pixelSlices.lastNonZeroRow() + 2;
-      info.skipBelowY = cutRow < m ? static_cast<float>(std::cos(cutRow * kPi / m)) : -2.0f;
+      setFusedSkip(info, level, pixelSlices.lastNonZeroRow());
     } else {
       info.sliceBase = static_cast<std::uint32_t>(sliceData.size() / (3 * n));
       for (std::size_t t = 0; t < T; ++t) {
@@ -256,12 +256,26 @@ void VulkanRenderer::Impl::uploadScene() {
     b.write(data, bytes);
   };
   if (fused) {
-    // The vertices' lists as they are: a (first, count) header per vertex,
-    // then (index, value bits) entries; fused.comp scatters them densely.
-    const std::vector<std::uint32_t> words = packVisibilityEntries(vis, level);
     visibilityBlocks.resize(vis.size());
     for (std::size_t v = 0; v < vis.size(); ++v) visibilityBlocks[v] = vis[v].size();
-    upload(visibility, words.data(), words.size() * sizeof(std::uint32_t));
+    const std::size_t planeBytes = vis.size() * n * sizeof(float);
+    fusedVertexPlanes = !limits.fusedVisibilityLists &&
+                        planeBytes <= std::min<std::size_t>(kFusedPlanesBudget,
+                                                            context.properties().limits.maxStorageBufferRange);
+    if (fusedVertexPlanes) {
+      // Every vertex's visibility in pixel form (synthesised once here):
+      // fused.comp blends three of them per direction.
+      visibility = Buffer(context, planeBytes);
+      for (std::size_t v = 0; v < vis.size(); ++v) {
+        const SphereMap pixelsOf = inverseHaar(vis[v].toDense());
+        visibility.write(pixelsOf.values().data(), n * sizeof(float), v * n * sizeof(float));
+      }
+    } else {
+      // The lists as they are: a (first, count) header per vertex, then
+      // (index, value bits) entries; fused.comp merges and synthesises them.
+      const std::vector<std::uint32_t> words = packVisibilityEntries(vis, level);
+      upload(visibility, words.data(), words.size() * sizeof(std::uint32_t));
+    }
   } else {
     const std::vector<glm::uvec4> visPacked = packSparseLists(vis, level);
     visibilityBlocks.resize(vis.size());
@@ -317,7 +331,7 @@ void VulkanRenderer::Impl::createFusedPipeline(std::uint32_t local) {
   // reduction's vec3 per invocation), else a slice of a global buffer per
   // workgroup, whose size bounds the workgroups in flight.
   const VkPhysicalDeviceLimits& lim = context.properties().limits;
-  const std::size_t floats = fusedScratchFloats(level);
+  const std::size_t floats = fusedScratchFloats(level, fusedVertexPlanes);
   fusedLocal = limits.fusedLocalSize ? limits.fusedLocalSize : local;
   fusedShared = !limits.fusedGlobalScratch &&
                 floats * sizeof(float) + fusedLocal * 4 * sizeof(float) <= lim.maxComputeSharedMemorySize;
@@ -336,7 +350,8 @@ void VulkanRenderer::Impl::createFusedPipeline(std::uint32_t local) {
       std::vector<SpecConstant>{{0, static_cast<std::uint32_t>(level)},
                                 {2, fusedLocal},
                                 {3, fusedShared ? static_cast<std::uint32_t>(floats) : 1u},
-                                {4, options.interpolateSlices ? 1u : 0u}});
+                                {4, options.interpolateSlices ? 1u : 0u},
+                                {5, fusedVertexPlanes ? 1u : 0u}});
 }
 
 void VulkanRenderer::Impl::createGraphicsPipeline() {
@@ -806,7 +821,10 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
     for (std::uint32_t v : sh[i].vertex) entries += v < visibilityBlocks.size() ? visibilityBlocks[v] : 0;
     const shared::SliceBlend blend =
         shared::sliceBlendAt(rs[i].thetaOut, static_cast<shared::uint>(options.thetaSamples), options.interpolateSlices ? 1u : 0u);
-    bytes += fusedPixelBytes(level, blend.weight != 0.0f && blend.second != blend.first, entries);
+    // With the vertices' pixel forms, three planes of N floats replace the lists.
+    bytes += fusedVertexPlanes ? fusedPixelBytes(level, blend.weight != 0.0f && blend.second != blend.first, 0) +
+                                     3 * coefficients * sizeof(float)
+                               : fusedPixelBytes(level, blend.weight != 0.0f && blend.second != blend.first, entries);
   }
   frame.coefficientBytes = bytes;
   frame.seconds = since(start);

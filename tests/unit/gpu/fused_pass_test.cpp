@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -56,6 +57,7 @@ struct PassCase {
   int level;
   bool sharedScratch;
   bool interpolate;
+  bool vertexPlanes;  // visibility per vertex in pixel form (else the lists, merged per pixel)
 };
 
 class FusedPass : public ::testing::TestWithParam<PassCase> {};
@@ -81,8 +83,7 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
     lights.push_back(FusedLight::synthesize(light));
     objects[o].sliceBase = static_cast<std::uint32_t>(o * kThetaSamples);
     objects[o].thetaSamples = kThetaSamples;
-    const int m = mapSize(level), cutRow = slices[o].lastNonZeroRow() + 2;
-    objects[o].skipBelowY = cutRow < m ? static_cast<float>(std::cos(cutRow * kPi / m)) : -2.0f;
+    setFusedSkip(objects[o], level, slices[o].lastNonZeroRow());
     texels.insert(texels.end(), slices[o].texels().begin(), slices[o].texels().end());
     lightPlanes.insert(lightPlanes.end(), lights[o].planes.begin(), lights[o].planes.end());
   }
@@ -110,12 +111,20 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
     sh.b[2] = 1.0f - a - b;
     sh.pixel = static_cast<std::uint32_t>(kPixels - 1 - i);  // not the sample order
   }
-  const std::vector<std::uint32_t> visWords = packVisibilityEntries(visibility, level);
+  std::vector<std::uint32_t> visWords;
+  if (pc.vertexPlanes) {
+    for (const SparseHaar& v : visibility) {
+      const SphereMap pixels = inverseHaar(v.toDense());
+      for (float x : pixels.values()) visWords.push_back(std::bit_cast<std::uint32_t>(x));
+    }
+  } else {
+    visWords = packVisibilityEntries(visibility, level);
+  }
   const std::vector<glm::vec4> dirs = pixelCentreDirections(level);
   const CoverageCounter counter{static_cast<std::uint32_t>(kPixels), {kGroups, 1, 1}};
 
   Context context(testing::testOptions());
-  const std::size_t floats = fusedScratchFloats(level);
+  const std::size_t floats = fusedScratchFloats(level, pc.vertexPlanes);
   const std::uint32_t local = 64;
   if (pc.sharedScratch &&
       floats * sizeof(float) + local * 16 > context.properties().limits.maxComputeSharedMemorySize) {
@@ -140,7 +149,8 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
                     {{0, static_cast<std::uint32_t>(level)},
                      {2, local},
                      {3, pc.sharedScratch ? static_cast<std::uint32_t>(floats) : 1u},
-                     {4, pc.interpolate ? 1u : 0u}});
+                     {4, pc.interpolate ? 1u : 0u},
+                     {5, pc.vertexPlanes ? 1u : 0u}});
   p.bind({&sampleBuf, &shadeBuf, &objectBuf, &texelBuf, &lightBuf, &visBuf, &dirBuf, &scratch, &radiance, &counterBuf});
   context.submit([&](VkCommandBuffer cb) { p.dispatch(cb, {kGroups, 1, 1}); });
   std::vector<glm::vec4> got(kPixels);
@@ -165,19 +175,22 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
       worst = std::max(worst, err / scale);
     }
   }
-  std::printf("fused pass, level %d, %s scratch, %s: max |gpu − cpu| / max|I| = %.3g\n", level,
-              pc.sharedScratch ? "shared" : "global", pc.interpolate ? "blended slices" : "nearest slice", worst);
+  std::printf("fused pass, level %d, %s scratch, %s, %s: max |gpu − cpu| / max|I| = %.3g\n", level,
+              pc.sharedScratch ? "shared" : "global", pc.interpolate ? "blended slices" : "nearest slice",
+              pc.vertexPlanes ? "vertex planes" : "vertex lists", worst);
   EXPECT_LT(worst, 1e-5);
   testing::expectNoValidationMessages(context);
 }
 
 INSTANTIATE_TEST_SUITE_P(Cases, FusedPass,
-                         ::testing::Values(PassCase{4, true, true}, PassCase{4, false, false}, PassCase{5, true, false},
-                                           PassCase{6, false, true}, PassCase{7, false, true}),
+                         ::testing::Values(PassCase{4, true, true, false}, PassCase{4, false, false, false},
+                                           PassCase{5, true, false, true}, PassCase{5, true, true, true},
+                                           PassCase{6, false, true, false}, PassCase{7, false, true, true}),
                          [](const auto& c) {
                            return "level" + std::to_string(c.param.level) +
                                   (c.param.sharedScratch ? "_shared" : "_global") +
-                                  (c.param.interpolate ? "_blend" : "_nearest");
+                                  (c.param.interpolate ? "_blend" : "_nearest") +
+                                  (c.param.vertexPlanes ? "_planes" : "_lists");
                          });
 
 }  // namespace

@@ -161,10 +161,9 @@ TEST_P(FusedFrame, VulkanMatchesTheCpuBackend) {
   ASSERT_EQ(b.stages.size(), 5u);
   const char* names[] = {"light", "gbuffer", "rotation-input", "fused", "tonemap"};
   for (std::size_t i = 0; i < 5; ++i) EXPECT_EQ(b.stages[i].name, names[i]);
-  // Counted alike; a pixel whose hit lies on a shared edge may name the
-  // other triangle's vertices (the same point, other visibility lists).
-  EXPECT_NEAR(static_cast<double>(b.coefficientBytes), static_cast<double>(a.coefficientBytes),
-              1e-3 * static_cast<double>(a.coefficientBytes));
+  // The GPU counts what it reads: with the vertices' pixel forms (levels
+  // 4–6 here), three planes of N floats per pixel instead of the lists.
+  EXPECT_GT(b.coefficientBytes, 0u);
   const auto expected = render::tonemapRgba8(b.image, request.exposureStops);
   ASSERT_EQ(expected.size(), b.rgba8.size());
   std::size_t differ = 0;
@@ -187,12 +186,26 @@ TEST(VulkanRenderer, FusedDispatchShapeAndReadback) {
   VulkanRendererLimits few;
   few.fusedGroups = 3;
   few.fusedGlobalScratch = true;
+  few.fusedVisibilityLists = true;
   VulkanRenderer looped(scene, o, testing::testOptions(), {}, few);
   render::FrameRequest request = requestFor(scene, 40, 40);
   const render::Frame a = whole.render(request);
   const render::Frame b = looped.render(request);
   EXPECT_EQ(a.objectMask, b.objectMask);
-  EXPECT_EQ(a.image.rgb, b.image.rgb) << "every pixel is computed alone, whichever workgroup takes it";
+  // The two visibility paths differ by float rounding only (synthesis of the
+  // blend vs blend of the syntheses); the dispatch shape changes nothing.
+  ASSERT_EQ(a.image.rgb.size(), b.image.rgb.size());
+  double worst = 0.0, peak = 0.0;
+  for (std::size_t i = 0; i < a.image.rgb.size(); ++i) {
+    worst = std::max(worst, std::abs(static_cast<double>(a.image.rgb[i]) - b.image.rgb[i]));
+    peak = std::max(peak, std::abs(static_cast<double>(a.image.rgb[i])));
+  }
+  EXPECT_LT(worst, 1e-5 * peak);
+  VulkanRendererLimits fewShared = few;
+  fewShared.fusedGlobalScratch = false;
+  VulkanRenderer loopedShared(scene, o, testing::testOptions(), {}, fewShared);
+  EXPECT_EQ(loopedShared.render(request).image.rgb, b.image.rgb)
+      << "every pixel is computed alone, whichever workgroup takes it and wherever its scratch is";
   const std::uint64_t allocations = whole.context().allocationCount();
   request.linearImage = false;
   const render::Frame c = whole.render(request);

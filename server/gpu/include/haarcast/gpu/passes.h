@@ -60,12 +60,19 @@ std::vector<std::uint32_t> packVisibilityEntries(std::span<const SparseHaar> lis
 // by row (w unused), computed in double as core fused's and rounded to float.
 std::vector<glm::vec4> pixelCentreDirections(int level);
 
-// Floats of fused.comp's scratch per workgroup: the N merged coefficients,
-// the finest synthesis step's N values and the previous step's N/4.
-inline std::size_t fusedScratchFloats(int level) {
+// Floats of fused.comp's scratch per workgroup: the θₒ-blended slice (3N),
+// after, without vertex planes, the per-pixel synthesis (the N merged
+// coefficients and the finest step's N values; shaders/fused.comp).
+inline std::size_t fusedScratchFloats(int level, bool vertexPlanes) {
   const std::size_t n = std::size_t{1} << (2 * level);
-  return n + n + n / 4;
+  return (vertexPlanes ? 0 : 2 * n) + 3 * n;
 }
+
+// ObjectInfo's skipBelowY and blendRows for fused.comp, from the slices'
+// last non-zero row (core PixelSlices::lastNonZeroRow): directions whose
+// rotated cos θ' is below skipBelowY read only zero texels (fusedShade's
+// cut), and the others read rows below blendRows only.
+void setFusedSkip(ObjectInfo& info, int level, int lastNonZeroRow);
 
 // The level range of the GPU passes: shared memory holds one level-6 map
 // (16 KiB) per workgroup, the least that Vulkan guarantees (and lavapipe's

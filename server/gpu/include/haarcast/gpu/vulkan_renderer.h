@@ -35,10 +35,13 @@ struct VulkanRendererLimits {
   // Workgroup size of rotate_spatial.comp; 0 = 64 on CPU devices, 256 on GPUs.
   std::uint32_t spatialLocalSize = 0;
   // `fused`: workgroup size (0 = 64 on CPU devices, 256 on GPUs), the most
-  // workgroups in flight (0 = as the scratch allows), and its scratch forced
-  // into global memory even where shared memory would hold it (tests).
+  // workgroups in flight (0 = as the scratch allows), the per-pixel merge
+  // and synthesis of the visibility lists even where every vertex's pixel
+  // form would fit in memory, and that synthesis's scratch in global memory
+  // even where shared memory would hold it (tests).
   std::uint32_t fusedLocalSize = 0;
   std::uint32_t fusedGroups = 0;
+  bool fusedVisibilityLists = false;
   bool fusedGlobalScratch = false;
 };
 
