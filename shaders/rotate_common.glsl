@@ -44,14 +44,9 @@ layout(std430, set = 0, binding = 3) coherent buffer Rotated { float rotated[]; 
 
 float methodFloat(uint word) { return uintBitsToFloat(methodData[word]); }
 
-// Index of a detail coefficient in quadrant layout: HaarMap::detailIndexOf.
-// band 0 = horizontal, 1 = vertical, 2 = diagonal; level l, block (i, j).
-uint detailIndex(uint band, uint l, uint i, uint j) {
-  const uint blocks = 1u << l;
-  const uint row = i + (band == 0u ? 0u : blocks);
-  const uint col = j + (band == 1u ? 0u : blocks);
-  return row * M + col;
-}
+// Index of a detail coefficient in quadrant layout (shared_layout.h
+// haarDetailIndex, HaarMap::detailIndexOf): band 0 = h, 1 = v, 2 = d.
+uint detailIndex(uint band, uint l, uint i, uint j) { return haarDetailIndex(M, band, l, i, j); }
 
 // Value of pixel (row, col) of the map whose coefficients start at base in
 // `slices`: the inverse Haar transform at one pixel, O(log N). Every basis

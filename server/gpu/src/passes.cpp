@@ -13,19 +13,26 @@
 
 namespace haarcast::gpu {
 
+CameraBasis cameraBasis(const render::Camera& camera) {
+  // The basis of render::CameraRays, computed the same way in double.
+  CameraBasis b;
+  b.forward = glm::normalize(camera.target - camera.eye);
+  b.right = glm::normalize(glm::cross(b.forward, camera.up));
+  b.up = glm::cross(b.right, b.forward);
+  b.tanHalf = std::tan(glm::radians(camera.fovYDegrees) * 0.5);
+  return b;
+}
+
 FrameParams makeFrameParams(const render::Camera& camera, int width, int height, const glm::dmat3& lightRotation,
                             double exposureStops, bool background, int backgroundLevel) {
-  // The basis of render::CameraRays, computed the same way in double.
-  const glm::dvec3 forward = glm::normalize(camera.target - camera.eye);
-  const glm::dvec3 right = glm::normalize(glm::cross(forward, camera.up));
-  const glm::dvec3 up = glm::cross(right, forward);
+  const CameraBasis basis = cameraBasis(camera);
   FrameParams f{};
-  f.forward = glm::vec4(glm::vec3(forward), 0.0f);
-  f.right = glm::vec4(glm::vec3(right), 0.0f);
-  f.up = glm::vec4(glm::vec3(up), 0.0f);
+  f.forward = glm::vec4(glm::vec3(basis.forward), 0.0f);
+  f.right = glm::vec4(glm::vec3(basis.right), 0.0f);
+  f.up = glm::vec4(glm::vec3(basis.up), 0.0f);
   const glm::dmat3 lt = glm::transpose(lightRotation);
   for (int c = 0; c < 3; ++c) f.lightRotT[c] = glm::vec4(glm::vec3(lt[c]), 0.0f);
-  f.tanHalf = static_cast<float>(std::tan(glm::radians(camera.fovYDegrees) * 0.5));
+  f.tanHalf = static_cast<float>(basis.tanHalf);
   f.aspect = static_cast<float>(static_cast<double>(width) / height);
   f.gain = static_cast<float>(std::exp2(exposureStops));
   f.background = background ? 1u : 0u;

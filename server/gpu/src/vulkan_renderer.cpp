@@ -632,10 +632,9 @@ namespace {
 // reversed, infinite-far Z (depth = near / distance, greatest wins), whose
 // float precision does not depend on the scene's depth range.
 glm::dmat4 viewProjection(const render::Camera& camera, int width, int height, double nearPlane) {
-  const glm::dvec3 f = glm::normalize(camera.target - camera.eye);
-  const glm::dvec3 r = glm::normalize(glm::cross(f, camera.up));
-  const glm::dvec3 u = glm::cross(r, f);
-  const double tanHalf = std::tan(glm::radians(camera.fovYDegrees) * 0.5);
+  const CameraBasis basis = cameraBasis(camera);
+  const glm::dvec3 &f = basis.forward, &r = basis.right, &u = basis.up;
+  const double tanHalf = basis.tanHalf;
   const double aspect = static_cast<double>(width) / height;
   const glm::dvec3& e = camera.eye;
   glm::dmat4 m(0.0);  // m[column][row]

@@ -73,6 +73,19 @@ SliceBlend sliceBlendAt(float thetaOut, uint thetaSamples, uint interpolate) {
   return b;
 }
 
+// Index of a detail coefficient in the quadrant layout of an m×m Haar map
+// (HaarMap::detailIndexOf): band 0 = horizontal, 1 = vertical, 2 = diagonal;
+// level l, block (i, j).
+#ifdef __cplusplus
+inline constexpr
+#endif
+uint haarDetailIndex(uint m, uint band, uint l, uint i, uint j) {
+  const uint blocks = 1u << l;
+  const uint row = i + (band == 0u ? 0u : blocks);
+  const uint col = j + (band == 1u ? 0u : blocks);
+  return row * m + col;
+}
+
 // ---- Records the Vulkan passes exchange (std430; the C++ side checks sizes
 // and offsets below). Zero-initialise them on the host (`T x{}`): GLSL has no
 // member initialisers.

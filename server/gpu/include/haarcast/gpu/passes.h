@@ -28,6 +28,15 @@ using shared::ObjectInfo;
 using shared::RotationSample;
 using shared::ShadeSample;
 
+// render::CameraRays' pinhole basis, in double: forward, right, up. The frame
+// parameters (the compute passes' rays) and the G-buffer's projection both
+// take it from here.
+struct CameraBasis {
+  glm::dvec3 forward, right, up;
+  double tanHalf;  // tan(fovY / 2)
+};
+CameraBasis cameraBasis(const render::Camera& camera);
+
 // The camera of render::CameraRays and the frame's settings.
 FrameParams makeFrameParams(const render::Camera& camera, int width, int height, const glm::dmat3& lightRotation,
                             double exposureStops, bool background, int backgroundLevel);

@@ -6,6 +6,9 @@
 //   rotation-input  compute: slice index and Y-X-Y angles per covered pixel, compacted
 //   rotation        compute: shaders/rotate_<method>.comp, in batches of covered pixels
 //   triple-product  compute: light × rotated slice × interpolated visibility
+//   fused           `fused` only, in place of the two above: shaders/fused.comp,
+//                   one indirect dispatch sized by rotation-input; the frame is
+//                   one command buffer (timestamps per stage on GPUs)
 //   tonemap         compute: backdrop, linear image kept, RGBA8
 // Scene data (slices, method data, meshes, visibility, backdrop) is uploaded
 // once; frame buffers are allocated once per resolution and reused, so a
