@@ -79,7 +79,10 @@ Comparison compare(const render::Frame& reference, const render::Frame& test) {
     }
   }
   c.mse = c.compared ? sum / (3.0 * static_cast<double>(c.compared)) : 0.0;
-  c.psnr = c.mse > 0.0 ? 10.0 * std::log10(peak * peak / c.mse) : std::numeric_limits<double>::infinity();
+  // A NaN anywhere makes the MSE NaN: that is the worst result, not a perfect one.
+  c.psnr = std::isnan(c.mse)  ? -std::numeric_limits<double>::infinity()
+           : c.mse > 0.0      ? 10.0 * std::log10(peak * peak / c.mse)
+                              : std::numeric_limits<double>::infinity();
   return c;
 }
 
