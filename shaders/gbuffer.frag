@@ -2,13 +2,9 @@
 // The "gbuffer" pass, fragment stage: object-frame normal and position,
 // object id + 1 (0 = background), triangle id within the object and the
 // barycentrics (u, v) as float bits.
-layout(push_constant) uniform Push {
-  mat4 objectToClip;
-  uint objectId;
-  uint triangleBase;
-  uint pad0;
-  uint pad1;
-} pc;
+#extension GL_GOOGLE_include_directive : require
+#include "haarcast/core/shared_layout.h"
+layout(push_constant) uniform Push { GBufferPush pc; };
 
 layout(location = 0) in vec3 inNormal;
 layout(location = 1) in vec3 inPosition;

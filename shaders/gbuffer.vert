@@ -4,13 +4,9 @@
 // through the object's index list, so the fragment stage gets the exact
 // barycentrics (corner one-hot, interpolated perspective-correct) and the
 // triangle id without any extension.
-layout(push_constant) uniform Push {
-  mat4 objectToClip;   // projection · view · object → world
-  uint objectId;       // scene order
-  uint triangleBase;   // the object's triangle 0 in the global numbering
-  uint pad0;
-  uint pad1;
-} pc;
+#extension GL_GOOGLE_include_directive : require
+#include "haarcast/core/shared_layout.h"
+layout(push_constant) uniform Push { GBufferPush pc; };
 
 layout(std430, set = 0, binding = 0) readonly buffer Positions { vec4 positions[]; };  // object frame, global vertex ids
 layout(std430, set = 0, binding = 1) readonly buffer Normals { vec4 normals[]; };

@@ -18,6 +18,8 @@
 // acosPrecise: Vulkan's own may be off by thousands of ULP, lavapipe's are)
 // and rotationYXY, rotX, rotY of core/rotation.cpp.
 #include "common/sphere.glsl"
+// RotationSample (core/shared_layout.h, shared with the host).
+#include "haarcast/core/shared_layout.h"
 
 layout(constant_id = 0) const uint LEVEL = 5u;
 layout(constant_id = 1) const uint THETA_SAMPLES = 16u;
@@ -25,17 +27,6 @@ layout(constant_id = 1) const uint THETA_SAMPLES = 16u;
 const uint M = 1u << LEVEL;   // map side
 const uint N = M * M;         // coefficients per map
 const uint HALF = M / 2u;     // blocks per side at the finest detail level
-
-struct RotationSample {
-  uint slice;       // global slice index into binding 1
-  uint methodBase;  // the object's block in binding 2, in 32-bit words
-  float alpha;      // Y-X-Y Euler angles: R = Ry(α) Rx(β) Ry(γ) (core/rotation.h)
-  float beta;
-  float gamma;
-  uint pixel;
-  uint pad0;
-  uint pad1;
-};
 
 layout(push_constant) uniform RotationPush {
   uint first;
@@ -53,14 +44,9 @@ layout(std430, set = 0, binding = 3) coherent buffer Rotated { float rotated[]; 
 
 float methodFloat(uint word) { return uintBitsToFloat(methodData[word]); }
 
-// Index of a detail coefficient in quadrant layout: HaarMap::detailIndexOf.
-// band 0 = horizontal, 1 = vertical, 2 = diagonal; level l, block (i, j).
-uint detailIndex(uint band, uint l, uint i, uint j) {
-  const uint blocks = 1u << l;
-  const uint row = i + (band == 0u ? 0u : blocks);
-  const uint col = j + (band == 1u ? 0u : blocks);
-  return row * M + col;
-}
+// Index of a detail coefficient in quadrant layout (shared_layout.h
+// haarDetailIndex, HaarMap::detailIndexOf): band 0 = h, 1 = v, 2 = d.
+uint detailIndex(uint band, uint l, uint i, uint j) { return haarDetailIndex(M, band, l, i, j); }
 
 // Value of pixel (row, col) of the map whose coefficients start at base in
 // `slices`: the inverse Haar transform at one pixel, O(log N). Every basis

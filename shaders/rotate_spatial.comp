@@ -11,6 +11,7 @@
 // while f still occupies shared memory, then read back for the analysis.
 #extension GL_GOOGLE_include_directive : require
 #include "common/sphere.glsl"
+#include "haarcast/core/shared_layout.h"  // RotationSample
 
 layout(local_size_x_id = 2) in;
 layout(constant_id = 0) const int LEVEL = 5;
@@ -19,17 +20,6 @@ layout(constant_id = 1) const int THETA_SAMPLES = 16;  // part of the contract; 
 const int LOCAL = int(gl_WorkGroupSize.x);
 const int M = 1 << LEVEL;
 const int N = M * M;
-
-struct RotationSample {
-  uint slice;
-  uint methodBase;
-  float alpha;
-  float beta;
-  float gamma;
-  uint pixel;
-  uint pad0;
-  uint pad1;
-};
 
 layout(push_constant) uniform Push {
   uint first;

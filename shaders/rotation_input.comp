@@ -12,17 +12,6 @@
 
 layout(local_size_x = 64) in;
 
-struct RotationSample {
-  uint slice;
-  uint methodBase;
-  float alpha;
-  float beta;
-  float gamma;
-  uint pixel;
-  uint pad0;
-  uint pad1;
-};
-
 layout(std430, set = 0, binding = 0) readonly buffer Frame { FrameParams frame; };
 layout(std430, set = 0, binding = 1) readonly buffer Objects { ObjectInfo objects[]; };
 layout(std430, set = 0, binding = 2) readonly buffer Ids { uvec4 ids[]; };          // G-buffer: object+1, triangle, b1, b2
@@ -30,7 +19,7 @@ layout(std430, set = 0, binding = 3) readonly buffer Normals { vec4 normals[]; }
 layout(std430, set = 0, binding = 4) readonly buffer Triangles { uint triangles[]; };  // global vertex ids, 3 per triangle
 layout(std430, set = 0, binding = 5) writeonly buffer Samples { RotationSample samples[]; };
 layout(std430, set = 0, binding = 6) writeonly buffer Shade { ShadeSample shade[]; };
-layout(std430, set = 0, binding = 7) buffer Counter { uint covered; };
+layout(std430, set = 0, binding = 7) buffer Counter { CoverageCounter counter; };
 
 void main() {
   uint p = gl_GlobalInvocationID.x;
@@ -41,7 +30,7 @@ void main() {
   uint x = p % frame.width, y = p / frame.width;
 
   vec3 n = normalize(normals[p].xyz);
-  mat3 toWorld = mat3(o.rot0.xyz, o.rot1.xyz, o.rot2.xyz);
+  mat3 toWorld = mat3(o.rotation[0].xyz, o.rotation[1].xyz, o.rotation[2].xyz);
   vec3 wo = transpose(toWorld) * -cameraDirection(frame, x, y);  // toward the eye, object frame
 
   // shadingFrame: +Y = n, wo in the (Y, Z) half-plane at φ = 0.
@@ -71,10 +60,19 @@ void main() {
   int t = clamp(int(floor(clamp(thetaOut, 0.0, kPi / 2.0) / (kPi / 2.0) * float(o.thetaSamples))), 0,
                 int(o.thetaSamples) - 1);
 
-  uint k = atomicAdd(covered, 1u);
-  samples[k] = RotationSample(o.sliceBase + uint(t), o.methodBase, alpha, beta, gamma, p, 0u, 0u);
+  uint k = atomicAdd(counter.covered, 1u);
+  // `fused`'s indirect dispatch: one workgroup per covered pixel, at most
+  // frame.fusedGroups (each loops over the pixels beyond).
+  if (k < frame.fusedGroups) {
+    atomicMax(counter.groups[0], k + 1u);
+    if (k == 0u) {
+      atomicMax(counter.groups[1], 1u);
+      atomicMax(counter.groups[2], 1u);
+    }
+  }
+  samples[k] = RotationSample(o.sliceBase + uint(t), o.methodBase, alpha, beta, gamma, p, thetaOut, 0u);
   uint tri = o.triangleBase + id.y;
   float b1 = uintBitsToFloat(id.z), b2 = uintBitsToFloat(id.w);
-  shade[k] = ShadeSample(id.x - 1u, triangles[3u * tri], triangles[3u * tri + 1u], triangles[3u * tri + 2u],
-                         1.0 - b1 - b2, b1, b2, p);
+  shade[k] = ShadeSample(id.x - 1u, uint[3](triangles[3u * tri], triangles[3u * tri + 1u], triangles[3u * tri + 2u]),
+                         float[3](1.0 - b1 - b2, b1, b2), p);
 }

@@ -44,7 +44,7 @@ void main() {
     rgb = radiance[p].rgb;
   } else if (frame.background != 0u) {
     uint x = p % frame.width, y = p / frame.width;
-    mat3 lightRotT = mat3(frame.lightRotT0.xyz, frame.lightRotT1.xyz, frame.lightRotT2.xyz);
+    mat3 lightRotT = mat3(frame.lightRotT[0].xyz, frame.lightRotT[1].xyz, frame.lightRotT[2].xyz);
     vec2 tp = directionToSpherical(lightRotT * cameraDirection(frame, x, y));
     int level = int(frame.backgroundLevel);
     int m = 1 << level;

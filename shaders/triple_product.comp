@@ -115,8 +115,8 @@ void main() {
   ShadeSample s = shade[pc.first + local];
   uvec4 lightHeader = light[s.object * 3u + c];
   uint brdfBase = (local * 3u + c) * uint(N);
-  float sum = s.b0 * tripleProduct(lightHeader, brdfBase, vis[s.v0]) +
-              s.b1 * tripleProduct(lightHeader, brdfBase, vis[s.v1]) +
-              s.b2 * tripleProduct(lightHeader, brdfBase, vis[s.v2]);
+  float sum = s.b[0] * tripleProduct(lightHeader, brdfBase, vis[s.vertex[0]]) +
+              s.b[1] * tripleProduct(lightHeader, brdfBase, vis[s.vertex[1]]) +
+              s.b[2] * tripleProduct(lightHeader, brdfBase, vis[s.vertex[2]]);
   radiance[s.pixel][c] = sum;
 }

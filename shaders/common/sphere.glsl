@@ -36,8 +36,7 @@ float cosPrecise(float x) { return sinCosPrecise(x).y; }
 float atan2Precise(float y, float x) {
   float ax = abs(x), ay = abs(y);
   float hi = max(ax, ay), lo = min(ax, ay);
-  if (hi == 0.0) return 0.0;
-  float t = lo / hi;  // in [0, 1]
+  float t = lo / max(hi, 1e-30);  // in [0, 1]; 0 at (0, 0), which then gives 0 (no branch: SIMD devices mask them)
   float base = 0.0;
   if (t > 0.4142135623730950) {  // tan(π/8): reduce to |t| ≤ tan(π/8)
     base = 0.78539816339744831;

@@ -109,6 +109,17 @@ void ComputePipeline::bind(std::initializer_list<const Buffer*> buffers) {
 
 void ComputePipeline::dispatch(VkCommandBuffer cb, std::array<std::uint32_t, 3> groups, const void* push,
                                std::uint32_t pushBytes) const {
+  bindForDispatch(cb, push, pushBytes);
+  if (groups[0] && groups[1] && groups[2]) vkCmdDispatch(cb, groups[0], groups[1], groups[2]);
+}
+
+void ComputePipeline::dispatchIndirect(VkCommandBuffer cb, const Buffer& args, VkDeviceSize offset, const void* push,
+                                       std::uint32_t pushBytes) const {
+  bindForDispatch(cb, push, pushBytes);
+  vkCmdDispatchIndirect(cb, args.handle(), offset);
+}
+
+void ComputePipeline::bindForDispatch(VkCommandBuffer cb, const void* push, std::uint32_t pushBytes) const {
   if (pushBytes != pushBytes_) {
     throw std::invalid_argument(name_ + ": push constants of " + std::to_string(pushBytes) + " bytes, expected " +
                                 std::to_string(pushBytes_));
@@ -116,7 +127,6 @@ void ComputePipeline::dispatch(VkCommandBuffer cb, std::array<std::uint32_t, 3> 
   vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
   vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &set_, 0, nullptr);
   if (pushBytes) vkCmdPushConstants(cb, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, pushBytes, push);
-  if (groups[0] && groups[1] && groups[2]) vkCmdDispatch(cb, groups[0], groups[1], groups[2]);
 }
 
 void computeBarrier(VkCommandBuffer cb) {
@@ -124,9 +134,10 @@ void computeBarrier(VkCommandBuffer cb) {
   m.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
   m.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
   m.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT |
-                    VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_HOST_READ_BIT;
+                    VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_HOST_READ_BIT | VK_ACCESS_INDIRECT_COMMAND_READ_BIT;
   vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
-                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_HOST_BIT,
+                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_HOST_BIT |
+                           VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT,
                        0, 1, &m, 0, nullptr, 0, nullptr);
 }
 

@@ -1,5 +1,7 @@
 #include "haarcast/gpu/passes.h"
 
+#include "haarcast/core/sphere_map.h"
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -11,19 +13,26 @@
 
 namespace haarcast::gpu {
 
+CameraBasis cameraBasis(const render::Camera& camera) {
+  // The basis of render::CameraRays, computed the same way in double.
+  CameraBasis b;
+  b.forward = glm::normalize(camera.target - camera.eye);
+  b.right = glm::normalize(glm::cross(b.forward, camera.up));
+  b.up = glm::cross(b.right, b.forward);
+  b.tanHalf = std::tan(glm::radians(camera.fovYDegrees) * 0.5);
+  return b;
+}
+
 FrameParams makeFrameParams(const render::Camera& camera, int width, int height, const glm::dmat3& lightRotation,
                             double exposureStops, bool background, int backgroundLevel) {
-  // The basis of render::CameraRays, computed the same way in double.
-  const glm::dvec3 forward = glm::normalize(camera.target - camera.eye);
-  const glm::dvec3 right = glm::normalize(glm::cross(forward, camera.up));
-  const glm::dvec3 up = glm::cross(right, forward);
-  FrameParams f;
-  f.forward = glm::vec4(glm::vec3(forward), 0.0f);
-  f.right = glm::vec4(glm::vec3(right), 0.0f);
-  f.up = glm::vec4(glm::vec3(up), 0.0f);
+  const CameraBasis basis = cameraBasis(camera);
+  FrameParams f{};
+  f.forward = glm::vec4(glm::vec3(basis.forward), 0.0f);
+  f.right = glm::vec4(glm::vec3(basis.right), 0.0f);
+  f.up = glm::vec4(glm::vec3(basis.up), 0.0f);
   const glm::dmat3 lt = glm::transpose(lightRotation);
   for (int c = 0; c < 3; ++c) f.lightRotT[c] = glm::vec4(glm::vec3(lt[c]), 0.0f);
-  f.tanHalf = static_cast<float>(std::tan(glm::radians(camera.fovYDegrees) * 0.5));
+  f.tanHalf = static_cast<float>(basis.tanHalf);
   f.aspect = static_cast<float>(static_cast<double>(width) / height);
   f.gain = static_cast<float>(std::exp2(exposureStops));
   f.background = background ? 1u : 0u;
@@ -44,6 +53,49 @@ std::array<float, 256> srgbThresholds(double exposureStops) {
     t[static_cast<std::size_t>(k)] = static_cast<float>(linear / gain);
   }
   return t;
+}
+
+void setFusedSkip(ObjectInfo& info, int level, int lastNonZeroRow) {
+  // As fusedShade: beyond the last non-zero row + 1 every lookup reads zeros;
+  // one more row absorbs the rounding of θ'. The taps of the directions kept
+  // reach rows up to cutRow (r0 ≤ cutRow − 1, r1 = r0 + 1).
+  const int m = mapSize(level), cutRow = lastNonZeroRow + 2;
+  info.skipBelowY = cutRow < m ? static_cast<float>(std::cos(cutRow * kPi / m)) : -2.0f;
+  info.blendRows = static_cast<std::uint32_t>(std::min(m, cutRow + 1));
+}
+
+std::vector<glm::vec4> pixelCentreDirections(int level) {
+  const int m = mapSize(level);
+  std::vector<glm::vec4> out;
+  out.reserve(static_cast<std::size_t>(m) * static_cast<std::size_t>(m));
+  for (int i = 0; i < m; ++i) {
+    for (int j = 0; j < m; ++j) out.emplace_back(glm::vec3(sphericalToDirection(rowTheta(level, i), colPhi(level, j))), 0.0f);
+  }
+  return out;
+}
+
+std::vector<std::uint32_t> packVisibilityEntries(std::span<const SparseHaar> lists, int level) {
+  const std::size_t count = static_cast<std::size_t>(mapSize(level)) * static_cast<std::size_t>(mapSize(level));
+  std::vector<std::uint32_t> out(2 * lists.size());
+  for (std::size_t n = 0; n < lists.size(); ++n) {
+    const SparseHaar& list = lists[n];
+    if (list.level != level || list.index.size() != list.value.size()) {
+      throw std::invalid_argument("packVisibilityEntries: list " + std::to_string(n) + " has level " +
+                                  std::to_string(list.level) + " (expected " + std::to_string(level) + ") or " +
+                                  "unequal index and value counts");
+    }
+    out[2 * n] = static_cast<std::uint32_t>(out.size() / 2);
+    out[2 * n + 1] = static_cast<std::uint32_t>(list.size());
+    for (std::size_t k = 0; k < list.size(); ++k) {
+      if (list.index[k] >= count) {
+        throw std::invalid_argument("packVisibilityEntries: list " + std::to_string(n) + " index " +
+                                    std::to_string(list.index[k]) + " is outside a level-" + std::to_string(level) + " map");
+      }
+      out.push_back(list.index[k]);
+      out.push_back(std::bit_cast<std::uint32_t>(list.value[k]));
+    }
+  }
+  return out;
 }
 
 std::uint32_t preorderKey(int mapLevel, int l, int i, int j) {

@@ -13,6 +13,7 @@
 #include <glm/mat4x4.hpp>
 #include <glm/trigonometric.hpp>
 
+#include "haarcast/core/fused.h"
 #include "haarcast/gpu/compute.h"
 #include "haarcast/gpu/rotation_data.h"
 #include "haarcast/gpu/shaders.h"
@@ -28,17 +29,12 @@ constexpr VkFormat kIdsFormat = VK_FORMAT_R32G32B32A32_UINT;
 constexpr VkFormat kPositionFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
 constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
 constexpr std::size_t kRotatedBudget = 256u << 20;  // bytes of rotated coefficients per batch, at most
+constexpr std::size_t kFusedScratchBudget = 256u << 20;  // bytes of `fused` scratch in global memory, at most
+constexpr std::size_t kFusedPlanesBudget = 256u << 20;   // bytes of vertex visibility in pixel form, at most
 
 std::uint32_t groupsOf(std::size_t items, std::uint32_t local) {
   return static_cast<std::uint32_t>((items + local - 1) / local);
 }
-
-// The G-buffer pass's push block (gbuffer.vert / .frag).
-struct GBufferPush {
-  glm::mat4 objectToClip;
-  std::uint32_t objectId = 0, triangleBase = 0, pad0 = 0, pad1 = 0;
-};
-static_assert(sizeof(GBufferPush) == 80);
 
 struct Push16 {
   std::uint32_t first = 0, count = 0, pad0 = 0, pad1 = 0;
@@ -71,9 +67,17 @@ struct VulkanRenderer::Impl {
   std::vector<std::size_t> methodBytesPerChannel;  // per object: method data one rotation reads
   Buffer slices, methodData, positions, normals, triangles, visibility, background;
   Buffer objects, light, frameParams, thresholds;
+  // `fused`: the slices in pixel form (texels), the light in pixel form per
+  // frame (in `light`), the pixel-centre directions and the workgroups' scratch.
+  bool fused = false;
+  Buffer directions, scratch;
+  std::uint32_t fusedGroups = 0;     // the most workgroups of the fused dispatch
+  std::uint32_t fusedLocal = 0;      // its local size
+  bool fusedShared = false;          // scratch in shared memory (else in `scratch`)
+  bool fusedVertexPlanes = false;    // visibility uploaded per vertex in pixel form (else as lists)
 
   // ---- Pipelines ---------------------------------------------------------------
-  std::unique_ptr<ComputePipeline> rotate, rotationInput, tripleProduct, tonemap;
+  std::unique_ptr<ComputePipeline> rotate, rotationInput, tripleProduct, tonemap, fusedPass;
   VkRenderPass renderPass = VK_NULL_HANDLE;
   VkDescriptorSetLayout gbufferSetLayout = VK_NULL_HANDLE;
   VkPipelineLayout gbufferLayout = VK_NULL_HANDLE;
@@ -92,8 +96,11 @@ struct VulkanRenderer::Impl {
   // lavapipe's timestamps do not wait for compute dispatches (measured: 0.8 s
   // of timestamps in a 3.8 s submission). On a CPU device, host time is device time.
   bool useTimestamps = false;
+  static constexpr std::uint32_t kMaxTimedStages = 8;
   VkQueryPool queries = VK_NULL_HANDLE;
 
+  void createFusedPipeline(std::uint32_t local);
+  render::Frame renderFused(const render::FrameRequest& request);
   Impl(const render::Scene& scene, const render::RenderOptions& o, const VulkanOptions& vulkan,
        const render::RenderProgress& progress, const VulkanRendererLimits& l);
   ~Impl();
@@ -104,6 +111,14 @@ struct VulkanRenderer::Impl {
   Image createImage(VkFormat format, VkImageUsageFlags usage, VkImageAspectFlags aspect);
   void destroyImage(Image& image);
   render::Frame render(const render::FrameRequest& request);
+  const render::Pose& poseOf(const render::FrameRequest& request, std::size_t i) const;
+  glm::dmat4 frameViewProjection(const render::FrameRequest& request) const;
+  void recordGBuffer(VkCommandBuffer cb, const render::FrameRequest& request, const glm::dmat4& viewProj);
+  // The stages of a frame, in order: with timestamps, recorded into one
+  // command buffer (a timestamp after each) and submitted once; otherwise
+  // (a CPU device) one submission per stage, timed on the host.
+  void runStages(const std::vector<std::pair<const char*, std::function<void(VkCommandBuffer)>>>& stages,
+                 render::Frame& frame);
 };
 
 // ------------------------------------------------------------------ setup
@@ -112,28 +127,33 @@ VulkanRenderer::Impl::Impl(const render::Scene& scene, const render::RenderOptio
                            const render::RenderProgress& progress, const VulkanRendererLimits& l)
     : options(o), limits(l), prepared(), context(vulkan) {
   render::checkRenderOptions(options);
-  if (options.level < kMinGpuLevel || options.level > kMaxGpuLevel) {
+  fused = options.method == RotationMethod::Fused;
+  if (fused) {
+    checkFusedLevel(options.level);  // 2–7: its scratch need not fit in shared memory
+  } else if (options.level < kMinGpuLevel || options.level > kMaxGpuLevel) {
     throw std::invalid_argument("the Vulkan backend takes map levels " + std::to_string(kMinGpuLevel) + " to " +
                                 std::to_string(kMaxGpuLevel) + " (got " + std::to_string(options.level) +
                                 "): a rotation workgroup keeps one map in shared memory, and a level-6 map is the "
                                 "16 KiB every Vulkan device guarantees");
   }
   methodName = std::string(haarcast::methodName(options.method));
-  if (embeddedShader("rotate_" + methodName + ".comp").empty()) {
-    throw std::invalid_argument("rotation method \"" + methodName + "\" has no Vulkan shader in this build (shaders/rotate_" +
-                                methodName + ".comp is missing)");
+  const std::string shader = fused ? "fused.comp" : "rotate_" + methodName + ".comp";
+  if (embeddedShader(shader).empty()) {
+    throw std::invalid_argument("rotation method \"" + methodName + "\" has no Vulkan shader in this build (shaders/" +
+                                shader + " is missing)");
   }
   level = options.level;
   coefficients = static_cast<std::size_t>(mapSize(level)) * static_cast<std::size_t>(mapSize(level));
   prepared = render::prepareScene(scene, options, progress);
   uploadScene();
   createGraphicsPipeline();
-  useTimestamps = context.timestampsSupported() && context.info().type != "cpu";
+  useTimestamps = context.timestampsSupported() && context.properties().limits.timestampComputeAndGraphics &&
+                  context.info().type != "cpu";
   if (useTimestamps) {
     VkQueryPoolCreateInfo q{};
     q.sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO;
     q.queryType = VK_QUERY_TYPE_TIMESTAMP;
-    q.queryCount = 2;
+    q.queryCount = kMaxTimedStages + 1;
     vkCheck(vkCreateQueryPool(context.device(), &q, nullptr, &queries), "vkCreateQueryPool");
   }
 }
@@ -169,16 +189,24 @@ void VulkanRenderer::Impl::uploadScene() {
     if (static_cast<std::size_t>(p.table.thetaSamples()) != T || p.table.level() != level) {
       throw std::logic_error("Vulkan backend: object " + p.name + " has a slice table unlike the options");
     }
-    info.sliceBase = static_cast<std::uint32_t>(sliceData.size() / (3 * n));
     info.thetaSamples = static_cast<std::uint32_t>(T);
-    for (std::size_t t = 0; t < T; ++t) {
-      for (int c = 0; c < 3; ++c) {
-        const auto coeffs = p.table.slice(c, static_cast<int>(t)).coefficients();
-        sliceData.insert(sliceData.end(), coeffs.begin(), coeffs.end());
+    if (fused) {
+      // The slices in pixel form, RGB0 texels (core PixelSlices), slice s at s·N texels.
+      const PixelSlices pixelSlices = PixelSlices::synthesize(p.table);
+      info.sliceBase = static_cast<std::uint32_t>(sliceData.size() / (shared::kTexelFloats * n));
+      sliceData.insert(sliceData.end(), pixelSlices.texels().begin(), pixelSlices.texels().end());
+      setFusedSkip(info, level, pixelSlices.lastNonZeroRow());
+    } else {
+      info.sliceBase = static_cast<std::uint32_t>(sliceData.size() / (3 * n));
+      for (std::size_t t = 0; t < T; ++t) {
+        for (int c = 0; c < 3; ++c) {
+          const auto coeffs = p.table.slice(c, static_cast<int>(t)).coefficients();
+          sliceData.insert(sliceData.end(), coeffs.begin(), coeffs.end());
+        }
       }
     }
     const std::size_t before = method.size();
-    info.methodBase = options.method == RotationMethod::Spatial
+    info.methodBase = options.method == RotationMethod::Spatial || fused
                           ? static_cast<std::uint32_t>(method.size())
                           : appendRotationData(options.method, p.table, info.sliceBase, method, options.rotator);
     const std::size_t blockWords = method.size() - before;
@@ -195,7 +223,8 @@ void VulkanRenderer::Impl::uploadScene() {
         methodBytes = 2 * (blockWords * 4) / matrices;
         break;
       }
-      case RotationMethod::Spatial: break;
+      case RotationMethod::Spatial:
+      case RotationMethod::Fused: break;
     }
     methodBytesPerChannel.push_back(methodBytes);
 
@@ -222,21 +251,43 @@ void VulkanRenderer::Impl::uploadScene() {
   totalTriangles = tri.size() / 3;
   rotationBytesPerChannel = n * sizeof(float);  // the slice, or for table the copy that replaces it
 
-  const std::vector<glm::uvec4> visPacked = packSparseLists(vis, level);
-  visibilityBlocks.resize(vis.size());
-  for (std::size_t v = 0; v < vis.size(); ++v) visibilityBlocks[v] = visPacked[v].y;
-
   auto upload = [&](Buffer& b, const void* data, std::size_t bytes) {
     b = Buffer(context, bytes);
     b.write(data, bytes);
   };
+  if (fused) {
+    visibilityBlocks.resize(vis.size());
+    for (std::size_t v = 0; v < vis.size(); ++v) visibilityBlocks[v] = vis[v].size();
+    const std::size_t planeBytes = vis.size() * n * sizeof(float);
+    fusedVertexPlanes = !limits.fusedVisibilityLists &&
+                        planeBytes <= std::min<std::size_t>(kFusedPlanesBudget,
+                                                            context.properties().limits.maxStorageBufferRange);
+    if (fusedVertexPlanes) {
+      // Every vertex's visibility in pixel form (synthesised once here):
+      // fused.comp blends three of them per direction.
+      visibility = Buffer(context, planeBytes);
+      for (std::size_t v = 0; v < vis.size(); ++v) {
+        const SphereMap pixelsOf = inverseHaar(vis[v].toDense());
+        visibility.write(pixelsOf.values().data(), n * sizeof(float), v * n * sizeof(float));
+      }
+    } else {
+      // The lists as they are: a (first, count) header per vertex, then
+      // (index, value bits) entries; fused.comp merges and synthesises them.
+      const std::vector<std::uint32_t> words = packVisibilityEntries(vis, level);
+      upload(visibility, words.data(), words.size() * sizeof(std::uint32_t));
+    }
+  } else {
+    const std::vector<glm::uvec4> visPacked = packSparseLists(vis, level);
+    visibilityBlocks.resize(vis.size());
+    for (std::size_t v = 0; v < vis.size(); ++v) visibilityBlocks[v] = visPacked[v].y;
+    upload(visibility, visPacked.data(), visPacked.size() * sizeof(glm::uvec4));
+  }
   upload(slices, sliceData.data(), sliceData.size() * sizeof(float));
   if (method.empty()) method.push_back(0u);  // spatial: a 4-byte dummy (the contract)
   upload(methodData, method.data(), method.size() * sizeof(std::uint32_t));
   upload(positions, pos.data(), pos.size() * sizeof(glm::vec4));
   upload(normals, nor.data(), nor.size() * sizeof(glm::vec4));
   upload(triangles, tri.data(), tri.size() * sizeof(std::uint32_t));
-  upload(visibility, visPacked.data(), visPacked.size() * sizeof(glm::uvec4));
 
   // Backdrop maps, [channel][row][col].
   std::vector<float> bg;
@@ -244,8 +295,10 @@ void VulkanRenderer::Impl::uploadScene() {
   upload(background, bg.data(), bg.size() * sizeof(float));
 
   objects = Buffer(context, objectCount * sizeof(ObjectInfo));
-  // The light: per object and channel a header and at most (N − 1)/3 blocks.
-  light = Buffer(context, objectCount * 3 * (1 + (n - 1) / 3) * sizeof(glm::uvec4));
+  // The light: per object and channel a header and at most (N − 1)/3 blocks;
+  // for `fused` its pixel form, three planes of N floats per object.
+  light = Buffer(context, fused ? objectCount * 3 * n * sizeof(float)
+                                : objectCount * 3 * (1 + (n - 1) / 3) * sizeof(glm::uvec4));
   frameParams = Buffer(context, sizeof(FrameParams));
   thresholds = Buffer(context, 256 * sizeof(float));
 
@@ -255,13 +308,50 @@ void VulkanRenderer::Impl::uploadScene() {
   // workgroup make each barrier cheaper (docs/gpu.md, "Performance").
   std::uint32_t local = context.info().type == "cpu" ? 64u : 256u;
   if (limits.spatialLocalSize) local = limits.spatialLocalSize;
+  rotationInput = std::make_unique<ComputePipeline>(context, "rotation_input.comp", 8, 0);
+  tonemap = std::make_unique<ComputePipeline>(context, "tonemap.comp", 6, 0);
+  if (fused) {
+    createFusedPipeline(local);
+    return;
+  }
   rotate = std::make_unique<ComputePipeline>(
       context, "rotate_" + methodName + ".comp", 4, 16,
       std::vector<SpecConstant>{{0, lvl}, {1, static_cast<std::uint32_t>(T)}, {2, local}});
-  rotationInput = std::make_unique<ComputePipeline>(context, "rotation_input.comp", 8, 0);
   tripleProduct = std::make_unique<ComputePipeline>(context, "triple_product.comp", 5, 16,
                                                     std::vector<SpecConstant>{{0, lvl}});
-  tonemap = std::make_unique<ComputePipeline>(context, "tonemap.comp", 6, 0);
+}
+
+void VulkanRenderer::Impl::createFusedPipeline(std::uint32_t local) {
+  // The pixel-centre directions, as core fused builds them (double → float).
+  const std::vector<glm::vec4> dirs = pixelCentreDirections(level);
+  directions = Buffer(context, dirs.size() * sizeof(glm::vec4));
+  directions.write(dirs.data(), dirs.size() * sizeof(glm::vec4));
+
+  // Scratch: in shared memory where the device has room for it (and the
+  // reduction's vec3 per invocation), else a slice of a global buffer per
+  // workgroup, whose size bounds the workgroups in flight.
+  const VkPhysicalDeviceLimits& lim = context.properties().limits;
+  const std::size_t floats = fusedScratchFloats(level, fusedVertexPlanes);
+  fusedLocal = limits.fusedLocalSize ? limits.fusedLocalSize : local;
+  fusedShared = !limits.fusedGlobalScratch &&
+                floats * sizeof(float) + fusedLocal * 4 * sizeof(float) <= lim.maxComputeSharedMemorySize;
+  const std::size_t maxGroups = lim.maxComputeWorkGroupCount[0];
+  if (fusedShared) {
+    fusedGroups = static_cast<std::uint32_t>(std::min<std::size_t>(maxGroups, 1u << 16));
+    scratch = Buffer(context, sizeof(float));
+  } else {
+    const std::size_t budget = std::min<std::size_t>(kFusedScratchBudget, lim.maxStorageBufferRange);
+    fusedGroups = static_cast<std::uint32_t>(std::clamp<std::size_t>(budget / (floats * sizeof(float)), 1, maxGroups));
+    scratch = Buffer(context, std::size_t{fusedGroups} * floats * sizeof(float));
+  }
+  if (limits.fusedGroups) fusedGroups = std::min(fusedGroups, limits.fusedGroups);
+  fusedPass = std::make_unique<ComputePipeline>(
+      context, "fused.comp", 10, 0,
+      std::vector<SpecConstant>{{0, static_cast<std::uint32_t>(level)},
+                                {2, fusedLocal},
+                                {3, fusedShared ? static_cast<std::uint32_t>(floats) : 1u},
+                                {4, options.interpolateSlices ? 1u : 0u},
+                                {5, fusedVertexPlanes ? 1u : 0u}});
 }
 
 void VulkanRenderer::Impl::createGraphicsPipeline() {
@@ -502,9 +592,19 @@ void VulkanRenderer::Impl::ensureResolution(int w, int h) {
   gbufPositions = Buffer(context, pixels * sizeof(glm::vec4));
   samples = Buffer(context, pixels * sizeof(RotationSample));
   shade = Buffer(context, pixels * sizeof(ShadeSample));
-  counter = Buffer(context, sizeof(std::uint32_t));
+  // The covered-pixel count and `fused`'s indirect dispatch arguments.
+  counter = Buffer(context, sizeof(CoverageCounter),
+                   VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
+                       VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
   radiance = Buffer(context, pixels * sizeof(glm::vec4));
   rgba8 = Buffer(context, pixels * sizeof(std::uint32_t));
+
+  rotationInput->bind({&frameParams, &objects, &gbufIds, &gbufNormals, &triangles, &samples, &shade, &counter});
+  tonemap->bind({&frameParams, &gbufIds, &radiance, &background, &rgba8, &thresholds});
+  if (fused) {
+    fusedPass->bind({&samples, &shade, &objects, &slices, &light, &visibility, &directions, &scratch, &radiance, &counter});
+    return;
+  }
 
   // The batch: as many covered pixels as the rotated buffer holds within the
   // budget, the device's storage-buffer range and one dispatch's group count.
@@ -519,10 +619,8 @@ void VulkanRenderer::Impl::ensureResolution(int w, int h) {
   rotated = Buffer(context, batch * perSample);
 
 
-  rotationInput->bind({&frameParams, &objects, &gbufIds, &gbufNormals, &triangles, &samples, &shade, &counter});
   rotate->bind({&samples, &slices, &methodData, &rotated});
   tripleProduct->bind({&shade, &rotated, &light, &visibility, &radiance});
-  tonemap->bind({&frameParams, &gbufIds, &radiance, &background, &rgba8, &thresholds});
 }
 
 // ------------------------------------------------------------------ a frame
@@ -534,10 +632,9 @@ namespace {
 // reversed, infinite-far Z (depth = near / distance, greatest wins), whose
 // float precision does not depend on the scene's depth range.
 glm::dmat4 viewProjection(const render::Camera& camera, int width, int height, double nearPlane) {
-  const glm::dvec3 f = glm::normalize(camera.target - camera.eye);
-  const glm::dvec3 r = glm::normalize(glm::cross(f, camera.up));
-  const glm::dvec3 u = glm::cross(r, f);
-  const double tanHalf = std::tan(glm::radians(camera.fovYDegrees) * 0.5);
+  const CameraBasis basis = cameraBasis(camera);
+  const glm::dvec3 &f = basis.forward, &r = basis.right, &u = basis.up;
+  const double tanHalf = basis.tanHalf;
   const double aspect = static_cast<double>(width) / height;
   const glm::dvec3& e = camera.eye;
   glm::dmat4 m(0.0);  // m[column][row]
@@ -557,7 +654,184 @@ glm::dmat4 viewProjection(const render::Camera& camera, int width, int height, d
 
 }  // namespace
 
+const render::Pose& VulkanRenderer::Impl::poseOf(const render::FrameRequest& request, std::size_t i) const {
+  return request.poses.empty() ? prepared.objects[i].pose : request.poses[i];
+}
+
+glm::dmat4 VulkanRenderer::Impl::frameViewProjection(const render::FrameRequest& request) const {
+  // Near plane: a fraction of the nearest object's bounding-sphere distance.
+  double nearest = std::numeric_limits<double>::infinity(), farthest = 0.0;
+  for (std::size_t i = 0; i < prepared.objects.size(); ++i) {
+    const Bounds b = prepared.objects[i].mesh->bounds();
+    const glm::dvec3 centre = glm::dvec3(poseOf(request, i).objectToWorld() * glm::dvec4(b.centre(), 1.0));
+    const double radius = b.radius() * poseOf(request, i).scale;
+    const double d = glm::length(centre - request.camera.eye);
+    nearest = std::min(nearest, d - radius);
+    farthest = std::max(farthest, d + radius);
+  }
+  const double nearPlane = nearest > 0.0 ? std::max(0.5 * nearest, 1e-6 * farthest) : 1e-6 * std::max(farthest, 1.0);
+  return viewProjection(request.camera, request.width, request.height, nearPlane);
+}
+
+// The G-buffer: every object rasterised, then the attachments copied to the
+// storage buffers the compute passes read.
+void VulkanRenderer::Impl::recordGBuffer(VkCommandBuffer cb, const render::FrameRequest& request,
+                                         const glm::dmat4& viewProj) {
+  std::array<VkClearValue, 4> clear{};
+  clear[3].depthStencil = {0.0f, 0};  // reversed Z: 0 is infinitely far
+  VkRenderPassBeginInfo rb{};
+  rb.sType = VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO;
+  rb.renderPass = renderPass;
+  rb.framebuffer = framebuffer;
+  rb.renderArea = {{0, 0}, {static_cast<std::uint32_t>(width), static_cast<std::uint32_t>(height)}};
+  rb.clearValueCount = 4;
+  rb.pClearValues = clear.data();
+  vkCmdBeginRenderPass(cb, &rb, VK_SUBPASS_CONTENTS_INLINE);
+  const VkViewport viewport{0.0f, 0.0f, static_cast<float>(width), static_cast<float>(height), 0.0f, 1.0f};
+  const VkRect2D scissor{{0, 0}, {static_cast<std::uint32_t>(width), static_cast<std::uint32_t>(height)}};
+  vkCmdSetViewport(cb, 0, 1, &viewport);
+  vkCmdSetScissor(cb, 0, 1, &scissor);
+  vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, gbufferPipeline);
+  vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, gbufferLayout, 0, 1, &gbufferSet, 0, nullptr);
+  for (std::size_t i = 0; i < prepared.objects.size(); ++i) {
+    GBufferPush push;
+    push.objectToClip = glm::mat4(viewProj * poseOf(request, i).objectToWorld());
+    push.objectId = static_cast<std::uint32_t>(i);
+    push.triangleBase = objectInfo[i].triangleBase;
+    vkCmdPushConstants(cb, gbufferLayout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof push,
+                       &push);
+    vkCmdDraw(cb, 3 * triangleCount[i], 1, 0, 0);
+  }
+  vkCmdEndRenderPass(cb);
+  VkBufferImageCopy region{};
+  region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+  region.imageExtent = {static_cast<std::uint32_t>(width), static_cast<std::uint32_t>(height), 1};
+  vkCmdCopyImageToBuffer(cb, normalImage.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, gbufNormals.handle(), 1, &region);
+  vkCmdCopyImageToBuffer(cb, idsImage.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, gbufIds.handle(), 1, &region);
+  vkCmdCopyImageToBuffer(cb, positionImage.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, gbufPositions.handle(), 1,
+                         &region);
+}
+
+void VulkanRenderer::Impl::runStages(
+    const std::vector<std::pair<const char*, std::function<void(VkCommandBuffer)>>>& stages, render::Frame& frame) {
+  if (!useTimestamps) {
+    for (const auto& [name, record] : stages) {
+      const auto t = Clock::now();
+      context.submit([&](VkCommandBuffer cb) {
+        record(cb);
+        computeBarrier(cb);
+      });
+      frame.stages.push_back({name, since(t)});
+    }
+    return;
+  }
+  const auto count = static_cast<std::uint32_t>(stages.size());
+  if (count > kMaxTimedStages) throw std::logic_error("runStages: more stages than timestamp queries");
+  context.submit([&](VkCommandBuffer cb) {
+    vkCmdResetQueryPool(cb, queries, 0, count + 1);
+    vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, queries, 0);
+    for (std::uint32_t i = 0; i < count; ++i) {
+      stages[i].second(cb);
+      computeBarrier(cb);
+      vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, queries, i + 1);
+    }
+  });
+  std::array<std::uint64_t, kMaxTimedStages + 1> ticks{};
+  vkCheck(vkGetQueryPoolResults(context.device(), queries, 0, count + 1, (count + 1) * sizeof(std::uint64_t), ticks.data(),
+                                sizeof(std::uint64_t), VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
+          "vkGetQueryPoolResults");
+  // Only timestampValidBits of a tick count; differences are taken modulo that.
+  const std::uint64_t mask = context.timestampValidBits() >= 64 ? ~std::uint64_t{0}
+                                                                 : (std::uint64_t{1} << context.timestampValidBits()) - 1;
+  for (std::uint32_t i = 0; i < count; ++i) {
+    const std::uint64_t delta = (ticks[i + 1] - ticks[i]) & mask;
+    frame.stages.push_back({stages[i].first, static_cast<double>(delta) * context.timestampPeriodNs() * 1e-9});
+  }
+}
+
+// `fused`: G-buffer → rotation input (compaction, indirect arguments) →
+// fused (vkCmdDispatchIndirect, no readback of the count) → tonemap.
+render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& request) {
+  const auto start = Clock::now();
+  render::Frame frame;
+
+  // ---- light (host): resolveFrame, as the CPU backend; its pixel form uploaded
+  auto t0 = Clock::now();
+  const render::ResolvedFrame resolved = render::resolveFrame(prepared, options, request);
+  ensureResolution(request.width, request.height);
+  const std::size_t objectCount = prepared.objects.size();
+  const std::size_t planeBytes = 3 * coefficients * sizeof(float);
+  for (std::size_t i = 0; i < objectCount; ++i) {
+    const render::ResolvedObject& o = resolved.objects[i];
+    light.write(o.fusedLight.planes.data(), planeBytes, i * planeBytes);
+    for (int c = 0; c < 3; ++c) objectInfo[i].rotation[c] = glm::vec4(glm::vec3(o.rotation[c]), 0.0f);
+  }
+  objects.write(objectInfo.data(), objectInfo.size() * sizeof(ObjectInfo));
+  FrameParams params = makeFrameParams(request.camera, request.width, request.height, request.lightRotation,
+                                       request.exposureStops, options.environmentBackground,
+                                       prepared.background[0].level());
+  params.fusedGroups = fusedGroups;
+  frameParams.write(&params, sizeof params);
+  const std::array<float, 256> encoding = srgbThresholds(request.exposureStops);
+  thresholds.write(encoding.data(), sizeof encoding);
+  frame.stages.push_back({"light", since(t0)});
+
+  // ---- the device's part: one command buffer (timestamps) or one per stage
+  const glm::dmat4 viewProj = frameViewProjection(request);
+  const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  runStages({{"gbuffer", [&](VkCommandBuffer cb) { recordGBuffer(cb, request, viewProj); }},
+             {"rotation-input",
+              [&](VkCommandBuffer cb) {
+                vkCmdFillBuffer(cb, counter.handle(), 0, VK_WHOLE_SIZE, 0u);
+                computeBarrier(cb);
+                rotationInput->dispatch(cb, {groupsOf(pixels, 64), 1, 1});
+              }},
+             {"fused",
+              [&](VkCommandBuffer cb) {
+                fusedPass->dispatchIndirect(cb, counter, offsetof(CoverageCounter, groups));
+              }},
+             {"tonemap", [&](VkCommandBuffer cb) { tonemap->dispatch(cb, {groupsOf(pixels, 64), 1, 1}); }}},
+            frame);
+
+  // ---- Results: RGBA8 always, the linear image only when asked for ----------
+  frame.rgba8.resize(pixels * 4);
+  rgba8.read(frame.rgba8.data(), frame.rgba8.size());
+  frame.objectMask.assign(pixels, 0);
+  const auto* ids = static_cast<const glm::uvec4*>(gbufIds.mapped());
+  for (std::size_t p = 0; p < pixels; ++p) frame.objectMask[p] = ids[p].x != 0 ? 1 : 0;
+  if (request.linearImage) {
+    frame.image = io::makeImage(width, height);
+    const auto* rad = static_cast<const glm::vec4*>(radiance.mapped());
+    for (std::size_t p = 0; p < pixels; ++p) {
+      for (std::size_t c = 0; c < 3; ++c) frame.image.rgb[3 * p + c] = rad[p][static_cast<int>(c)];
+    }
+  }
+
+  // Coefficient bytes read, counted as the CPU backend counts them: the light
+  // lists, and per covered pixel core fusedPixelBytes (one slice or two, the
+  // light planes, the three vertices' entries).
+  std::size_t bytes = resolved.lightBytes;
+  CoverageCounter count{};
+  counter.read(&count, sizeof count);
+  const auto* rs = static_cast<const RotationSample*>(samples.mapped());
+  const auto* sh = static_cast<const ShadeSample*>(shade.mapped());
+  for (std::uint32_t i = 0; i < count.covered && i < pixels; ++i) {
+    std::size_t entries = 0;
+    for (std::uint32_t v : sh[i].vertex) entries += v < visibilityBlocks.size() ? visibilityBlocks[v] : 0;
+    const shared::SliceBlend blend =
+        shared::sliceBlendAt(rs[i].thetaOut, static_cast<shared::uint>(options.thetaSamples), options.interpolateSlices ? 1u : 0u);
+    // With the vertices' pixel forms, three planes of N floats replace the lists.
+    bytes += fusedVertexPlanes ? fusedPixelBytes(level, blend.weight != 0.0f && blend.second != blend.first, 0) +
+                                     3 * coefficients * sizeof(float)
+                               : fusedPixelBytes(level, blend.weight != 0.0f && blend.second != blend.first, entries);
+  }
+  frame.coefficientBytes = bytes;
+  frame.seconds = since(start);
+  return frame;
+}
+
 render::Frame VulkanRenderer::Impl::render(const render::FrameRequest& request) {
+  if (fused) return renderFused(request);
   render::checkFrameRequest(request, prepared.objects.size());
   const auto start = Clock::now();
   ensureResolution(request.width, request.height);
@@ -592,18 +866,7 @@ render::Frame VulkanRenderer::Impl::render(const render::FrameRequest& request) 
   thresholds.write(encoding.data(), sizeof encoding);
   frame.stages.push_back({"light", since(t0)});
 
-  // Near plane: a fraction of the nearest object's bounding-sphere distance.
-  double nearest = std::numeric_limits<double>::infinity(), farthest = 0.0;
-  for (std::size_t i = 0; i < objectCount; ++i) {
-    const Bounds b = prepared.objects[i].mesh->bounds();
-    const glm::dvec3 centre = glm::dvec3(poseOf(i).objectToWorld() * glm::dvec4(b.centre(), 1.0));
-    const double radius = b.radius() * poseOf(i).scale;
-    const double d = glm::length(centre - request.camera.eye);
-    nearest = std::min(nearest, d - radius);
-    farthest = std::max(farthest, d + radius);
-  }
-  const double nearPlane = nearest > 0.0 ? std::max(0.5 * nearest, 1e-6 * farthest) : 1e-6 * std::max(farthest, 1.0);
-  const glm::dmat4 viewProj = viewProjection(request.camera, request.width, request.height, nearPlane);
+  const glm::dmat4 viewProj = frameViewProjection(request);
 
   const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
   // Each stage is its own submission, timed as the member comment says.
@@ -631,41 +894,7 @@ render::Frame VulkanRenderer::Impl::render(const render::FrameRequest& request) 
   double gbuffer = 0, rotInput = 0, rotation = 0, product = 0, tone = 0;
 
   // ---- gbuffer ------------------------------------------------------------------
-  timed(gbuffer, [&](VkCommandBuffer cb) {
-    std::array<VkClearValue, 4> clear{};
-    clear[3].depthStencil = {0.0f, 0};  // reversed Z: 0 is infinitely far
-    VkRenderPassBeginInfo rb{};
-    rb.sType = VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO;
-    rb.renderPass = renderPass;
-    rb.framebuffer = framebuffer;
-    rb.renderArea = {{0, 0}, {static_cast<std::uint32_t>(width), static_cast<std::uint32_t>(height)}};
-    rb.clearValueCount = 4;
-    rb.pClearValues = clear.data();
-    vkCmdBeginRenderPass(cb, &rb, VK_SUBPASS_CONTENTS_INLINE);
-    const VkViewport viewport{0.0f, 0.0f, static_cast<float>(width), static_cast<float>(height), 0.0f, 1.0f};
-    const VkRect2D scissor{{0, 0}, {static_cast<std::uint32_t>(width), static_cast<std::uint32_t>(height)}};
-    vkCmdSetViewport(cb, 0, 1, &viewport);
-    vkCmdSetScissor(cb, 0, 1, &scissor);
-    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, gbufferPipeline);
-    vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, gbufferLayout, 0, 1, &gbufferSet, 0, nullptr);
-    for (std::size_t i = 0; i < objectCount; ++i) {
-      GBufferPush push;
-      push.objectToClip = glm::mat4(viewProj * poseOf(i).objectToWorld());
-      push.objectId = static_cast<std::uint32_t>(i);
-      push.triangleBase = objectInfo[i].triangleBase;
-      vkCmdPushConstants(cb, gbufferLayout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof push,
-                         &push);
-      vkCmdDraw(cb, 3 * triangleCount[i], 1, 0, 0);
-    }
-    vkCmdEndRenderPass(cb);
-    VkBufferImageCopy region{};
-    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-    region.imageExtent = {static_cast<std::uint32_t>(width), static_cast<std::uint32_t>(height), 1};
-    vkCmdCopyImageToBuffer(cb, normalImage.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, gbufNormals.handle(), 1, &region);
-    vkCmdCopyImageToBuffer(cb, idsImage.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, gbufIds.handle(), 1, &region);
-    vkCmdCopyImageToBuffer(cb, positionImage.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, gbufPositions.handle(), 1,
-                           &region);
-  });
+  timed(gbuffer, [&](VkCommandBuffer cb) { recordGBuffer(cb, request, viewProj); });
 
   // ---- rotation-input -----------------------------------------------------------
   timed(rotInput, [&](VkCommandBuffer cb) {

@@ -70,7 +70,7 @@ TEST_P(SpatialRotationPass, MatchesTheCpuRotatorCoefficientByCoefficient) {
   const std::vector<EulerYXY> rotations = randomRotations(24, 11);
   std::vector<RotationSample> samples;
   for (std::size_t i = 0; i < rotations.size(); ++i) {
-    RotationSample s;
+    RotationSample s{};
     s.slice = static_cast<std::uint32_t>(i % kSlices);
     s.alpha = static_cast<float>(rotations[i].alpha);
     s.beta = static_cast<float>(rotations[i].beta);
@@ -139,7 +139,7 @@ TEST(TripleProductPass, MatchesCoreTripleProductOnRandomSparseInputs) {
     std::vector<float> radianceInit(kSamples * 4, -7.0f);
     std::uniform_real_distribution<float> u(0.0f, 1.0f);
     for (int s = 0; s < kSamples; ++s) {
-      ShadeSample sh;
+      ShadeSample sh{};
       sh.object = static_cast<std::uint32_t>(s % 2);
       for (int v = 0; v < 3; ++v) sh.vertex[v] = static_cast<std::uint32_t>((s + 2 * v) % 6);
       const float b1 = 0.5f * u(rng), b2 = 0.5f * u(rng);

@@ -34,19 +34,13 @@
 #include "haarcast/core/rotation.h"
 #include "haarcast/gpu/compute.h"
 #include "haarcast/gpu/context.h"
+#include "haarcast/gpu/passes.h"
 #include "haarcast/gpu/rotation_data.h"
 
 namespace haarcast::gpu {
 namespace {
 
-// The contract's binding-0 record (rotate_common.glsl).
-struct RotationSample {
-  std::uint32_t slice = 0;
-  std::uint32_t methodBase = 0;
-  float alpha = 0, beta = 0, gamma = 0;
-  std::uint32_t pixel = 0, pad0 = 0, pad1 = 0;
-};
-static_assert(sizeof(RotationSample) == 32);
+// The contract's binding-0 record: gpu::RotationSample (core/shared_layout.h).
 
 struct RotationPush {
   std::uint32_t first = 0, count = 0, pad0 = 0, pad1 = 0;
@@ -59,6 +53,7 @@ const char* shaderOf(RotationMethod m) {
     case RotationMethod::Table: return "rotate_table.comp";
     case RotationMethod::Matrix: return "rotate_matrix.comp";
     case RotationMethod::Spatial: return "rotate_spatial.comp";
+    case RotationMethod::Fused: return "";  // no rotated coefficients: fused.comp (fused_pass_test.cpp)
   }
   return "";
 }
@@ -157,7 +152,7 @@ GpuRun rotateOnGpu(Context& context, RotationMethod method, const std::vector<Br
   const std::size_t n = static_cast<std::size_t>(mapSize(level)) * static_cast<std::size_t>(mapSize(level));
   std::vector<RotationSample> samples;
   for (const Case& c : list) {
-    RotationSample s;
+    RotationSample s{};
     s.slice = static_cast<std::uint32_t>(c.object * thetaSamples + c.theta);
     s.methodBase = methodBase[static_cast<std::size_t>(c.object)];
     s.alpha = static_cast<float>(c.r.alpha);

@@ -43,10 +43,16 @@ class ComputePipeline {
   void dispatch(VkCommandBuffer cb, std::array<std::uint32_t, 3> groups, const void* push = nullptr,
                 std::uint32_t pushBytes = 0) const;
 
+  // The same with the group counts read on the device from `args` at
+  // `offset` (a VkDispatchIndirectCommand; the buffer needs INDIRECT usage).
+  void dispatchIndirect(VkCommandBuffer cb, const Buffer& args, VkDeviceSize offset, const void* push = nullptr,
+                        std::uint32_t pushBytes = 0) const;
+
   const std::string& name() const { return name_; }
 
  private:
   void destroy();
+  void bindForDispatch(VkCommandBuffer cb, const void* push, std::uint32_t pushBytes) const;
   Context& context_;
   std::string name_;
   std::uint32_t bindings_ = 0;
@@ -58,8 +64,9 @@ class ComputePipeline {
   VkDescriptorSet set_ = VK_NULL_HANDLE;
 };
 
-// Compute writes visible to later compute reads and transfers (the
-// barrier between two passes of one command buffer).
+// Compute and transfer writes visible to later compute reads, indirect
+// dispatch arguments, transfers and the host (the barrier between two
+// passes of one command buffer).
 void computeBarrier(VkCommandBuffer cb);
 
 // A set layout of `storageBuffers` storage buffers at bindings 0…count−1,

@@ -99,6 +99,7 @@ class Context {
   // Timestamp queries: supported on the queue, and nanoseconds per tick.
   bool timestampsSupported() const { return timestampValidBits_ > 0 && properties_.limits.timestampPeriod > 0; }
   double timestampPeriodNs() const { return properties_.limits.timestampPeriod; }
+  std::uint32_t timestampValidBits() const { return timestampValidBits_; }
 
   // Records with `record` into a fresh primary command buffer, submits it and
   // waits for the queue to finish it.

@@ -1,5 +1,5 @@
-// Host mirrors of the records the Vulkan passes exchange (shaders/common/
-// frame.glsl, the rotation contract), and the host-side packing they need.
+// The records the Vulkan passes exchange (core/shared_layout.h) and the
+// host-side packing they need.
 // The renderer and the per-pass tests share these, so a test drives a
 // shader with exactly the data the renderer gives it.
 #pragma once
@@ -14,46 +14,28 @@
 #include <glm/vec4.hpp>
 
 #include "haarcast/core/haar.h"
+#include "haarcast/core/shared_layout.h"
 #include "haarcast/render/scene.h"
 
 namespace haarcast::gpu {
 
-// The rotation contract's sample (32 bytes; rotate_*.comp binding 0).
-struct RotationSample {
-  std::uint32_t slice = 0;       // global slice: the object's slice base + θ slice
-  std::uint32_t methodBase = 0;  // the object's offset into the method data, in words
-  float alpha = 0, beta = 0, gamma = 0;
-  std::uint32_t pixel = 0;
-  std::uint32_t pad0 = 0, pad1 = 0;
-};
-static_assert(sizeof(RotationSample) == 32);
+// The records the passes exchange, defined once for C++ and GLSL
+// (core/shared_layout.h, with their size and offset checks).
+using shared::CoverageCounter;
+using shared::FrameParams;
+using shared::GBufferPush;
+using shared::ObjectInfo;
+using shared::RotationSample;
+using shared::ShadeSample;
 
-// What the triple product needs of a covered pixel (frame.glsl ShadeSample).
-struct ShadeSample {
-  std::uint32_t object = 0;
-  std::uint32_t vertex[3] = {0, 0, 0};  // global vertex ids
-  float b[3] = {0, 0, 0};               // barycentrics, b0 = 1 − u − v
-  std::uint32_t pixel = 0;
+// render::CameraRays' pinhole basis, in double: forward, right, up. The frame
+// parameters (the compute passes' rays) and the G-buffer's projection both
+// take it from here.
+struct CameraBasis {
+  glm::dvec3 forward, right, up;
+  double tanHalf;  // tan(fovY / 2)
 };
-static_assert(sizeof(ShadeSample) == 32);
-
-// frame.glsl FrameParams (std430).
-struct FrameParams {
-  glm::vec4 forward{0}, right{0}, up{0};
-  glm::vec4 lightRotT[3]{glm::vec4(0), glm::vec4(0), glm::vec4(0)};  // columns of lightRotationᵀ
-  float tanHalf = 0, aspect = 0, gain = 1;
-  std::uint32_t background = 0;
-  std::uint32_t width = 0, height = 0, backgroundLevel = 0, pad = 0;
-};
-static_assert(sizeof(FrameParams) == 128);
-
-// frame.glsl ObjectInfo (std430).
-struct ObjectInfo {
-  glm::vec4 rotation[3]{glm::vec4(0), glm::vec4(0), glm::vec4(0)};  // object → world, columns
-  std::uint32_t sliceBase = 0, methodBase = 0, thetaSamples = 0, vertexBase = 0, triangleBase = 0;
-  std::uint32_t pad[3] = {0, 0, 0};
-};
-static_assert(sizeof(ObjectInfo) == 80);
+CameraBasis cameraBasis(const render::Camera& camera);
 
 // The camera of render::CameraRays and the frame's settings.
 FrameParams makeFrameParams(const render::Camera& camera, int width, int height, const glm::dmat3& lightRotation,
@@ -76,6 +58,30 @@ std::size_t blockCount(const SparseHaar& list);
 // The preorder key of triple_product.cpp: Morton code of the block's top-left
 // finest block, shifted left by 4, | l.
 std::uint32_t preorderKey(int mapLevel, int l, int i, int j);
+
+// `fused`'s visibility: per list a header (first word, entry count) and then
+// its (index, value bits) entries in list order, as uint pairs; entry
+// offsets count uvec2 pairs from the start of the buffer. Throws
+// std::invalid_argument when a list's level differs from `level`.
+std::vector<std::uint32_t> packVisibilityEntries(std::span<const SparseHaar> lists, int level);
+
+// fused.comp's directions: the unit vectors of a level's pixel centres, row
+// by row (w unused), computed in double as core fused's and rounded to float.
+std::vector<glm::vec4> pixelCentreDirections(int level);
+
+// Floats of fused.comp's scratch per workgroup: the θₒ-blended slice (3N),
+// after, without vertex planes, the per-pixel synthesis (the N merged
+// coefficients and the finest step's N values; shaders/fused.comp).
+inline std::size_t fusedScratchFloats(int level, bool vertexPlanes) {
+  const std::size_t n = std::size_t{1} << (2 * level);
+  return (vertexPlanes ? 0 : 2 * n) + 3 * n;
+}
+
+// ObjectInfo's skipBelowY and blendRows for fused.comp, from the slices'
+// last non-zero row (core PixelSlices::lastNonZeroRow): directions whose
+// rotated cos θ' is below skipBelowY read only zero texels (fusedShade's
+// cut), and the others read rows below blendRows only.
+void setFusedSkip(ObjectInfo& info, int level, int lastNonZeroRow);
 
 // The level range of the GPU passes: shared memory holds one level-6 map
 // (16 KiB) per workgroup, the least that Vulkan guarantees (and lavapipe's

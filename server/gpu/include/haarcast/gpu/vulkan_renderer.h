@@ -6,6 +6,9 @@
 //   rotation-input  compute: slice index and Y-X-Y angles per covered pixel, compacted
 //   rotation        compute: shaders/rotate_<method>.comp, in batches of covered pixels
 //   triple-product  compute: light × rotated slice × interpolated visibility
+//   fused           `fused` only, in place of the two above: shaders/fused.comp,
+//                   one indirect dispatch sized by rotation-input; the frame is
+//                   one command buffer (timestamps per stage on GPUs)
 //   tonemap         compute: backdrop, linear image kept, RGBA8
 // Scene data (slices, method data, meshes, visibility, backdrop) is uploaded
 // once; frame buffers are allocated once per resolution and reused, so a
@@ -34,6 +37,15 @@ struct VulkanRendererLimits {
   std::size_t batchSamples = 0;
   // Workgroup size of rotate_spatial.comp; 0 = 64 on CPU devices, 256 on GPUs.
   std::uint32_t spatialLocalSize = 0;
+  // `fused`: workgroup size (0 = 64 on CPU devices, 256 on GPUs), the most
+  // workgroups in flight (0 = as the scratch allows), the per-pixel merge
+  // and synthesis of the visibility lists even where every vertex's pixel
+  // form would fit in memory, and that synthesis's scratch in global memory
+  // even where shared memory would hold it (tests).
+  std::uint32_t fusedLocalSize = 0;
+  std::uint32_t fusedGroups = 0;
+  bool fusedVisibilityLists = false;
+  bool fusedGlobalScratch = false;
 };
 
 class VulkanRenderer final : public render::Renderer {
