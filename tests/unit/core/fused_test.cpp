@@ -10,9 +10,12 @@
 
 #include "haarcast/core/brdf.h"
 #include "haarcast/core/triple_product.h"
+#include "test_maps.h"
 
 namespace haarcast {
 namespace {
+
+using testing::randomSparse;
 
 std::vector<double> thetaOutLayout(int t) {
   std::vector<double> out;
@@ -35,17 +38,6 @@ BrdfSliceTable randomTable(int level, int thetaSamples, bool upperOnly, std::mt1
     }
   }
   return BrdfSliceTable::fromSlices(thetaOutLayout(thetaSamples), std::move(slices));
-}
-
-// k random non-zero coefficients (the scaling one always among them).
-SparseHaar randomSparse(int level, std::size_t k, double lo, double hi, std::mt19937& rng) {
-  const std::size_t n = static_cast<std::size_t>(mapSize(level)) * static_cast<std::size_t>(mapSize(level));
-  std::uniform_real_distribution<double> value(lo, hi);
-  HaarMap dense(level);
-  dense[0] = static_cast<float>(std::abs(value(rng)) + 0.5);
-  std::uniform_int_distribution<std::size_t> index(1, n - 1);
-  for (std::size_t e = 1; e < std::min(k, n); ++e) dense[index(rng)] = static_cast<float>(value(rng));
-  return SparseHaar::fromDense(dense);
 }
 
 struct Case {

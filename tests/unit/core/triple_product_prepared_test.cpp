@@ -14,23 +14,13 @@
 #include "haarcast/core/haar.h"
 #include "haarcast/core/sphere_map.h"
 #include "haarcast/core/triple_product.h"
+#include "test_maps.h"
 
 namespace haarcast {
 namespace {
 
-SphereMap randomMap(int level, double lo, double hi, std::mt19937& rng) {
-  std::uniform_real_distribution<double> dist(lo, hi);
-  SphereMap map(level);
-  for (float& x : map.values()) x = static_cast<float>(dist(rng));
-  return map;
-}
-
-SphereMap randomBinaryMap(int level, std::mt19937& rng) {
-  std::bernoulli_distribution visible(0.6);
-  SphereMap map(level);
-  for (float& x : map.values()) x = visible(rng) ? 1.0f : 0.0f;
-  return map;
-}
+using testing::randomBinaryMap;
+using testing::randomMap;
 
 // A random subset of a dense map's coefficients (the scaling one included or
 // not): blocks with one, two or three bands, in light only, visibility only

@@ -10,27 +10,16 @@
 
 #include "haarcast/core/haar.h"
 #include "haarcast/core/sphere_map.h"
+#include "test_maps.h"
 
 namespace haarcast {
 namespace {
 
+using testing::randomBinaryMap;
+using testing::randomMap;
+
 // float storage of maps and coefficients bounds the agreement.
 constexpr double kRelativeTolerance = 1e-5;
-
-SphereMap randomMap(int level, double lo, double hi, std::mt19937& rng) {
-  std::uniform_real_distribution<double> dist(lo, hi);
-  SphereMap map(level);
-  for (float& x : map.values()) x = static_cast<float>(dist(rng));
-  return map;
-}
-
-// Visibility-like: 0 or 1 per pixel, occluded with probability 0.4.
-SphereMap randomBinaryMap(int level, std::mt19937& rng) {
-  std::bernoulli_distribution visible(0.6);
-  SphereMap map(level);
-  for (float& x : map.values()) x = visible(rng) ? 1.0f : 0.0f;
-  return map;
-}
 
 // The triple product directly on pixels, and Σ|·| to scale the tolerance by.
 struct PixelSum {
@@ -102,7 +91,7 @@ TEST(TripleProduct, FullLightMatchesPixelSumAtLevels0To6) {
     EXPECT_NEAR(got, expected.value, kRelativeTolerance * expected.magnitude);
     worst = std::max(worst, std::abs(got - expected.value) / expected.magnitude);
   }
-  RecordProperty("max_relative_error", (testing::Message() << worst).GetString());
+  RecordProperty("max_relative_error", (::testing::Message() << worst).GetString());
 }
 
 // Zero-mean maps: the scaling term no longer dominates, so the detail terms
@@ -137,7 +126,7 @@ TEST(TripleProduct, TruncatedLightAndVisibilityMatchPixelSum) {
     const HaarMap visibilityCoeffs = forwardHaar(visibility);
     for (const std::size_t kLight : {1u, 2u, 4u, 16u, 64u, 256u, 4096u}) {
       for (const std::size_t kVisibility : {1u, 3u, 8u, 32u, 128u}) {
-        SCOPED_TRACE(testing::Message() << "kLight=" << kLight << " kVisibility=" << kVisibility);
+        SCOPED_TRACE(::testing::Message() << "kLight=" << kLight << " kVisibility=" << kVisibility);
         const SparseHaar lightK = keepLargest(lightCoeffs, kLight);
         const SparseHaar visibilityK = keepLargest(visibilityCoeffs, kVisibility);
         const PixelSum expected =
@@ -150,7 +139,7 @@ TEST(TripleProduct, TruncatedLightAndVisibilityMatchPixelSum) {
       }
     }
   }
-  RecordProperty("max_relative_error", (testing::Message() << worst).GetString());
+  RecordProperty("max_relative_error", (::testing::Message() << worst).GetString());
 }
 
 // Empty sparse inputs are zero functions.

@@ -19,9 +19,12 @@
 #include "haarcast/core/fused.h"
 #include "haarcast/gpu/compute.h"
 #include "haarcast/gpu/passes.h"
+#include "../core/test_maps.h"
 
 namespace haarcast::gpu {
 namespace {
+
+using haarcast::testing::randomSparse;
 
 BrdfSliceTable randomTable(int level, int thetaSamples, bool upperOnly, std::mt19937& rng) {
   std::uniform_real_distribution<double> dist(0.05, 1.0);
@@ -40,17 +43,6 @@ BrdfSliceTable randomTable(int level, int thetaSamples, bool upperOnly, std::mt1
     }
   }
   return BrdfSliceTable::fromSlices(std::move(thetaOut), std::move(slices));
-}
-
-// k random coefficients, the scaling one always among them.
-SparseHaar randomSparse(int level, std::size_t k, double lo, double hi, std::mt19937& rng) {
-  const std::size_t n = static_cast<std::size_t>(mapSize(level)) * static_cast<std::size_t>(mapSize(level));
-  std::uniform_real_distribution<double> value(lo, hi);
-  HaarMap dense(level);
-  dense[0] = static_cast<float>(std::abs(value(rng)) + 0.5);
-  std::uniform_int_distribution<std::size_t> index(1, n - 1);
-  for (std::size_t e = 1; e < std::min(k, n); ++e) dense[index(rng)] = static_cast<float>(value(rng));
-  return SparseHaar::fromDense(dense);
 }
 
 struct PassCase {
