@@ -754,6 +754,8 @@ void VulkanRenderer::Impl::runStages(
 render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& request) {
   const auto start = Clock::now();
   render::Frame frame;
+  frame.width = request.width;
+  frame.height = request.height;
 
   // ---- light (host): resolveFrame, as the CPU backend; its pixel form uploaded
   auto t0 = Clock::now();
@@ -841,6 +843,8 @@ render::Frame VulkanRenderer::Impl::render(const render::FrameRequest& request) 
   };
   const std::size_t k = request.lightCoefficients ? request.lightCoefficients : options.lightCoefficients;
   render::Frame frame;
+  frame.width = request.width;
+  frame.height = request.height;
   std::size_t bytes = 0;
 
   // ---- light (host): the same code as the CPU backend ----------------------

@@ -160,12 +160,12 @@ std::string encodeExr(const io::RgbImage& linear) {
   return stream.take();
 }
 
-std::string encodeFrame(FrameEncoding encoding, const std::vector<std::uint8_t>& rgba8, const io::RgbImage& linear,
-                        int jpegQuality) {
+std::string encodeFrame(FrameEncoding encoding, const std::vector<std::uint8_t>& rgba8, int width, int height,
+                        const io::RgbImage& linear, int jpegQuality) {
   switch (encoding) {
-    case FrameEncoding::Jpeg: return encodeJpeg(rgba8, linear.width, linear.height, jpegQuality);
-    case FrameEncoding::Png: return encodePng(rgba8, linear.width, linear.height);
-    case FrameEncoding::RawRgba8: return encodeRaw(rgba8, linear.width, linear.height);
+    case FrameEncoding::Jpeg: return encodeJpeg(rgba8, width, height, jpegQuality);
+    case FrameEncoding::Png: return encodePng(rgba8, width, height);
+    case FrameEncoding::RawRgba8: return encodeRaw(rgba8, width, height);
     case FrameEncoding::Exr: return encodeExr(linear);
   }
   throw std::runtime_error("encodeFrame: unknown encoding");

@@ -162,6 +162,9 @@ struct RenderService::Impl {
     const double queuedSeconds = secondsSince(submitted);
     std::optional<render::FrameRequest> request = job.take();
     if (!request) return;  // the session has gone
+    // Only EXR encodes the linear image; every other encoding needs RGBA8
+    // alone, and a GPU backend then skips reading the linear image back.
+    request->linearImage = job.encoding == FrameEncoding::Exr;
     RenderedFrame out;
     out.queuedSeconds = queuedSeconds;
     try {
@@ -174,7 +177,8 @@ struct RenderService::Impl {
     encodeQueue.push([job = std::move(job), out = std::move(out)]() mutable {
       try {
         const auto t0 = Clock::now();
-        out.encoded = encodeFrame(job.encoding, out.frame.rgba8, out.frame.image, job.jpegQuality);
+        out.encoded = encodeFrame(job.encoding, out.frame.rgba8, out.frame.width, out.frame.height, out.frame.image,
+                                  job.jpegQuality);
         out.encodeSeconds = secondsSince(t0);
       } catch (const std::exception& e) {
         job.done(std::nullopt, std::string("encode failed: ") + e.what());

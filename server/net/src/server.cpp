@@ -505,8 +505,8 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
     auto* f = m.mutable_frame();
     f->set_sequence(++frameSequence_);
     f->set_pose_sequence(context.poseSequence);
-    f->set_width(static_cast<std::uint32_t>(rendered->frame.image.width));
-    f->set_height(static_cast<std::uint32_t>(rendered->frame.image.height));
+    f->set_width(static_cast<std::uint32_t>(rendered->frame.width));
+    f->set_height(static_cast<std::uint32_t>(rendered->frame.height));
     f->set_encoding(toWire(context.config.encoding));
     const std::size_t payload = rendered->encoded.size();
     f->set_data(std::move(rendered->encoded));

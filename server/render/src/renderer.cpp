@@ -273,6 +273,8 @@ Frame CpuRenderer::render(const FrameRequest& request) {
   for (std::size_t i = 0; i < resolved.objects.size(); ++i) rays_->setTransform(i, glm::mat4(resolved.objects[i].objectToWorld));
   const RayScene& rays = *rays_;
   const int w = request.width, h = request.height;
+  frame.width = w;
+  frame.height = h;
   const CameraRays camera(request.camera, w, h);
   const std::size_t pixels = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
   std::vector<std::optional<Hit>> hits(pixels);

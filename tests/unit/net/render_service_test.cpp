@@ -27,6 +27,8 @@ class FakeRenderer final : public render::Renderer {
     if (busy_.exchange(true)) overlapped.store(true);
     std::this_thread::sleep_for(2ms);
     render::Frame f;
+    f.width = request.width;
+    f.height = request.height;
     f.image = io::makeImage(request.width, request.height);
     f.rgba8.assign(static_cast<std::size_t>(request.width) * request.height * 4, 128);
     f.stages = {{"light", 0.001}};

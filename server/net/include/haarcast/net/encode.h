@@ -30,9 +30,11 @@ std::string encodePng(const std::vector<std::uint8_t>& rgba8, int width, int hei
 std::string encodeRaw(const std::vector<std::uint8_t>& rgba8, int width, int height);
 std::string encodeExr(const io::RgbImage& linear);
 
-// One entry point: the RGBA8 image for the 8-bit encodings, the linear one for EXR.
-std::string encodeFrame(FrameEncoding encoding, const std::vector<std::uint8_t>& rgba8, const io::RgbImage& linear,
-                        int jpegQuality);
+// One entry point: the RGBA8 image (width × height) for the 8-bit
+// encodings, the linear one for EXR (a frame rendered for an 8-bit encoding
+// may carry no linear image: FrameRequest::linearImage).
+std::string encodeFrame(FrameEncoding encoding, const std::vector<std::uint8_t>& rgba8, int width, int height,
+                        const io::RgbImage& linear, int jpegQuality);
 
 struct Rgba8Image {
   int width = 0;

@@ -1,15 +1,19 @@
 // The CPU reference backend: the seed's passes on the CPU, one definition of
 // every number that the Vulkan backend is tested against.
 //
-//   once per object   slice tables (unrotated, cached on disk), a rotator per
-//                     channel, per-vertex visibility in the object frame
-//   once per frame    the light rotated world→object, solid angle folded in,
-//                     Haar-coded and cut to its k largest coefficients
-//   per pixel         G-buffer by Embree primary rays → slice index (θₒ) and
-//                     Y-X-Y Euler angles of the local frame → rotation of the
-//                     slice by the chosen method → triple product with the
-//                     light and the barycentric blend of the three vertices'
-//                     visibility (linear, so three triple products)
+//   once per object   slice tables (unrotated, cached on disk), per-vertex
+//                     visibility in the object frame; for `fused` the slices
+//                     in pixel form, for the rotating methods their rotators
+//   once per frame    resolveFrame: the light rotated world→object, solid
+//                     angle folded in, Haar-coded, cut to its k largest
+//                     coefficients (for `fused` synthesised to pixel form)
+//   per pixel         G-buffer by Embree primary rays → θₒ and the Y-X-Y
+//                     Euler angles of the local frame → the three vertices'
+//                     visibility merged with their barycentric weights (the
+//                     product is linear in V) → `fused`: one pass over the map
+//                     directions (core/fused.h); the rotating methods: the
+//                     slice rotated (the three channels together for haar),
+//                     then one triple product per channel
 //
 // Visibility is each object's own (self-shadowing); objects do not shadow
 // each other, as in precomputed-transfer renderers whose objects move.

@@ -57,7 +57,9 @@ struct StageTime {
 };
 
 struct Frame {
-  io::RgbImage image;                 // linear radiance, for EXR and exact checks
+  int width = 0;                      // the request's size, whatever was read back
+  int height = 0;
+  io::RgbImage image;                 // linear radiance, for EXR and exact checks (empty if not requested)
   std::vector<std::uint8_t> rgba8;    // tonemapped, row 0 at the top, 4 bytes per pixel
   std::vector<std::uint8_t> objectMask;  // 1 where an object was hit
   std::vector<StageTime> stages;      // in pipeline order
