@@ -550,9 +550,14 @@ TEST(ServerBadInput, OversizedMessages) {
       EXPECT_EQ(c.closeReason.code, websocket::close_code::too_big);
     }
   }
-  EXPECT_NE(server.server().metrics().prometheusText().find("haarcast_errors_total{code=\"message_too_large\"} 2"),
-            std::string::npos)
-      << server.server().metrics().prometheusText();
+  // The client may see the reset before the server's read handler has
+  // counted the cut: wait for the count rather than race it.
+  const auto counted = [&] {
+    return server.server().metrics().prometheusText().find("haarcast_errors_total{code=\"message_too_large\"} 2") !=
+           std::string::npos;
+  };
+  for (int i = 0; i < 100 && !counted(); ++i) std::this_thread::sleep_for(50ms);
+  EXPECT_TRUE(counted()) << server.server().metrics().prometheusText();
   EXPECT_TRUE(healthy.waitForFrames(2));
 }
 
