@@ -113,6 +113,9 @@ struct VulkanRenderer::Impl {
   render::Frame render(const render::FrameRequest& request);
   const render::Pose& poseOf(const render::FrameRequest& request, std::size_t i) const;
   glm::dmat4 frameViewProjection(const render::FrameRequest& request) const;
+  // The frame's uniforms (camera, light turn, exposure, the fused dispatch's
+  // workgroup count) and the sRGB thresholds of its exposure.
+  void uploadFrameUniforms(const render::FrameRequest& request);
   void recordGBuffer(VkCommandBuffer cb, const render::FrameRequest& request, const glm::dmat4& viewProj);
   // The stages of a frame, in order: with timestamps, recorded into one
   // command buffer (a timestamp after each) and submitted once; otherwise
@@ -751,6 +754,16 @@ void VulkanRenderer::Impl::runStages(
 
 // `fused`: G-buffer → rotation input (compaction, indirect arguments) →
 // fused (vkCmdDispatchIndirect, no readback of the count) → tonemap.
+void VulkanRenderer::Impl::uploadFrameUniforms(const render::FrameRequest& request) {
+  FrameParams params = makeFrameParams(request.camera, request.width, request.height, request.lightRotation,
+                                       request.exposureStops, options.environmentBackground,
+                                       prepared.background[0].level());
+  params.fusedGroups = fusedGroups;
+  frameParams.write(&params, sizeof params);
+  const std::array<float, 256> encoding = srgbThresholds(request.exposureStops);
+  thresholds.write(encoding.data(), sizeof encoding);
+}
+
 render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& request) {
   const auto start = Clock::now();
   render::Frame frame;
@@ -769,13 +782,7 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
     for (int c = 0; c < 3; ++c) objectInfo[i].rotation[c] = glm::vec4(glm::vec3(o.rotation[c]), 0.0f);
   }
   objects.write(objectInfo.data(), objectInfo.size() * sizeof(ObjectInfo));
-  FrameParams params = makeFrameParams(request.camera, request.width, request.height, request.lightRotation,
-                                       request.exposureStops, options.environmentBackground,
-                                       prepared.background[0].level());
-  params.fusedGroups = fusedGroups;
-  frameParams.write(&params, sizeof params);
-  const std::array<float, 256> encoding = srgbThresholds(request.exposureStops);
-  thresholds.write(encoding.data(), sizeof encoding);
+  uploadFrameUniforms(request);
   frame.stages.push_back({"light", since(t0)});
 
   // ---- the device's part: one command buffer (timestamps) or one per stage
@@ -862,12 +869,7 @@ render::Frame VulkanRenderer::Impl::render(const render::FrameRequest& request) 
   light.write(lightPacked.data(), lightPacked.size() * sizeof(glm::uvec4));
   bytes += (lightPacked.size() - lights.size()) * sizeof(glm::uvec4);
   objects.write(objectInfo.data(), objectInfo.size() * sizeof(ObjectInfo));
-  const FrameParams params = makeFrameParams(request.camera, request.width, request.height, request.lightRotation,
-                                             request.exposureStops, options.environmentBackground,
-                                             prepared.background[0].level());
-  frameParams.write(&params, sizeof params);
-  const std::array<float, 256> encoding = srgbThresholds(request.exposureStops);
-  thresholds.write(encoding.data(), sizeof encoding);
+  uploadFrameUniforms(request);
   frame.stages.push_back({"light", since(t0)});
 
   const glm::dmat4 viewProj = frameViewProjection(request);

@@ -215,7 +215,11 @@ class CpuRenderer final : public Renderer {
   }
 
   std::string backend() const override { return "cpu"; }
-  std::string deviceName() const override { return "cpu reference (" + std::to_string(hardwareThreads(options_.threads)) + " threads)"; }
+  std::string deviceName() const override {
+    // The SIMD target the fused pass dispatched to on this machine, for reports.
+    return "cpu reference (" + std::to_string(hardwareThreads(options_.threads)) + " threads" +
+           (options_.method == RotationMethod::Fused ? ", " + fusedTargetName() : std::string()) + ")";
+  }
   const RenderOptions& options() const override { return options_; }
   std::size_t objectCount() const override { return prepared_.objects.size(); }
 
@@ -240,6 +244,24 @@ class CpuRenderer final : public Renderer {
                             const std::vector<PixelInput>& inputs, Frame& frame, int w, int h);
   std::size_t shadeFused(const ResolvedFrame& resolved, const std::vector<std::optional<Hit>>& hits,
                          const std::vector<PixelInput>& inputs, Frame& frame, int w, int h);
+  // Runs shade(i, x, y, object) on every covered pixel, rows in parallel,
+  // after marking it in objectMask; sums what each row's calls return (bytes).
+  template <class Shade>
+  std::size_t forEachCoveredPixel(const std::vector<std::optional<Hit>>& hits, Frame& frame, int w, int h,
+                                  const Shade& shade) const {
+    std::atomic<std::size_t> total{0};
+    parallelFor(static_cast<std::size_t>(h), [&](std::size_t y) {
+      std::size_t rowBytes = 0;
+      for (int x = 0; x < w; ++x) {
+        const std::size_t i = y * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
+        if (!hits[i]) continue;
+        frame.objectMask[i] = 1;
+        rowBytes += shade(i, x, static_cast<int>(y), hits[i]->object);
+      }
+      total += rowBytes;
+    }, {}, options_.threads);
+    return total.load();
+  }
 
   RenderOptions options_;
   PreparedScene prepared_;
@@ -348,9 +370,8 @@ std::size_t CpuRenderer::shadeRotating(const ResolvedFrame& resolved, const std:
   // to the thread time each took.
   const auto t0 = Clock::now();
   std::atomic<std::int64_t> rotationNs{0}, productNs{0};
-  std::atomic<std::size_t> shadingBytes{0};
-  parallelFor(static_cast<std::size_t>(h), [&](std::size_t y) {
-    // Per worker thread, kept across rows: no allocation per pixel once warm.
+  const std::size_t bytes = forEachCoveredPixel(hits, frame, w, h, [&](std::size_t i, int x, int y, std::size_t object) {
+    // Per worker thread, kept across pixels: no allocation per pixel once warm.
     struct Scratch {
       std::array<HaarMap, 3> rotated;
       HaarRotationScratch haar;
@@ -358,83 +379,63 @@ std::size_t CpuRenderer::shadeRotating(const ResolvedFrame& resolved, const std:
       PreparedVisibility visibility;
     };
     thread_local Scratch s;
-    std::int64_t rot = 0, prod = 0;
-    std::size_t rowBytes = 0;
-    for (int x = 0; x < w; ++x) {
-      const std::size_t i = y * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
-      if (!hits[i]) continue;
-      frame.objectMask[i] = 1;
-      const std::size_t object = hits[i]->object;
-      const PreparedObject& p = prepared_.objects[object];
-      const PixelInput& in = inputs[i];
-      const auto a = Clock::now();
-      const std::size_t slice = static_cast<std::size_t>(in.rotation.slice);
-      if (rgbHaar_[object]) {
-        rgbHaar_[object]->rotate(slice, in.rotation.euler, s.rotated, s.haar);
-      } else {
-        for (std::size_t c = 0; c < 3; ++c) rotators_[object][c]->rotate(slice, in.rotation.euler, s.rotated[c]);
-      }
-      const auto b = Clock::now();
-      // The product is linear in V: the three vertices' lists merged with
-      // their barycentric weights, then one product per channel.
-      const std::array<const SparseHaar*, 3> vertices{&p.visibility[in.vertex[0]], &p.visibility[in.vertex[1]],
-                                                      &p.visibility[in.vertex[2]]};
-      mergeVisibility(vertices, {in.b[0], in.b[1], in.b[2]}, s.merged);
-      s.visibility.assign(s.merged);
-      for (std::size_t c = 0; c < 3; ++c) {
-        frame.image.at(static_cast<int>(y), x, static_cast<int>(c)) =
-            static_cast<float>(tripleProduct(light[object][c], s.rotated[c], s.visibility));
-      }
-      rot += std::chrono::duration_cast<std::chrono::nanoseconds>(b - a).count();
-      prod += std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - b).count();
-      for (const SparseHaar* v : vertices) rowBytes += v->size() * (sizeof(std::uint32_t) + sizeof(float));
-      rowBytes += 3 * rotationBytes(object);
+    const PreparedObject& p = prepared_.objects[object];
+    const PixelInput& in = inputs[i];
+    const auto a = Clock::now();
+    const std::size_t slice = static_cast<std::size_t>(in.rotation.slice);
+    if (rgbHaar_[object]) {
+      rgbHaar_[object]->rotate(slice, in.rotation.euler, s.rotated, s.haar);
+    } else {
+      for (std::size_t c = 0; c < 3; ++c) rotators_[object][c]->rotate(slice, in.rotation.euler, s.rotated[c]);
     }
-    rotationNs += rot;
-    productNs += prod;
-    shadingBytes += rowBytes;
-  }, {}, options_.threads);
+    const auto b = Clock::now();
+    // The product is linear in V: the three vertices' lists merged with
+    // their barycentric weights, then one product per channel.
+    const std::array<const SparseHaar*, 3> vertices{&p.visibility[in.vertex[0]], &p.visibility[in.vertex[1]],
+                                                    &p.visibility[in.vertex[2]]};
+    mergeVisibility(vertices, {in.b[0], in.b[1], in.b[2]}, s.merged);
+    s.visibility.assign(s.merged);
+    for (std::size_t c = 0; c < 3; ++c) {
+      frame.image.at(y, x, static_cast<int>(c)) = static_cast<float>(tripleProduct(light[object][c], s.rotated[c], s.visibility));
+    }
+    rotationNs += std::chrono::duration_cast<std::chrono::nanoseconds>(b - a).count();
+    productNs += std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - b).count();
+    std::size_t read = 3 * rotationBytes(object);
+    for (const SparseHaar* v : vertices) read += v->size() * (sizeof(std::uint32_t) + sizeof(float));
+    return read;
+  });
   const double shading = since(t0);
   const double busy = static_cast<double>(rotationNs.load() + productNs.load());
   const double rotationShare = busy > 0.0 ? static_cast<double>(rotationNs.load()) / busy : 0.5;
   frame.stages.push_back({"rotation", shading * rotationShare});
   frame.stages.push_back({"triple-product", shading * (1.0 - rotationShare)});
-  return shadingBytes.load();
+  return bytes;
 }
 
 std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const std::vector<std::optional<Hit>>& hits,
                                     const std::vector<PixelInput>& inputs, Frame& frame, int w, int h) {
   const auto t0 = Clock::now();
-  std::atomic<std::size_t> shadingBytes{0};
-  parallelFor(static_cast<std::size_t>(h), [&](std::size_t y) {
-    // Per worker thread, kept across rows: no allocation per pixel.
+  const std::size_t bytes = forEachCoveredPixel(hits, frame, w, h, [&](std::size_t i, int x, int y, std::size_t object) {
+    // Per worker thread, kept across pixels: no allocation per pixel.
     thread_local FusedScratch scratch;
-    std::size_t rowBytes = 0;
-    for (int x = 0; x < w; ++x) {
-      const std::size_t i = y * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
-      if (!hits[i]) continue;
-      frame.objectMask[i] = 1;
-      const std::size_t object = hits[i]->object;
-      const PreparedObject& p = prepared_.objects[object];
-      const PixelInput& in = inputs[i];
-      std::array<WeightedVisibility, 3> vis;
-      std::size_t entries = 0;
-      for (std::size_t v = 0; v < 3; ++v) {
-        vis[v] = {&p.visibility[in.vertex[v]], static_cast<float>(in.b[v])};
-        entries += vis[v].list->size();
-      }
-      const PixelSlices& slices = pixelSlices_[object];
-      const shared::SliceBlend blend = shared::sliceBlendAt(static_cast<float>(in.rotation.thetaOut),
-                                                            static_cast<shared::uint>(slices.thetaSamples()),
-                                                            options_.interpolateSlices ? 1u : 0u);
-      const std::array<float, 3> rgb = fusedShade(slices, blend, in.rotation.euler, resolved.objects[object].fusedLight, vis, scratch);
-      for (int c = 0; c < 3; ++c) frame.image.at(static_cast<int>(y), x, c) = rgb[static_cast<std::size_t>(c)];
-      rowBytes += fusedPixelBytes(slices.level(), blend.weight != 0.0f, entries);
+    const PreparedObject& p = prepared_.objects[object];
+    const PixelInput& in = inputs[i];
+    std::array<WeightedVisibility, 3> vis;
+    std::size_t entries = 0;
+    for (std::size_t v = 0; v < 3; ++v) {
+      vis[v] = {&p.visibility[in.vertex[v]], static_cast<float>(in.b[v])};
+      entries += vis[v].list->size();
     }
-    shadingBytes += rowBytes;
-  }, {}, options_.threads);
+    const PixelSlices& slices = pixelSlices_[object];
+    const shared::SliceBlend blend = shared::sliceBlendAt(static_cast<float>(in.rotation.thetaOut),
+                                                          static_cast<shared::uint>(slices.thetaSamples()),
+                                                          options_.interpolateSlices ? 1u : 0u);
+    const std::array<float, 3> rgb = fusedShade(slices, blend, in.rotation.euler, resolved.objects[object].fusedLight, vis, scratch);
+    for (int c = 0; c < 3; ++c) frame.image.at(y, x, c) = rgb[static_cast<std::size_t>(c)];
+    return fusedPixelBytes(slices.level(), blend.weight != 0.0f, entries);
+  });
   frame.stages.push_back({"fused", since(t0)});
-  return shadingBytes.load();
+  return bytes;
 }
 
 }  // namespace

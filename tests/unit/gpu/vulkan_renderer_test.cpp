@@ -86,6 +86,20 @@ Comparison compare(const render::Frame& reference, const render::Frame& test) {
   return c;
 }
 
+// The stages in pipeline order under the shared names, some coefficient
+// bytes read, and RGBA8 equal to the CPU encoding of the frame's own linear
+// image (within two bytes of rounding).
+void expectStagesAndRgba8(const render::Frame& b, const std::vector<std::string>& names, double exposureStops) {
+  ASSERT_EQ(b.stages.size(), names.size());
+  for (std::size_t i = 0; i < names.size(); ++i) EXPECT_EQ(b.stages[i].name, names[i]);
+  EXPECT_GT(b.coefficientBytes, 0u);
+  const auto expected = render::tonemapRgba8(b.image, exposureStops);
+  ASSERT_EQ(expected.size(), b.rgba8.size());
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < expected.size(); ++i) differ += expected[i] != b.rgba8[i];
+  EXPECT_LE(differ, 2u);
+}
+
 // Renders one frame on each backend and checks what the comparison promises.
 void expectBackendsAgree(RotationMethod method, bool background) {
   const render::Scene scene = render::defaultScene();
@@ -102,17 +116,8 @@ void expectBackendsAgree(RotationMethod method, bool background) {
   EXPECT_GE(c.psnr, 60.0);
   EXPECT_LE(static_cast<double>(c.mismatched), 0.005 * static_cast<double>(c.objectPixels) + 1.0);
   EXPECT_GT(c.objectPixels, 500u);
-  // The stages, in pipeline order, under the shared names.
-  ASSERT_EQ(b.stages.size(), 6u);
-  const char* names[] = {"light", "gbuffer", "rotation-input", "rotation", "triple-product", "tonemap"};
-  for (std::size_t i = 0; i < 6; ++i) EXPECT_EQ(b.stages[i].name, names[i]);
-  EXPECT_GT(b.coefficientBytes, 0u);
-  // RGBA8 is the CPU encoding of the frame's own linear image.
-  const auto expected = render::tonemapRgba8(b.image, request.exposureStops);
-  ASSERT_EQ(expected.size(), b.rgba8.size());
-  std::size_t differ = 0;
-  for (std::size_t i = 0; i < expected.size(); ++i) differ += expected[i] != b.rgba8[i];
-  EXPECT_LE(differ, 2u);
+  expectStagesAndRgba8(b, {"light", "gbuffer", "rotation-input", "rotation", "triple-product", "tonemap"},
+                       request.exposureStops);
   testing::expectNoValidationMessages(gpu.context());
 }
 
@@ -161,17 +166,9 @@ TEST_P(FusedFrame, VulkanMatchesTheCpuBackend) {
   EXPECT_GE(c.psnr, kFusedPsnrFloor);
   EXPECT_EQ(c.mismatched, 0u);
   EXPECT_GT(c.objectPixels, 500u);
-  ASSERT_EQ(b.stages.size(), 5u);
-  const char* names[] = {"light", "gbuffer", "rotation-input", "fused", "tonemap"};
-  for (std::size_t i = 0; i < 5; ++i) EXPECT_EQ(b.stages[i].name, names[i]);
   // The GPU counts what it reads: with the vertices' pixel forms (levels
   // 4–6 here), three planes of N floats per pixel instead of the lists.
-  EXPECT_GT(b.coefficientBytes, 0u);
-  const auto expected = render::tonemapRgba8(b.image, request.exposureStops);
-  ASSERT_EQ(expected.size(), b.rgba8.size());
-  std::size_t differ = 0;
-  for (std::size_t i = 0; i < expected.size(); ++i) differ += expected[i] != b.rgba8[i];
-  EXPECT_LE(differ, 2u);
+  expectStagesAndRgba8(b, {"light", "gbuffer", "rotation-input", "fused", "tonemap"}, request.exposureStops);
   testing::expectNoValidationMessages(gpu.context());
 }
 
