@@ -2,16 +2,17 @@
 // The "tonemap" pass: uncovered pixels get the backdrop (bilinear in the
 // level-kBackgroundLevel maps at lightRotationᵀ·direction, as
 // render::backgroundRadiance) or black; every pixel is then encoded as
-// render::tonemapRgba8 / io::writePng do: × 2^exposure, clamp to [0, 1], sRGB
-// transfer (IEC 61966-2-1), rounded, alpha 255. The linear image stays in
-// `radiance` for EXR output. Local size 64, one invocation per pixel.
+// render::tonemapRgba8 does (render/tonemap.h): × 2^exposure, Reinhard's
+// extended curve (white kToneWhite), sRGB transfer (IEC 61966-2-1), rounded,
+// alpha 255. The linear image stays in `radiance` for EXR output. Local size
+// 64, one invocation per pixel.
 //
 // The encoding is not evaluated with pow (loose on Vulkan: lavapipe's
-// differs from the CPU's in 0.6% of bytes) but by counting thresholds:
-// code ≥ k exactly when linear·2^exposure ≥ sRGB⁻¹((k − ½)/255), and the
-// host computes those 255 thresholds, divided by the gain, in double
-// (gpu/passes.h srgbThresholds). Eight comparisons give the same byte as
-// the CPU for every float that is not within an ulp of a threshold.
+// differs from the CPU's in 0.6% of bytes) but by counting thresholds: code
+// ≥ k exactly when the linear value ≥ threshold[k], the transform's inverse
+// at the rounding boundary (k − ½)/255, which the host computes in double
+// (render::tonemapThresholds) and the CPU counts the same way. So both give
+// the same byte for every float.
 #extension GL_GOOGLE_include_directive : require
 #include "common/frame.glsl"
 #include "common/sphere.glsl"

@@ -1,7 +1,11 @@
 #include "client_options.h"
 
 #include <charconv>
+#include <cmath>
 #include <stdexcept>
+#include <string>
+
+#include "haarcast/core/shared_layout.h"
 
 namespace haarcast::client {
 
@@ -121,6 +125,20 @@ std::string encodingFileExtension(v1::Encoding encoding) {
     default: return ".bin";
   }
 }
+
+Exposure parseExposure(const std::string& text) {
+  if (text == "auto") return {};
+  try {
+    std::size_t used = 0;
+    const double stops = std::stod(text, &used);
+    if (used == text.size() && std::isfinite(stops)) return {v1::EXPOSURE_MODE_FIXED, stops};
+  } catch (const std::logic_error&) {
+  }
+  throw std::invalid_argument("--exposure must be auto or a number of stops, e.g. -1.5 (got \"" + text + "\")");
+}
+
+std::uint32_t minLevel() { return shared::kMinLevel; }
+std::uint32_t maxLevel() { return shared::kFusedMaxLevel; }
 
 v1::RotationMethod parseMethod(const std::string& name) {
   if (name.empty()) return v1::ROTATION_METHOD_UNSPECIFIED;

@@ -39,7 +39,19 @@ v1::Encoding parseEncoding(const std::string& name);
 std::string encodingName(v1::Encoding encoding);
 std::string encodingFileExtension(v1::Encoding encoding);
 
-// "haar" | "spatial" | "matrix" | "table"; "" = server default.
+// "auto" → automatic exposure; a number → that many stops, fixed.
+struct Exposure {
+  v1::ExposureMode mode = v1::EXPOSURE_MODE_AUTO;
+  double stops = 0.0;
+};
+Exposure parseExposure(const std::string& text);
+
+// Map levels every renderer accepts (the servers say which of them they
+// serve in Welcome.limits): shared_layout.h's, the one definition.
+std::uint32_t minLevel();
+std::uint32_t maxLevel();
+
+// "fused" | "haar" | "spatial" | "matrix" | "table"; "" = server default.
 v1::RotationMethod parseMethod(const std::string& name);
 std::string methodName(v1::RotationMethod method);
 

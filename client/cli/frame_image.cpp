@@ -144,14 +144,16 @@ PixelStats pixelStats(const Rgba8Image& image) {
   if (n == 0) return {};
   // Welford's update: one pass, no catastrophic cancellation.
   double mean = 0.0, m2 = 0.0;
+  std::size_t clipped = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const std::uint8_t* p = &image.pixels[i * 4];
+    clipped += (p[0] == 255 || p[1] == 255 || p[2] == 255) ? 1 : 0;
     const double luma = 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
     const double delta = luma - mean;
     mean += delta / static_cast<double>(i + 1);
     m2 += delta * (luma - mean);
   }
-  return {mean, std::sqrt(m2 / static_cast<double>(n))};
+  return {mean, std::sqrt(m2 / static_cast<double>(n)), static_cast<double>(clipped) / static_cast<double>(n)};
 }
 
 std::vector<std::uint8_t> encodePam(const Rgba8Image& image) {

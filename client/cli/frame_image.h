@@ -29,6 +29,7 @@ Rgba8Image decodeFrame(v1::Encoding encoding, std::span<const std::uint8_t> data
 struct PixelStats {
   double meanLuma = 0.0;    // Rec. 709 luma of the 8-bit sRGB values, 0..255
   double stddevLuma = 0.0;  // over all pixels
+  double clippedFraction = 0.0;  // of the pixels with a channel at 255 (blown out)
 };
 PixelStats pixelStats(const Rgba8Image& image);
 

@@ -140,6 +140,8 @@ int run(int argc, char** argv) {
   double timeout = 30.0;
   bool json = false;
   bool checkNotBlank = false;
+  std::string exposure = "auto";
+  double maxClipped = -1.0;
   bool quiet = false;
   bool perFrame = false;
 
@@ -154,7 +156,15 @@ int run(int argc, char** argv) {
       ->check(CLI::Range(0.0, 1000.0));
   app.add_option("--quality", quality, "JPEG quality 1..100 (0 = the server's default)")->check(CLI::Range(0u, 100u));
   app.add_option("--method", method, "Per-pixel method: fused | haar | spatial | matrix | table (default: the server's)");
-  app.add_option("--level", level, "Map level n, 2^n x 2^n (0 = the server's default)")->check(CLI::Range(0u, 12u));
+  app.add_option("--level", level,
+                 "Map level n, 2^n x 2^n: " + std::to_string(minLevel()) + ".." + std::to_string(maxLevel()) +
+                     " as far as the server allows (its Welcome says; 0 = the server's default)")
+      ->check(CLI::Range(0u, maxLevel()));
+  app.add_option("--exposure", exposure, "auto (the lit object pixels' log-average → 0.18, eased) or fixed stops, e.g. -1")
+      ->capture_default_str();
+  app.add_option("--max-clipped", maxClipped,
+                 "Fail a frame with more than this fraction of pixels at 255 (blown out), e.g. 0.02; decodes every frame")
+      ->check(CLI::Range(0.0, 1.0));
   app.add_option("--coefficients,-k", coefficients, "Light coefficients kept (0 = the server's default)");
   app.add_option("--scene", scene, "Scene name offered by the server (default: the server's)");
   app.add_option("--material", materials, "Material SPEC for object 0, or OBJECT=SPEC; repeatable");
@@ -187,7 +197,9 @@ int run(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // --help and --version exit 0; every flag error exits 2, as the checks
+    // below do.
+    return app.exit(e) == 0 ? 0 : 2;
   }
 
   SessionConfig base;
@@ -205,6 +217,9 @@ int run(int argc, char** argv) {
     settings->set_method(parseMethod(method));
     settings->set_level(level);
     settings->set_light_coefficients(coefficients);
+    const Exposure e = parseExposure(exposure);
+    settings->set_exposure_mode(e.mode);
+    settings->set_exposure_stops(e.stops);
     if (!scene.empty() || !materials.empty()) {
       auto* choice = base.hello.mutable_scene();
       choice->set_scene(scene);
@@ -230,6 +245,7 @@ int run(int argc, char** argv) {
   base.warmup = warmup;
   base.durationSeconds = duration;
   base.checkNotBlank = checkNotBlank;
+  base.maxClipped = maxClipped;
   base.timeoutSeconds = timeout;
 
   boost::asio::io_context io;
@@ -282,7 +298,17 @@ int run(int argc, char** argv) {
   }
   const nlohmann::json j = summaryJson(summary);
   if (json) std::cout << j.dump(2) << std::endl;
-  if (!quiet || !json) {
+  // No frames and a failure: say why instead of a line of zeros.
+  bool explained = false;
+  if (j["frames"].get<std::uint64_t>() == 0) {
+    for (std::size_t i = 0; i < summary.sessions.size(); ++i) {
+      if (summary.sessions[i].failure.empty()) continue;
+      const std::string who = clients > 1 ? " from client " + std::to_string(i) : "";
+      std::fprintf(stderr, "haarcast-client: no frames%s: %s\n", who.c_str(), summary.sessions[i].failure.c_str());
+      explained = true;
+    }
+  }
+  if (!explained && (!quiet || !json)) {
     std::fprintf(stderr, "haarcast-client: %llu frames, %.1f fps, latency p50 %.1f ms p99 %.1f ms, %.0f bytes/frame, %llu dropped, %llu errors\n",
                  static_cast<unsigned long long>(j["frames"].get<std::uint64_t>()), j["fps"].get<double>(),
                  j["latency_ms_p50"].get<double>(), j["latency_ms_p99"].get<double>(), j["bytes_per_frame"].get<double>(),
@@ -292,7 +318,8 @@ int run(int argc, char** argv) {
 
   // Exit 1 when anything went wrong: a failed session, a server Error, a
   // blank frame, or a frame that never came.
-  bool ok = j["errors"].get<std::uint64_t>() == 0 && j["blank_frames"].get<std::uint64_t>() == 0;
+  bool ok = j["errors"].get<std::uint64_t>() == 0 && j["blank_frames"].get<std::uint64_t>() == 0 &&
+            j["clipped_frames"].get<std::uint64_t>() == 0;
   for (const auto& s : summary.sessions) ok = ok && s.failure.empty();
   const std::uint64_t answered = j["frames"].get<std::uint64_t>() + j["dropped"].get<std::uint64_t>();
   if (ok && duration <= 0.0 && answered != frames * clients) ok = false;

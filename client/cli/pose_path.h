@@ -23,10 +23,10 @@ struct OrbitSweep {
   std::uint32_t spinObject = 0;
   double lightDegrees = 0.0;    // the environment about world +Y
   // At azimuth 0 these reproduce the built-in default scene's camera, eye
-  // (0, 0.6, 3.4) looking at the origin.
-  double distance = 3.4525;
-  double elevationDegrees = 10.008;
-  double fovYDegrees = 35.0;
+  // (0, 0.85, 4.8) looking at the origin, 45° field of view.
+  double distance = 4.8747;
+  double elevationDegrees = 10.042;
+  double fovYDegrees = 45.0;
 };
 
 class PosePath {

@@ -42,6 +42,8 @@ nlohmann::json latencyFields(const std::vector<double>& latency) {
 
 nlohmann::json summaryJson(const RunSummary& run) {
   std::uint64_t frames = 0, dropped = 0, errors = 0, payload = 0, wire = 0, blank = 0, extra = 0, failed = 0;
+  std::uint64_t clippedFrames = 0;
+  double clippedMax = -1.0;
   std::vector<double> latency, server;
   std::map<std::string, std::vector<double>> stages;
   nlohmann::json perClient = nlohmann::json::array();
@@ -53,6 +55,8 @@ nlohmann::json summaryJson(const RunSummary& run) {
     payload += s.payloadBytes;
     wire += s.wireBytes;
     blank += s.blankFrames;
+    clippedFrames += s.clippedFrames;
+    clippedMax = std::max(clippedMax, s.clippedFractionMax);
     extra += s.extraFrames;
     failed += s.failure.empty() ? 0 : 1;
     latency.insert(latency.end(), s.latencyMs.begin(), s.latencyMs.end());
@@ -66,6 +70,7 @@ nlohmann::json summaryJson(const RunSummary& run) {
         {"dropped", s.dropped},
         {"errors", s.errors},
         {"server_fps", s.serverFps},
+        {"exposure_stops", s.lastExposureStops},
         {"failure", s.failure},
     };
     c.update(latencyFields(s.latencyMs));
@@ -83,6 +88,8 @@ nlohmann::json summaryJson(const RunSummary& run) {
       {"extra_frames", extra},
       {"errors", errors},
       {"blank_frames", blank},
+      {"clipped_frames", clippedFrames},
+      {"clipped_fraction_max", clippedMax < 0.0 ? nlohmann::json(nullptr) : nlohmann::json(clippedMax)},
       {"failed_clients", failed},
       {"encoding", run.encoding},
       {"width", run.width},

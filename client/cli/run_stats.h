@@ -25,6 +25,9 @@ struct SessionStats {
   std::uint64_t payloadBytes = 0;   // Frame.data bytes of the counted frames
   std::uint64_t wireBytes = 0;      // whole WebSocket messages of those frames
   std::uint64_t blankFrames = 0;    // only counted with --check-not-blank
+  std::uint64_t clippedFrames = 0;  // over --max-clipped
+  double clippedFractionMax = -1.0; // the most blown-out frame's share of pixels at 255; < 0: not measured
+  double lastExposureStops = 0.0;   // Frame.exposure_stops of the last frame
   double firstPoseSeconds = 0.0;    // steady-clock times, from the run's start
   double lastFrameSeconds = 0.0;
   std::vector<double> latencyMs;    // pose sent → its frame received, per frame

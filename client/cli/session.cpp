@@ -308,10 +308,24 @@ struct Session::Impl : std::enable_shared_from_this<Session::Impl> {
     const std::span<const std::uint8_t> data(reinterpret_cast<const std::uint8_t*>(frame.data().data()),
                                              frame.data().size());
     const bool raw = encoding == v1::ENCODING_RAW_RGBA8;
-    if (!config.checkNotBlank && (config.outDir.empty())) return true;
+    stats.lastExposureStops = frame.exposure_stops();
+    const bool inspect = config.checkNotBlank || config.maxClipped >= 0.0;
+    if (!inspect && config.outDir.empty()) return true;
     try {
       Rgba8Image image;
-      if (config.checkNotBlank || raw) image = decodeFrame(encoding, data, frame.width(), frame.height());
+      if (inspect || raw) image = decodeFrame(encoding, data, frame.width(), frame.height());
+      if (inspect) {
+        const PixelStats px = pixelStats(image);
+        stats.clippedFractionMax = std::max(stats.clippedFractionMax, px.clippedFraction);
+        if (config.maxClipped >= 0.0 && px.clippedFraction > config.maxClipped) {
+          ++stats.clippedFrames;
+          onMessage(who() + "frame " + std::to_string(frame.sequence()) + " (pose " +
+                    std::to_string(frame.pose_sequence()) + ") is blown out: " +
+                    std::to_string(100.0 * px.clippedFraction) + "% of its pixels at 255 (--max-clipped " +
+                    std::to_string(100.0 * config.maxClipped) + "%), exposure " +
+                    std::to_string(frame.exposure_stops()) + " stops");
+        }
+      }
       if (config.checkNotBlank) {
         const PixelStats px = pixelStats(image);
         if (isBlank(px)) {

@@ -30,6 +30,9 @@ struct SessionConfig {
   double durationSeconds = 0; // > 0: stop sending poses after this long (the path cycles)
   std::string outDir;         // empty: do not record
   bool checkNotBlank = false;
+  // Fail a frame with more than this share of its pixels at 255 in a
+  // channel (blown out); < 0: not checked.
+  double maxClipped = -1.0;
   double timeoutSeconds = 30.0;  // for the upgrade, Welcome, and each frame
   std::chrono::steady_clock::time_point runStart;
 };

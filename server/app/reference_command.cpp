@@ -31,6 +31,7 @@ int run(ReferenceArgs& a) {
   a.options.environmentBackground = environmentBackground(a.scene);
   a.options.sampling = *sampling;
   render::checkReferenceOptions(a.options);
+  checkOutputPath(a.scene);
   const render::Scene scene = sceneFromFlags(a.scene);
 
   // Progress at most once a second (a pair of passes can take milliseconds).
@@ -43,7 +44,7 @@ int run(ReferenceArgs& a) {
     std::fflush(stderr);
   });
 
-  writeOutputImages(a.scene, r.image);
+  writeOutputImages(a.scene, r.image, r.objectMask);
   std::fprintf(stderr, "%d×%d, %s: %d samples/pixel, half-image difference %.4f (tolerance %.4f), %.2f s\n",
                a.options.width, a.options.height, a.sampling.c_str(), r.samples, r.halfError, a.options.tolerance,
                r.seconds);

@@ -71,6 +71,7 @@ int run(RenderArgs& a) {
   a.options.environmentBackground = environmentBackground(a.scene);
   a.options.cacheDir = a.cacheDir.empty() ? defaultCacheDir() : (a.cacheDir == "none" ? "" : a.cacheDir);
   render::checkRenderOptions(a.options);
+  checkOutputPath(a.scene);
 
   const render::Scene scene = sceneFromFlags(a.scene);
   for (const auto& object : scene.objects) {
@@ -89,7 +90,7 @@ int run(RenderArgs& a) {
   request.height = a.options.height;
   request.camera = scene.camera;  // poses: empty = the scene's own
   const render::Frame frame = renderer->render(request);
-  writeOutputImages(a.scene, frame.image);
+  writeOutputImages(a.scene, frame.image, frame.objectMask);
   std::string stages;
   for (const render::StageTime& s : frame.stages) {
     char buf[64];

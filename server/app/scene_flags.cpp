@@ -5,8 +5,11 @@
 #include <memory>
 #include <stdexcept>
 
+#include <unistd.h>
+
 #include "haarcast/io/mesh_io.h"
-#include "plots.h"
+#include "haarcast/render/renderer.h"
+#include "haarcast/render/tonemap.h"
 
 namespace haarcast::app {
 
@@ -25,7 +28,7 @@ void addSceneFlags(CLI::App& c, SceneFlags& f) {
   c.add_option("--background", f.background, "env|black (black: only the object's pixels are non-zero)")
       ->capture_default_str();
   c.add_option("--out", f.out, "Output .exr (a .png is written beside it) or .png")->capture_default_str();
-  c.add_option("--exposure", f.exposure, "PNG exposure in stops (default: log-average luminance → 0.18)");
+  c.add_option("--exposure", f.exposure, "PNG exposure in stops (default: auto, the lit object pixels' log-average luminance → 0.18)");
 }
 
 render::Scene sceneFromFlags(const SceneFlags& f) {
@@ -59,20 +62,38 @@ bool environmentBackground(const SceneFlags& f) {
   return f.background == "env";
 }
 
-void writeOutputImages(const SceneFlags& f, const io::RgbImage& image) {
-  const double exposure = f.exposure ? *f.exposure : reinhardKeyExposure(image);
+void checkOutputPath(const SceneFlags& f) {
   const fs::path out(f.out);
   const std::string ext = out.extension().string();
-  if (ext == ".exr") {
+  if (ext != ".exr" && ext != ".png") {
+    throw std::invalid_argument("--out must end in .exr or .png (got \"" + f.out + "\")");
+  }
+  // Before the work starts, not after a render of minutes.
+  const fs::path dir = out.has_parent_path() ? out.parent_path() : fs::path(".");
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) {
+    throw std::invalid_argument("--out " + f.out + ": the folder " + dir.string() + " does not exist");
+  }
+  if (::access(dir.c_str(), W_OK) != 0) {
+    throw std::invalid_argument("--out " + f.out + ": the folder " + dir.string() + " is not writable");
+  }
+}
+
+void writeOutputImages(const SceneFlags& f, const io::RgbImage& image, const std::vector<std::uint8_t>& objectMask) {
+  checkOutputPath(f);
+  // The service's display transform (render/tonemap.h); auto exposure over
+  // the lit object pixels unless --exposure fixes it.
+  const double exposure = f.exposure ? *f.exposure : render::keyExposure(render::frameLogAverage(image, objectMask));
+  const std::vector<std::uint8_t> rgba8 = render::tonemapRgba8(image, exposure);
+  const fs::path out(f.out);
+  if (out.extension() == ".exr") {
     io::writeExr(out.string(), image);
     fs::path png = out;
-    io::writePng(png.replace_extension(".png").string(), image, exposure);
-    std::fprintf(stderr, "wrote %s and %s\n", out.c_str(), png.c_str());
-  } else if (ext == ".png") {
-    io::writePng(out.string(), image, exposure);
-    std::fprintf(stderr, "wrote %s\n", out.c_str());
+    io::writePngRgba8(png.replace_extension(".png").string(), rgba8, image.width, image.height);
+    std::fprintf(stderr, "wrote %s and %s (exposure %+.2f stops)\n", out.c_str(), png.c_str(), exposure);
   } else {
-    throw std::invalid_argument("--out must end in .exr or .png (got \"" + f.out + "\")");
+    io::writePngRgba8(out.string(), rgba8, image.width, image.height);
+    std::fprintf(stderr, "wrote %s (exposure %+.2f stops)\n", out.c_str(), exposure);
   }
 }
 

@@ -2,6 +2,7 @@
 // it. One definition, so the two commands always draw the same scene.
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -33,8 +34,13 @@ render::Scene sceneFromFlags(const SceneFlags& flags);
 // --background env|black, validated.
 bool environmentBackground(const SceneFlags& flags);
 
+// --out ends in .exr or .png and its folder exists and is writable: checked
+// before any work starts. Throws std::invalid_argument naming the problem.
+void checkOutputPath(const SceneFlags& flags);
+
 // --out .exr (and a tonemapped .png beside it) or .png; --exposure, or
-// Reinhard's key. Prints what it wrote.
-void writeOutputImages(const SceneFlags& flags, const io::RgbImage& image);
+// auto exposure over the lit object pixels (render/tonemap.h). Prints what
+// it wrote.
+void writeOutputImages(const SceneFlags& flags, const io::RgbImage& image, const std::vector<std::uint8_t>& objectMask);
 
 }  // namespace haarcast::app

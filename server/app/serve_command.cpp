@@ -99,16 +99,21 @@ int run(ServeArgs& a) {
     }
   }
   for (const auto& s : scenes) {
-    net::Catalog::SceneEntry entry{s.name, {}, s.scene.camera, {}};
+    net::Catalog::SceneEntry entry;
+    entry.name = s.name;
+    entry.camera = s.scene.camera;
     for (const auto& o : s.scene.objects) {
       entry.defaultMaterials.push_back(o.material.name);
+      entry.objectNames.push_back(o.name);
       entry.poses.push_back(o.pose);
     }
     catalog.scenes.push_back(std::move(entry));
   }
   catalog.backends = gpu::availableBackends();
   if (!catalog.offersBackend(a.backend)) {
-    throw std::invalid_argument("--backend " + a.backend + " is not built into this server");
+    std::string offered;
+    for (const auto& b : catalog.backends) offered += (offered.empty() ? "" : ", ") + b;
+    throw std::invalid_argument("--backend " + a.backend + " is not one this server offers (valid: " + offered + ")");
   }
 
   const auto method = parseRotationMethod(a.method);

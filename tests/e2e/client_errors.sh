@@ -35,6 +35,8 @@ expect() {
 expect "bad --size" 2 "--size" -- "$client_bin" ws://127.0.0.1:1 --size 0x10
 expect "bad --encoding" 2 "--encoding must be" -- "$client_bin" ws://127.0.0.1:1 --encoding webp
 expect "wss:// refused" 2 "wss://" -- "$client_bin" wss://127.0.0.1:1
+expect "bad --level" 2 "--level: Value 12 not in range 0 to 7" -- "$client_bin" ws://127.0.0.1:1 --level 12
+expect "bad --exposure" 2 "--exposure must be auto or a number of stops" -- "$client_bin" ws://127.0.0.1:1 --exposure bright
 expect "connection refused" 1 "Connection refused" -- "$client_bin" ws://127.0.0.1:1 --frames 1 --quiet
 
 "$server_bin" serve --port 0 --token sekret --backend "${HAARCAST_SMOKE_BACKEND:-cpu}" \
@@ -56,7 +58,10 @@ url="ws://127.0.0.1:$port"
 common=(--frames 2 --size 64x64 --quiet --timeout 60)
 expect "no token" 1 "HTTP 401" -- "$client_bin" "$url" "${common[@]}"
 expect "wrong token" 1 "wrong --token" -- "$client_bin" "$url" "${common[@]}" --token nope
-expect "server Error (bad level)" 1 "ERROR_CODE_BAD_SETTINGS" -- "$client_bin" "$url" "${common[@]}" --token sekret --level 12
+expect "server Error (level over the server's --max-level)" 1 "is outside 2..6" -- \
+  "$client_bin" "$url" "${common[@]}" --token sekret --level 7
+expect "good run, auto exposure, not blown out" 0 "" -- \
+  "$client_bin" "$url" "${common[@]}" --token sekret --check-not-blank --max-clipped 0.02
 expect "server Error (unknown material)" 1 "ERROR_CODE_UNKNOWN_MATERIAL" -- \
   "$client_bin" "$url" "${common[@]}" --token sekret --material 0=no-such-material
 expect "good run" 0 "" -- "$client_bin" "$url" "${common[@]}" --token sekret --check-not-blank

@@ -80,8 +80,9 @@ TEST(PosePath, OrbitStartsAtTheDefaultSceneCamera) {
   const PosePath path = PosePath::orbit(OrbitSweep{});
   const v1::PoseUpdate p = path.at(0, 100);
   EXPECT_NEAR(p.camera().eye().x(), 0.0, 1e-9);
-  EXPECT_NEAR(p.camera().eye().y(), 0.6, 1e-3);
-  EXPECT_NEAR(p.camera().eye().z(), 3.4, 1e-3);
+  EXPECT_NEAR(p.camera().eye().y(), 0.85, 1e-3);
+  EXPECT_NEAR(p.camera().eye().z(), 4.8, 1e-3);
+  EXPECT_EQ(p.camera().fov_y_degrees(), 45.0);
   EXPECT_EQ(p.objects_size(), 0) << "no spin asked: the scene's object poses must stay untouched";
 }
 

@@ -42,19 +42,6 @@ FrameParams makeFrameParams(const render::Camera& camera, int width, int height,
   return f;
 }
 
-std::array<float, 256> srgbThresholds(double exposureStops) {
-  const double gain = std::exp2(exposureStops);
-  std::array<float, 256> t{};
-  for (int k = 1; k < 256; ++k) {
-    // The inverse of the IEC 61966-2-1 transfer function at the rounding
-    // boundary (k − ½)/255 of the 8-bit code k.
-    const double v = (k - 0.5) / 255.0;
-    const double linear = v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4);
-    t[static_cast<std::size_t>(k)] = static_cast<float>(linear / gain);
-  }
-  return t;
-}
-
 void setFusedSkip(ObjectInfo& info, int level, int lastNonZeroRow) {
   // As fusedShade: beyond the last non-zero row + 1 every lookup reads zeros;
   // one more row absorbs the rounding of θ'. The taps of the directions kept

@@ -17,6 +17,7 @@
 #include "haarcast/gpu/compute.h"
 #include "haarcast/gpu/rotation_data.h"
 #include "haarcast/gpu/shaders.h"
+#include "haarcast/render/tonemap.h"
 
 namespace haarcast::gpu {
 namespace {
@@ -116,6 +117,11 @@ struct VulkanRenderer::Impl {
   // The frame's uniforms (camera, light turn, exposure, the fused dispatch's
   // workgroup count) and the sRGB thresholds of its exposure.
   void uploadFrameUniforms(const render::FrameRequest& request);
+  // Auto exposure: the frame was tonemapped on the device with
+  // provisionalStops(); measure the lit object pixels (mapped radiance and
+  // ids) and, when the exposure they call for differs, tonemap again on the
+  // host (the same thresholds, so the same bytes the device would give).
+  void finishExposure(const render::FrameRequest& request, render::Frame& frame);
   void recordGBuffer(VkCommandBuffer cb, const render::FrameRequest& request, const glm::dmat4& viewProj);
   // The stages of a frame, in order: with timestamps, recorded into one
   // command buffer (a timestamp after each) and submitted once; otherwise
@@ -754,14 +760,38 @@ void VulkanRenderer::Impl::runStages(
 
 // `fused`: G-buffer → rotation input (compaction, indirect arguments) →
 // fused (vkCmdDispatchIndirect, no readback of the count) → tonemap.
+namespace {
+double provisionalStops(const render::ExposureControl& exposure) {
+  return exposure.automatic ? exposure.previousStops.value_or(0.0) : exposure.stops;
+}
+}  // namespace
+
 void VulkanRenderer::Impl::uploadFrameUniforms(const render::FrameRequest& request) {
-  FrameParams params = makeFrameParams(request.camera, request.width, request.height, request.lightRotation,
-                                       request.exposureStops, options.environmentBackground,
-                                       prepared.background[0].level());
+  const double stops = provisionalStops(request.exposure);
+  FrameParams params = makeFrameParams(request.camera, request.width, request.height, request.lightRotation, stops,
+                                       options.environmentBackground, prepared.background[0].level());
   params.fusedGroups = fusedGroups;
   frameParams.write(&params, sizeof params);
-  const std::array<float, 256> encoding = srgbThresholds(request.exposureStops);
+  const std::array<float, 256> encoding = render::tonemapThresholds(stops);
   thresholds.write(encoding.data(), sizeof encoding);
+}
+
+void VulkanRenderer::Impl::finishExposure(const render::FrameRequest& request, render::Frame& frame) {
+  const double provisional = provisionalStops(request.exposure);
+  frame.exposureStops = provisional;
+  if (!request.exposure.automatic) return;
+  const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  io::RgbImage linear = frame.image;
+  if (linear.rgb.empty()) {
+    linear = io::makeImage(width, height);
+    const auto* rad = static_cast<const glm::vec4*>(radiance.mapped());
+    for (std::size_t p = 0; p < pixels; ++p) {
+      for (std::size_t c = 0; c < 3; ++c) linear.rgb[3 * p + c] = rad[p][static_cast<int>(c)];
+    }
+  }
+  frame.logAverageLuminance = render::frameLogAverage(linear, frame.objectMask);
+  frame.exposureStops = render::applyExposure(request.exposure, frame.logAverageLuminance);
+  if (frame.exposureStops != provisional) frame.rgba8 = render::tonemapRgba8(linear, frame.exposureStops);
 }
 
 render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& request) {
@@ -815,6 +845,7 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
       for (std::size_t c = 0; c < 3; ++c) frame.image.rgb[3 * p + c] = rad[p][static_cast<int>(c)];
     }
   }
+  finishExposure(request, frame);
 
   // Coefficient bytes read, counted as the CPU backend counts them: the light
   // lists, and per covered pixel core fusedPixelBytes (one slice or two, the
@@ -942,6 +973,7 @@ render::Frame VulkanRenderer::Impl::render(const render::FrameRequest& request) 
     }
     rgba8.read(frame.rgba8.data(), frame.rgba8.size());
   }
+  finishExposure(request, frame);
 
   frame.stages.push_back({"gbuffer", gbuffer});
   frame.stages.push_back({"rotation-input", rotInput});

@@ -484,24 +484,39 @@ void writePfm(const std::string& path, const RgbImage& image) {
 
 // ---------------------------------------------------------------- PNG
 
+namespace {
+
+// libpng's simplified API reports errors in image.message instead of
+// longjmp-ing through C++ frames. An 8-bit non-linear format is written
+// with an sRGB chunk.
+void writePngPixels(const std::string& path, int width, int height, png_uint_32 format, const std::uint8_t* pixels) {
+  png_image png{};
+  png.version = PNG_IMAGE_VERSION;
+  png.width = static_cast<png_uint_32>(width);
+  png.height = static_cast<png_uint_32>(height);
+  png.format = format;
+  if (png_image_write_to_file(&png, path.c_str(), 0, pixels, 0, nullptr) == 0) {
+    const std::string message = png.message;
+    png_image_free(&png);
+    fail(path, "cannot write PNG: " + message);
+  }
+}
+
+}  // namespace
+
 void writePng(const std::string& path, const RgbImage& image, double exposureStops) {
   checkImage(path, image);
   const double gain = std::exp2(exposureStops);
   std::vector<std::uint8_t> pixels(image.rgb.size());
   for (std::size_t k = 0; k < pixels.size(); ++k) pixels[k] = encodeSrgb(image.rgb[k] * gain);
-  // libpng's simplified API reports errors in image.message instead of
-  // longjmp-ing through C++ frames. An 8-bit non-linear format is written
-  // with an sRGB chunk.
-  png_image png{};
-  png.version = PNG_IMAGE_VERSION;
-  png.width = static_cast<png_uint_32>(image.width);
-  png.height = static_cast<png_uint_32>(image.height);
-  png.format = PNG_FORMAT_RGB;
-  if (png_image_write_to_file(&png, path.c_str(), 0, pixels.data(), 0, nullptr) == 0) {
-    const std::string message = png.message;
-    png_image_free(&png);
-    fail(path, "cannot write PNG: " + message);
+  writePngPixels(path, image.width, image.height, PNG_FORMAT_RGB, pixels.data());
+}
+
+void writePngRgba8(const std::string& path, const std::vector<std::uint8_t>& rgba8, int width, int height) {
+  if (width <= 0 || height <= 0 || rgba8.size() != 4 * static_cast<std::size_t>(width) * static_cast<std::size_t>(height)) {
+    fail(path, "RGBA8 image of " + std::to_string(rgba8.size()) + " bytes does not match " + sizeText(width, height));
   }
+  writePngPixels(path, width, height, PNG_FORMAT_RGBA, rgba8.data());
 }
 
 // ---------------------------------------------------------------- dispatch

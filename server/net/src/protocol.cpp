@@ -16,6 +16,23 @@ ProtocolError error(v1::ErrorCode code, std::string message, bool fatal) {
 bool finite(const v1::Vec3& v) { return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z()); }
 glm::dvec3 toGlm(const v1::Vec3& v) { return {v.x(), v.y(), v.z()}; }
 
+// "a, b, c" (at most `most` items, then "… (n in all)").
+std::string joined(const std::vector<std::string>& items, std::size_t most = 24) {
+  std::string out;
+  for (std::size_t i = 0; i < items.size() && i < most; ++i) out += (i ? ", " : "") + items[i];
+  if (items.size() > most) out += ", … (" + std::to_string(items.size()) + " in all)";
+  return out.empty() ? "none" : out;
+}
+
+// The wire names of the per-pixel methods, with their numbers.
+std::string wireMethodNames() {
+  std::string out;
+  for (const RotationMethod m : kAllPixelMethods) {
+    out += (out.empty() ? "" : ", ") + v1::RotationMethod_Name(toWire(m)) + " = " + std::to_string(toWire(m));
+  }
+  return out;
+}
+
 std::optional<FrameEncoding> fromWire(v1::Encoding e) {
   switch (e) {
     case v1::ENCODING_JPEG: return FrameEncoding::Jpeg;
@@ -43,7 +60,10 @@ std::optional<ProtocolError> mergeSettings(SessionConfig& config, const v1::Rend
   SessionConfig next = config;
   if (s.method() != v1::ROTATION_METHOD_UNSPECIFIED) {
     const auto m = methodFromWire(s.method());
-    if (!m) return error(v1::ERROR_CODE_BAD_SETTINGS, "unknown rotation method " + std::to_string(s.method()), fatal);
+    if (!m) {
+      return error(v1::ERROR_CODE_BAD_SETTINGS,
+                   "unknown rotation method " + std::to_string(s.method()) + " (valid: " + wireMethodNames() + ")", fatal);
+    }
     next.method = *m;
   }
   if (s.level() != 0) {
@@ -68,16 +88,35 @@ std::optional<ProtocolError> mergeSettings(SessionConfig& config, const v1::Rend
     const std::string name = s.backend() == v1::BACKEND_CPU      ? "cpu"
                              : s.backend() == v1::BACKEND_VULKAN ? "vulkan"
                                                                  : "";
-    if (name.empty()) return error(v1::ERROR_CODE_BAD_SETTINGS, "unknown backend " + std::to_string(s.backend()), fatal);
+    if (name.empty()) {
+      return error(v1::ERROR_CODE_BAD_SETTINGS,
+                   "unknown backend " + std::to_string(s.backend()) + " (this server offers " + joined(catalog.backends) + ")",
+                   fatal);
+    }
     if (!catalog.offersBackend(name)) {
-      return error(v1::ERROR_CODE_BAD_SETTINGS, "backend " + name + " is not available on this server", fatal);
+      return error(v1::ERROR_CODE_BAD_SETTINGS,
+                   "backend " + name + " is not available on this server (it offers " + joined(catalog.backends) + ")",
+                   fatal);
     }
     next.backend = name;
   }
-  if (!std::isfinite(s.exposure_stops()) || std::abs(s.exposure_stops()) > 32.0) {
-    return error(v1::ERROR_CODE_BAD_SETTINGS, "exposure_stops must be finite and within ±32", fatal);
+  switch (s.exposure_mode()) {
+    case v1::EXPOSURE_MODE_UNSPECIFIED: break;  // unchanged (a Hello starts with auto)
+    case v1::EXPOSURE_MODE_AUTO: next.autoExposure = true; break;
+    case v1::EXPOSURE_MODE_FIXED:
+      if (!(std::abs(s.exposure_stops()) <= render::kMaxExposureStops)) {
+        return error(v1::ERROR_CODE_BAD_SETTINGS,
+                     "exposure_stops " + std::to_string(s.exposure_stops()) + " is outside ±" +
+                         std::to_string(static_cast<int>(render::kMaxExposureStops)),
+                     fatal);
+      }
+      next.autoExposure = false;
+      next.exposureStops = s.exposure_stops();
+      break;
+    default:
+      return error(v1::ERROR_CODE_BAD_SETTINGS,
+                   "unknown exposure_mode " + std::to_string(s.exposure_mode()) + " (valid: AUTO, FIXED)", fatal);
   }
-  next.exposureStops = s.exposure_stops();
   config = std::move(next);
   return std::nullopt;
 }
@@ -85,7 +124,10 @@ std::optional<ProtocolError> mergeSettings(SessionConfig& config, const v1::Rend
 std::optional<ProtocolError> mergeScene(SessionConfig& config, const v1::SceneChoice& choice, const Catalog& catalog,
                                         bool fatal) {
   const Catalog::SceneEntry* scene = catalog.findScene(choice.scene());
-  if (!scene) return error(v1::ERROR_CODE_UNKNOWN_SCENE, "unknown scene \"" + choice.scene() + "\"", fatal);
+  if (!scene) {
+    return error(v1::ERROR_CODE_UNKNOWN_SCENE,
+                 "unknown scene \"" + choice.scene() + "\" (this server offers " + joined(catalog.sceneNames()) + ")", fatal);
+  }
   std::vector<std::string> materials = scene->name == config.scene && !config.materials.empty()
                                            ? config.materials
                                            : scene->defaultMaterials;
@@ -100,7 +142,9 @@ std::optional<ProtocolError> mergeScene(SessionConfig& config, const v1::SceneCh
     }
     // Only offered specs: a client must never make the server open a path.
     if (!catalog.offersMaterial(spec)) {
-      return error(v1::ERROR_CODE_UNKNOWN_MATERIAL, "material \"" + spec + "\" is not offered by this server", fatal);
+      return error(v1::ERROR_CODE_UNKNOWN_MATERIAL,
+                   "material \"" + spec + "\" is not offered by this server (it offers " + joined(catalog.materials) + ")",
+                   fatal);
     }
     materials[object] = spec;
   }
@@ -118,6 +162,12 @@ const Catalog::SceneEntry* Catalog::findScene(std::string_view name) const {
     if (s.name == name) return &s;
   }
   return nullptr;
+}
+
+std::vector<std::string> Catalog::sceneNames() const {
+  std::vector<std::string> names;
+  for (const auto& s : scenes) names.push_back(s.name);
+  return names;
 }
 
 bool Catalog::offersMaterial(std::string_view spec) const {
@@ -279,7 +329,8 @@ render::FrameRequest frameRequest(const PoseState& pose, const SessionConfig& co
   light.rotateDegrees = pose.lightRotateDegrees;
   r.lightRotation = light.rotation();
   r.lightCoefficients = config.lightCoefficients;
-  r.exposureStops = config.exposureStops;
+  r.exposure.automatic = config.autoExposure;
+  r.exposure.stops = config.exposureStops;
   return r;
 }
 
@@ -316,8 +367,47 @@ v1::RenderSettings settingsToWire(const SessionConfig& config) {
   s.set_level(static_cast<std::uint32_t>(config.level));
   s.set_light_coefficients(static_cast<std::uint32_t>(config.lightCoefficients));
   s.set_backend(backendToWire(config.backend));
+  s.set_exposure_mode(config.autoExposure ? v1::EXPOSURE_MODE_AUTO : v1::EXPOSURE_MODE_FIXED);
   s.set_exposure_stops(config.exposureStops);
   return s;
+}
+
+v1::ServerLimits limitsToWire(const Limits& limits) {
+  v1::ServerLimits l;
+  l.set_min_level(static_cast<std::uint32_t>(limits.minLevel));
+  l.set_max_level(static_cast<std::uint32_t>(limits.maxLevel));
+  l.set_max_width(static_cast<std::uint32_t>(limits.maxWidth));
+  l.set_max_height(static_cast<std::uint32_t>(limits.maxHeight));
+  l.set_max_fps(limits.maxFps);
+  l.set_max_light_coefficients(static_cast<std::uint32_t>(limits.maxLightCoefficients));
+  l.set_max_exposure_stops(render::kMaxExposureStops);
+  return l;
+}
+
+v1::SceneInfo sceneInfo(const SessionConfig& config, const Catalog& catalog) {
+  v1::SceneInfo info;
+  info.set_name(config.scene);
+  const Catalog::SceneEntry* scene = catalog.findScene(config.scene);
+  if (scene) {
+    auto* camera = info.mutable_camera();
+    const auto vec = [](v1::Vec3* out, const glm::dvec3& v) {
+      out->set_x(v.x);
+      out->set_y(v.y);
+      out->set_z(v.z);
+    };
+    vec(camera->mutable_eye(), scene->camera.eye);
+    vec(camera->mutable_target(), scene->camera.target);
+    vec(camera->mutable_up(), scene->camera.up);
+    camera->set_fov_y_degrees(scene->camera.fovYDegrees);
+  }
+  for (std::size_t i = 0; i < config.materials.size(); ++i) {
+    auto* o = info.add_objects();
+    o->set_index(static_cast<std::uint32_t>(i));
+    const bool named = scene && i < scene->objectNames.size() && !scene->objectNames[i].empty();
+    o->set_name(named ? scene->objectNames[i] : "object " + std::to_string(i));
+    o->set_material(config.materials[i]);
+  }
+  return info;
 }
 
 std::string serialize(const v1::ServerMessage& message) {

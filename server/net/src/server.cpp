@@ -364,7 +364,7 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
       sendError(*e);
       return;
     }
-    adopt(std::move(next), false);
+    adopt(std::move(next), false, false);
   }
 
   void onScene(const v1::SceneChoice& choice) {
@@ -373,15 +373,19 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
       sendError(*e);
       return;
     }
-    adopt(std::move(next), next.scene != config_.scene);
+    const bool newScene = next.scene != config_.scene;
+    adopt(std::move(next), newScene, true);
   }
 
   // A changed config: a new renderer when its key changed; the scene's own
-  // view again when the scene did (the objects are others).
-  void adopt(SessionConfig next, bool newScene) {
+  // view again when the scene did (the objects are others). An accepted
+  // SceneChoice is answered with the scene's SceneInfo.
+  void adopt(SessionConfig next, bool newScene, bool announceScene) {
     const bool newRenderer = next.rendererKey() != config_.rendererKey();
     {
       std::lock_guard lock(mutex_);
+      // Auto exposure starts afresh for another scene or after a fixed spell.
+      if (newScene || !next.autoExposure) lastExposure_.reset();
       config_ = std::move(next);
       if (newScene) {
         const auto* scene = server_.catalog.findScene(config_.scene);
@@ -389,6 +393,11 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
         pose_ = initialPose(scene->camera, scene->poses);
         pose_.sequence = sequence;  // later poses stay newer
       }
+    }
+    if (announceScene && welcomed_) {
+      v1::ServerMessage m;
+      *m.mutable_scene_info() = sceneInfo(config_, server_.catalog);
+      send(serialize(m));
     }
     wantFrame_ = true;
     if (newRenderer) {
@@ -434,6 +443,8 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
       *w->mutable_settings() = settingsToWire(config_);
       w->set_object_count(static_cast<std::uint32_t>(renderer_->renderer->objectCount()));
       w->set_device(renderer_->renderer->deviceName());
+      *w->mutable_scene_info() = sceneInfo(config_, server_.catalog);
+      *w->mutable_limits() = limitsToWire(server_.options.limits);
       send(serialize(m));
     }
     wantFrame_ = true;
@@ -473,7 +484,12 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
       context->clientTimeMs = self->pose_.clientTimeMs;
       context->poseReceived = self->poseReceived_;
       context->config = self->config_;
-      return frameRequest(self->pose_, self->config_);
+      render::FrameRequest request = frameRequest(self->pose_, self->config_);
+      if (request.exposure.automatic && self->lastExposure_) {
+        request.exposure.previousStops = self->lastExposure_;
+        request.exposure.adaptation = render::exposureAdaptation(secondsBetween(self->lastExposureAt_, Clock::now()));
+      }
+      return request;
     };
     job.done = [weak = weak_from_this(), context](std::optional<RenderedFrame> frame, std::string error) {
       if (auto self = weak.lock()) {
@@ -495,6 +511,13 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
       return;
     }
     lastRenderError_.clear();
+    if (context.config.autoExposure) {
+      std::lock_guard lock(mutex_);
+      if (config_.autoExposure && config_.scene == context.config.scene) {
+        lastExposure_ = rendered->frame.exposureStops;
+        lastExposureAt_ = Clock::now();
+      }
+    }
     auto stages = rendered->frame.stages;
     stages.push_back({"encode", rendered->encodeSeconds});
     server_.metrics.addStages(stages);
@@ -518,6 +541,7 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
     f->set_client_time_ms(context.clientTimeMs);
     f->set_server_ms(secondsBetween(context.poseReceived, Clock::now()) * 1e3);
     *f->mutable_settings() = settingsToWire(context.config);
+    f->set_exposure_stops(rendered->frame.exposureStops);
 
     if (frameSlot_) {  // the client has not taken the last one yet: latest wins
       ++framesDropped_;
@@ -713,6 +737,9 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   SessionConfig config_;
   PoseState pose_;
   Clock::time_point poseReceived_;
+  // Auto exposure: the last frame's exposure, eased from (tonemap.h).
+  std::optional<double> lastExposure_;
+  Clock::time_point lastExposureAt_;
   std::atomic<bool> closing_{false};
 };
 

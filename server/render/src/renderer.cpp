@@ -35,10 +35,9 @@ void checkRenderOptions(const RenderOptions& o) {
   if (o.width < 1 || o.height < 1 || o.width > 8192 || o.height > 8192) {
     bad("resolution " + std::to_string(o.width) + "×" + std::to_string(o.height) + " is outside 1..8192");
   }
-  if (o.level < 2 || o.level > 8) bad("level " + std::to_string(o.level) + " is outside 2..8");
-  if (o.method == RotationMethod::Fused && o.level > static_cast<int>(shared::kFusedMaxLevel)) {
-    bad("level " + std::to_string(o.level) + " is outside " + std::to_string(shared::kMinLevel) + ".." +
-        std::to_string(shared::kFusedMaxLevel) + " for fused");
+  if (o.level < kMinRenderLevel || o.level > kMaxRenderLevel) {
+    bad("level " + std::to_string(o.level) + " is outside " + std::to_string(kMinRenderLevel) + ".." +
+        std::to_string(kMaxRenderLevel));
   }
   if (o.lightCoefficients == 0) bad("light coefficients must be at least 1");
   if (o.thetaSamples < 1 || o.thetaSamples > 256) bad("theta samples must be in 1..256");
@@ -120,15 +119,9 @@ glm::dvec3 backgroundRadiance(const std::array<SphereMap, 3>& background, const 
   return out;
 }
 
-std::vector<std::uint8_t> tonemapRgba8(const io::RgbImage& image, double exposureStops) {
-  const double gain = std::exp2(exposureStops);
-  const std::size_t pixels = static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height);
-  std::vector<std::uint8_t> out(pixels * 4);
-  for (std::size_t p = 0; p < pixels; ++p) {
-    for (std::size_t c = 0; c < 3; ++c) out[4 * p + c] = io::encodeSrgb(image.rgb[3 * p + c] * gain);
-    out[4 * p + 3] = 255;
-  }
-  return out;
+double frameLogAverage(const io::RgbImage& image, const std::vector<std::uint8_t>& objectMask) {
+  const double objects = logAverageLuminance(image, objectMask);
+  return objects > 0.0 ? objects : logAverageLuminance(image);
 }
 
 void checkFrameRequest(const FrameRequest& r, std::size_t objectCount) {
@@ -160,7 +153,12 @@ void checkFrameRequest(const FrameRequest& r, std::size_t objectCount) {
       bad("a pose is not finite (or its scale is not positive)");
     }
   }
-  if (!std::isfinite(r.exposureStops)) bad("exposure is not finite");
+  const ExposureControl& e = r.exposure;
+  if (!e.automatic && !(std::abs(e.stops) <= kMaxExposureStops)) {
+    bad("exposure " + std::to_string(e.stops) + " stops is outside ±" + std::to_string(static_cast<int>(kMaxExposureStops)));
+  }
+  if (e.previousStops && !(std::abs(*e.previousStops) <= kMaxExposureStops)) bad("previous exposure is not finite");
+  if (!(e.adaptation >= 0.0 && e.adaptation <= 1.0)) bad("exposure adaptation must be in 0..1");
 }
 
 ResolvedFrame resolveFrame(const PreparedScene& prepared, const RenderOptions& options, const FrameRequest& request) {
@@ -352,7 +350,9 @@ Frame CpuRenderer::render(const FrameRequest& request) {
       }
     }, {}, threads);
   }
-  frame.rgba8 = tonemapRgba8(frame.image, request.exposureStops);
+  frame.logAverageLuminance = frameLogAverage(frame.image, frame.objectMask);
+  frame.exposureStops = applyExposure(request.exposure, frame.logAverageLuminance);
+  frame.rgba8 = tonemapRgba8(frame.image, frame.exposureStops);
   frame.stages.push_back({"tonemap", since(t0)});
   frame.coefficientBytes = bytes;
   frame.seconds = since(start);

@@ -143,7 +143,10 @@ Scene defaultScene() {
   b.pose.translate = {0.8, 0.0, 0.0};
   b.pose.rotateDegrees = {60.0, 20.0, 0.0};
   s.objects = {a, b};
-  s.camera.eye = {0.0, 0.6, 3.4};
+  // Both objects inside a square view with a margin, so no aspect ratio
+  // crops them (a portrait frame keeps this field across its width).
+  s.camera.eye = {0.0, 0.85, 4.8};
+  s.camera.fovYDegrees = 45.0;
   return s;
 }
 

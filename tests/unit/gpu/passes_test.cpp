@@ -228,7 +228,7 @@ TEST(TonemapPass, BackdropAndEncodingMatchTheCpuDefinitions) {
   Context context(testing::testOptions());
   Buffer paramBuf(context, sizeof params), idBuf(context, pixels * 16), radBuf(context, pixels * 16),
       bgBuf(context, bg.size() * 4), rgbaBuf(context, pixels * 4), thresholdBuf(context, 256 * 4);
-  const auto thresholds = srgbThresholds(exposure);
+  const auto thresholds = render::tonemapThresholds(exposure);
   thresholdBuf.upload(std::span<const float>(thresholds));
   paramBuf.write(&params, sizeof params);
   idBuf.upload(std::span<const glm::uvec4>(ids));

@@ -28,7 +28,7 @@ const std::string& cacheDir() {
 }
 
 // Vulkan fused vs CPU fused, whole frames (measured: see docs/gpu.md).
-constexpr double kFusedPsnrFloor = 130.0;  // measured 141.5–144.7 dB on lavapipe
+constexpr double kFusedPsnrFloor = 115.0;  // measured 127.7–135.5 dB on lavapipe (float rounding only)
 
 render::RenderOptions frameOptions(RotationMethod method, bool background) {
   render::RenderOptions o;
@@ -46,6 +46,10 @@ render::FrameRequest requestFor(const render::Scene& scene, int width, int heigh
   r.width = width;
   r.height = height;
   r.camera = scene.camera;
+  // A fixed exposure, so that the device's tonemap pass makes the bytes
+  // compared below (auto exposure has its own test).
+  r.exposure.automatic = false;
+  r.exposure.stops = -0.5;
   return r;
 }
 
@@ -90,6 +94,7 @@ Comparison compare(const render::Frame& reference, const render::Frame& test) {
 // bytes read, and RGBA8 equal to the CPU encoding of the frame's own linear
 // image (within two bytes of rounding).
 void expectStagesAndRgba8(const render::Frame& b, const std::vector<std::string>& names, double exposureStops) {
+  EXPECT_EQ(b.exposureStops, exposureStops);
   ASSERT_EQ(b.stages.size(), names.size());
   for (std::size_t i = 0; i < names.size(); ++i) EXPECT_EQ(b.stages[i].name, names[i]);
   EXPECT_GT(b.coefficientBytes, 0u);
@@ -117,7 +122,7 @@ void expectBackendsAgree(RotationMethod method, bool background) {
   EXPECT_LE(static_cast<double>(c.mismatched), 0.005 * static_cast<double>(c.objectPixels) + 1.0);
   EXPECT_GT(c.objectPixels, 500u);
   expectStagesAndRgba8(b, {"light", "gbuffer", "rotation-input", "rotation", "triple-product", "tonemap"},
-                       request.exposureStops);
+                       request.exposure.stops);
   testing::expectNoValidationMessages(gpu.context());
 }
 
@@ -168,11 +173,36 @@ TEST_P(FusedFrame, VulkanMatchesTheCpuBackend) {
   EXPECT_GT(c.objectPixels, 500u);
   // The GPU counts what it reads: with the vertices' pixel forms (levels
   // 4–6 here), three planes of N floats per pixel instead of the lists.
-  expectStagesAndRgba8(b, {"light", "gbuffer", "rotation-input", "fused", "tonemap"}, request.exposureStops);
+  expectStagesAndRgba8(b, {"light", "gbuffer", "rotation-input", "fused", "tonemap"}, request.exposure.stops);
   testing::expectNoValidationMessages(gpu.context());
 }
 
 INSTANTIATE_TEST_SUITE_P(Levels, FusedFrame, ::testing::Values(4, 5, 6, 7));
+
+// Auto exposure: the device's frame is measured and exposed as the CPU's
+// (the lit object pixels' log-average, the same transform), and eases from
+// a previous exposure by the fraction asked for.
+TEST(VulkanRenderer, AutoExposureMatchesTheCpuBackend) {
+  HAARCAST_REQUIRE_VULKAN();
+  const render::Scene scene = render::defaultScene();
+  const render::RenderOptions o = frameOptions(RotationMethod::Fused, true);
+  const auto cpu = render::makeCpuRenderer(scene, o);
+  VulkanRenderer gpu(scene, o, testing::testOptions());
+  render::FrameRequest request = requestFor(scene, o.width, o.height);
+  request.exposure = render::ExposureControl{};  // automatic, nothing to ease from
+  const render::Frame a = cpu->render(request);
+  const render::Frame b = gpu.render(request);
+  ASSERT_GT(a.logAverageLuminance, 0.0);
+  EXPECT_NEAR(b.logAverageLuminance, a.logAverageLuminance, 1e-3 * a.logAverageLuminance);
+  EXPECT_NEAR(a.exposureStops, render::keyExposure(a.logAverageLuminance), 1e-12);
+  EXPECT_NEAR(b.exposureStops, a.exposureStops, 1e-3);
+  request.exposure.previousStops = a.exposureStops + 2.0;
+  request.exposure.adaptation = 0.25;
+  const render::Frame c = gpu.render(request);
+  EXPECT_NEAR(c.exposureStops, a.exposureStops + 1.5, 1e-3);
+  expectStagesAndRgba8(c, {"light", "gbuffer", "rotation-input", "fused", "tonemap"}, c.exposureStops);
+  testing::expectNoValidationMessages(gpu.context());
+}
 
 // The fused dispatch's shape does not change a bit of the image: scratch
 // in shared or in global memory, as many workgroups as pixels or 3 that

@@ -124,13 +124,16 @@ TEST(Protocol, BadHellosNameWhatIsWrong) {
 
   h = goodHello();
   h.mutable_scene()->set_scene("nope");
-  EXPECT_EQ(helloError(h).code, v1::ERROR_CODE_UNKNOWN_SCENE);
+  e = helloError(h);
+  EXPECT_EQ(e.code, v1::ERROR_CODE_UNKNOWN_SCENE);
+  EXPECT_NE(e.message.find("offers default, other"), std::string::npos) << e.message;
 
   h = goodHello();
   (*h.mutable_scene()->mutable_object_materials())[0] = "/etc/passwd";
   e = helloError(h);
   EXPECT_EQ(e.code, v1::ERROR_CODE_UNKNOWN_MATERIAL);
   EXPECT_NE(e.message.find("/etc/passwd"), std::string::npos);
+  EXPECT_NE(e.message.find("offers lambert, phong:64, ggx:0.3, merl:steel"), std::string::npos) << e.message;
 
   h = goodHello();
   (*h.mutable_scene()->mutable_object_materials())[5] = "lambert";
@@ -145,6 +148,45 @@ TEST(Protocol, BadHellosNameWhatIsWrong) {
   e = helloError(h);
   EXPECT_EQ(e.code, v1::ERROR_CODE_BAD_SETTINGS);
   EXPECT_NE(e.message.find("vulkan"), std::string::npos);
+  EXPECT_NE(e.message.find("offers cpu"), std::string::npos) << e.message;
+
+  h = goodHello();
+  h.mutable_settings()->set_method(static_cast<v1::RotationMethod>(42));
+  e = helloError(h);
+  EXPECT_EQ(e.code, v1::ERROR_CODE_BAD_SETTINGS);
+  EXPECT_NE(e.message.find("ROTATION_METHOD_FUSED = 5"), std::string::npos) << e.message;
+
+  h = goodHello();
+  h.mutable_settings()->set_exposure_mode(v1::EXPOSURE_MODE_FIXED);
+  h.mutable_settings()->set_exposure_stops(40.0);
+  e = helloError(h);
+  EXPECT_EQ(e.code, v1::ERROR_CODE_BAD_SETTINGS);
+  EXPECT_NE(e.message.find("exposure_stops"), std::string::npos) << e.message;
+}
+
+// Exposure: auto unless a Hello or later settings fix it; a settings message
+// that leaves the mode unset keeps it; the request carries it.
+TEST(Protocol, ExposureModes) {
+  auto c = std::get<SessionConfig>(configFromHello(goodHello(), Limits{}, Defaults{}, testCatalog()));
+  EXPECT_TRUE(c.autoExposure);
+  EXPECT_TRUE(frameRequest(initialPose(render::Camera{}, {}), c).exposure.automatic);
+  v1::RenderSettings s;
+  s.set_exposure_mode(v1::EXPOSURE_MODE_FIXED);
+  s.set_exposure_stops(-2.5);
+  ASSERT_FALSE(applySettings(c, s, Limits{}, testCatalog()));
+  EXPECT_FALSE(c.autoExposure);
+  const render::FrameRequest r = frameRequest(initialPose(render::Camera{}, {}), c);
+  EXPECT_FALSE(r.exposure.automatic);
+  EXPECT_EQ(r.exposure.stops, -2.5);
+  EXPECT_EQ(settingsToWire(c).exposure_mode(), v1::EXPOSURE_MODE_FIXED);
+  v1::RenderSettings levelOnly;
+  levelOnly.set_level(3);
+  ASSERT_FALSE(applySettings(c, levelOnly, Limits{}, testCatalog()));
+  EXPECT_FALSE(c.autoExposure);
+  v1::RenderSettings automatic;
+  automatic.set_exposure_mode(v1::EXPOSURE_MODE_AUTO);
+  ASSERT_FALSE(applySettings(c, automatic, Limits{}, testCatalog()));
+  EXPECT_TRUE(c.autoExposure);
 }
 
 TEST(Protocol, SettingsChangeAllOrNothing) {

@@ -39,6 +39,7 @@ Catalog testCatalog(const render::Scene& scene) {
   for (const auto& o : scene.objects) {
     entry.defaultMaterials.push_back(o.material.name);
     entry.poses.push_back(o.pose);
+    entry.objectNames.push_back(o.name);
   }
   c.scenes.push_back(entry);
   c.materials = {"lambert", "phong:16", "phong:64", "ggx:0.3"};
@@ -423,9 +424,15 @@ TEST(Server, PacedToFpsCapAndLatestPoseWins) {
 TEST(Server, EncodingsAgree) {
   TestServer server;
   std::map<v1::Encoding, std::string> data;
+  std::map<v1::Encoding, double> exposure;
   for (const auto e : {v1::ENCODING_RAW_RGBA8, v1::ENCODING_PNG, v1::ENCODING_JPEG, v1::ENCODING_EXR}) {
     Client c(server.port());
-    c.handshake(hello(32, 32, e));
+    // A fixed exposure: auto exposure eases from the session's earlier
+    // frames, which differ between sessions in how many came before pose 1.
+    auto h = hello(32, 32, e);
+    h.mutable_hello()->mutable_settings()->set_exposure_mode(v1::EXPOSURE_MODE_FIXED);
+    h.mutable_hello()->mutable_settings()->set_exposure_stops(-1.5);
+    c.handshake(h);
     c.send(pose(1, 45));
     for (int i = 0; i < 3; ++i) {
       auto f = c.expect(v1::ServerMessage::kFrame);
@@ -433,6 +440,7 @@ TEST(Server, EncodingsAgree) {
       EXPECT_EQ(f->frame().encoding(), e);
       if (f->frame().pose_sequence() == 1) {
         data[e] = f->frame().data();
+        exposure[e] = f->frame().exposure_stops();
         break;
       }
     }
@@ -447,7 +455,8 @@ TEST(Server, EncodingsAgree) {
   for (std::size_t i = 0; i < rgba.size(); ++i) error += std::abs(int(jpeg.rgba[i]) - int(rgba[i]));
   EXPECT_LT(error / static_cast<double>(rgba.size()), 12.0);
   const auto linear = decodeExr(data[v1::ENCODING_EXR]);
-  const auto fromExr = render::tonemapRgba8(linear, 0.0);
+  for (const auto& [e, stops] : exposure) EXPECT_EQ(stops, -1.5) << v1::Encoding_Name(e);
+  const auto fromExr = render::tonemapRgba8(linear, -1.5);
   ASSERT_EQ(fromExr.size(), rgba.size());
   int worst = 0;
   for (std::size_t i = 0; i < rgba.size(); ++i) worst = std::max(worst, std::abs(int(fromExr[i]) - int(rgba[i])));
@@ -472,6 +481,46 @@ TEST(Server, SettingsChangeTakesEffectAndBadOnesAreNotFatal) {
     if (f->frame().settings().level() == 3) return;
   }
   FAIL() << "no frame at level 3";
+}
+
+// Welcome names the scene, its objects and their materials and quotes the
+// server's limits; a material change is announced with a SceneInfo; frames
+// carry the exposure they were made with, automatic by default.
+TEST(Server, WelcomeDescribesTheSceneAndAMaterialChangeIsAnnounced) {
+  TestServer server;
+  Client c(server.port());
+  const v1::Welcome w = c.handshake();
+  const render::Scene scene = render::defaultScene();
+  EXPECT_EQ(w.scene_info().name(), "default");
+  ASSERT_EQ(static_cast<std::size_t>(w.scene_info().objects_size()), scene.objects.size());
+  for (std::size_t i = 0; i < scene.objects.size(); ++i) {
+    const auto& o = w.scene_info().objects(static_cast<int>(i));
+    EXPECT_EQ(o.index(), i);
+    EXPECT_EQ(o.name(), scene.objects[i].name);
+    EXPECT_EQ(o.material(), scene.objects[i].material.name);
+  }
+  EXPECT_EQ(w.scene_info().camera().eye().z(), scene.camera.eye.z);
+  EXPECT_EQ(w.scene_info().camera().fov_y_degrees(), scene.camera.fovYDegrees);
+  const Limits limits;
+  EXPECT_EQ(w.limits().min_level(), static_cast<std::uint32_t>(limits.minLevel));
+  EXPECT_EQ(w.limits().max_level(), static_cast<std::uint32_t>(limits.maxLevel));
+  EXPECT_GT(w.limits().max_width(), 0u);
+  EXPECT_EQ(w.limits().max_exposure_stops(), render::kMaxExposureStops);
+  EXPECT_EQ(w.settings().exposure_mode(), v1::EXPOSURE_MODE_AUTO);
+
+  v1::ClientMessage change;
+  (*change.mutable_scene()->mutable_object_materials())[1] = "lambert";
+  c.send(change);
+  const auto info = c.expect(v1::ServerMessage::kSceneInfo);
+  ASSERT_TRUE(info);
+  ASSERT_EQ(info->scene_info().objects_size(), w.scene_info().objects_size());
+  EXPECT_EQ(info->scene_info().objects(0).material(), w.scene_info().objects(0).material());
+  EXPECT_EQ(info->scene_info().objects(1).material(), "lambert");
+
+  const auto f = c.expect(v1::ServerMessage::kFrame);
+  ASSERT_TRUE(f);
+  EXPECT_TRUE(std::isfinite(f->frame().exposure_stops()));
+  EXPECT_NE(f->frame().exposure_stops(), 0.0) << "auto exposure measured nothing";
 }
 
 // ---------------------------------------------------------------- HTTP

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "haarcast/assets/procedural_mesh.h"
+#include "haarcast/render/renderer.h"
 
 namespace haarcast::render {
 namespace {
@@ -108,9 +109,16 @@ TEST(CpuRenderer, BadOptionsAreRefusedByName) {
   EXPECT_THROW(checkRenderOptions(o), std::invalid_argument);
   o = smallOptions();
   o.method = RotationMethod::Fused;
-  o.level = 8;  // fused stops at 7
+  o.level = kMaxRenderLevel + 1;  // one range for every method
   EXPECT_THROW(checkRenderOptions(o), std::invalid_argument);
   o.method = RotationMethod::Haar;
+  try {
+    checkRenderOptions(o);
+    ADD_FAILURE() << "level " << o.level << " accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("outside 2..7"), std::string::npos) << e.what();
+  }
+  o.level = kMaxRenderLevel;
   EXPECT_NO_THROW(checkRenderOptions(o));
   EXPECT_THROW(materialFromSpec("phong:"), std::invalid_argument);
   EXPECT_THROW(materialFromSpec("velvet"), std::invalid_argument);

@@ -41,10 +41,6 @@ CameraBasis cameraBasis(const render::Camera& camera);
 FrameParams makeFrameParams(const render::Camera& camera, int width, int height, const glm::dmat3& lightRotation,
                             double exposureStops, bool background, int backgroundLevel);
 
-// The tonemap pass's encoding table: [k] for k = 1 … 255 is the least linear
-// value (before the gain 2^exposureStops) that io::writePng's sRGB encoding
-// rounds to k or more, sRGB⁻¹((k − ½)/255) / gain, computed in double; [0] = 0.
-std::array<float, 256> srgbThresholds(double exposureStops);
 
 // Sparse Haar lists in the triple-product shader's form: one 16-byte block
 // entry (preorder key, h, v, d bits) per block with a non-zero detail,

@@ -74,6 +74,10 @@ void writePfm(const std::string& path, const RgbImage& image);
 // function (IEC 61966-2-1) and rounded.
 void writePng(const std::string& path, const RgbImage& image, double exposureStops = 0.0);
 
+// An already encoded 8-bit sRGB image (render::tonemapRgba8's layout: row 0
+// at the top, 4 bytes per pixel) as an RGBA PNG.
+void writePngRgba8(const std::string& path, const std::vector<std::uint8_t>& rgba8, int width, int height);
+
 // One linear value to an 8-bit sRGB byte: clamped to [0, 1] (NaN → 0), the
 // IEC 61966-2-1 transfer function, rounded. writePng and every tonemap use it.
 std::uint8_t encodeSrgb(double linear);

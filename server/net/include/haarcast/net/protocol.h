@@ -30,8 +30,8 @@ struct Limits {
   int maxHeight = 2048;
   double maxFps = 60.0;
   double defaultFps = 30.0;
-  int minLevel = 2;
-  int maxLevel = 6;
+  int minLevel = render::kMinRenderLevel;
+  int maxLevel = 6;  // ≤ render::kMaxRenderLevel; a level-7 scene takes minutes to prepare
   std::size_t maxLightCoefficients = 4096;
   std::size_t maxMessageBytes = 64 * 1024;  // client → server; poses are ~100 bytes
   int maxSessions = 64;
@@ -59,12 +59,14 @@ struct Catalog {
     std::vector<std::string> defaultMaterials;  // per object, as the scene names them
     render::Camera camera;                      // the scene's own view
     std::vector<render::Pose> poses;            // per object
+    std::vector<std::string> objectNames;       // per object (SceneInfo); empty = "object <i>"
   };
   std::vector<SceneEntry> scenes;             // the first is the default
   std::vector<std::string> materials;         // offered specs: "lambert", "phong:64", MERL names …
   std::vector<std::string> backends;          // "cpu", "vulkan"
 
   const SceneEntry* findScene(std::string_view name) const;  // "" = the default
+  std::vector<std::string> sceneNames() const;
   bool offersMaterial(std::string_view spec) const;
   bool offersBackend(std::string_view backend) const;
 };
@@ -89,6 +91,7 @@ struct SessionConfig {
   int level = 5;
   std::size_t lightCoefficients = 256;
   std::string backend = "cpu";
+  bool autoExposure = true;   // else exposureStops
   double exposureStops = 0.0;
 
   // Identifies the prepared renderer this config needs; equal keys share one.
@@ -130,7 +133,8 @@ PoseState initialPose(const render::Camera& camera, const std::vector<render::Po
 // fatal) and nothing of the update is applied.
 std::optional<ProtocolError> applyPose(PoseState& state, const v1::PoseUpdate& update);
 
-// The render request for a pose under a config.
+// The render request for a pose under a config (exposure: the config's mode;
+// the session adds the previous frame's exposure for auto).
 render::FrameRequest frameRequest(const PoseState& pose, const SessionConfig& config);
 
 // Wire enums ↔ ours.
@@ -138,6 +142,9 @@ v1::Encoding toWire(FrameEncoding encoding);
 v1::RotationMethod toWire(RotationMethod method);
 v1::Backend backendToWire(std::string_view backend);
 v1::RenderSettings settingsToWire(const SessionConfig& config);
+v1::ServerLimits limitsToWire(const Limits& limits);
+// The config's scene, its objects (named by the catalog) and their materials.
+v1::SceneInfo sceneInfo(const SessionConfig& config, const Catalog& catalog);
 
 // Serialised ServerMessages.
 std::string serialize(const v1::ServerMessage& message);

@@ -28,10 +28,12 @@
 #include "haarcast/core/fused.h"
 #include "haarcast/core/haar.h"
 #include "haarcast/core/rotation.h"
+#include "haarcast/core/shared_layout.h"
 #include "haarcast/core/sphere_map.h"
 #include "haarcast/io/image.h"
 #include "haarcast/render/cpu_renderer.h"
 #include "haarcast/render/scene.h"
+#include "haarcast/render/tonemap.h"
 
 namespace haarcast::render {
 
@@ -45,7 +47,8 @@ struct FrameRequest {
   glm::dmat3 lightRotation{1.0};
   // k, the light's largest coefficients kept; 0 = RenderOptions::lightCoefficients.
   std::size_t lightCoefficients = 0;
-  double exposureStops = 0.0;  // for the RGBA8 image only
+  // The RGBA8 image's exposure (tonemap.h): automatic by default.
+  ExposureControl exposure;
   // false: the caller needs only rgba8 (an encoder), so a backend may skip
   // reading the linear image back (Frame::image is then empty).
   bool linearImage = true;
@@ -65,6 +68,8 @@ struct Frame {
   std::vector<StageTime> stages;      // in pipeline order
   double seconds = 0.0;               // wall time of render()
   std::size_t coefficientBytes = 0;   // coefficient data read this frame (slices, light, visibility, method tables)
+  double exposureStops = 0.0;         // the exposure rgba8 was made with
+  double logAverageLuminance = 0.0;   // of the lit object pixels (frameLogAverage); 0: none lit
 };
 
 class Renderer {
@@ -126,9 +131,9 @@ RotationInput rotationInput(const glm::dvec3& normal, const glm::dvec3& towardEy
 glm::dvec3 backgroundRadiance(const std::array<SphereMap, 3>& background, const glm::dmat3& lightRotation,
                               const glm::dvec3& direction);
 
-// Exposure, clamp to [0, 1], sRGB transfer, alpha 255: the same encoding as
-// io::writePng. The Vulkan tonemap pass is tested against this.
-std::vector<std::uint8_t> tonemapRgba8(const io::RgbImage& image, double exposureStops);
+// What auto exposure measures: the log-average luminance of the lit object
+// pixels (tonemap.h), or of the whole image when no object pixel is lit.
+double frameLogAverage(const io::RgbImage& image, const std::vector<std::uint8_t>& objectMask);
 
 // Throws std::invalid_argument naming the problem.
 void checkFrameRequest(const FrameRequest& request, std::size_t objectCount);
@@ -136,6 +141,9 @@ void checkFrameRequest(const FrameRequest& request, std::size_t objectCount);
 // The bounds a frame request must keep (checkFrameRequest), one set for every
 // backend, the service and the clients.
 inline constexpr int kMaxFrameSide = 8192;
+// Map levels every per-pixel method accepts on both backends (`fused`'s cap).
+inline constexpr int kMinRenderLevel = static_cast<int>(shared::kMinLevel);
+inline constexpr int kMaxRenderLevel = static_cast<int>(shared::kFusedMaxLevel);
 inline constexpr double kMinFovDegrees = 1.0;
 inline constexpr double kMaxFovDegrees = 170.0;
 inline constexpr double kMinEyeDistance = 1e-3;  // eye to target, scene units
