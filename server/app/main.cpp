@@ -2,6 +2,9 @@
 #include <cstdio>
 #include <exception>
 #include <iostream>
+#include <optional>
+#include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -13,6 +16,42 @@
 #include "serve_command.h"
 
 namespace {
+
+// Edit distance (insertions, deletions, substitutions), for "did you mean".
+std::size_t editDistance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = up;
+    }
+  }
+  return row[b.size()];
+}
+
+// A first argument that is not an option and names no command: CLI11 would
+// only say "A subcommand is required". Name the word, the nearest command
+// and every command.
+std::optional<std::string> unknownCommand(const CLI::App& app, int argc, char** argv) {
+  if (argc < 2 || argv[1][0] == '-') return std::nullopt;
+  const std::string word = argv[1];
+  std::string all, nearest;
+  std::size_t best = std::string::npos;
+  for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) {
+    const std::string& name = sub->get_name();
+    if (name == word) return std::nullopt;
+    all += (all.empty() ? "" : ", ") + name;
+    const std::size_t d = editDistance(word, name);
+    if (d < best) best = d, nearest = name;
+  }
+  std::string message = "unknown command \"" + word + "\"";
+  if (best <= 2) message += "; did you mean " + nearest + "?";
+  return message + " (commands: " + all + "; --help explains each)";
+}
 
 int runReport(const haarcast::app::RotationReportOptions& options, bool json) {
   const auto report = haarcast::app::runRotationReport(options, [](const std::string& line) {
@@ -53,6 +92,10 @@ int main(int argc, char** argv) {
   const auto runBenchFrame = haarcast::app::addBenchFrameCommand(app);
   const auto runServe = haarcast::app::addServeCommand(app);
 
+  if (const auto unknown = unknownCommand(app, argc, argv)) {
+    std::fprintf(stderr, "haarcast: error: %s\n", unknown->c_str());
+    return 2;
+  }
   try {
     app.parse(argc, argv);
     if (const int rc = runRender(); rc >= 0) return rc;
@@ -67,7 +110,8 @@ int main(int argc, char** argv) {
       return runReport(report, json);
     }
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // --help exits 0; every flag error exits 2, as the checks below do.
+    return app.exit(e) == 0 ? 0 : 2;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "haarcast: error: %s\n", e.what());
     return 2;

@@ -20,8 +20,9 @@ void addSceneFlags(CLI::App& c, SceneFlags& f) {
   c.add_option("--env", f.env, "Environment: EXR, HDR or PFM light probe (lat-long or angular)");
   c.add_option("--env-layout", f.layout, "auto|latlong|angular")->capture_default_str();
   c.add_option("--mesh", f.mesh, "OBJ or PLY mesh (centred and scaled to unit radius)");
-  c.add_option("--material", f.material, "lambert, phong:EXP, blinn-phong:EXP, ggx:ROUGHNESS or a MERL .binary")
-      ->capture_default_str();
+  c.add_option("--material", f.material,
+               std::string("With --mesh: lambert, phong:EXP, blinn-phong:EXP, ggx:ROUGHNESS or a MERL .binary (default ") +
+                   kMeshMaterial + ")");
   c.add_option("--rotate", f.rotate, "Object rotation X,Y,Z in degrees")->delimiter(',')->expected(3);
   c.add_option("--width", f.width, "Image width")->capture_default_str();
   c.add_option("--height", f.height, "Image height")->capture_default_str();
@@ -37,7 +38,10 @@ render::Scene sceneFromFlags(const SceneFlags& f) {
     return render::loadScene(f.scene);
   }
   if (f.mesh.empty()) {
+    // The built-in scene's objects have their own materials and poses.
     if (!f.env.empty()) throw std::invalid_argument("--env needs --mesh (or use --scene)");
+    if (!f.material.empty()) throw std::invalid_argument("--material applies to --mesh (the default scene's objects have their own)");
+    if (!f.rotate.empty()) throw std::invalid_argument("--rotate applies to --mesh (the default scene's objects have their own poses)");
     return render::defaultScene();
   }
   render::Scene scene = render::defaultScene();
@@ -45,7 +49,7 @@ render::Scene sceneFromFlags(const SceneFlags& f) {
   if (!f.env.empty()) scene.environment = render::environmentFromFile(f.env, f.layout);
   auto mesh = std::make_shared<Mesh>(io::loadMesh(f.mesh));
   render::fitToUnitSphere(*mesh);
-  render::SceneObject object{fs::path(f.mesh).stem().string(), mesh, render::materialFromSpec(f.material), {}};
+  render::SceneObject object{fs::path(f.mesh).stem().string(), mesh, render::materialFromSpec(f.material.empty() ? kMeshMaterial : f.material), {}};
   if (!f.rotate.empty()) {
     if (f.rotate.size() != 3) throw std::invalid_argument("--rotate takes X,Y,Z in degrees");
     object.pose.rotateDegrees = {f.rotate[0], f.rotate[1], f.rotate[2]};

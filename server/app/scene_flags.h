@@ -14,8 +14,11 @@
 
 namespace haarcast::app {
 
+// The material of a --mesh object when --material is not given.
+inline constexpr const char* kMeshMaterial = "phong:64";
+
 struct SceneFlags {
-  std::string scene, env, layout = "auto", mesh, material = "phong:64";
+  std::string scene, env, layout = "auto", mesh, material;
   std::vector<double> rotate;
   int width = 128, height = 128;
   std::string background = "env";

@@ -17,6 +17,7 @@
 
 #include "haarcast/gpu/backend.h"
 #include "haarcast/net/server.h"
+#include "haarcast/render/renderer.h"
 #include "haarcast/render/scene.h"
 
 namespace haarcast::app {
@@ -27,6 +28,7 @@ namespace fs = std::filesystem;
 struct ServeArgs {
   net::ServerOptions server;
   std::string token;
+  int port = 8080;  // checked, then narrowed into server.port
   std::string backend = "cpu", method = "fused", encoding = "jpeg";
   int level = 4;
   std::size_t lightCoefficients = 256;
@@ -128,7 +130,12 @@ int run(ServeArgs& a) {
   else if (a.encoding == "raw") d.encoding = net::FrameEncoding::RawRgba8;
   else if (a.encoding == "exr") d.encoding = net::FrameEncoding::Exr;
   else throw std::invalid_argument("--encoding must be jpeg, png, raw or exr (got \"" + a.encoding + "\")");
+  a.server.port = static_cast<std::uint16_t>(a.port);
   auto& limits = a.server.limits;
+  if (limits.maxLevel < render::kMinRenderLevel || limits.maxLevel > render::kMaxRenderLevel) {
+    throw std::invalid_argument("--max-level " + std::to_string(limits.maxLevel) + " is outside " +
+                                std::to_string(render::kMinRenderLevel) + ".." + std::to_string(render::kMaxRenderLevel));
+  }
   if (a.level < limits.minLevel || a.level > limits.maxLevel) {
     throw std::invalid_argument("--level " + std::to_string(a.level) + " is outside " + std::to_string(limits.minLevel) +
                                 ".." + std::to_string(limits.maxLevel) + " (see --max-level)");
@@ -141,6 +148,17 @@ int run(ServeArgs& a) {
   a.server.token = !a.token.empty() ? a.token : (std::getenv("HAARCAST_TOKEN") ? std::getenv("HAARCAST_TOKEN") : "");
   a.server.webRoot = !a.webRoot.empty() ? fs::path(a.webRoot)
                                         : findShipped("client/web", {"../share/haarcast/web", "../client/web", "web"});
+  if (!a.webRoot.empty()) {
+    std::error_code ec;
+    if (!fs::is_regular_file(a.server.webRoot / "index.html", ec)) {
+      throw std::invalid_argument("--web-root " + a.webRoot + ": " +
+                                  (fs::is_directory(a.server.webRoot, ec) ? "has no index.html" : "no such folder") +
+                                  " (it takes the browser client's folder, client/web in the source tree)");
+    }
+  }
+  if (!a.protoFile.empty() && !fs::is_regular_file(a.server.protoFile)) {
+    throw std::invalid_argument("--proto-file " + a.protoFile + ": no such file");
+  }
   a.server.protoFile = !a.protoFile.empty()
                            ? fs::path(a.protoFile)
                            : findShipped("proto/haarcast.proto", {"../share/haarcast/haarcast.proto", "haarcast.proto"});
@@ -199,11 +217,14 @@ std::function<int()> addServeCommand(CLI::App& app) {
   auto a = std::make_shared<ServeArgs>();
   auto* c = app.add_subcommand("serve", "Serve frames over WebSocket to CLI and browser clients (HTTP on the same port)");
   auto& o = a->server;
-  c->add_option("--port", o.port, "TCP port (0 = any free one; the bound one is printed)")->capture_default_str();
+  c->add_option("--port", a->port, "TCP port 0..65535 (0 = any free one; the bound one is printed)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 65535));
   c->add_option("--bind", o.bindAddress, "Address to listen on")->capture_default_str();
   c->add_option("--token", a->token, "Required token (?token=T or Authorization: Bearer T); default $HAARCAST_TOKEN");
   c->add_option("--backend", a->backend, "Default backend: cpu|vulkan")->capture_default_str();
-  c->add_option("--level", a->level, "Default map level n (M = 2^n)")->capture_default_str();
+  c->add_option("--level", a->level, "Default map level n (M = 2^n), within the session limits (--max-level)")
+      ->capture_default_str();
   c->add_option("--method", a->method, "Default per-pixel method: " + pixelMethodNames())->capture_default_str();
   c->add_option("--light-coeffs", a->lightCoefficients, "Default light coefficients kept (k)")->capture_default_str();
   c->add_option("--encoding", a->encoding, "Default encoding: jpeg|png|raw|exr")->capture_default_str();
@@ -216,7 +237,10 @@ std::function<int()> addServeCommand(CLI::App& app) {
   c->add_option("--max-width", o.limits.maxWidth, "Largest frame width")->capture_default_str();
   c->add_option("--max-height", o.limits.maxHeight, "Largest frame height")->capture_default_str();
   c->add_option("--max-fps", o.limits.maxFps, "Largest frame rate per session")->capture_default_str();
-  c->add_option("--max-level", o.limits.maxLevel, "Largest map level a client may ask for")->capture_default_str();
+  c->add_option("--max-level", o.limits.maxLevel,
+                 "Largest map level a client may ask for (" + std::to_string(render::kMinRenderLevel) + ".." +
+                     std::to_string(render::kMaxRenderLevel) + ")")
+      ->capture_default_str();
   c->add_option("--max-message-bytes", o.limits.maxMessageBytes, "Largest client message")->capture_default_str();
   c->add_option("--handshake-timeout", o.handshakeSeconds, "Seconds for the HTTP request and the Hello")->capture_default_str();
   c->add_option("--idle-timeout", o.idleSeconds, "Seconds without a client message before closing")->capture_default_str();

@@ -1,0 +1,50 @@
+#!/usr/bin/env bash
+# `haarcast`'s errors for what a user mistypes: each exits 2 before any work
+# starts, with a message that names the problem and the valid choices.
+#
+# usage: haarcast_errors.sh HAARCAST
+set -uo pipefail
+bin="${1:?usage: haarcast_errors.sh HAARCAST}"
+work="$(mktemp -d -t haarcast-errors.XXXXXX)"
+trap 'rm -rf "$work"' EXIT
+
+failures=0
+# expect NAME WANT_TEXT -- command...: exit 2 and a piece of stderr.
+expect() {
+  local name="$1" want_text="$2"
+  shift 3
+  local rc=0
+  timeout 60 "$@" >"$work/out" 2>"$work/err" </dev/null || rc=$?
+  if [[ "$rc" != 2 ]] || ! grep -qF -- "$want_text" "$work/err"; then
+    echo "FAIL $name: exit $rc (want 2), stderr must contain \"$want_text\":"
+    sed 's/^/    /' "$work/err"
+    failures=$((failures + 1))
+  else
+    echo "ok   $name: \"$want_text\""
+  fi
+}
+
+expect "misspelt command" 'unknown command "rendr"; did you mean render?' -- "$bin" rendr
+expect "commands listed" "commands: rotation-report, render, reference, eval, bench-frame, serve" -- "$bin" rendr
+expect "port out of range" "--port: Value 99999 not in range 0 to 65535" -- "$bin" serve --port 99999
+expect "backend not offered" "--backend gpu is not one this server offers (valid: cpu" -- "$bin" serve --backend gpu
+expect "missing web root" "--web-root $work/none: no such folder" -- "$bin" serve --web-root "$work/none"
+expect "max level outside the range" "--max-level 9 is outside 2..7" -- "$bin" serve --max-level 9
+expect "serve level over --max-level" "--level 7 is outside 2..6 (see --max-level)" -- "$bin" serve --level 7
+expect "render level outside the range" "level 8 is outside 2..7" -- "$bin" render --level 8 --out "$work/x.exr"
+expect "unknown method" "--method must be one of fused" -- "$bin" render --method fast --out "$work/x.exr"
+expect "material without a mesh" "--material applies to --mesh" -- "$bin" render --material velvet --out "$work/x.exr"
+expect "output folder missing" "--out $work/none/x.exr: the folder $work/none does not exist" -- \
+  "$bin" render --out "$work/none/x.exr"
+expect "output extension" "--out must end in .exr or .png" -- "$bin" render --out "$work/x.jpg"
+expect "unknown scene file" "$work/none.json" -- "$bin" serve --scene "$work/none.json"
+
+# Checked before the work: no output was started for any of the above.
+if compgen -G "$work/*.exr" >/dev/null || compgen -G "$work/*.png" >/dev/null; then
+  echo "FAIL an output file was written by a command that failed"
+  failures=$((failures + 1))
+fi
+if ((failures > 0)); then
+  echo "$failures check(s) failed"
+  exit 1
+fi
