@@ -1,0 +1,313 @@
+// The CPU reference backend behind the Renderer interface: Embree primary
+// rays, per-pixel shading on a thread pool, edge pixels antialiased.
+#include "haarcast/render/renderer.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <thread>
+
+#include <glm/geometric.hpp>
+
+#include "haarcast/core/parallel.h"
+#include "haarcast/core/rotate_haar.h"
+#include "haarcast/core/triple_product.h"
+#include "haarcast/render/embree_scene.h"
+#include "haarcast/render/shading.h"
+
+namespace haarcast::render {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+class CpuRenderer final : public Renderer {
+ public:
+  CpuRenderer(const Scene& scene, const RenderOptions& options, const RenderProgress& progress)
+      : options_(options), prepared_(prepareScene(scene, options, progress)) {
+    for (const PreparedObject& p : prepared_.objects) {
+      if (options.method == RotationMethod::Fused) {
+        // The only per-object data fused keeps: the unrotated slices in pixel form.
+        pixelSlices_.push_back(PixelSlices::synthesize(p.table));
+        continue;
+      }
+      std::array<std::unique_ptr<SliceRotator>, 3> r;
+      for (int c = 0; c < 3; ++c) r[static_cast<std::size_t>(c)] = makeRotator(options.method, p.table.channelSlices(c), options.rotator);
+      rotators_.push_back(std::move(r));
+      // haar refined rotates the three channels together, sharing the
+      // geometry and the cell walk (rotate_haar.h).
+      if (options.method == RotationMethod::Haar && options.rotator.haarVariant == HaarVariant::Refined) {
+        rgbHaar_.push_back(std::make_unique<RgbHaarRotator>(
+            std::array<std::vector<HaarMap>, 3>{p.table.channelSlices(0), p.table.channelSlices(1), p.table.channelSlices(2)},
+            options.rotator));
+      } else {
+        rgbHaar_.push_back(nullptr);
+      }
+    }
+    // The meshes' ray structures are built once; frames only move them.
+    std::vector<Instance> instances;
+    for (const PreparedObject& p : prepared_.objects) instances.push_back({p.mesh.get(), glm::mat4(p.pose.objectToWorld())});
+    rays_ = std::make_unique<RayScene>(std::move(instances));
+  }
+
+  std::string backend() const override { return "cpu"; }
+  std::string deviceName() const override {
+    // The SIMD target the fused pass dispatched to on this machine, for reports.
+    return "cpu reference (" + std::to_string(hardwareThreads(options_.threads)) + " threads" +
+           (options_.method == RotationMethod::Fused ? ", " + fusedTargetName() : std::string()) + ")";
+  }
+  const RenderOptions& options() const override { return options_; }
+  std::size_t objectCount() const override { return prepared_.objects.size(); }
+
+  Frame render(const FrameRequest& request) override;
+
+ private:
+  static unsigned hardwareThreads(unsigned t) { return t ? t : std::max(1u, std::thread::hardware_concurrency()); }
+  // Bytes one rotation of one channel reads: the slice, plus for `matrix`
+  // the two elevation matrices it blends and for `table` the stored copy
+  // (which replaces the slice).
+  std::size_t rotationBytes(std::size_t object) const;
+
+  struct PixelInput {
+    RotationInput rotation;
+    double b[3];
+    unsigned vertex[3];
+  };
+  // The per-pixel passes: rotation + triple product (the rotating methods),
+  // or one fused pass. Each fills frame.image and objectMask, adds its stages
+  // and returns the coefficient bytes it read.
+  std::size_t shadeRotating(const ResolvedFrame& resolved, const std::vector<std::optional<Hit>>& hits,
+                            const std::vector<PixelInput>& inputs, Frame& frame, int w, int h);
+  std::size_t shadeFused(const ResolvedFrame& resolved, const std::vector<std::optional<Hit>>& hits,
+                         const std::vector<PixelInput>& inputs, Frame& frame, int w, int h);
+  // Runs shade(i, x, y, object) on every covered pixel, rows in parallel,
+  // after marking it in objectMask; sums what each row's calls return (bytes).
+  template <class Shade>
+  std::size_t forEachCoveredPixel(const std::vector<std::optional<Hit>>& hits, Frame& frame, int w, int h,
+                                  const Shade& shade) const {
+    std::atomic<std::size_t> total{0};
+    parallelFor(static_cast<std::size_t>(h), [&](std::size_t y) {
+      std::size_t rowBytes = 0;
+      for (int x = 0; x < w; ++x) {
+        const std::size_t i = y * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
+        if (!hits[i]) continue;
+        frame.objectMask[i] = 1;
+        rowBytes += shade(i, x, static_cast<int>(y), hits[i]->object);
+      }
+      total += rowBytes;
+    }, {}, options_.threads);
+    return total.load();
+  }
+
+  RenderOptions options_;
+  PreparedScene prepared_;
+  std::vector<std::array<std::unique_ptr<SliceRotator>, 3>> rotators_;  // rotating methods
+  std::vector<std::unique_ptr<RgbHaarRotator>> rgbHaar_;                 // haar refined, else null
+  std::vector<PixelSlices> pixelSlices_;                                 // fused
+  std::unique_ptr<RayScene> rays_;  // posed per frame with setTransform (top level only)
+};
+
+std::size_t CpuRenderer::rotationBytes(std::size_t object) const {
+  const std::size_t slice = static_cast<std::size_t>(mapSize(options_.level)) * static_cast<std::size_t>(mapSize(options_.level)) * sizeof(float);
+  if (options_.method != RotationMethod::Matrix) return slice;
+  const SliceRotator& r = *rotators_[object][0];
+  const std::size_t matrices = r.storedBytes() - slice * r.sliceCount();
+  return slice + 2 * matrices / static_cast<std::size_t>(std::max(1, options_.rotator.matrixElevations));
+}
+
+Frame CpuRenderer::render(const FrameRequest& request) {
+  const auto start = Clock::now();
+  const unsigned threads = options_.threads;
+  Frame frame;
+
+  // ---- light: world → each object's frame, once per frame -----------------
+  auto t0 = Clock::now();
+  const ResolvedFrame resolved = resolveFrame(prepared_, options_, request);
+  std::size_t bytes = resolved.lightBytes;
+  frame.stages.push_back({"light", since(t0)});
+
+  // ---- gbuffer: Embree primary rays at pixel centres ----------------------
+  t0 = Clock::now();
+  for (std::size_t i = 0; i < resolved.objects.size(); ++i) rays_->setTransform(i, glm::mat4(resolved.objects[i].objectToWorld));
+  const RayScene& rays = *rays_;
+  const int w = request.width, h = request.height;
+  frame.width = w;
+  frame.height = h;
+  const CameraRays camera(request.camera, w, h);
+  const std::size_t pixels = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
+  std::vector<std::optional<Hit>> hits(pixels);
+  parallelFor(static_cast<std::size_t>(h), [&](std::size_t y) {
+    for (int x = 0; x < w; ++x) {
+      Ray r;
+      r.origin = glm::vec3(camera.origin());
+      r.direction = glm::vec3(camera.direction(x, static_cast<int>(y)));
+      hits[y * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)] = rays.intersect(r);
+    }
+  }, {}, threads);
+  frame.stages.push_back({"gbuffer", since(t0)});
+
+  // ---- rotation-input: slice and Euler angles per covered pixel -----------
+  t0 = Clock::now();
+  std::vector<PixelInput> inputs(pixels);
+  parallelFor(static_cast<std::size_t>(h), [&](std::size_t y) {
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = y * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
+      if (!hits[i]) continue;
+      const Hit& hit = *hits[i];
+      const PreparedObject& p = prepared_.objects[hit.object];
+      const Mesh& mesh = *p.mesh;
+      const glm::uvec3 tri = mesh.triangles[hit.triangle];
+      PixelInput& in = inputs[i];
+      in.b[0] = 1.0 - hit.u - hit.v;
+      in.b[1] = hit.u;
+      in.b[2] = hit.v;
+      in.vertex[0] = tri.x;
+      in.vertex[1] = tri.y;
+      in.vertex[2] = tri.z;
+      const glm::dvec3 n = glm::normalize(in.b[0] * glm::dvec3(mesh.normals[tri.x]) + in.b[1] * glm::dvec3(mesh.normals[tri.y]) +
+                                          in.b[2] * glm::dvec3(mesh.normals[tri.z]));
+      const glm::dvec3 wo = glm::transpose(resolved.objects[hit.object].rotation) * -camera.direction(x, static_cast<int>(y));
+      in.rotation = rotationInput(n, wo, p.table);
+    }
+  }, {}, threads);
+  frame.stages.push_back({"rotation-input", since(t0)});
+
+  frame.image = io::makeImage(w, h);
+  frame.objectMask.assign(pixels, 0);
+  bytes += options_.method == RotationMethod::Fused ? shadeFused(resolved, hits, inputs, frame, w, h)
+                                                    : shadeRotating(resolved, hits, inputs, frame, w, h);
+
+  // ---- tonemap: backdrop, RGBA8 --------------------------------------------
+  t0 = Clock::now();
+  if (options_.environmentBackground) {
+    parallelFor(static_cast<std::size_t>(h), [&](std::size_t y) {
+      for (int x = 0; x < w; ++x) {
+        if (frame.objectMask[y * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)]) continue;
+        const glm::dvec3 L = backgroundRadiance(prepared_.background, request.lightRotation, camera.direction(x, static_cast<int>(y)));
+        for (int c = 0; c < 3; ++c) frame.image.at(static_cast<int>(y), x, c) = static_cast<float>(L[c]);
+      }
+    }, {}, threads);
+  }
+  frame.logAverageLuminance = frameLogAverage(frame.image, frame.objectMask);
+  frame.exposureStops = applyExposure(request.exposure, frame.logAverageLuminance);
+  frame.rgba8 = tonemapRgba8(frame.image, frame.exposureStops);
+  frame.stages.push_back({"tonemap", since(t0)});
+  frame.coefficientBytes = bytes;
+  frame.seconds = since(start);
+  return frame;
+}
+
+std::size_t CpuRenderer::shadeRotating(const ResolvedFrame& resolved, const std::vector<std::optional<Hit>>& hits,
+                                       const std::vector<PixelInput>& inputs, Frame& frame, int w, int h) {
+  // The light's lists are validated and put in the walk's order once per frame.
+  std::vector<std::array<PreparedLight, 3>> light(resolved.objects.size());
+  for (std::size_t i = 0; i < light.size(); ++i)
+    for (std::size_t c = 0; c < 3; ++c) light[i][c].assign(resolved.objects[i].light[c]);
+  // The CPU keeps one rotated map per thread instead of a frame's worth, so
+  // the two stages run interleaved; their wall time is split in proportion
+  // to the thread time each took.
+  const auto t0 = Clock::now();
+  std::atomic<std::int64_t> rotationNs{0}, productNs{0};
+  const std::size_t bytes = forEachCoveredPixel(hits, frame, w, h, [&](std::size_t i, int x, int y, std::size_t object) {
+    // Per worker thread, kept across pixels: no allocation per pixel once warm.
+    struct Scratch {
+      std::array<HaarMap, 3> rotated;
+      HaarRotationScratch haar;
+      SparseHaar merged;
+      PreparedVisibility visibility;
+    };
+    thread_local Scratch s;
+    const PreparedObject& p = prepared_.objects[object];
+    const PixelInput& in = inputs[i];
+    const auto a = Clock::now();
+    const std::size_t slice = static_cast<std::size_t>(in.rotation.slice);
+    if (rgbHaar_[object]) {
+      rgbHaar_[object]->rotate(slice, in.rotation.euler, s.rotated, s.haar);
+    } else {
+      for (std::size_t c = 0; c < 3; ++c) rotators_[object][c]->rotate(slice, in.rotation.euler, s.rotated[c]);
+    }
+    const auto b = Clock::now();
+    // The product is linear in V: the three vertices' lists merged with
+    // their barycentric weights, then one product per channel.
+    const std::array<const SparseHaar*, 3> vertices{&p.visibility[in.vertex[0]], &p.visibility[in.vertex[1]],
+                                                    &p.visibility[in.vertex[2]]};
+    mergeVisibility(vertices, {in.b[0], in.b[1], in.b[2]}, s.merged);
+    s.visibility.assign(s.merged);
+    for (std::size_t c = 0; c < 3; ++c) {
+      frame.image.at(y, x, static_cast<int>(c)) = static_cast<float>(tripleProduct(light[object][c], s.rotated[c], s.visibility));
+    }
+    rotationNs += std::chrono::duration_cast<std::chrono::nanoseconds>(b - a).count();
+    productNs += std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - b).count();
+    std::size_t read = 3 * rotationBytes(object);
+    for (const SparseHaar* v : vertices) read += v->size() * (sizeof(std::uint32_t) + sizeof(float));
+    return read;
+  });
+  const double shading = since(t0);
+  const double busy = static_cast<double>(rotationNs.load() + productNs.load());
+  const double rotationShare = busy > 0.0 ? static_cast<double>(rotationNs.load()) / busy : 0.5;
+  frame.stages.push_back({"rotation", shading * rotationShare});
+  frame.stages.push_back({"triple-product", shading * (1.0 - rotationShare)});
+  return bytes;
+}
+
+std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const std::vector<std::optional<Hit>>& hits,
+                                    const std::vector<PixelInput>& inputs, Frame& frame, int w, int h) {
+  const auto t0 = Clock::now();
+  const std::size_t bytes = forEachCoveredPixel(hits, frame, w, h, [&](std::size_t i, int x, int y, std::size_t object) {
+    // Per worker thread, kept across pixels: no allocation per pixel.
+    thread_local FusedScratch scratch;
+    const PreparedObject& p = prepared_.objects[object];
+    const PixelInput& in = inputs[i];
+    std::array<WeightedVisibility, 3> vis;
+    std::size_t entries = 0;
+    for (std::size_t v = 0; v < 3; ++v) {
+      vis[v] = {&p.visibility[in.vertex[v]], static_cast<float>(in.b[v])};
+      entries += vis[v].list->size();
+    }
+    const PixelSlices& slices = pixelSlices_[object];
+    const shared::SliceBlend blend = shared::sliceBlendAt(static_cast<float>(in.rotation.thetaOut),
+                                                          static_cast<shared::uint>(slices.thetaSamples()),
+                                                          options_.interpolateSlices ? 1u : 0u);
+    const std::array<float, 3> rgb = fusedShade(slices, blend, in.rotation.euler, resolved.objects[object].fusedLight, vis, scratch);
+    for (int c = 0; c < 3; ++c) frame.image.at(y, x, c) = rgb[static_cast<std::size_t>(c)];
+    return fusedPixelBytes(slices.level(), blend.weight != 0.0f, entries);
+  });
+  frame.stages.push_back({"fused", since(t0)});
+  return bytes;
+}
+
+}  // namespace
+
+std::unique_ptr<Renderer> makeCpuRenderer(const Scene& scene, const RenderOptions& options, const RenderProgress& progress) {
+  return std::make_unique<CpuRenderer>(scene, options, progress);
+}
+
+// The one-frame convenience of step 2, now a CPU renderer used once.
+RenderResult renderCpu(const Scene& scene, const RenderOptions& options, const RenderProgress& progress) {
+  const auto t0 = Clock::now();
+  const auto renderer = makeCpuRenderer(scene, options, progress);
+  RenderResult result;
+  result.timings.precompute = since(t0);
+  FrameRequest request;
+  request.width = options.width;
+  request.height = options.height;
+  request.camera = scene.camera;
+  Frame frame = renderer->render(request);
+  for (const StageTime& s : frame.stages) {
+    if (s.name == "light") {
+      result.timings.light = s.seconds;
+    } else if (s.name == "gbuffer") {
+      result.timings.gbuffer = s.seconds;
+    } else {
+      result.timings.shading += s.seconds;
+    }
+  }
+  result.image = std::move(frame.image);
+  result.objectMask = std::move(frame.objectMask);
+  return result;
+}
+
+}  // namespace haarcast::render
