@@ -32,6 +32,7 @@ struct BenchArgs {
   std::string levels = "4";
   std::string methods{methodName(kDefaultPixelMethod)};
   std::string slices = "blend";  // fused: blend | nearest
+  std::string antialias = "off";  // on: CPU only (the cost of the edge sub-samples)
   std::string scene;  // scene file; empty = the built-in default
   std::string device;
   std::string cacheDir;
@@ -156,6 +157,11 @@ int run(const BenchArgs& a) {
   const std::vector<int> levels = parseInts(a.levels, "--levels", 2, 8);
   const std::vector<RotationMethod> methods = parseMethods(a.methods);
   const bool cpu = a.backend != "vulkan", vulkan = a.backend != "cpu";
+  if (a.antialias != "on" && a.antialias != "off") {
+    throw std::invalid_argument("--antialias must be on or off (got \"" + a.antialias + "\")");
+  }
+  const bool antialias = a.antialias == "on";
+  if (antialias && vulkan) throw std::invalid_argument("--antialias on needs --backend cpu (the Vulkan backend takes one sample per pixel)");
   const render::Scene scene = a.scene.empty() ? render::defaultScene() : render::loadScene(a.scene);
 
   nlohmann::json out;
@@ -185,6 +191,7 @@ int run(const BenchArgs& a) {
       options.level = level;
       options.method = method;
       options.interpolateSlices = a.slices == "blend";
+      options.antialias = antialias;
       options.cacheDir = a.cacheDir == "none" ? "" : a.cacheDir;
       std::fprintf(stderr, "[bench-frame] level %d, %s: preparing\n", level, std::string(methodName(method)).c_str());
       std::unique_ptr<render::Renderer> cpuRenderer, gpuRenderer;
@@ -242,6 +249,7 @@ int run(const BenchArgs& a) {
           }
           out["runs"].push_back(run);
           if (method == RotationMethod::Fused) run["slices"] = a.slices;
+          run["antialias"] = antialias;
           std::string row = "| " + std::to_string(level) + " | " + std::string(methodName(method)) + " | " +
                             std::to_string(width) + "×" + std::to_string(height) + " | " + backend + " |";
           for (const char* name : {"light", "gbuffer", "rotation-input", "rotation", "triple-product", "fused", "tonemap"}) {
@@ -281,6 +289,8 @@ std::function<int()> addBenchFrameCommand(CLI::App& app) {
   c->add_option("--levels", args->levels, "Map levels, comma-separated (2..8; fused 2..7; the other methods on Vulkan 2..6)")
       ->capture_default_str();
   c->add_option("--method", args->methods, "Per-pixel methods, comma-separated (" + pixelMethodNames() + "), or all")
+      ->capture_default_str();
+  c->add_option("--antialias", args->antialias, "on|off: edge pixels as the mean of 4 sub-samples (on: --backend cpu)")
       ->capture_default_str();
   c->add_option("--slices", args->slices, "fused: blend the two nearest θo slices (blend) or take the nearest (nearest)")
       ->capture_default_str();

@@ -21,7 +21,7 @@ namespace fs = std::filesystem;
 
 struct RenderArgs {
   SceneFlags scene;
-  std::string method = "fused", variant = "refined", backend = "cpu", device, cacheDir;
+  std::string method = "fused", variant = "refined", backend = "cpu", device, cacheDir, antialias = "auto";
   bool validation = gpu::kValidationByDefault;
   render::RenderOptions options;
 };
@@ -69,6 +69,7 @@ int run(RenderArgs& a) {
   a.options.width = a.scene.width;
   a.options.height = a.scene.height;
   a.options.environmentBackground = environmentBackground(a.scene);
+  a.options.antialias = antialiasFor(a.antialias, a.backend);
   a.options.cacheDir = a.cacheDir.empty() ? defaultCacheDir() : (a.cacheDir == "none" ? "" : a.cacheDir);
   render::checkRenderOptions(a.options);
   checkOutputPath(a.scene);
@@ -118,6 +119,8 @@ std::function<int()> addRenderCommand(CLI::App& app) {
   c->add_option("--visibility-coeffs", args->options.visibility.keep, "Visibility coefficients kept per vertex")
       ->capture_default_str();
   c->add_option("--backend", args->backend, "cpu|vulkan")->capture_default_str();
+  c->add_option("--antialias", args->antialias, "auto|on|off: edge pixels as the mean of 4 sub-samples (auto: on for cpu)")
+      ->capture_default_str();
   c->add_option("--device", args->device, "Vulkan device: an index or a name substring (default: discrete > integrated > CPU)");
   c->add_flag("--validation,!--no-validation", args->validation, "Vulkan validation layers (when installed)")
       ->capture_default_str();

@@ -19,6 +19,7 @@
 #include "haarcast/net/server.h"
 #include "haarcast/render/renderer.h"
 #include "haarcast/render/scene.h"
+#include "scene_flags.h"
 
 namespace haarcast::app {
 namespace {
@@ -29,6 +30,7 @@ struct ServeArgs {
   net::ServerOptions server;
   std::string token;
   int port = 8080;  // checked, then narrowed into server.port
+  std::string antialias = "auto";
   std::string backend = "cpu", method = "fused", encoding = "jpeg";
   int level = 4;
   std::size_t lightCoefficients = 256;
@@ -173,7 +175,10 @@ int run(ServeArgs& a) {
   const gpu::VulkanOptions vulkanOptions{a.vulkanDevice, a.vulkanValidation};
   auto sharedScenes = std::make_shared<std::vector<SceneSource>>(std::move(scenes));
   const bool quiet = a.quiet;
-  net::RendererBuilder builder = [sharedScenes, materialFiles, base, vulkanOptions, quiet](const net::SessionConfig& c) {
+  const std::string antialias = a.antialias;
+  antialiasFor(antialias, a.backend);  // a bad flag fails at start, not in a session
+  net::RendererBuilder builder = [sharedScenes, materialFiles, base, vulkanOptions, quiet,
+                                  antialias](const net::SessionConfig& c) {
     const auto it = std::find_if(sharedScenes->begin(), sharedScenes->end(),
                                  [&](const SceneSource& s) { return s.name == c.scene; });
     if (it == sharedScenes->end()) throw std::invalid_argument("unknown scene \"" + c.scene + "\"");
@@ -188,6 +193,7 @@ int run(ServeArgs& a) {
     options.level = c.level;
     options.method = c.method;
     options.lightCoefficients = c.lightCoefficients;
+    options.antialias = antialiasFor(antialias, c.backend);
     if (!quiet) std::fprintf(stderr, "[serve] preparing renderer %s\n", c.rendererKey().c_str());
     auto prepared = std::make_shared<net::PreparedRenderer>();
     prepared->renderer = gpu::makeRenderer(c.backend, scene, options, vulkanOptions);
@@ -223,6 +229,8 @@ std::function<int()> addServeCommand(CLI::App& app) {
   c->add_option("--bind", o.bindAddress, "Address to listen on")->capture_default_str();
   c->add_option("--token", a->token, "Required token (?token=T or Authorization: Bearer T); default $HAARCAST_TOKEN");
   c->add_option("--backend", a->backend, "Default backend: cpu|vulkan")->capture_default_str();
+  c->add_option("--antialias", a->antialias, "auto|on|off: edge pixels as the mean of 4 sub-samples (auto: on for cpu)")
+      ->capture_default_str();
   c->add_option("--level", a->level, "Default map level n (M = 2^n), within the session limits (--max-level)")
       ->capture_default_str();
   c->add_option("--method", a->method, "Default per-pixel method: " + pixelMethodNames())->capture_default_str();

@@ -11,6 +11,8 @@
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
 
+#include "haarcast/render/shading.h"
+
 namespace haarcast::gpu {
 
 CameraBasis cameraBasis(const render::Camera& camera) {
@@ -32,7 +34,7 @@ FrameParams makeFrameParams(const render::Camera& camera, int width, int height,
   f.up = glm::vec4(glm::vec3(basis.up), 0.0f);
   const glm::dmat3 lt = glm::transpose(lightRotation);
   for (int c = 0; c < 3; ++c) f.lightRotT[c] = glm::vec4(glm::vec3(lt[c]), 0.0f);
-  f.tanHalf = static_cast<float>(basis.tanHalf);
+  f.tanHalf = static_cast<float>(render::verticalTanHalf(camera, width, height));
   f.aspect = static_cast<float>(static_cast<double>(width) / height);
   f.gain = static_cast<float>(std::exp2(exposureStops));
   f.background = background ? 1u : 0u;

@@ -17,6 +17,7 @@
 #include "haarcast/gpu/compute.h"
 #include "haarcast/gpu/rotation_data.h"
 #include "haarcast/gpu/shaders.h"
+#include "haarcast/render/shading.h"
 #include "haarcast/render/tonemap.h"
 
 namespace haarcast::gpu {
@@ -136,6 +137,9 @@ VulkanRenderer::Impl::Impl(const render::Scene& scene, const render::RenderOptio
                            const render::RenderProgress& progress, const VulkanRendererLimits& l)
     : options(o), limits(l), prepared(), context(vulkan) {
   render::checkRenderOptions(options);
+  if (options.antialias) {
+    throw std::invalid_argument("antialiasing is drawn by the CPU backend only: the Vulkan backend takes one sample per pixel");
+  }
   fused = options.method == RotationMethod::Fused;
   if (fused) {
     checkFusedLevel(options.level);  // 2–7: its scratch need not fit in shared memory
@@ -643,7 +647,7 @@ namespace {
 glm::dmat4 viewProjection(const render::Camera& camera, int width, int height, double nearPlane) {
   const CameraBasis basis = cameraBasis(camera);
   const glm::dvec3 &f = basis.forward, &r = basis.right, &u = basis.up;
-  const double tanHalf = basis.tanHalf;
+  const double tanHalf = render::verticalTanHalf(camera, width, height);
   const double aspect = static_cast<double>(width) / height;
   const glm::dvec3& e = camera.eye;
   glm::dmat4 m(0.0);  // m[column][row]

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <functional>
 #include <thread>
 
 #include <glm/geometric.hpp>
@@ -76,31 +77,40 @@ class CpuRenderer final : public Renderer {
     double b[3];
     unsigned vertex[3];
   };
+  // One shaded sample: the centre of a covered pixel, or a covered
+  // sub-sample of an edge pixel (shared::kSubsamples of them).
+  struct Sample {
+    std::size_t object = 0;
+    Hit hit;
+    glm::dvec3 direction{0.0};  // of the camera ray, world frame
+    PixelInput input;           // filled by the rotation-input stage
+  };
+  static constexpr std::uint32_t kInterior = ~0u;
+  // The frame's primary visibility: the centre sample of every pixel, and
+  // for each edge pixel (edge[i] ≠ kInterior) its sub-samples.
+  struct GBuffer {
+    std::vector<std::optional<Sample>> centre;
+    std::vector<std::uint32_t> edge;
+    std::vector<std::array<std::optional<Sample>, shared::kSubsamples>> sub;
+  };
+  // gbuffer: traces the centres, finds the edge pixels, traces their
+  // sub-samples. rotation-input: each sample's slice and Euler angles.
+  void traceGBuffer(const CameraRays& camera, int w, int h, GBuffer& g) const;
+  void fillInputs(const ResolvedFrame& resolved, GBuffer& g) const;
+  static glm::dvec3 subsampleDirection(const CameraRays& camera, int x, int y, unsigned k);
+  // rgb = the sample's radiance; returns the coefficient bytes read.
+  using Shade = std::function<std::size_t(const Sample&, std::array<float, 3>& rgb)>;
+  // Every covered pixel: the centre sample shaded, or for an edge pixel the
+  // mean of its sub-samples (the backdrop where one misses); rows in
+  // parallel. Marks objectMask; returns the bytes read.
+  std::size_t shadePixels(const GBuffer& g, const FrameRequest& request, const CameraRays& camera, Frame& frame,
+                          const Shade& shade) const;
   // The per-pixel passes: rotation + triple product (the rotating methods),
-  // or one fused pass. Each fills frame.image and objectMask, adds its stages
-  // and returns the coefficient bytes it read.
-  std::size_t shadeRotating(const ResolvedFrame& resolved, const std::vector<std::optional<Hit>>& hits,
-                            const std::vector<PixelInput>& inputs, Frame& frame, int w, int h);
-  std::size_t shadeFused(const ResolvedFrame& resolved, const std::vector<std::optional<Hit>>& hits,
-                         const std::vector<PixelInput>& inputs, Frame& frame, int w, int h);
-  // Runs shade(i, x, y, object) on every covered pixel, rows in parallel,
-  // after marking it in objectMask; sums what each row's calls return (bytes).
-  template <class Shade>
-  std::size_t forEachCoveredPixel(const std::vector<std::optional<Hit>>& hits, Frame& frame, int w, int h,
-                                  const Shade& shade) const {
-    std::atomic<std::size_t> total{0};
-    parallelFor(static_cast<std::size_t>(h), [&](std::size_t y) {
-      std::size_t rowBytes = 0;
-      for (int x = 0; x < w; ++x) {
-        const std::size_t i = y * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
-        if (!hits[i]) continue;
-        frame.objectMask[i] = 1;
-        rowBytes += shade(i, x, static_cast<int>(y), hits[i]->object);
-      }
-      total += rowBytes;
-    }, {}, options_.threads);
-    return total.load();
-  }
+  // or one fused pass. Each adds its stages and returns the bytes read.
+  std::size_t shadeRotating(const ResolvedFrame& resolved, const GBuffer& g, const FrameRequest& request,
+                            const CameraRays& camera, Frame& frame);
+  std::size_t shadeFused(const ResolvedFrame& resolved, const GBuffer& g, const FrameRequest& request,
+                         const CameraRays& camera, Frame& frame);
 
   RenderOptions options_;
   PreparedScene prepared_;
@@ -118,9 +128,124 @@ std::size_t CpuRenderer::rotationBytes(std::size_t object) const {
   return slice + 2 * matrices / static_cast<std::size_t>(std::max(1, options_.rotator.matrixElevations));
 }
 
+glm::dvec3 CpuRenderer::subsampleDirection(const CameraRays& camera, int x, int y, unsigned k) {
+  const double o = shared::kSubsampleOffset;
+  return camera.directionAt(x + 0.5 + ((k & 1u) ? o : -o), y + 0.5 + ((k & 2u) ? o : -o));
+}
+
+void CpuRenderer::traceGBuffer(const CameraRays& camera, int w, int h, GBuffer& g) const {
+  const std::size_t pixels = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
+  const RayScene& rays = *rays_;
+  auto trace = [&](const glm::dvec3& direction) -> std::optional<Sample> {
+    Ray r;
+    r.origin = glm::vec3(camera.origin());
+    r.direction = glm::vec3(direction);
+    const std::optional<Hit> hit = rays.intersect(r);
+    if (!hit) return std::nullopt;
+    Sample s;
+    s.object = hit->object;
+    s.hit = *hit;
+    s.direction = direction;
+    return s;
+  };
+  g.centre.assign(pixels, std::nullopt);
+  parallelFor(static_cast<std::size_t>(h), [&](std::size_t y) {
+    for (int x = 0; x < w; ++x) g.centre[y * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)] = trace(camera.direction(x, static_cast<int>(y)));
+  }, {}, options_.threads);
+
+  // Edge pixels (shared_layout.h): the 3×3 centres do not agree on the object.
+  g.edge.assign(pixels, kInterior);
+  g.sub.clear();
+  if (!options_.antialias) return;
+  auto id = [&](int x, int y) -> std::size_t {
+    const auto& c = g.centre[static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)];
+    return c ? c->object + 1 : 0;
+  };
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const std::size_t mine = id(x, y);
+      bool edge = false;
+      for (int dy = -1; dy <= 1 && !edge; ++dy)
+        for (int dx = -1; dx <= 1 && !edge; ++dx) edge = id(std::clamp(x + dx, 0, w - 1), std::clamp(y + dy, 0, h - 1)) != mine;
+      if (!edge) continue;
+      g.edge[static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)] =
+          static_cast<std::uint32_t>(g.sub.size());
+      g.sub.emplace_back();
+    }
+  }
+  parallelFor(static_cast<std::size_t>(h), [&](std::size_t y) {
+    for (int x = 0; x < w; ++x) {
+      const std::uint32_t e = g.edge[y * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)];
+      if (e == kInterior) continue;
+      for (unsigned k = 0; k < shared::kSubsamples; ++k) g.sub[e][k] = trace(subsampleDirection(camera, x, static_cast<int>(y), k));
+    }
+  }, {}, options_.threads);
+}
+
+void CpuRenderer::fillInputs(const ResolvedFrame& resolved, GBuffer& g) const {
+  // The interpolated normal and the view direction in the object's frame.
+  auto fill = [&](Sample& s) {
+    const PreparedObject& p = prepared_.objects[s.object];
+    const Mesh& mesh = *p.mesh;
+    const glm::uvec3 tri = mesh.triangles[s.hit.triangle];
+    PixelInput& in = s.input;
+    in.b[0] = 1.0 - s.hit.u - s.hit.v;
+    in.b[1] = s.hit.u;
+    in.b[2] = s.hit.v;
+    in.vertex[0] = tri.x;
+    in.vertex[1] = tri.y;
+    in.vertex[2] = tri.z;
+    const glm::dvec3 n = glm::normalize(in.b[0] * glm::dvec3(mesh.normals[tri.x]) + in.b[1] * glm::dvec3(mesh.normals[tri.y]) +
+                                        in.b[2] * glm::dvec3(mesh.normals[tri.z]));
+    const glm::dvec3 wo = glm::transpose(resolved.objects[s.object].rotation) * -s.direction;
+    in.rotation = rotationInput(n, wo, p.table);
+  };
+  parallelFor(g.centre.size(), [&](std::size_t i) {
+    if (g.centre[i]) fill(*g.centre[i]);
+  }, {}, options_.threads);
+  parallelFor(g.sub.size(), [&](std::size_t e) {
+    for (auto& s : g.sub[e])
+      if (s) fill(*s);
+  }, {}, options_.threads);
+}
+
+std::size_t CpuRenderer::shadePixels(const GBuffer& g, const FrameRequest& request, const CameraRays& camera,
+                                     Frame& frame, const Shade& shade) const {
+  const int w = frame.width, h = frame.height;
+  std::atomic<std::size_t> total{0};
+  parallelFor(static_cast<std::size_t>(h), [&](std::size_t y) {
+    std::size_t rowBytes = 0;
+    std::array<float, 3> rgb{};
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = y * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
+      if (g.centre[i]) frame.objectMask[i] = 1;
+      if (g.edge[i] == kInterior) {
+        if (!g.centre[i]) continue;  // the backdrop, drawn by the tonemap stage
+        rowBytes += shade(*g.centre[i], rgb);
+        for (int c = 0; c < 3; ++c) frame.image.at(static_cast<int>(y), x, c) = rgb[static_cast<std::size_t>(c)];
+        continue;
+      }
+      glm::dvec3 sum(0.0);
+      for (unsigned k = 0; k < shared::kSubsamples; ++k) {
+        const auto& s = g.sub[g.edge[i]][k];
+        if (s) {
+          rowBytes += shade(*s, rgb);
+          sum += glm::dvec3(rgb[0], rgb[1], rgb[2]);
+        } else if (options_.environmentBackground) {
+          sum += backgroundRadiance(prepared_.background, request.lightRotation,
+                                    subsampleDirection(camera, x, static_cast<int>(y), k));
+        }
+      }
+      sum /= static_cast<double>(shared::kSubsamples);
+      for (int c = 0; c < 3; ++c) frame.image.at(static_cast<int>(y), x, c) = static_cast<float>(sum[c]);
+    }
+    total += rowBytes;
+  }, {}, options_.threads);
+  return total.load();
+}
+
 Frame CpuRenderer::render(const FrameRequest& request) {
   const auto start = Clock::now();
-  const unsigned threads = options_.threads;
   Frame frame;
 
   // ---- light: world → each object's frame, once per frame -----------------
@@ -129,67 +254,37 @@ Frame CpuRenderer::render(const FrameRequest& request) {
   std::size_t bytes = resolved.lightBytes;
   frame.stages.push_back({"light", since(t0)});
 
-  // ---- gbuffer: Embree primary rays at pixel centres ----------------------
-  t0 = Clock::now();
+  // ---- gbuffer, rotation-input: Embree primary rays, per-sample inputs ----
   for (std::size_t i = 0; i < resolved.objects.size(); ++i) rays_->setTransform(i, glm::mat4(resolved.objects[i].objectToWorld));
-  const RayScene& rays = *rays_;
   const int w = request.width, h = request.height;
   frame.width = w;
   frame.height = h;
   const CameraRays camera(request.camera, w, h);
   const std::size_t pixels = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
-  std::vector<std::optional<Hit>> hits(pixels);
-  parallelFor(static_cast<std::size_t>(h), [&](std::size_t y) {
-    for (int x = 0; x < w; ++x) {
-      Ray r;
-      r.origin = glm::vec3(camera.origin());
-      r.direction = glm::vec3(camera.direction(x, static_cast<int>(y)));
-      hits[y * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)] = rays.intersect(r);
-    }
-  }, {}, threads);
-  frame.stages.push_back({"gbuffer", since(t0)});
-
-  // ---- rotation-input: slice and Euler angles per covered pixel -----------
+  GBuffer g;
   t0 = Clock::now();
-  std::vector<PixelInput> inputs(pixels);
-  parallelFor(static_cast<std::size_t>(h), [&](std::size_t y) {
-    for (int x = 0; x < w; ++x) {
-      const std::size_t i = y * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
-      if (!hits[i]) continue;
-      const Hit& hit = *hits[i];
-      const PreparedObject& p = prepared_.objects[hit.object];
-      const Mesh& mesh = *p.mesh;
-      const glm::uvec3 tri = mesh.triangles[hit.triangle];
-      PixelInput& in = inputs[i];
-      in.b[0] = 1.0 - hit.u - hit.v;
-      in.b[1] = hit.u;
-      in.b[2] = hit.v;
-      in.vertex[0] = tri.x;
-      in.vertex[1] = tri.y;
-      in.vertex[2] = tri.z;
-      const glm::dvec3 n = glm::normalize(in.b[0] * glm::dvec3(mesh.normals[tri.x]) + in.b[1] * glm::dvec3(mesh.normals[tri.y]) +
-                                          in.b[2] * glm::dvec3(mesh.normals[tri.z]));
-      const glm::dvec3 wo = glm::transpose(resolved.objects[hit.object].rotation) * -camera.direction(x, static_cast<int>(y));
-      in.rotation = rotationInput(n, wo, p.table);
-    }
-  }, {}, threads);
+  traceGBuffer(camera, w, h, g);
+  frame.stages.push_back({"gbuffer", since(t0)});
+  t0 = Clock::now();
+  fillInputs(resolved, g);
   frame.stages.push_back({"rotation-input", since(t0)});
 
   frame.image = io::makeImage(w, h);
   frame.objectMask.assign(pixels, 0);
-  bytes += options_.method == RotationMethod::Fused ? shadeFused(resolved, hits, inputs, frame, w, h)
-                                                    : shadeRotating(resolved, hits, inputs, frame, w, h);
+  bytes += options_.method == RotationMethod::Fused ? shadeFused(resolved, g, request, camera, frame)
+                                                    : shadeRotating(resolved, g, request, camera, frame);
 
   // ---- tonemap: backdrop, RGBA8 --------------------------------------------
   t0 = Clock::now();
   if (options_.environmentBackground) {
     parallelFor(static_cast<std::size_t>(h), [&](std::size_t y) {
       for (int x = 0; x < w; ++x) {
-        if (frame.objectMask[y * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)]) continue;
+        const std::size_t i = y * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
+        if (frame.objectMask[i] || g.edge[i] != kInterior) continue;  // drawn by the shading
         const glm::dvec3 L = backgroundRadiance(prepared_.background, request.lightRotation, camera.direction(x, static_cast<int>(y)));
         for (int c = 0; c < 3; ++c) frame.image.at(static_cast<int>(y), x, c) = static_cast<float>(L[c]);
       }
-    }, {}, threads);
+    }, {}, options_.threads);
   }
   frame.logAverageLuminance = frameLogAverage(frame.image, frame.objectMask);
   frame.exposureStops = applyExposure(request.exposure, frame.logAverageLuminance);
@@ -200,8 +295,8 @@ Frame CpuRenderer::render(const FrameRequest& request) {
   return frame;
 }
 
-std::size_t CpuRenderer::shadeRotating(const ResolvedFrame& resolved, const std::vector<std::optional<Hit>>& hits,
-                                       const std::vector<PixelInput>& inputs, Frame& frame, int w, int h) {
+std::size_t CpuRenderer::shadeRotating(const ResolvedFrame& resolved, const GBuffer& g, const FrameRequest& request,
+                                       const CameraRays& camera, Frame& frame) {
   // The light's lists are validated and put in the walk's order once per frame.
   std::vector<std::array<PreparedLight, 3>> light(resolved.objects.size());
   for (std::size_t i = 0; i < light.size(); ++i)
@@ -211,7 +306,7 @@ std::size_t CpuRenderer::shadeRotating(const ResolvedFrame& resolved, const std:
   // to the thread time each took.
   const auto t0 = Clock::now();
   std::atomic<std::int64_t> rotationNs{0}, productNs{0};
-  const std::size_t bytes = forEachCoveredPixel(hits, frame, w, h, [&](std::size_t i, int x, int y, std::size_t object) {
+  const std::size_t bytes = shadePixels(g, request, camera, frame, [&](const Sample& sample, std::array<float, 3>& rgb) {
     // Per worker thread, kept across pixels: no allocation per pixel once warm.
     struct Scratch {
       std::array<HaarMap, 3> rotated;
@@ -220,8 +315,9 @@ std::size_t CpuRenderer::shadeRotating(const ResolvedFrame& resolved, const std:
       PreparedVisibility visibility;
     };
     thread_local Scratch s;
+    const std::size_t object = sample.object;
     const PreparedObject& p = prepared_.objects[object];
-    const PixelInput& in = inputs[i];
+    const PixelInput& in = sample.input;
     const auto a = Clock::now();
     const std::size_t slice = static_cast<std::size_t>(in.rotation.slice);
     if (rgbHaar_[object]) {
@@ -236,9 +332,7 @@ std::size_t CpuRenderer::shadeRotating(const ResolvedFrame& resolved, const std:
                                                     &p.visibility[in.vertex[2]]};
     mergeVisibility(vertices, {in.b[0], in.b[1], in.b[2]}, s.merged);
     s.visibility.assign(s.merged);
-    for (std::size_t c = 0; c < 3; ++c) {
-      frame.image.at(y, x, static_cast<int>(c)) = static_cast<float>(tripleProduct(light[object][c], s.rotated[c], s.visibility));
-    }
+    for (std::size_t c = 0; c < 3; ++c) rgb[c] = static_cast<float>(tripleProduct(light[object][c], s.rotated[c], s.visibility));
     rotationNs += std::chrono::duration_cast<std::chrono::nanoseconds>(b - a).count();
     productNs += std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - b).count();
     std::size_t read = 3 * rotationBytes(object);
@@ -253,26 +347,25 @@ std::size_t CpuRenderer::shadeRotating(const ResolvedFrame& resolved, const std:
   return bytes;
 }
 
-std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const std::vector<std::optional<Hit>>& hits,
-                                    const std::vector<PixelInput>& inputs, Frame& frame, int w, int h) {
+std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const GBuffer& g, const FrameRequest& request,
+                                    const CameraRays& camera, Frame& frame) {
   const auto t0 = Clock::now();
-  const std::size_t bytes = forEachCoveredPixel(hits, frame, w, h, [&](std::size_t i, int x, int y, std::size_t object) {
+  const std::size_t bytes = shadePixels(g, request, camera, frame, [&](const Sample& sample, std::array<float, 3>& rgb) {
     // Per worker thread, kept across pixels: no allocation per pixel.
     thread_local FusedScratch scratch;
-    const PreparedObject& p = prepared_.objects[object];
-    const PixelInput& in = inputs[i];
+    const PreparedObject& p = prepared_.objects[sample.object];
+    const PixelInput& in = sample.input;
     std::array<WeightedVisibility, 3> vis;
     std::size_t entries = 0;
     for (std::size_t v = 0; v < 3; ++v) {
       vis[v] = {&p.visibility[in.vertex[v]], static_cast<float>(in.b[v])};
       entries += vis[v].list->size();
     }
-    const PixelSlices& slices = pixelSlices_[object];
+    const PixelSlices& slices = pixelSlices_[sample.object];
     const shared::SliceBlend blend = shared::sliceBlendAt(static_cast<float>(in.rotation.thetaOut),
                                                           static_cast<shared::uint>(slices.thetaSamples()),
                                                           options_.interpolateSlices ? 1u : 0u);
-    const std::array<float, 3> rgb = fusedShade(slices, blend, in.rotation.euler, resolved.objects[object].fusedLight, vis, scratch);
-    for (int c = 0; c < 3; ++c) frame.image.at(y, x, c) = rgb[static_cast<std::size_t>(c)];
+    rgb = fusedShade(slices, blend, in.rotation.euler, resolved.objects[sample.object].fusedLight, vis, scratch);
     return fusedPixelBytes(slices.level(), blend.weight != 0.0f, entries);
   });
   frame.stages.push_back({"fused", since(t0)});

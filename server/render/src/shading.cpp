@@ -8,19 +8,26 @@
 
 namespace haarcast::render {
 
+double verticalTanHalf(const Camera& camera, int width, int height) {
+  const double tanHalf = std::tan(glm::radians(camera.fovYDegrees) * 0.5);
+  return width < height ? tanHalf * static_cast<double>(height) / width : tanHalf;
+}
+
 CameraRays::CameraRays(const Camera& camera, int width, int height)
     : eye_(camera.eye),
       forward_(glm::normalize(camera.target - camera.eye)),
       right_(glm::normalize(glm::cross(forward_, camera.up))),
       up_(glm::cross(right_, forward_)),
-      tanHalf_(std::tan(glm::radians(camera.fovYDegrees) * 0.5)),
+      tanHalf_(verticalTanHalf(camera, width, height)),
       aspect_(static_cast<double>(width) / height),
       width_(width),
       height_(height) {}
 
-glm::dvec3 CameraRays::direction(int x, int y) const {
-  const double sx = (2.0 * (x + 0.5) / width_ - 1.0) * tanHalf_ * aspect_;
-  const double sy = (1.0 - 2.0 * (y + 0.5) / height_) * tanHalf_;
+glm::dvec3 CameraRays::direction(int x, int y) const { return directionAt(x + 0.5, y + 0.5); }
+
+glm::dvec3 CameraRays::directionAt(double px, double py) const {
+  const double sx = (2.0 * px / width_ - 1.0) * tanHalf_ * aspect_;
+  const double sy = (1.0 - 2.0 * py / height_) * tanHalf_;
   return glm::normalize(forward_ + sx * right_ + sy * up_);
 }
 

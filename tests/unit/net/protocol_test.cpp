@@ -7,8 +7,8 @@ namespace {
 
 Catalog testCatalog() {
   Catalog c;
-  c.scenes.push_back({"default", {"phong:64", "lambert"}, render::Camera{}, {render::Pose{}, render::Pose{}}});
-  c.scenes.push_back({"other", {"ggx:0.3"}, render::Camera{}, {render::Pose{}}});
+  c.scenes.push_back({"default", {"phong:64", "lambert"}, render::Camera{}, {render::Pose{}, render::Pose{}}, {"ball", "ring"}});
+  c.scenes.push_back({"other", {"ggx:0.3"}, render::Camera{}, {render::Pose{}}, {"teapot"}});
   c.materials = {"lambert", "phong:64", "ggx:0.3", "merl:steel"};
   c.backends = {"cpu"};
   return c;

@@ -35,7 +35,7 @@ constexpr const char* kToken = "s3cret";
 
 Catalog testCatalog(const render::Scene& scene) {
   Catalog c;
-  Catalog::SceneEntry entry{"default", {}, scene.camera, {}};
+  Catalog::SceneEntry entry{"default", {}, scene.camera, {}, {}};
   for (const auto& o : scene.objects) {
     entry.defaultMaterials.push_back(o.material.name);
     entry.poses.push_back(o.pose);

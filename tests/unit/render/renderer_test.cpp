@@ -1,5 +1,6 @@
 // The Renderer interface's CPU backend and the steps every backend shares.
 #include "haarcast/render/renderer.h"
+#include "haarcast/render/shading.h"
 
 #include <algorithm>
 #include <cmath>
@@ -75,6 +76,22 @@ TEST(SharedSteps, BackgroundMatchesTheMapAtPixelCentresAndTurnsWithTheLight) {
   const glm::dmat3 r = rotationAbout(glm::normalize(glm::dvec3(1.0, 0.5, 0.2)), 63.0);
   const glm::dvec3 turned = backgroundRadiance(maps, r, r * d);
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(turned[c], L[c], 1e-4 * (1.0 + L[c]));
+}
+
+// The camera's field of view spans the frame's shorter side: a wide frame
+// keeps it vertically, a tall one horizontally (and sees more vertically).
+TEST(SharedSteps, TheFieldOfViewSpansTheShorterSide) {
+  Camera camera;
+  camera.fovYDegrees = 40.0;
+  const double fov = glm::radians(camera.fovYDegrees);
+  auto angle = [](const glm::dvec3& a, const glm::dvec3& b) { return std::acos(std::clamp(glm::dot(a, b), -1.0, 1.0)); };
+  const CameraRays square(camera, 100, 100), wide(camera, 200, 100), tall(camera, 100, 200);
+  EXPECT_NEAR(angle(square.directionAt(50, 0), square.directionAt(50, 100)), fov, 1e-9);
+  EXPECT_NEAR(angle(square.directionAt(0, 50), square.directionAt(100, 50)), fov, 1e-9);
+  EXPECT_NEAR(angle(wide.directionAt(100, 0), wide.directionAt(100, 100)), fov, 1e-9);
+  EXPECT_NEAR(angle(tall.directionAt(0, 100), tall.directionAt(100, 100)), fov, 1e-9);
+  EXPECT_GT(angle(tall.directionAt(50, 0), tall.directionAt(50, 200)), fov + 0.3);
+  EXPECT_EQ(verticalTanHalf(camera, 100, 200), 2.0 * verticalTanHalf(camera, 100, 100));
 }
 
 TEST(SharedSteps, FrameRequestsAreCheckedWithClearErrors) {

@@ -36,6 +36,16 @@ HC_CONST uint kMinLevel = 2u;
 // `fused` on both backends: at level 7 a map is 16,384 pixels.
 HC_CONST uint kFusedMaxLevel = 7u;
 
+// Antialiasing (RenderOptions::antialias): a pixel is an edge pixel when the
+// centre samples of its 3×3 neighbourhood do not all see the same object
+// (or all none). An edge pixel is the mean of kSubsamples samples at
+// (±kSubsampleOffset, ±kSubsampleOffset) pixels from its centre, sample k
+// taking + in x when k & 1 and + in y (down) when k & 2: the pixel centres
+// of the frame at twice the resolution. Each is shaded alone, or shows the
+// backdrop where it misses.
+HC_CONST uint kSubsamples = 4u;
+HC_CONST float kSubsampleOffset = 0.25f;
+
 // A BRDF slice in pixel form, as `fused` samples it: texel (row, col) of
 // slice t at ((t·M + row)·M + col)·kTexelFloats, holding R, G, B and a zero.
 HC_CONST uint kTexelFloats = 4u;

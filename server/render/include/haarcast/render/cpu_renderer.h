@@ -38,6 +38,11 @@ struct RenderOptions {
   // fused: blend the two nearest θₒ slices (false: the nearest alone, as the
   // rotating methods do).
   bool interpolateSlices = true;
+  // Edge pixels drawn as the mean of shared::kSubsamples sub-samples
+  // (shared_layout.h); interior pixels keep one sample at the centre. Off
+  // here, so that measurements compare one sample per pixel with the
+  // reference; `render` and `serve` turn it on for what users look at.
+  bool antialias = false;
   RotatorOptions rotator;
   std::size_t lightCoefficients = 256;    // k: the light's largest coefficients kept
   int thetaSamples = 16;                  // BRDF slices per channel

@@ -9,11 +9,20 @@
 
 namespace haarcast::render {
 
+// tan(½ vertical field of view) of a width × height frame: the camera's
+// field of view spans the frame's shorter side, so what a camera frames in a
+// square view stays in view at every aspect ratio (a portrait frame widens
+// its vertical field instead of cropping the sides).
+double verticalTanHalf(const Camera& camera, int width, int height);
+
 // A pinhole camera's rays through pixel centres (row 0 at the top).
 class CameraRays {
  public:
   CameraRays(const Camera& camera, int width, int height);
   glm::dvec3 direction(int x, int y) const;  // unit, world frame
+  // Through the point (px, py) of the image plane in pixels: pixel (x, y)'s
+  // centre is (x + ½, y + ½).
+  glm::dvec3 directionAt(double px, double py) const;
   const glm::dvec3& origin() const { return eye_; }
 
  private:
