@@ -294,6 +294,7 @@ function onWelcome(w) {
   state.lastShownSequence = 0;
   frameWindow.clear();
   $('reconnect').hidden = true;
+  $('banner').hidden = true;  // what it said was about the previous session
   setFrameSize(w.width, w.height);
   effective = w.settings || {};
   const limits = w.limits || {};
