@@ -546,7 +546,9 @@ function showFrameExposure(stops, mode) {
 
 let exposureDragging = false;
 $('exposure').addEventListener('pointerdown', () => { exposureDragging = true; });
-$('exposure').addEventListener('pointerup', () => { exposureDragging = false; });
+// The release may land outside the slider: any pointerup ends the drag.
+window.addEventListener('pointerup', () => { exposureDragging = false; });
+$('exposure').addEventListener('change', () => { exposureDragging = false; });
 $('exposure').addEventListener('input', () => {
   $('exposure-auto').checked = false;
   choices.exposure = { auto: false, stops: Number($('exposure').value) };
