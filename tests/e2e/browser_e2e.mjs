@@ -1,18 +1,38 @@
-// End-to-end test of the browser client: starts `haarcast serve --port 0`,
-// opens the page in Debian's Chromium (headless, driven by playwright-core;
-// no browser is ever downloaded), and checks that
-//   1. a frame arrives on the canvas and a screenshot of it is not blank;
-//   2. a drag (camera orbit) brings a new frame that differs from the first;
-//   3. shift-drag (object) and alt-drag (light) are sent as poses and answered;
-//   4. the HUD shows fps, latency, kbit/s and the method, and keeps updating;
-//   5. the method control reaches the server (frames come back with it);
-//   6. the server exits 0 on SIGTERM.
+// End-to-end test of the browser client: starts `haarcast serve --port 0`
+// with a second scene (a box, written to a temporary folder), opens the page
+// in Debian's Chromium (headless, driven by playwright-core; no browser is
+// ever downloaded), and checks that
+//   1. a bad page parameter (?method=fast, ?encoding=exr) is shown on the
+//      page within 2 s, naming the parameter and its valid values, and
+//      nothing connects;
+//   2. a server Error (?level=99) is shown with its code and message, and a
+//      fatal one that reconnecting cannot fix is not retried;
+//   3. a frame arrives on the canvas and a screenshot of it is not blank;
+//   4. a drag (camera orbit) brings a new frame that differs from the first;
+//      shift-drag (object) and alt-drag (light) are sent and answered;
+//   5. the HUD shows fps, latency, kbit/s, frame time, stage times and the
+//      method, keeps updating, and never shows "0 fps" once a frame arrived,
+//      also at 0.8 fps;
+//   6. the method control reaches the server (frames come back with it);
+//   7. the scene picker lists the served scenes; switching changes the frame
+//      and starts the orbit at the new scene's camera; objects are named,
+//      each with the material in effect; a material change is answered;
+//   8. exposure "auto" gives a frame with < 2 % of its pixels at 255, a
+//      fixed +3 stops gives more, and each frame's exposure is shown;
+//   9. at 1200×800 every control is visible without scrolling; at 400×800
+//      nothing is wider than the window; the canvas keeps the frame's aspect
+//      ratio (also for a 128×96 frame) and goes full window and back;
+//  10. a dropped connection (a proxy between page and server cuts it) shows
+//      the countdown to the next attempt and reconnects;
+//  11. no page errors and no request outside the server; SIGTERM → exit 0.
 //
 // usage: node browser_e2e.mjs --haarcast BUILD/bin/haarcast [--chromium /usr/bin/chromium]
-//        [--out DIR] [--page-query 'size=64x64&encoding=jpeg'] [-- extra `serve` args]
+//        [--out DIR] [--page-query 'size=96x96&encoding=jpeg'] [-- extra `serve` args]
 import { spawn } from 'node:child_process';
-import { mkdirSync, writeFileSync } from 'node:fs';
+import { mkdirSync, mkdtempSync, rmSync, writeFileSync } from 'node:fs';
 import { createRequire } from 'node:module';
+import net from 'node:net';
+import { tmpdir } from 'node:os';
 import { dirname, join, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { inflateSync } from 'node:zlib';
@@ -39,6 +59,7 @@ function check(condition, what) {
   console.log(`${condition ? 'ok  ' : 'FAIL'} ${what}`);
   if (!condition) failures.push(what);
 }
+const section = (what) => console.log(`--- ${what}`);
 
 // ---- a tiny PNG decoder (8-bit RGB/RGBA, not interlaced: what Chromium writes) ----
 
@@ -109,10 +130,27 @@ function meanAbsDiff(a, b) {
   return s / a.length;
 }
 
-// ---- the server -------------------------------------------------------------------
+// Pixels of the canvas, exactly as drawn (raw frames are put unchanged).
+async function canvasPixels(page) {
+  return page.evaluate(() => {
+    const c = document.getElementById('frame');
+    return Array.from(c.getContext('2d').getImageData(0, 0, c.width, c.height).data);
+  });
+}
 
-function startServer() {
-  const child = spawn(opts.haarcast, ['serve', '--port', '0', ...opts.serveArgs], {
+// The share of pixels with a channel at 255: clipped highlights.
+function clippedShare(rgba) {
+  let clipped = 0;
+  for (let i = 0; i < rgba.length; i += 4) {
+    if (rgba[i] === 255 || rgba[i + 1] === 255 || rgba[i + 2] === 255) clipped++;
+  }
+  return clipped / (rgba.length / 4);
+}
+
+// ---- the server, and a proxy that can cut its connections ------------------------------
+
+function startServer(serveArgs) {
+  const child = spawn(opts.haarcast, ['serve', '--port', '0', ...serveArgs], {
     stdio: ['ignore', 'pipe', 'pipe'],
   });
   let log = '';
@@ -134,10 +172,49 @@ function startServer() {
   return { child, url, exited, log: () => log };
 }
 
+// A TCP proxy to the server: `drop(ms)` resets every connection through it
+// (the page sees its WebSocket die without a close frame, as when a network
+// goes away) and refuses new ones for `ms`.
+async function startProxy(target) {
+  const live = new Set();
+  let refuseUntil = 0;
+  const kill = (s) => (s.resetAndDestroy ? s.resetAndDestroy() : s.destroy());
+  const server = net.createServer((client) => {
+    if (Date.now() < refuseUntil) { kill(client); return; }
+    const upstream = net.connect(Number(target.port), target.hostname);
+    const pair = [client, upstream];
+    live.add(pair);
+    client.pipe(upstream);
+    upstream.pipe(client);
+    const end = () => { live.delete(pair); client.destroy(); upstream.destroy(); };
+    for (const s of pair) { s.on('error', end); s.on('close', end); }
+  });
+  await new Promise((r) => server.listen(0, '127.0.0.1', r));
+  return {
+    base: `http://127.0.0.1:${server.address().port}/`,
+    drop(ms) {
+      refuseUntil = Date.now() + ms;
+      for (const pair of live) pair.forEach(kill);
+      live.clear();
+    },
+    close: () => new Promise((r) => { for (const pair of live) pair.forEach(kill); server.close(r); }),
+  };
+}
+
 // ---- the test ---------------------------------------------------------------------
 
-const server = startServer();
+// The second scene: a box with its own camera (docs/scenes.md).
+const sceneDir = mkdtempSync(join(tmpdir(), 'haarcast-e2e-'));
+const boxScene = join(sceneDir, 'e2e-box.json');
+const boxCamera = [1.6, 1.2, 2.6];
+writeFileSync(boxScene, JSON.stringify({
+  camera: { eye: boxCamera, target: [0, 0, 0], up: [0, 1, 0], fov_y: 40 },
+  objects: [{ name: 'box', mesh: { builtin: 'box' }, material: 'lambert', rotate: [0, 30, 0], scale: 0.8 }],
+}));
+
+const server = startServer(['--scene', boxScene, ...opts.serveArgs]);
 let browser = null;
+let proxy = null;
 try {
   const base = await server.url;
   console.log(`server at ${base}`);
@@ -147,27 +224,96 @@ try {
     // Root in a container has no user namespace for the sandbox.
     args: ['--no-sandbox', '--disable-gpu', '--disable-dev-shm-usage'],
   });
-  const page = await browser.newPage({ viewport: { width: 900, height: 900 } });
-  const consoleErrors = [];
-  page.on('console', (m) => { if (m.type() === 'error') consoleErrors.push(m.text()); });
-  page.on('pageerror', (e) => consoleErrors.push(e.message));
-  page.on('request', (r) => {
-    if (!r.url().startsWith(base)) consoleErrors.push(`request outside the server: ${r.url()}`);
-  });
 
-  await page.goto(`${base}?${opts['page-query']}`);
-  const state = () => page.evaluate(() => ({ ...window.haarcast, welcome: !!window.haarcast.welcome }));
+  // A page whose console errors, page errors and requests outside `origin`
+  // are collected. `networkErrors`: a page whose connection is cut on
+  // purpose logs failed WebSocket and fetch attempts; those are expected.
+  const openPage = async (query, { origin = base, viewport = { width: 900, height: 900 }, networkErrors = false } = {}) => {
+    const page = await browser.newPage({ viewport });
+    const problems = [];
+    const expected = /WebSocket connection to .* failed|net::ERR_(CONNECTION|EMPTY_RESPONSE|SOCKET)|Failed to load resource/;
+    page.on('console', (m) => {
+      if (m.type() === 'error' && !(networkErrors && expected.test(m.text()))) problems.push(m.text());
+    });
+    page.on('pageerror', (e) => problems.push(e.message));
+    page.on('request', (r) => {
+      if (!r.url().startsWith(origin)) problems.push(`request outside the server: ${r.url()}`);
+    });
+    const started = Date.now();
+    await page.goto(`${origin}?${query}`);
+    return { page, problems, started };
+  };
+  const pick = (page) => page.evaluate(() => {
+    const h = window.haarcast;
+    return {
+      framesShown: h.framesShown, lastFrame: h.lastFrame, posesSent: h.posesSent, errors: h.errors,
+      connection: h.connection, connections: h.connections, welcomes: h.welcomes, scene: h.scene,
+      sceneInfo: h.sceneInfo && { name: h.sceneInfo.name, objects: h.sceneInfo.objects.map((o) => ({ ...o })) },
+      viewEye: h.viewEye(),
+    };
+  });
+  const text = (page, selector) => page.evaluate((s) => {
+    const e = document.querySelector(s);
+    return e && !e.closest('[hidden]') ? e.textContent : null;
+  }, selector);
+  const waitFrames = (page, n, timeout = 120000) =>
+    page.waitForFunction((k) => window.haarcast && window.haarcast.framesShown >= k, n, { timeout });
+
+  // 1. Bad page parameters: named on the page at once, nothing connects.
+  section('page parameters');
+  for (const [query, words] of [['method=fast', ['?method=fast', 'fused', 'haar']],
+                                 ['encoding=exr', ['?encoding=exr', 'jpeg, png, raw']]]) {
+    const { page, problems, started } = await openPage(query);
+    await page.waitForFunction(() => !document.getElementById('banner').hidden, null,
+                               { timeout: Math.max(1, 2000 - (Date.now() - started)) }).catch(() => {});
+    const elapsed = Date.now() - started;
+    const banner = (await text(page, '#banner-text')) || '';
+    check(words.every((w) => banner.includes(w)) && elapsed <= 2000,
+          `?${query}: the page says ${JSON.stringify(banner)} after ${elapsed} ms (want ${words.join(', ')} within 2 s)`);
+    const s = await pick(page);
+    check(s.connections === 0, `?${query}: no connection is opened (${s.connections})`);
+    check(problems.length === 0, `?${query}: no page errors (${problems.join('; ')})`);
+    await page.close();
+  }
+
+  // 2. A server Error: shown with its code, and not retried (a bad setting stays bad).
+  section('server errors');
+  {
+    const { page, started } = await openPage('level=99&size=64x64');
+    await page.waitForFunction(() => !document.getElementById('banner').hidden, null, { timeout: 10000 }).catch(() => {});
+    const banner = (await text(page, '#banner-text')) || '';
+    check(/ERROR_CODE_BAD_SETTINGS/.test(banner) && /level 99 is outside \d+\.\.\d+/.test(banner),
+          `?level=99: the page shows the server's Error ${JSON.stringify(banner)} (${Date.now() - started} ms)`);
+    await page.waitForTimeout(2500);
+    const s = await pick(page);
+    check(s.connection === 'stopped' && s.connections === 1,
+          `a fatal BAD_SETTINGS is not retried (state ${s.connection}, ${s.connections} connection(s) in 2.5 s)`);
+    await page.close();
+  }
+
+  // 3.–6. The main page.
+  section('frames, drags, HUD');
+  const { page, problems: consoleErrors } = await openPage(opts['page-query']);
+  const state = () => pick(page);
   // The first frame may wait for the server to prepare the scene (slice
   // tables, visibility): generous, but bounded.
-  await page.waitForFunction(() => window.haarcast && window.haarcast.framesShown >= 1, null, { timeout: 120000 });
+  await waitFrames(page, 1);
+  // From now on, every text the fps field takes is recorded.
+  await page.evaluate(() => {
+    const fps = document.getElementById('hud-fps');
+    window.fpsTexts = [fps.textContent];
+    new MutationObserver(() => window.fpsTexts.push(fps.textContent))
+      .observe(fps, { childList: true, characterData: true, subtree: true });
+  });
   const first = await state();
   check(first.framesShown >= 1, `a frame is on the canvas (frame ${first.lastFrame.sequence}, ${first.lastFrame.bytes} bytes)`);
 
   const canvas = page.locator('#frame');
-  // The HUD floats over the canvas: hidden in screenshots, or its text alone
-  // would make a blank frame look varied.
-  const shotOptions = { style: '#hud { visibility: hidden !important; }' };
-  const shot1 = decodePng(await canvas.screenshot(shotOptions));
+  // The HUD and the full-window button float over the canvas: hidden in
+  // screenshots, or their text alone would make a blank frame look varied.
+  const shotOptions = { style: '#hud, #fullwindow { visibility: hidden !important; }' };
+  const shot = async () => decodePng(await canvas.screenshot(shotOptions));
+  const shot1 = await shot();
   const l1 = luma(shot1);
   const sd1 = stddev(l1);
   check(sd1 > 2, `the screenshot is not blank (luma stddev ${sd1.toFixed(1)} > 2)`);
@@ -176,17 +322,21 @@ try {
     writeFileSync(join(opts.out, 'first.png'), await canvas.screenshot(shotOptions));
   }
 
-  // 2. Drag to orbit: the frame must change.
-  const box = await canvas.boundingBox();
-  const cx = box.x + box.width / 2, cy = box.y + box.height / 2;
-  const dragAndWait = async (what, modifier) => {
-    const before = await state();
+  // Drag to orbit: the frame must change.
+  let box = await canvas.boundingBox();
+  const drag = async (modifier, dx = 120, dy = 20) => {
+    box = await canvas.boundingBox();
+    const cx = box.x + box.width / 2, cy = box.y + box.height / 2;
     if (modifier) await page.keyboard.down(modifier);
     await page.mouse.move(cx, cy);
     await page.mouse.down();
-    await page.mouse.move(cx + 120, cy + 20, { steps: 6 });
+    await page.mouse.move(cx + dx, cy + dy, { steps: 6 });
     await page.mouse.up();
     if (modifier) await page.keyboard.up(modifier);
+  };
+  const dragAndWait = async (what, modifier) => {
+    const before = await state();
+    await drag(modifier);
     const sentTo = (await state()).posesSent;
     check(sentTo > before.posesSent, `${what}: poses sent (${before.posesSent} → ${sentTo})`);
     // Wait for the frame that answers the last pose of the drag.
@@ -196,51 +346,48 @@ try {
     await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => r())));
   };
   await dragAndWait('drag (orbit)');
-  const shot2 = decodePng(await canvas.screenshot(shotOptions));
+  const shot2 = await shot();
   const diffOrbit = meanAbsDiff(l1, luma(shot2));
   check(diffOrbit > 1, `the frame changed after the orbit drag (mean |Δluma| ${diffOrbit.toFixed(2)} > 1)`);
   if (opts.out) writeFileSync(join(opts.out, 'orbit.png'), await canvas.screenshot(shotOptions));
 
   await dragAndWait('alt-drag (light)', 'Alt');
-  const shot3 = decodePng(await canvas.screenshot(shotOptions));
+  const shot3 = await shot();
   const diffLight = meanAbsDiff(luma(shot2), luma(shot3));
   check(diffLight > 0.5, `the frame changed after the light drag (mean |Δluma| ${diffLight.toFixed(2)} > 0.5)`);
   await dragAndWait('shift-drag (object)', 'Shift');
 
-  // 4. The HUD: numbers, and they keep updating.
-  const hud = async () => page.evaluate(() => ({
-    fps: document.getElementById('hud-fps').textContent,
-    latency: document.getElementById('hud-latency').textContent,
-    kbps: document.getElementById('hud-kbps').textContent,
-    method: document.getElementById('hud-method').textContent,
-    updates: window.haarcast.hudUpdates,
-  }));
-  // Keep frames flowing until the HUD's one-second window holds one (on the
-  // CPU backend a frame can take most of a second).
+  // The HUD: numbers, and they keep updating.
+  const hud = async () => page.evaluate(() => {
+    const t = (id) => document.getElementById(id).textContent;
+    return { fps: t('hud-fps'), latency: t('hud-latency'), kbps: t('hud-kbps'), frameMs: t('hud-frame-ms'),
+             stages: t('hud-stages'), method: t('hud-method'), exposure: t('hud-exposure'),
+             updates: window.haarcast.hudUpdates };
+  });
+  // Keep frames flowing until the HUD's window holds three (on the CPU
+  // backend a frame can take most of a second).
   let h1 = await hud();
   for (const deadline = Date.now() + 30000; Date.now() < deadline;) {
-    await page.mouse.move(cx, cy);
-    await page.mouse.down();
-    await page.mouse.move(cx + 10, cy, { steps: 2 });
-    await page.mouse.up();
+    await drag(null, 10, 0);
     await page.waitForTimeout(200);
     h1 = await hud();
-    if (Number(h1.fps) > 0 && Number(h1.latency) > 0 && Number(h1.kbps) > 0) break;
+    if (Number(h1.fps) > 0 && Number(h1.latency) > 0 && Number(h1.kbps) > 0 && Number(h1.frameMs) > 0) break;
   }
-  console.log(`HUD: ${h1.fps} fps, ${h1.latency} ms, ${h1.kbps} kbit/s, ${h1.method}`);
+  console.log(`HUD: ${h1.fps} fps, ${h1.latency} ms, ${h1.kbps} kbit/s, frame ${h1.frameMs} ms, ${h1.method}, ` +
+              `${h1.exposure}; ${h1.stages}`);
   check(Number(h1.fps) > 0, `HUD fps is a positive number ("${h1.fps}")`);
   check(Number(h1.latency) > 0, `HUD latency is a positive number of ms ("${h1.latency}")`);
   check(Number(h1.kbps) > 0, `HUD kbit/s is a positive number ("${h1.kbps}")`);
+  check(Number(h1.frameMs) > 0, `HUD frame time is a positive number of ms ("${h1.frameMs}")`);
+  check(/encode \d/.test(h1.stages) && /(fused|triple-product) \d/.test(h1.stages),
+        `HUD shows the server's stage times ("${h1.stages}")`);
   check(['fused', 'haar', 'spatial', 'matrix', 'table'].includes(h1.method), `HUD method names a method ("${h1.method}")`);
+  check(/stops (auto|fixed)$/.test(h1.exposure), `HUD shows the frame's exposure ("${h1.exposure}")`);
   await page.waitForTimeout(600);
   const h2 = await hud();
   check(h2.updates > h1.updates, `the HUD keeps updating (${h1.updates} → ${h2.updates} redraws)`);
 
-  // The controls were filled from Welcome.
-  const materials = await page.locator('#material option').count();
-  check(materials > 0, `the material control lists the server's materials (${materials})`);
-
-  // 5. A control reaches the server: switch the method, drag, and the next
+  // A control reaches the server: switch the method, drag, and the next
   // frame must come back rendered with it.
   const target = h1.method === 'fused' ? 'haar' : 'fused';
   await page.selectOption('#method', target);
@@ -252,14 +399,251 @@ try {
   await page.waitForTimeout(400);
   const h3 = await hud();
   check(h3.method === target, `the HUD shows method ${target} ("${h3.method}")`);
+  await page.selectOption('#method', h1.method);
 
-  check(after.errors.length === 0, `no server errors (${JSON.stringify(after.errors)})`);
+  // The level choices are the server's range (Welcome.limits), not a copy.
+  const levels = await page.evaluate(() => ({
+    options: [...document.querySelectorAll('#level option')].map((o) => Number(o.value)),
+    limits: { min: window.haarcast.welcome.limits.minLevel, max: window.haarcast.welcome.limits.maxLevel },
+  }));
+  const wantLevels = Array.from({ length: levels.limits.max - levels.limits.min + 1 }, (_, i) => levels.limits.min + i);
+  check(JSON.stringify(levels.options) === JSON.stringify(wantLevels),
+        `level choices ${levels.options.join(',')} are Welcome.limits ${levels.limits.min}..${levels.limits.max}`);
+
+  // 7. Scenes and objects.
+  section('scenes and materials');
+  const objects = () => page.evaluate(() => [...document.querySelectorAll('#objects li')].map((li) => ({
+    name: li.querySelector('.name').firstChild.textContent, material: li.querySelector('select').value,
+    offered: li.querySelectorAll('select option').length,
+  })));
+  const scenes = await page.evaluate(() => [...document.querySelectorAll('#scene option')].map((o) => o.value));
+  check(JSON.stringify(scenes) === JSON.stringify(['default', 'e2e-box']),
+        `the scene picker lists the served scenes (${scenes.join(', ')})`);
+  let objs = await objects();
+  check(JSON.stringify(objs.map((o) => [o.name, o.material])) === JSON.stringify([['sphere', 'phong:64'], ['torus', 'ggx:0.3']]),
+        `the default scene's objects are named, each with its material (${JSON.stringify(objs.map((o) => [o.name, o.material]))})`);
+  check(objs.every((o) => o.offered > 1), `each object's material select lists the offered materials (${objs.map((o) => o.offered)})`);
+
+  // Waits for the SceneInfo answer and a frame of the new scene (one that
+  // answers a pose sent after the answer).
+  const switchScene = async (name) => {
+    await page.selectOption('#scene', name);
+    const answered = await page.waitForFunction((n) => {
+      const h = window.haarcast;
+      return h.sceneInfo.name === n && h.scene.name === n && h.lastFrame.poseSequence >= h.scene.firstPose;
+    }, name, { timeout: 30000 }).then(() => true, () => false);
+    const s = await state();
+    check(answered, `choosing ${name} is answered with its SceneInfo and a frame of it (scene "${s.sceneInfo.name}")`);
+    if (!answered) throw new Error(`no switch to ${name}`);
+    await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => r())));
+  };
+  const beforeSwitch = await shot();
+  await switchScene('e2e-box');
+  const afterSwitch = await shot();
+  const diffScene = meanAbsDiff(luma(beforeSwitch), luma(afterSwitch));
+  check(diffScene > 3, `switching to e2e-box changes the frame (mean |Δluma| ${diffScene.toFixed(2)} > 3)`);
+  if (opts.out) writeFileSync(join(opts.out, 'scene-e2e-box.png'), await canvas.screenshot(shotOptions));
+  let s = await state();
+  const eyeError = Math.hypot(s.viewEye.x - boxCamera[0], s.viewEye.y - boxCamera[1], s.viewEye.z - boxCamera[2]);
+  check(eyeError < 1e-6, `the orbit starts at the new scene's camera (eye ${JSON.stringify(s.viewEye)}, want ${boxCamera})`);
+  objs = await objects();
+  check(JSON.stringify(objs.map((o) => [o.name, o.material])) === JSON.stringify([['box', 'lambert']]),
+        `e2e-box's objects are listed (${JSON.stringify(objs.map((o) => [o.name, o.material]))})`);
+  await switchScene('default');
+  objs = await objects();
+  check(objs.length === 2 && objs[0].material === 'phong:64', `back on default, sphere is phong:64 again (${objs[0] && objs[0].material})`);
+
+  // A material change: answered with a SceneInfo that the select shows.
+  await page.locator('#objects select').first().selectOption('lambert');
+  await page.waitForFunction(() => window.haarcast.sceneInfo.objects[0].material === 'lambert', null, { timeout: 30000 })
+    .catch(() => {});
+  s = await state();
+  objs = await objects();
+  check(s.sceneInfo.objects[0].material === 'lambert' && objs[0].material === 'lambert' && s.sceneInfo.name === 'default',
+        `a material change is answered (SceneInfo: ${s.sceneInfo.objects[0].material}; select: ${objs[0].material})`);
+
+  // A refused change: a non-fatal Error is shown in words, the select goes
+  // back to the material in effect, and the session goes on. (The page only
+  // offers what Welcome offers, so the test adds a bogus choice.)
+  await page.evaluate(() => {
+    const select = document.querySelector('#objects select');
+    select.add(new Option('merl:no-such-brdf', 'merl:no-such-brdf'));
+  });
+  await page.locator('#objects select').first().selectOption('merl:no-such-brdf');
+  await page.waitForFunction(() => window.haarcast.errors.length > 0, null, { timeout: 10000 }).catch(() => {});
+  await page.waitForTimeout(100);
+  s = await state();
+  const refused = (await text(page, '#banner-text')) || '';
+  objs = await objects();
+  check(/ERROR_CODE_UNKNOWN_MATERIAL: material "merl:no-such-brdf" is not offered/.test(refused) &&
+        s.errors.length === 1 && !s.errors[0].fatal,
+        `a refused material is shown (${JSON.stringify(refused)})`);
+  check(objs[0].material === 'lambert' && s.connection === 'ready',
+        `the select shows the material in effect again (${objs[0].material}) and the session goes on (${s.connection})`);
+  await page.click('#banner-close');
+  const expectedErrors = 1;
+
+  // 9. Layout.
+  section('layout');
+  const layout = () => page.evaluate(() => {
+    const r = (e) => e.getBoundingClientRect();
+    const c = r(document.getElementById('frame'));
+    const f = document.getElementById('frame');
+    const controls = [...document.querySelectorAll('#controls select, #controls input, #controls button, #fullwindow')]
+      .map((e) => ({ id: e.id || e.name || e.value || e.tagName, box: r(e) }));
+    return { canvas: { w: c.width, h: c.height, x: c.x, y: c.y }, frame: { w: f.width, h: f.height },
+             scrollW: document.documentElement.scrollWidth, scrollH: document.documentElement.scrollHeight,
+             controls };
+  });
+  const aspectOk = (l) => Math.abs(l.canvas.w / l.canvas.h - l.frame.w / l.frame.h) < 0.02 * (l.frame.w / l.frame.h);
+  await page.setViewportSize({ width: 1200, height: 800 });
+  await page.waitForTimeout(200);
+  let l = await layout();
+  const hiddenAt1200 = l.controls.filter((c) => c.box.bottom > 800 || c.box.right > 1200 || c.box.width === 0);
+  check(hiddenAt1200.length === 0 && l.scrollH <= 800,
+        `1200×800: every control is in view without scrolling (page ${l.scrollW}×${l.scrollH}` +
+        `${hiddenAt1200.length ? `; out of view: ${hiddenAt1200.map((c) => c.id).join(', ')}` : ''})`);
+  check(aspectOk(l) && l.canvas.h >= 700, `1200×800: the canvas is ${l.canvas.w.toFixed(0)}×${l.canvas.h.toFixed(0)} for a ${l.frame.w}×${l.frame.h} frame`);
+  if (opts.out) await page.screenshot({ path: join(opts.out, 'layout-1200x800.png') });
+
+  await page.setViewportSize({ width: 400, height: 800 });
+  await page.waitForTimeout(200);
+  l = await layout();
+  const wide = l.controls.filter((c) => c.box.right > 400 || c.box.left < 0);
+  check(l.scrollW <= 400 && wide.length === 0,
+        `400×800: nothing is wider than the window (page width ${l.scrollW}${wide.length ? `; too wide: ${wide.map((c) => c.id)}` : ''})`);
+  check(aspectOk(l) && l.canvas.w >= 360 && l.canvas.y + l.canvas.h <= 800,
+        `400×800: the canvas is ${l.canvas.w.toFixed(0)}×${l.canvas.h.toFixed(0)}, in view at the top`);
+  if (opts.out) await page.screenshot({ path: join(opts.out, 'layout-400x800.png'), fullPage: true });
+
+  await page.setViewportSize({ width: 1200, height: 800 });
+  await page.click('#fullwindow');
+  await page.waitForTimeout(300);
+  l = await layout();
+  const fullClass = await page.evaluate(() => document.getElementById('app').classList.contains('fullwindow'));
+  check(fullClass && aspectOk(l) && l.canvas.h >= 795, `full window: the canvas is ${l.canvas.w.toFixed(0)}×${l.canvas.h.toFixed(0)}`);
+  await page.keyboard.press('Escape');
+  await page.waitForTimeout(300);
+  const leftFull = await page.evaluate(() => !document.getElementById('app').classList.contains('fullwindow') &&
+                                             !document.fullscreenElement);
+  check(leftFull, 'Escape leaves the full window');
+
+  s = await state();
+  check(s.errors.length === expectedErrors, `no other server errors (${JSON.stringify(s.errors)})`);
+  const fpsTexts = await page.evaluate(() => window.fpsTexts);
+  const zeros = fpsTexts.filter((t) => Number(t) === 0);
+  check(zeros.length === 0, `the HUD never showed 0 fps after the first frame (${fpsTexts.length} values: ` +
+                            `${[...new Set(fpsTexts)].slice(0, 12).join(' ')}${zeros.length ? `; zeros: ${zeros.length}` : ''})`);
   check(consoleErrors.length === 0, `no page errors or outside requests (${consoleErrors.join('; ')})`);
+  await page.close();
+
+  // 8. Exposure, on raw frames (exact pixels) of a 128×96 view of the
+  // default scene. The clipped share is over the whole frame, sky included:
+  // simpler than an object mask, and stricter (the sky counts as well).
+  section('exposure');
+  {
+    const { page: p, problems } = await openPage('encoding=raw&size=128x96', { viewport: { width: 1200, height: 800 } });
+    await waitFrames(p, 1);
+    // Auto exposure eases over frames: a few poses, then the last frame.
+    for (let i = 0; i < 3; i++) {
+      await p.mouse.move(300, 300);
+      await p.mouse.down();
+      await p.mouse.move(302, 300);
+      await p.mouse.up();
+      await p.waitForTimeout(150);
+    }
+    let f = (await pick(p)).lastFrame;
+    const autoShare = clippedShare(await canvasPixels(p));
+    check(f.exposureMode === 'auto' && autoShare < 0.02,
+          `exposure auto (${f.exposureStops.toFixed(2)} stops): ${(100 * autoShare).toFixed(2)} % of pixels at 255 (< 2 %)`);
+    const shown = await text(p, '#exposure-value');
+    check(/stops \(auto\)$/.test(shown), `the exposure control shows the frame's exposure ("${shown}")`);
+    const la = await p.evaluate(() => {
+      const c = document.getElementById('frame').getBoundingClientRect();
+      return c.width / c.height;
+    });
+    check(Math.abs(la - 128 / 96) < 0.02, `a 128×96 frame keeps its aspect ratio on the page (${la.toFixed(3)})`);
+
+    // A fixed exposure three stops up: the slider sends it, frames say so,
+    // and the same measure now finds clipping (it can tell).
+    await p.evaluate(() => {
+      const slider = document.getElementById('exposure');
+      slider.value = '3';
+      slider.dispatchEvent(new Event('input', { bubbles: true }));
+    });
+    await p.waitForFunction(() => window.haarcast.lastFrame.exposureMode === 'fixed' &&
+                                  Math.abs(window.haarcast.lastFrame.exposureStops - 3) < 1e-6, null, { timeout: 30000 })
+      .catch(() => {});
+    f = (await pick(p)).lastFrame;
+    const fixedShare = clippedShare(await canvasPixels(p));
+    check(f.exposureMode === 'fixed' && f.exposureStops === 3 && fixedShare > 0.02,
+          `exposure fixed at ${f.exposureStops} stops: ${(100 * fixedShare).toFixed(2)} % of pixels at 255 (> 2 %)`);
+    await p.waitForTimeout(300);
+    const hudExposure = await text(p, '#hud-exposure');
+    check(hudExposure === '+3.0 stops fixed', `the HUD shows the fixed exposure ("${hudExposure}")`);
+    await p.check('#exposure-auto');
+    await p.waitForFunction(() => window.haarcast.lastFrame.exposureMode === 'auto', null, { timeout: 30000 }).catch(() => {});
+    f = (await pick(p)).lastFrame;
+    check(f.exposureMode === 'auto', `checking "auto" again brings auto-exposed frames (${f.exposureMode})`);
+    check(problems.length === 0, `exposure page: no page errors (${problems.join('; ')})`);
+    await p.close();
+  }
+
+  // 5. Below 1 fps (the server paces this session to 0.8 fps): the HUD
+  // settles on a number and never shows 0.
+  section('HUD below 1 fps');
+  {
+    const { page: p, problems } = await openPage('size=48x48&fps=0.8');
+    await waitFrames(p, 1);
+    const seen = [];
+    for (const end = Date.now() + 6000; Date.now() < end;) {
+      await p.mouse.move(300, 300);
+      await p.mouse.down();
+      await p.mouse.move(303, 300);
+      await p.mouse.up();
+      await p.waitForTimeout(100);
+      seen.push(await p.evaluate(() => document.getElementById('hud-fps').textContent));
+    }
+    const last = Number(seen.at(-1));
+    check(!seen.some((t) => Number(t) === 0) && last > 0.4 && last < 1.0,
+          `at 0.8 fps the HUD shows ${[...new Set(seen)].join(' ')} (never 0; settles on ${seen.at(-1)})`);
+    check(problems.length === 0, `slow page: no page errors (${problems.join('; ')})`);
+    await p.close();
+  }
+
+  // 10. A dropped connection: the page counts down and reconnects.
+  section('reconnect');
+  {
+    proxy = await startProxy(new URL(base));
+    const { page: p, problems } = await openPage('size=64x64', { origin: proxy.base, networkErrors: true });
+    await waitFrames(p, 1);
+    const before = await pick(p);
+    proxy.drop(2500);
+    await p.waitForFunction(() => window.haarcast.connection === 'reconnect-wait', null, { timeout: 5000 }).catch(() => {});
+    const status = await text(p, '#status');
+    check(/disconnected .*reconnecting in \d+ s \(attempt \d+\)/.test(status), `a dropped socket shows the countdown ("${status}")`);
+    await p.waitForFunction((w) => window.haarcast.welcomes > w && window.haarcast.framesShown > 0 &&
+                                   window.haarcast.lastShownSequence >= 1, before.welcomes, { timeout: 30000 }).catch(() => {});
+    const after = await pick(p);
+    const status2 = await text(p, '#status');
+    check(after.welcomes === before.welcomes + 1 && after.connection === 'ready' && after.connections >= 2,
+          `the page reconnected (${after.connections} connections, ${after.welcomes} Welcomes, "${status2}")`);
+    const framesBefore = after.framesShown;
+    await p.mouse.move(300, 300);
+    await p.mouse.down();
+    await p.mouse.move(340, 300, { steps: 3 });
+    await p.mouse.up();
+    await p.waitForFunction((n) => window.haarcast.framesShown > n, framesBefore, { timeout: 30000 }).catch(() => {});
+    check((await pick(p)).framesShown > framesBefore, 'after the reconnect a drag brings a frame');
+    check(problems.length === 0, `reconnect page: no page errors (${problems.join('; ')})`);
+    await p.close();
+  }
 } catch (err) {
   failures.push(err.message);
   console.log(`FAIL ${err.stack || err.message}`);
 } finally {
   if (browser) await browser.close();
+  if (proxy) await proxy.close();
   server.child.kill('SIGTERM');
   const timeout = new Promise((r) => setTimeout(() => r(null), 15000));
   const exit = await Promise.race([server.exited, timeout]);
@@ -269,6 +653,7 @@ try {
   } else {
     check(exit.code === 0, `the server exits 0 on SIGTERM (code ${exit.code}, signal ${exit.signal})`);
   }
+  rmSync(sceneDir, { recursive: true, force: true });
   if (failures.length) console.log(`--- server log ---\n${server.log().slice(-4000)}`);
 }
 

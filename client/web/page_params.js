@@ -1,0 +1,108 @@
+// The page's parameters (?size=…&encoding=…), checked before the page
+// connects: a bad one is reported at once, naming the parameter and its valid
+// values, instead of a Hello the server would refuse (or one never sent).
+// Pure, so that node tests it (tests/e2e/frame_stats_test.mjs).
+//
+// Ranges only the server knows (level, size, exposure, scene names) are left
+// to it: its Error names them, and the page shows that.
+
+// What the browser can draw: EXR frames are linear floats, not an image type.
+export const ENCODINGS = ['jpeg', 'png', 'raw'];
+
+export const PARAMETERS = {
+  size: 'WIDTHxHEIGHT, e.g. 256x256',
+  encoding: ENCODINGS.join(', '),
+  quality: 'a JPEG quality 1..100',
+  fps: 'frames per second at most, a number > 0',
+  token: 'the server\'s --token',
+  method: '',  // filled from the schema's RotationMethod values
+  level: 'a map level, e.g. 4 (the server says its range)',
+  k: 'light coefficients kept, a whole number > 0',
+  exposure: '"auto" or stops, e.g. -1.5',
+  scene: 'a scene the server offers, e.g. default',
+};
+
+function wholeNumber(text) {
+  return /^\d+$/.test(text) ? Number(text) : NaN;
+}
+
+// search: location.search (or a URLSearchParams); methods: the rotation
+// method names the schema defines ("fused", "haar", …).
+// Returns the choices and `errors`, one line per bad parameter.
+export function parsePageParameters(search, { methods }) {
+  const params = search instanceof URLSearchParams ? search : new URLSearchParams(search);
+  const out = {
+    width: 256, height: 256, encoding: 'jpeg', quality: 0, fps: 0, token: '',
+    method: '', level: 0, k: 0, exposure: { auto: true, stops: 0 }, scene: '',
+    errors: [],
+  };
+  const bad = (name, value, valid) => {
+    out.errors.push({ parameter: name, value, message: `?${name}=${value} is not valid: ${valid}` });
+  };
+  const valid = { ...PARAMETERS, method: `use one of ${methods.join(', ')}` };
+  for (const name of new Set(params.keys())) {
+    if (!(name in valid)) {
+      out.errors.push({ parameter: name, value: params.get(name),
+                        message: `?${name} is not a parameter of this page (it takes ${Object.keys(valid).join(', ')})` });
+    } else if (params.getAll(name).length > 1) {
+      out.errors.push({ parameter: name, value: params.getAll(name).join(','), message: `?${name} is given more than once` });
+    }
+  }
+  const get = (name) => params.get(name);
+
+  const size = get('size');
+  if (size !== null) {
+    const m = /^(\d+)x(\d+)$/.exec(size);
+    if (!m || Number(m[1]) < 1 || Number(m[2]) < 1) bad('size', size, 'use WIDTHxHEIGHT, e.g. 256x256');
+    else { out.width = Number(m[1]); out.height = Number(m[2]); }
+  }
+  const encoding = get('encoding');
+  if (encoding !== null) {
+    if (ENCODINGS.includes(encoding)) out.encoding = encoding;
+    else if (encoding === 'exr') bad('encoding', encoding, `the browser cannot show EXR frames (linear floats); use one of ${valid.encoding}`);
+    else bad('encoding', encoding, `use one of ${valid.encoding}`);
+  }
+  const quality = get('quality');
+  if (quality !== null) {
+    const q = wholeNumber(quality);
+    if (!(q >= 1 && q <= 100)) bad('quality', quality, 'use a JPEG quality 1..100');
+    else out.quality = q;
+  }
+  const fps = get('fps');
+  if (fps !== null) {
+    const f = Number(fps);
+    if (fps.trim() === '' || !Number.isFinite(f) || f <= 0) bad('fps', fps, 'use a number of frames per second > 0, e.g. 30');
+    else out.fps = f;
+  }
+  if (get('token') !== null) out.token = get('token');
+  const method = get('method');
+  if (method !== null) {
+    if (methods.includes(method)) out.method = method;
+    else bad('method', method, valid.method);
+  }
+  const level = get('level');
+  if (level !== null) {
+    const n = wholeNumber(level);
+    if (!(n >= 1)) bad('level', level, 'use a whole number, e.g. 4 (the server says its range)');
+    else out.level = n;
+  }
+  const k = get('k');
+  if (k !== null) {
+    const n = wholeNumber(k);
+    if (!(n >= 1)) bad('k', k, 'use a whole number of light coefficients > 0, e.g. 256');
+    else out.k = n;
+  }
+  const exposure = get('exposure');
+  if (exposure !== null) {
+    const stops = Number(exposure);
+    if (exposure === 'auto') out.exposure = { auto: true, stops: 0 };
+    else if (exposure.trim() !== '' && Number.isFinite(stops)) out.exposure = { auto: false, stops };
+    else bad('exposure', exposure, 'use "auto" or a number of stops, e.g. -1.5');
+  }
+  const scene = get('scene');
+  if (scene !== null) {
+    if (scene === '') bad('scene', scene, 'name a scene the server offers, e.g. default');
+    else out.scene = scene;
+  }
+  return out;
+}

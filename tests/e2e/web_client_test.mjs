@@ -1,0 +1,181 @@
+// Unit tests of the browser client's pure parts, in node (no browser): the
+// HUD's frame window (client/web/frame_stats.js) with made-up arrival times,
+// and the page-parameter checks (client/web/page_params.js).
+//
+// usage: node web_client_test.mjs
+import assert from 'node:assert/strict';
+import { dirname, join, resolve } from 'node:path';
+import { fileURLToPath, pathToFileURL } from 'node:url';
+
+const web = join(resolve(dirname(fileURLToPath(import.meta.url)), '..', '..'), 'client', 'web');
+const { FrameWindow, backoffMs, formatNumber, formatStops } = await import(pathToFileURL(join(web, 'frame_stats.js')));
+const { parsePageParameters } = await import(pathToFileURL(join(web, 'page_params.js')));
+
+const tests = [];
+const test = (name, fn) => tests.push({ name, fn });
+
+// Frames every `intervalMs` from t0: the window after each one, sampled
+// every 100 ms between frames as the HUD does (every 250 ms).
+function stream(w, { t0 = 0, count, intervalMs, sample }) {
+  let t = t0;
+  for (let i = 0; i < count; i++) {
+    w.add(t, { bytes: 1000, latencyMs: 50, serverMs: 40, stages: [{ name: 'fused', ms: 30 }, { name: 'encode', ms: 1 }] });
+    if (sample) for (let s = t; s < t + intervalMs; s += 100) sample(w.summary(s), s);
+    t += intervalMs;
+  }
+  return t - intervalMs;  // the last frame's time
+}
+
+test('no rate until three frames, then the stream rate', () => {
+  const w = new FrameWindow();
+  assert.equal(w.summary(0).fps, null);
+  w.add(0, { bytes: 500 });
+  assert.equal(w.summary(10).fps, null);
+  assert.equal(formatNumber(w.summary(10).fps), '—');
+  w.add(100, { bytes: 500 });
+  assert.equal(w.summary(110).fps, null);
+  w.add(200, { bytes: 500 });
+  assert.equal(w.summary(210).fps, 10);
+  // kbit/s: the bytes after the first frame over the span (1000 B in 200 ms = 40 kbit/s).
+  assert.equal(w.summary(210).kbps, 40);
+});
+
+test('30 fps: the rate over the last two seconds', () => {
+  const w = new FrameWindow();
+  stream(w, { count: 200, intervalMs: 1000 / 30 });
+  const s = w.summary(200 * 1000 / 30);
+  assert.ok(Math.abs(s.fps - 30) < 0.5, `fps ${s.fps}`);
+  assert.ok(s.frames >= 55 && s.frames <= 62, `frames in the window: ${s.frames}`);
+  assert.equal(s.latencyMs, 50);
+  assert.equal(s.serverMs, 40);
+  assert.deepEqual(s.stages.map((x) => x.name), ['fused', 'encode']);
+  assert.equal(formatNumber(s.fps), '30');
+});
+
+test('below 1 fps the number is steady and never 0', () => {
+  for (const fps of [0.9, 0.5, 0.2, 0.05]) {
+    const w = new FrameWindow();
+    const seen = [];
+    stream(w, {
+      count: 12, intervalMs: 1000 / fps,
+      sample: (s) => { if (w.frames.length >= 3) seen.push(s.fps); },
+    });
+    assert.ok(seen.every((x) => x !== null && x > 0), `${fps} fps: a null or zero rate among ${seen.length} samples`);
+    assert.ok(seen.every((x) => Math.abs(x - fps) / fps < 1e-9), `${fps} fps: the rate moved (${Math.min(...seen)}..${Math.max(...seen)})`);
+    assert.ok(seen.every((x) => !/^0(\.0*)?$/.test(formatNumber(x))), `${fps} fps printed as ${formatNumber(seen[0])}`);
+    assert.ok(!w.summary(w.frames.at(-1).t + 1000 / fps).idle, `${fps} fps: idle one interval after a frame`);
+  }
+});
+
+test('jittery 0.5 fps stays within 0.4..0.6', () => {
+  const w = new FrameWindow();
+  let t = 0;
+  const seen = [];
+  for (let i = 0; i < 30; i++) {
+    w.add(t);
+    for (let s = t; s < t + 1000; s += 250) if (w.frames.length >= 3) seen.push(w.summary(s).fps);
+    t += 2000 + (i % 3 - 1) * 600;  // 1.4, 2.0, 2.6 s
+  }
+  assert.ok(seen.every((x) => x > 0.4 && x < 0.6), `rates ${Math.min(...seen)}..${Math.max(...seen)}`);
+});
+
+test('a pause is idle, not a slow rate; the window restarts after it', () => {
+  const w = new FrameWindow();
+  const last = stream(w, { count: 60, intervalMs: 40 });
+  assert.ok(!w.summary(last + 100).idle);
+  const paused = w.summary(last + 10000);
+  assert.ok(paused.idle, 'idle 10 s after the last frame');
+  assert.ok(Math.abs(paused.fps - 25) < 0.5, `the last stretch's rate is kept (${paused.fps})`);
+  // The stream resumes 20 s later: the pause is not averaged in.
+  stream(w, { t0: last + 20000, count: 3, intervalMs: 100 });
+  const resumed = w.summary(last + 20250);
+  assert.equal(resumed.frames, 3);
+  assert.ok(Math.abs(resumed.fps - 10) < 1e-9, `fps after the pause ${resumed.fps}`);
+  assert.ok(!resumed.idle);
+});
+
+test('stage times: the newest frame\'s stages, averaged over the window', () => {
+  const w = new FrameWindow();
+  w.add(0, { stages: [{ name: 'rotation', ms: 20 }, { name: 'encode', ms: 1 }] });
+  w.add(100, { stages: [{ name: 'fused', ms: 4 }, { name: 'encode', ms: 2 }] });
+  w.add(200, { stages: [{ name: 'fused', ms: 6 }, { name: 'encode', ms: 3 }] });
+  assert.deepEqual(w.summary(200).stages, [{ name: 'fused', ms: 5 }, { name: 'encode', ms: 2 }]);
+});
+
+test('number formats', () => {
+  assert.equal(formatNumber(null), '—');
+  assert.equal(formatNumber(NaN), '—');
+  assert.equal(formatNumber(123.4), '123');
+  assert.equal(formatNumber(27.26), '27');
+  assert.equal(formatNumber(3.33), '3.3');
+  assert.equal(formatNumber(0.4), '0.40');
+  assert.equal(formatNumber(0.04), '0.040');
+  assert.equal(formatStops(1.26), '+1.3');
+  assert.equal(formatStops(-0.5), '−0.5');
+  assert.equal(formatStops(0.01), '0.0');
+  assert.equal(formatStops(NaN), '—');
+});
+
+test('reconnect back-off: 1, 2, 4, … 30 s with ±20 % jitter', () => {
+  assert.deepEqual([1, 2, 3, 4, 5, 6, 7, 12].map((a) => backoffMs(a, 0.5)),
+                   [1000, 2000, 4000, 8000, 16000, 30000, 30000, 30000]);
+  assert.equal(backoffMs(1, 0), 800);
+  assert.equal(backoffMs(1, 0.999999), 1200);
+});
+
+const methods = ['haar', 'spatial', 'matrix', 'table', 'fused'];
+
+test('page parameters: good ones', () => {
+  const p = parsePageParameters('?size=320x200&encoding=raw&quality=90&fps=0.5&token=a%20b&method=haar&level=5&k=64' +
+                                '&exposure=-1.5&scene=studio', { methods });
+  assert.deepEqual(p.errors, []);
+  assert.deepEqual([p.width, p.height, p.encoding, p.quality, p.fps, p.token, p.method, p.level, p.k, p.scene],
+                   [320, 200, 'raw', 90, 0.5, 'a b', 'haar', 5, 64, 'studio']);
+  assert.deepEqual(p.exposure, { auto: false, stops: -1.5 });
+  const defaults = parsePageParameters('', { methods });
+  assert.deepEqual(defaults.errors, []);
+  assert.deepEqual([defaults.width, defaults.height, defaults.encoding, defaults.method, defaults.level],
+                   [256, 256, 'jpeg', '', 0]);
+  assert.deepEqual(defaults.exposure, { auto: true, stops: 0 });
+  assert.deepEqual(parsePageParameters('?exposure=auto', { methods }).exposure, { auto: true, stops: 0 });
+});
+
+test('page parameters: each bad one is named with its valid values', () => {
+  const one = (query) => {
+    const p = parsePageParameters(query, { methods });
+    assert.equal(p.errors.length, 1, `${query}: ${JSON.stringify(p.errors)}`);
+    return p.errors[0];
+  };
+  let e = one('?method=fast');
+  assert.equal(e.parameter, 'method');
+  assert.match(e.message, /\?method=fast/);
+  assert.match(e.message, /haar, spatial, matrix, table, fused/);
+  e = one('?encoding=exr');
+  assert.match(e.message, /\?encoding=exr.*cannot show EXR.*jpeg, png, raw/);
+  assert.match(one('?encoding=gif').message, /jpeg, png, raw/);
+  assert.match(one('?size=big').message, /\?size=big.*WIDTHxHEIGHT/);
+  assert.match(one('?size=0x10').message, /\?size=0x10/);
+  assert.match(one('?level=4.5').message, /\?level=4\.5/);
+  assert.match(one('?level=-1').message, /\?level=-1/);
+  assert.match(one('?k=0').message, /\?k=0/);
+  assert.match(one('?fps=fast').message, /\?fps=fast/);
+  assert.match(one('?quality=101').message, /1\.\.100/);
+  assert.match(one('?exposure=bright').message, /"auto" or a number of stops/);
+  assert.match(one('?scene=').message, /\?scene=/);
+  assert.match(one('?methd=haar').message, /\?methd is not a parameter.*method/);
+  assert.match(one('?level=3&level=4').message, /more than once/);
+  assert.equal(parsePageParameters('?method=fast&encoding=exr', { methods }).errors.length, 2);
+});
+
+let failed = 0;
+for (const t of tests) {
+  try {
+    t.fn();
+    console.log(`ok   ${t.name}`);
+  } catch (err) {
+    failed++;
+    console.log(`FAIL ${t.name}\n     ${err.message.split('\n').join('\n     ')}`);
+  }
+}
+console.log(failed ? `${failed} of ${tests.length} failed` : `all ${tests.length} passed`);
+process.exit(failed ? 1 : 0);
