@@ -44,6 +44,7 @@ window.haarcast = state;
 // The eye the next camera pose would carry (for the test: a scene switch
 // starts the orbit at the scene's own camera).
 state.viewEye = () => (orbit.target ? orbitEye() : null);
+state.objectPose = (i) => objectRotation.get(i) || scenePoseOf(i);
 
 // ---- schema -------------------------------------------------------------------
 
@@ -113,6 +114,16 @@ function orbitEye() {
                             v3.scale(orbit.forward, c * Math.cos(orbit.azimuth))),
                      v3.scale(orbit.up, Math.sin(orbit.elevation)));
   return v3.add(orbit.target, v3.scale(dir, orbit.distance));
+}
+
+// The scene's own pose of an object (SceneInfo), where its turns start from,
+// so the first drag does not snap it back to no rotation.
+function scenePoseOf(index) {
+  const o = state.sceneInfo && state.sceneInfo.objects.find((x) => x.index === index);
+  const p = (o && o.pose) || {};
+  const r = p.rotateDegrees || {};
+  const t = p.translate || {};
+  return { x: r.x || 0, y: r.y || 0, z: r.z || 0, translate: { x: t.x || 0, y: t.y || 0, z: t.z || 0 } };
 }
 
 function resetView() {
@@ -683,7 +694,7 @@ canvas.addEventListener('pointermove', (e) => {
   } else if (target.startsWith('object:')) {
     const index = Number(target.slice(7));
     if (!state.sceneInfo.objects.some((o) => o.index === index)) return;
-    const r = objectRotation.get(index) || { x: 0, y: 0 };
+    const r = objectRotation.get(index) || scenePoseOf(index);
     r.y += dx * 0.5;
     r.x += dy * 0.5;
     objectRotation.set(index, r);
@@ -722,7 +733,7 @@ function sendPose() {
   if (touched.objects.size) {
     pose.objects = [...touched.objects].map((i) => {
       const r = objectRotation.get(i);
-      return { object: i, rotateDegrees: { x: r.x, y: r.y, z: 0 } };
+      return { object: i, rotateDegrees: { x: r.x, y: r.y, z: r.z }, translate: r.translate };
     });
   }
   if (touched.light) pose.lightRotateDegrees = { x: 0, y: lightY, z: 0 };

@@ -356,6 +356,11 @@ try {
   const diffLight = meanAbsDiff(luma(shot2), luma(shot3));
   check(diffLight > 0.5, `the frame changed after the light drag (mean |Δluma| ${diffLight.toFixed(2)} > 0.5)`);
   await dragAndWait('shift-drag (object)', 'Shift');
+  // An object's turns start from the scene's own pose (SceneInfo): the
+  // default scene's torus is turned (60, 20, 0) and translated to x = 0.8.
+  const torus = await page.evaluate(() => window.haarcast.objectPose(1));
+  check(torus.x === 60 && torus.y === 20 && Math.abs(torus.translate.x - 0.8) < 1e-9,
+        `object 1 starts from its scene pose (got ${JSON.stringify(torus)})`);
 
   // The HUD: numbers, and they keep updating.
   const hud = async () => page.evaluate(() => {

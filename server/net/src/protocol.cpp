@@ -388,13 +388,13 @@ v1::SceneInfo sceneInfo(const SessionConfig& config, const Catalog& catalog) {
   v1::SceneInfo info;
   info.set_name(config.scene);
   const Catalog::SceneEntry* scene = catalog.findScene(config.scene);
+  const auto vec = [](v1::Vec3* out, const glm::dvec3& v) {
+    out->set_x(v.x);
+    out->set_y(v.y);
+    out->set_z(v.z);
+  };
   if (scene) {
     auto* camera = info.mutable_camera();
-    const auto vec = [](v1::Vec3* out, const glm::dvec3& v) {
-      out->set_x(v.x);
-      out->set_y(v.y);
-      out->set_z(v.z);
-    };
     vec(camera->mutable_eye(), scene->camera.eye);
     vec(camera->mutable_target(), scene->camera.target);
     vec(camera->mutable_up(), scene->camera.up);
@@ -406,6 +406,12 @@ v1::SceneInfo sceneInfo(const SessionConfig& config, const Catalog& catalog) {
     const bool named = scene && i < scene->objectNames.size() && !scene->objectNames[i].empty();
     o->set_name(named ? scene->objectNames[i] : "object " + std::to_string(i));
     o->set_material(config.materials[i]);
+    if (scene && i < scene->poses.size()) {
+      auto* pose = o->mutable_pose();
+      pose->set_object(static_cast<std::uint32_t>(i));
+      vec(pose->mutable_rotate_degrees(), scene->poses[i].rotateDegrees);
+      vec(pose->mutable_translate(), scene->poses[i].translate);
+    }
   }
   return info;
 }

@@ -498,6 +498,8 @@ TEST(Server, WelcomeDescribesTheSceneAndAMaterialChangeIsAnnounced) {
     EXPECT_EQ(o.index(), i);
     EXPECT_EQ(o.name(), scene.objects[i].name);
     EXPECT_EQ(o.material(), scene.objects[i].material.name);
+    EXPECT_EQ(o.pose().rotate_degrees().x(), scene.objects[i].pose.rotateDegrees.x);
+    EXPECT_EQ(o.pose().translate().x(), scene.objects[i].pose.translate.x);
   }
   EXPECT_EQ(w.scene_info().camera().eye().z(), scene.camera.eye.z);
   EXPECT_EQ(w.scene_info().camera().fov_y_degrees(), scene.camera.fovYDegrees);
