@@ -209,6 +209,24 @@ class ProgressReporter {
   double lastDraw_ = 0.0;
 };
 
+// A Monte Carlo render's progress(samples, half-image difference) as a stage
+// of `reporter`: the percentage of the samples it will take to converge
+// (estimatedSamplesToConverge), so the time left is an estimate that firms
+// up as the error settles. Call reporter.finish(stage, …) after the render:
+// it may stop short of the estimate.
+inline std::function<void(int, double)> monteCarloProgress(ProgressReporter& reporter, std::string stage,
+                                                           double tolerance, int maxSamples) {
+  return [&reporter, stage = std::move(stage), tolerance, maxSamples](int samples, double error) {
+    const auto done = static_cast<std::size_t>(std::max(samples, 0));
+    const std::size_t total =
+        estimatedSamplesToConverge(done, error, tolerance, static_cast<std::size_t>(std::max(maxSamples, 1)));
+    char detail[128];
+    std::snprintf(detail, sizeof detail, "%d samples/pixel, half-image difference %.4f (goal %.4f)", samples, error,
+                  tolerance);
+    reporter.update(stage, done, total, detail);
+  };
+}
+
 // ---- bound to the process (progress.cpp) ------------------------------------
 
 // stderr is a terminal that can redraw a line (not TERM=dumb).

@@ -18,6 +18,7 @@
 #include "haarcast/gpu/backend.h"
 #include "haarcast/net/server.h"
 #include "haarcast/render/scene.h"
+#include "progress.h"
 
 namespace haarcast::app {
 namespace {
@@ -167,7 +168,10 @@ int run(ServeArgs& a) {
     options.lightCoefficients = c.lightCoefficients;
     if (!quiet) std::fprintf(stderr, "[serve] preparing renderer %s\n", c.rendererKey().c_str());
     auto prepared = std::make_shared<net::PreparedRenderer>();
-    prepared->renderer = gpu::makeRenderer(c.backend, scene, options, vulkanOptions);
+    // Slice tables and visibility: lines, not a redrawn one (sessions log in between).
+    StderrProgress progress("[serve] ", false);
+    prepared->renderer =
+        gpu::makeRenderer(c.backend, scene, options, vulkanOptions, quiet ? StageProgress{} : progress.callback());
     if (!quiet) {
       std::fprintf(stderr, "[serve] renderer ready: %s on %s\n", prepared->renderer->backend().c_str(),
                    prepared->renderer->deviceName().c_str());
