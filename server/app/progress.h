@@ -5,8 +5,8 @@
 //
 //   terminal   "\r[visibility bunny]  42% (15000/35947), 1 min 12 s left\x1b[K"  (redrawn)
 //              "\r[visibility bunny] 100% (35947/35947) in 1 min 35 s\x1b[K\n"    (at the end)
-//   log        "[visibility bunny]  40% (14379/35947), 1 min 20 s left\n"          (each 10 %, or
-//              "[visibility bunny] 100% (35947/35947) in 1 min 35 s\n"             every 10 s at least)
+//   log        "[visibility bunny]  40% (14379/35947), 1 min 20 s left\n"          (each 10 % more,
+//              "[visibility bunny] 100% (35947/35947) in 1 min 35 s\n"             or after 10 s)
 //
 // The logic is here, header-only, with the clock and the output injected so
 // that tests can drive it; stderrProgress() (progress.cpp) binds it to the
@@ -32,8 +32,8 @@ struct ProgressOptions {
   bool terminal = false;        // redraw one line in place, else print lines
   double quietSeconds = 2.0;    // a stage that ends sooner prints nothing
   double redrawSeconds = 0.1;   // terminal: redraw at most this often
-  int logPercentStep = 10;      // log: a line each time this many more percent are done,
-  double logSeconds = 10.0;     //      or when this long has passed without one
+  int logPercentStep = 10;      // log: a line when this many more percent are done than at the last,
+  double logSeconds = 10.0;     //      or when this long has passed since it
   std::string prefix;           // before every line, e.g. "[serve] "
 };
 
@@ -98,10 +98,12 @@ class ProgressReporter {
       if (s.shown && drawn_ == stage && now - lastDraw_ < o_.redrawSeconds) return;
       draw(stage, text, now);
     } else {
-      const int step = o_.logPercentStep > 0 ? percent(s) / o_.logPercentStep : 0;
-      if (s.shown && step <= s.loggedStep && now - s.lastLine < o_.logSeconds) return;
+      // Steps count from the last line, not from round percentages: a line
+      // printed after a silence at 19 % is not followed by another at 20 %.
+      const int pct = percent(s);
+      if (s.shown && pct - s.loggedPercent < o_.logPercentStep && now - s.lastLine < o_.logSeconds) return;
       sink_(o_.prefix + text + "\n");
-      s.loggedStep = step;
+      s.loggedPercent = pct;
       s.lastLine = now;
     }
     s.shown = true;
@@ -140,7 +142,7 @@ class ProgressReporter {
     std::size_t done = 0, total = 0;
     std::string detail;
     bool shown = false;
-    int loggedStep = -1;
+    int loggedPercent = 0;
     double lastLine = 0.0;
   };
 

@@ -93,25 +93,39 @@ TEST(Progress, LogPrintsLinesEveryStepOrAfterSilence) {
   ProgressReporter p = f.make();
   p.update("tables", 0, 100);
   for (int i = 1; i <= 100; ++i) {
-    f.now += 1.0;
+    // 1 % per second up to 30 %, then 25 % per second.
+    f.now += i <= 30 ? 1.0 : 0.04;
     p.update("tables", static_cast<std::size_t>(i), 100);
   }
-  // From 2 s on: a line at 2 % (the first), then at each 25 % step, and
-  // none closer than 10 s otherwise: here the steps come first.
+  // From 2 s on: the first line, then one every 10 s while slow (the time
+  // rule), then one per 25 % more while fast (the step rule), then the end.
   EXPECT_EQ(f.out,
             "[tables]   2% (2/100), 1 min 38 s left\n"
             "[tables]  12% (12/100), 1 min 28 s left\n"
             "[tables]  22% (22/100), 1 min 18 s left\n"
-            "[tables]  25% (25/100), 1 min 15 s left\n"
-            "[tables]  35% (35/100), 1 min 05 s left\n"
-            "[tables]  45% (45/100), 55 s left\n"
-            "[tables]  50% (50/100), 50 s left\n"
-            "[tables]  60% (60/100), 40 s left\n"
-            "[tables]  70% (70/100), 30 s left\n"
-            "[tables]  75% (75/100), 25 s left\n"
-            "[tables]  85% (85/100), 15 s left\n"
-            "[tables]  95% (95/100), 5.0 s left\n"
-            "[tables] 100% (100/100) in 1 min 40 s\n");
+            "[tables]  47% (47/100), 35 s left\n"
+            "[tables]  72% (72/100), 12 s left\n"
+            "[tables]  97% (97/100), 1.0 s left\n"
+            "[tables] 100% (100/100) in 33 s\n");
+}
+
+TEST(Progress, LogLineAfterASilenceIsNotRepeatedAtTheNextRoundPercentage) {
+  Fixture f;
+  f.options.terminal = false;
+  f.options.logPercentStep = 10;
+  f.options.logSeconds = 9.0;
+  ProgressReporter p = f.make();
+  p.update("visibility", 0, 100);
+  for (int i = 1; i < 32; ++i) {
+    f.now += 1.0;
+    p.update("visibility", static_cast<std::size_t>(i), 100);
+  }
+  // 2 (first), 11 (9 s), 20 (9 s), 29 (9 s): never 29 and then 30.
+  EXPECT_EQ(f.out,
+            "[visibility]   2% (2/100), 1 min 38 s left\n"
+            "[visibility]  11% (11/100), 1 min 29 s left\n"
+            "[visibility]  20% (20/100), 1 min 20 s left\n"
+            "[visibility]  29% (29/100), 1 min 11 s left\n");
 }
 
 TEST(Progress, NeverShowsOneHundredBeforeTheEnd) {
