@@ -31,7 +31,7 @@ DPI = 100
 MSE_SIZE_IN = (12.0, 5.0)      # one (level, material) figure: 1200×500 px
 TILE_IN = 2.0                  # a glossiness tile is drawn 200 px wide …
 TILE_GAP_IN = 0.1              # … 10 px apart
-SHEET_MARGINS_IN = {"left": 0.9, "right": 0.15, "top": 0.95, "bottom": 0.15}
+SHEET_MARGINS_IN = {"left": 0.9, "right": 0.15, "top": 0.75, "bottom": 0.15}
 
 # Okabe–Ito: distinguishable with colour-vision deficiencies.
 COLOURS = ["#E69F00", "#56B4E9", "#009E73", "#F0E442", "#0072B2", "#D55E00", "#CC79A7", "#999999"]
@@ -86,7 +86,8 @@ def mse_range(report):
                     values += [v for v in variants.values() if isinstance(v, (int, float)) and v > 0]
     if not values:
         return 1e-20, 1.0
-    lo = 10.0 ** math.floor(math.log10(min(values)))
+    # A decade below the smallest value, so that its bar is seen.
+    lo = 10.0 ** (math.floor(math.log10(min(values))) - 1)
     hi = 10.0 ** math.ceil(math.log10(max(values)) + 1e-9)
     return lo, max(hi, lo * 10.0)
 

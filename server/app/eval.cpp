@@ -1,7 +1,9 @@
 #include "eval.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -142,6 +144,38 @@ std::string listed(const nlohmann::json& array) {
   return out;
 }
 
+// A square of the image: the object's bounding box (mask), grown by a
+// margin and to a square, kept inside the image where it fits.
+struct Square {
+  int x = 0, y = 0, size = 0;
+};
+
+Square squareAround(const std::vector<std::uint8_t>& mask, int width, int height) {
+  int x0 = width, y0 = height, x1 = -1, y1 = -1;
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x)
+      if (mask[static_cast<std::size_t>(y * width + x)]) {
+        x0 = std::min(x0, x), x1 = std::max(x1, x);
+        y0 = std::min(y0, y), y1 = std::max(y1, y);
+      }
+  const int full = std::min(width, height);
+  if (x1 < 0) return {0, 0, full};  // nothing covered: the whole frame
+  const int margin = std::max(1, full / 32);
+  const int size = std::min(full, std::max(x1 - x0, y1 - y0) + 1 + 2 * margin);
+  auto start = [&](int lo, int hi, int extent) {
+    return std::clamp((lo + hi + 1 - size) / 2, 0, extent - size);  // centred on the box
+  };
+  return {start(x0, x1, width), start(y0, y1, height), size};
+}
+
+io::RgbImage cropped(const io::RgbImage& image, const Square& s) {
+  io::RgbImage out = io::makeImage(s.size, s.size);
+  for (int y = 0; y < s.size; ++y)
+    for (int x = 0; x < s.size; ++x)
+      for (int c = 0; c < 3; ++c) out.at(y, x, c) = image.at(s.y + y, s.x + x, c);
+  return out;
+}
+
 std::string levelKey(int level) { return "level" + std::to_string(level); }
 
 // The figure names, recorded in report.json: the script draws to them and
@@ -244,7 +278,8 @@ EvalResult runEval(const EvalOptions& o, ProgressReporter& progress) {
             modelMseRefined += refined.mse / rotations;
             modelMseFaithful += faithful.mse / rotations;
             ++count;
-            progress.update(stage, ++rendered, renders);
+            // The stage ends after its last result line, below.
+            if (++rendered < renders) progress.update(stage, rendered, renders);
           }
           report["mse"][levelKey(level)][matName][envName][a.models[mi].first] = {
               {"refined", modelMseRefined}, {"faithful", modelMseFaithful}};
@@ -257,16 +292,19 @@ EvalResult runEval(const EvalOptions& o, ProgressReporter& progress) {
       report["figures"]["mse"][levelKey(level)][matName] = msePlotName(level, matName);
     }
   }
+  progress.update(stage, renders, renders);
   }
   report["timings"]["tables_s"] = since(tTables);
 
   // ---- Glossiness grid: materials × light coefficients -------------------
   // Each tile is a PNG of its own (glossiness/); the script lays them out
-  // with their labels.
+  // with their labels. Every tile is cropped to the same square around the
+  // object (the union of the renders' object masks), so that the object,
+  // not the background, fills the sheet and the tiles still line up.
   const auto tGloss = Clock::now();
   if (!o.truthOnly) {
     const int glossLevel = o.quick ? 4 : 6;
-    const int tile = o.quick ? 32 : 192;
+    const int frameSize = o.quick ? 32 : 256;
     const std::vector<std::size_t> ks = {4, 16, 64, 256};
     const auto& model = a.models.size() > 3 ? a.models[3] : a.models.front();  // the bunny when there is one
     const std::string stage = "eval glossiness";
@@ -274,32 +312,38 @@ EvalResult runEval(const EvalOptions& o, ProgressReporter& progress) {
     std::size_t rendered = 0;
     progress.update(stage, 0, renders);
     fs::create_directories(fs::path(o.outDir) / "glossiness");
-    nlohmann::json tiles = nlohmann::json::array();  // [row = k][column = material]
-    for (std::size_t row = 0; row < ks.size(); ++row) tiles.push_back(nlohmann::json::array());
+    std::vector<std::vector<io::RgbImage>> byMaterial;  // [material][k]
+    std::vector<std::uint8_t> covered(static_cast<std::size_t>(frameSize * frameSize), 0);
     for (const auto& [matName, material] : a.glossMaterials) {
-      std::vector<io::RgbImage> byK;
+      byMaterial.emplace_back();
       for (std::size_t k : ks) {
         render::RenderOptions opt = base;
         opt.level = glossLevel;
-        opt.width = opt.height = tile;
+        opt.width = opt.height = frameSize;
         opt.lightCoefficients = k;
-        byK.push_back(render::renderCpu(singleObjectScene(a.environments.front().second, model.first, model.second,
-                                                          material, {0.0, 20.0, 0.0}),
-                                        opt, inner)
-                          .image);
+        render::RenderResult r = render::renderCpu(
+            singleObjectScene(a.environments.front().second, model.first, model.second, material, {0.0, 20.0, 0.0}),
+            opt, inner);
+        for (std::size_t i = 0; i < covered.size(); ++i) covered[i] |= r.objectMask[i];
+        byMaterial.back().push_back(std::move(r.image));
         progress.update(stage, ++rendered, renders);
       }
+    }
+    const Square crop = squareAround(covered, frameSize, frameSize);
+    nlohmann::json tiles = nlohmann::json::array();  // [row = k][column = material]
+    for (std::size_t row = 0; row < ks.size(); ++row) tiles.push_back(nlohmann::json::array());
+    for (std::size_t m = 0; m < a.glossMaterials.size(); ++m) {
       // One exposure per material, from its richest render.
-      const double stops = reinhardKeyExposure(byK.back());
+      const double stops = reinhardKeyExposure(byMaterial[m].back());
       for (std::size_t row = 0; row < ks.size(); ++row) {
-        const std::string file = "glossiness/k" + std::to_string(ks[row]) + "_" + matName + ".png";
-        io::writePng((fs::path(o.outDir) / file).string(), byK[row], stops);
+        const std::string file = "glossiness/k" + std::to_string(ks[row]) + "_" + a.glossMaterials[m].first + ".png";
+        io::writePng((fs::path(o.outDir) / file).string(), cropped(byMaterial[m][row], crop), stops);
         tiles[row].push_back(file);
       }
     }
     report["glossiness"] = {{"file", "glossiness.png"}, {"model", model.first}, {"level", glossLevel},
                             {"environment", a.environments.front().first}, {"light_coefficients", ks},
-                            {"tile_size", tile}, {"tiles", tiles}};
+                            {"frame_size", frameSize}, {"tile_size", crop.size}, {"tiles", tiles}};
     for (const auto& [name, m] : a.glossMaterials) report["glossiness"]["materials"].push_back(name);
   }
   report["timings"]["glossiness_s"] = since(tGloss);
@@ -383,8 +427,8 @@ EvalResult runEval(const EvalOptions& o, ProgressReporter& progress) {
         const render::RenderResult r = render::renderCpu(scene, opt, inner);
         const ErrorStats e = objectError(asResult, r.image, mc.objectMask);
         report["truth"][levelKey(level)][v.name] = {{"psnr", e.psnr}, {"mse", e.mse}, {"seconds", since(t)}};
-        progress.update(stage, ++rendered, renders);
         log("truth level " + std::to_string(level) + " " + v.name + ": " + fmt(e.psnr) + " dB");
+        progress.update(stage, ++rendered, renders);
       }
     }
   }
@@ -459,7 +503,8 @@ EvalResult runEval(const EvalOptions& o, ProgressReporter& progress) {
   if (drawn) md << "![glossiness](" << g["file"].get<std::string>() << ")\n\n";
   md << "Rows: " << listed(g["light_coefficients"]) << " light coefficients; columns: " << listed(g["materials"])
      << "; model " << g["model"].get<std::string>() << ", level " << g["level"].get<int>() << ", environment "
-     << g["environment"].get<std::string>() << ", " << g["tile_size"].get<int>() << "² tiles (glossiness/).\n";
+     << g["environment"].get<std::string>() << "; " << g["frame_size"].get<int>() << "² renders cropped to the "
+     << g["tile_size"].get<int>() << "² square around the object (glossiness/).\n";
   }
   const auto& tc = report["truth"]["config"];
   md << "\n## Truth PSNR against Monte Carlo\n\nModel " << tc["model"].get<std::string>() << ", environment "
