@@ -54,6 +54,8 @@ PACKAGES=(
   nodejs
   # Step 5: Google Highway for the fused kernel's SIMD (runtime dispatch).
   libhwy-dev
+  # eval's figures: matplotlib draws them from report.json (tools/plot_report.py).
+  python3-matplotlib
 )
 
 # Build folder, relative to the repository root (HAARCAST_BUILD_DIR overrides).

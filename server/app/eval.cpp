@@ -1,7 +1,9 @@
 #include "eval.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -17,8 +19,11 @@
 #include "haarcast/io/mesh_io.h"
 #include "haarcast/render/cpu_renderer.h"
 #include "haarcast/render/reference.h"
+#include "haarcast/render/renderer.h"
 #include "haarcast/render/scene.h"
-#include "plots.h"
+#include "haarcast/render/tonemap.h"
+#include "progress.h"
+#include "report_figures.h"
 
 namespace haarcast::app {
 namespace {
@@ -89,12 +94,13 @@ EvalAssets discoverAssets(const EvalOptions& o) {
   return a;
 }
 
-// One object at the origin in front of a camera that it nearly fills.
-render::Scene singleObjectScene(const render::Environment& env, std::shared_ptr<Mesh> mesh, const render::Material& m,
-                                const glm::dvec3& rotateDegrees) {
+// One object at the origin in front of a camera that it nearly fills; named
+// after its model, so that progress lines say which mesh is being prepared.
+render::Scene singleObjectScene(const render::Environment& env, const std::string& name, std::shared_ptr<Mesh> mesh,
+                                const render::Material& m, const glm::dvec3& rotateDegrees) {
   render::Scene s;
   s.environment = env;
-  render::SceneObject o{"object", std::move(mesh), m, {}};
+  render::SceneObject o{name, std::move(mesh), m, {}};
   o.pose.rotateDegrees = rotateDegrees;
   s.objects.push_back(o);
   s.camera.eye = {0.0, 0.0, 3.0};
@@ -126,11 +132,89 @@ std::string fmt(double v, int digits = 2) {
   return b;
 }
 
+std::string fmtSig(double v, int digits = 3) {
+  char b[64];
+  std::snprintf(b, sizeof b, "%.*g", digits, v);
+  return b;
+}
+
+// ["a", "b", 4] → "a, b, 4": lists in report.md's prose.
+std::string listed(const nlohmann::json& array) {
+  std::string out;
+  for (const auto& v : array) out += (out.empty() ? "" : ", ") + (v.is_string() ? v.get<std::string>() : v.dump());
+  return out;
+}
+
+// A square of the image: the object's bounding box (mask), grown by a
+// margin and to a square, kept inside the image where it fits.
+struct Square {
+  int x = 0, y = 0, size = 0;
+};
+
+Square squareAround(const std::vector<std::uint8_t>& mask, int width, int height) {
+  int x0 = width, y0 = height, x1 = -1, y1 = -1;
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x)
+      if (mask[static_cast<std::size_t>(y * width + x)]) {
+        x0 = std::min(x0, x), x1 = std::max(x1, x);
+        y0 = std::min(y0, y), y1 = std::max(y1, y);
+      }
+  const int full = std::min(width, height);
+  if (x1 < 0) return {0, 0, full};  // nothing covered: the whole frame
+  const int margin = std::max(1, full / 32);
+  const int size = std::min(full, std::max(x1 - x0, y1 - y0) + 1 + 2 * margin);
+  auto start = [&](int lo, int hi, int extent) {
+    return std::clamp((lo + hi + 1 - size) / 2, 0, extent - size);  // centred on the box
+  };
+  return {start(x0, x1, width), start(y0, y1, height), size};
+}
+
+io::RgbImage cropped(const io::RgbImage& image, const Square& s) {
+  io::RgbImage out = io::makeImage(s.size, s.size);
+  for (int y = 0; y < s.size; ++y)
+    for (int x = 0; x < s.size; ++x)
+      for (int c = 0; c < 3; ++c) out.at(y, x, c) = image.at(s.y + y, s.x + x, c);
+  return out;
+}
+
+std::string levelKey(int level) { return "level" + std::to_string(level); }
+
+// The figure names, recorded in report.json: the script draws to them and
+// report.md links them, so both read them from one place.
+std::string msePlotName(int level, const std::string& material) {
+  return "mse_level" + std::to_string(level) + "_" + material + ".png";
+}
+
+// report.md's timings: one row per stage of report.json's "timings".
+std::string timingsTable(const nlohmann::json& timings) {
+  const std::vector<std::pair<const char*, const char*>> rows = {
+      {"tables_s", "Tables 1–4 and the MSE data"},
+      {"glossiness_s", "glossiness grid"},
+      {"truth_s", "truth PSNR (Monte Carlo and every method)"}};
+  const double total = timings.value("total_s", 0.0);
+  std::ostringstream md;
+  auto row = [&](const std::string& name, double s) {
+    md << "| " << name << " | " << fmt(s, 1) << " | " << formatDuration(s) << " | "
+       << (total > 0.0 ? fmt(100.0 * s / total, 0) + " %" : std::string()) << " |\n";
+  };
+  md << "| stage | seconds | time | share |\n|---|---:|---:|---:|\n";
+  double stages = 0.0;
+  for (const auto& [key, name] : rows) {
+    if (!timings.contains(key)) continue;
+    row(name, timings[key].get<double>());
+    stages += timings[key].get<double>();
+  }
+  row("loading the assets, writing report.json", std::max(0.0, total - stages));
+  md << "| **total** | " << fmt(total, 1) << " | " << formatDuration(total) << " | |\n";
+  return md.str();
+}
+
 }  // namespace
 
-nlohmann::json runEval(const EvalOptions& o, const std::function<void(const std::string&)>& log) {
+EvalResult runEval(const EvalOptions& o, ProgressReporter& progress) {
   const auto tStart = Clock::now();
   fs::create_directories(o.outDir);
+  auto log = [&](const std::string& line) { progress.message("[eval] " + line); };
   const EvalAssets a = discoverAssets(o);
   for (const auto& n : a.notes) log("note: " + n);
 
@@ -145,14 +229,17 @@ nlohmann::json runEval(const EvalOptions& o, const std::function<void(const std:
   base.visibility.supersampling = 1;
   base.cacheDir = (fs::path(o.outDir) / "cache").string();
   base.threads = o.threads;
+  // The renders' own long stages (visibility of a new mesh) show inside ours.
+  const StageProgress inner = progress.callback();
 
   nlohmann::json report;
   report["config"] = {{"quick", o.quick}, {"frame", frame}, {"rotations_per_model", rotations}, {"levels", levels}};
   for (const auto& [name, env] : a.environments) report["config"]["environments"].push_back(name);
   for (const auto& [name, m] : a.models) report["config"]["models"].push_back(name);
+  for (const auto& [name, m] : a.tableMaterials) report["config"]["table_materials"].push_back(name);
   report["notes"] = a.notes;
 
-  // ---- Tables 1–4 and the MSE plots -------------------------------------
+  // ---- Tables 1–4 and the MSE data ----------------------------------------
   const auto tTables = Clock::now();
   if (!o.truthOnly) {
   const std::vector<glm::dvec3> poses = [&] {
@@ -162,83 +249,104 @@ nlohmann::json runEval(const EvalOptions& o, const std::function<void(const std:
     }
     return p;
   }();
+  const std::string stage = "eval tables 1–4";
+  const std::size_t renders = levels.size() * a.tableMaterials.size() * a.environments.size() * a.models.size() *
+                              static_cast<std::size_t>(rotations);
+  std::size_t rendered = 0;
+  progress.update(stage, 0, renders);
   for (int level : levels) {
     for (const auto& [matName, material] : a.tableMaterials) {
-      std::vector<std::vector<double>> mseRefined(a.models.size()), mseFaithful(a.models.size());
       for (const auto& [envName, env] : a.environments) {
         double sumRefined = 0.0, sumFaithful = 0.0;
         int count = 0;
         for (std::size_t mi = 0; mi < a.models.size(); ++mi) {
           double modelMseRefined = 0.0, modelMseFaithful = 0.0;
           for (int r = 0; r < rotations; ++r) {
-            const render::Scene scene = singleObjectScene(env, a.models[mi].second, material,
-                                                          poses[mi * static_cast<std::size_t>(rotations) + static_cast<std::size_t>(r)]);
+            const render::Scene scene =
+                singleObjectScene(env, a.models[mi].first, a.models[mi].second, material,
+                                  poses[mi * static_cast<std::size_t>(rotations) + static_cast<std::size_t>(r)]);
             render::RenderOptions opt = base;
             opt.level = level;
             opt.method = RotationMethod::Spatial;
-            const render::RenderResult spatial = render::renderCpu(scene, opt);
+            const render::RenderResult spatial = render::renderCpu(scene, opt, inner);
             opt.method = RotationMethod::Haar;
             opt.rotator.haarVariant = HaarVariant::Refined;
-            const ErrorStats refined = objectError(spatial, render::renderCpu(scene, opt).image, spatial.objectMask);
+            const ErrorStats refined = objectError(spatial, render::renderCpu(scene, opt, inner).image, spatial.objectMask);
             opt.rotator.haarVariant = HaarVariant::Faithful;
-            const ErrorStats faithful = objectError(spatial, render::renderCpu(scene, opt).image, spatial.objectMask);
+            const ErrorStats faithful = objectError(spatial, render::renderCpu(scene, opt, inner).image, spatial.objectMask);
             sumRefined += refined.psnr;
             sumFaithful += faithful.psnr;
             modelMseRefined += refined.mse / rotations;
             modelMseFaithful += faithful.mse / rotations;
             ++count;
+            // The stage ends after its last result line, below.
+            if (++rendered < renders) progress.update(stage, rendered, renders);
           }
-          mseRefined[mi].push_back(modelMseRefined);
-          mseFaithful[mi].push_back(modelMseFaithful);
-          report["mse"]["level" + std::to_string(level)][matName][envName][a.models[mi].first] = {
+          report["mse"][levelKey(level)][matName][envName][a.models[mi].first] = {
               {"refined", modelMseRefined}, {"faithful", modelMseFaithful}};
         }
-        report["tables"]["level" + std::to_string(level)][matName][envName] = {
+        report["tables"][levelKey(level)][matName][envName] = {
             {"refined", sumRefined / count}, {"faithful", sumFaithful / count}};
         log("table level " + std::to_string(level) + " " + matName + " " + envName + ": refined " +
             fmt(sumRefined / count) + " dB, faithful " + fmt(sumFaithful / count) + " dB");
       }
-      for (const auto& [variant, mse] : {std::pair{"refined", &mseRefined}, std::pair{"faithful", &mseFaithful}}) {
-        const std::string file = "mse_level" + std::to_string(level) + "_" + matName + "_" + variant + ".png";
-        io::writePng((fs::path(o.outDir) / file).string(), groupedLogBarChart(*mse));
-        report["plots"].push_back(file);
-      }
+      report["figures"]["mse"][levelKey(level)][matName] = msePlotName(level, matName);
     }
   }
+  progress.update(stage, renders, renders);
   }
   report["timings"]["tables_s"] = since(tTables);
 
   // ---- Glossiness grid: materials × light coefficients -------------------
+  // Each tile is a PNG of its own (glossiness/); the script lays them out
+  // with their labels. Every tile is cropped to the same square around the
+  // object (the union of the renders' object masks), so that the object,
+  // not the background, fills the sheet and the tiles still line up.
   const auto tGloss = Clock::now();
   if (!o.truthOnly) {
     const int glossLevel = o.quick ? 4 : 6;
+    const int frameSize = o.quick ? 32 : 256;
     const std::vector<std::size_t> ks = {4, 16, 64, 256};
-    std::vector<io::RgbImage> tiles;
     const auto& model = a.models.size() > 3 ? a.models[3] : a.models.front();  // the bunny when there is one
-    std::vector<std::vector<io::RgbImage>> byMaterial(a.glossMaterials.size());
-    for (std::size_t m = 0; m < a.glossMaterials.size(); ++m) {
+    const std::string stage = "eval glossiness";
+    const std::size_t renders = a.glossMaterials.size() * ks.size();
+    std::size_t rendered = 0;
+    progress.update(stage, 0, renders);
+    fs::create_directories(fs::path(o.outDir) / "glossiness");
+    std::vector<std::vector<io::RgbImage>> byMaterial;  // [material][k]
+    std::vector<std::uint8_t> covered(static_cast<std::size_t>(frameSize * frameSize), 0);
+    for (const auto& [matName, material] : a.glossMaterials) {
+      byMaterial.emplace_back();
       for (std::size_t k : ks) {
         render::RenderOptions opt = base;
         opt.level = glossLevel;
-        opt.width = opt.height = o.quick ? 24 : 96;
+        opt.width = opt.height = frameSize;
         opt.lightCoefficients = k;
-        byMaterial[m].push_back(
-            render::renderCpu(singleObjectScene(a.environments.front().second, model.second, a.glossMaterials[m].second,
-                                                {0.0, 20.0, 0.0}),
-                              opt)
-                .image);
+        render::RenderResult r = render::renderCpu(
+            singleObjectScene(a.environments.front().second, model.first, model.second, material, {0.0, 20.0, 0.0}),
+            opt, inner);
+        for (std::size_t i = 0; i < covered.size(); ++i) covered[i] |= r.objectMask[i];
+        byMaterial.back().push_back(std::move(r.image));
+        progress.update(stage, ++rendered, renders);
       }
-      // One exposure per material, from its richest render.
-      const double stops = reinhardKeyExposure(byMaterial[m].back());
-      for (auto& img : byMaterial[m])
-        for (float& v : img.rgb) v = static_cast<float>(std::min(1.0, v * std::exp2(stops)));
     }
-    for (std::size_t row = 0; row < ks.size(); ++row)
-      for (std::size_t m = 0; m < a.glossMaterials.size(); ++m) tiles.push_back(byMaterial[m][row]);
-    io::writePng((fs::path(o.outDir) / "glossiness.png").string(),
-                 contactSheet(tiles, static_cast<int>(a.glossMaterials.size())));
+    const Square crop = squareAround(covered, frameSize, frameSize);
+    nlohmann::json tiles = nlohmann::json::array();  // [row = k][column = material]
+    for (std::size_t row = 0; row < ks.size(); ++row) tiles.push_back(nlohmann::json::array());
+    for (std::size_t m = 0; m < a.glossMaterials.size(); ++m) {
+      // One exposure per material, from its richest render, through the
+      // display transform every haarcast image uses (render/tonemap.h).
+      const double stops = render::keyExposure(render::frameLogAverage(byMaterial[m].back(), covered));
+      for (std::size_t row = 0; row < ks.size(); ++row) {
+        const std::string file = "glossiness/k" + std::to_string(ks[row]) + "_" + a.glossMaterials[m].first + ".png";
+        const io::RgbImage tile = cropped(byMaterial[m][row], crop);
+        io::writePngRgba8((fs::path(o.outDir) / file).string(), render::tonemapRgba8(tile, stops), tile.width, tile.height);
+        tiles[row].push_back(file);
+      }
+    }
     report["glossiness"] = {{"file", "glossiness.png"}, {"model", model.first}, {"level", glossLevel},
-                            {"environment", a.environments.front().first}, {"light_coefficients", ks}};
+                            {"environment", a.environments.front().first}, {"light_coefficients", ks},
+                            {"frame_size", frameSize}, {"tile_size", crop.size}, {"tiles", tiles}};
     for (const auto& [name, m] : a.glossMaterials) report["glossiness"]["materials"].push_back(name);
   }
   report["timings"]["glossiness_s"] = since(tGloss);
@@ -252,15 +360,18 @@ nlohmann::json runEval(const EvalOptions& o, const std::function<void(const std:
   const auto tTruth = Clock::now();
   {
     const auto& model = a.models.front();
-    const render::Scene scene =
-        singleObjectScene(a.environments.front().second, model.second, a.tableMaterials.back().second, {0.0, 20.0, 0.0});
+    const render::Scene scene = singleObjectScene(a.environments.front().second, model.first, model.second,
+                                                  a.tableMaterials.back().second, {0.0, 20.0, 0.0});
     render::ReferenceOptions ro;
     ro.width = ro.height = o.quick ? 16 : 48;
     ro.environmentBackground = false;
     ro.tolerance = o.quick ? 0.05 : 0.01;
     ro.maxSamples = o.quick ? 256 : 65536;
     ro.threads = o.threads;
-    const render::ReferenceResult mc = render::renderReference(scene, ro);
+    const std::string mcStage = "eval truth: Monte Carlo";
+    const render::ReferenceResult mc =
+        render::renderReference(scene, ro, monteCarloProgress(progress, mcStage, ro.tolerance, ro.maxSamples));
+    progress.finish(mcStage);
     render::RenderResult asResult;
     asResult.image = mc.image;
     // The average of two halves differing by RMS d has an error of RMS d/2.
@@ -291,15 +402,23 @@ nlohmann::json runEval(const EvalOptions& o, const std::function<void(const std:
     };
     // fused with and without the θₒ slice blend; level 7 for fused alone
     // (the rotating methods there cost minutes and add nothing new).
-    for (int level : o.quick ? std::vector<int>{4} : std::vector<int>{5, 6, 7}) {
-      for (const Variant& v : {Variant{"fused", RotationMethod::Fused, HaarVariant::Refined},
-                               Variant{"fused/nearest", RotationMethod::Fused, HaarVariant::Refined},
-                               Variant{"haar", RotationMethod::Haar, HaarVariant::Refined},
-                               Variant{"haar/faithful", RotationMethod::Haar, HaarVariant::Faithful},
-                               Variant{"spatial", RotationMethod::Spatial, HaarVariant::Refined},
-                               Variant{"matrix", RotationMethod::Matrix, HaarVariant::Refined},
-                               Variant{"table", RotationMethod::Table, HaarVariant::Refined}}) {
-        if (level > 6 && v.method != RotationMethod::Fused) continue;
+    const std::vector<Variant> variants = {Variant{"fused", RotationMethod::Fused, HaarVariant::Refined},
+                                           Variant{"fused/nearest", RotationMethod::Fused, HaarVariant::Refined},
+                                           Variant{"haar", RotationMethod::Haar, HaarVariant::Refined},
+                                           Variant{"haar/faithful", RotationMethod::Haar, HaarVariant::Faithful},
+                                           Variant{"spatial", RotationMethod::Spatial, HaarVariant::Refined},
+                                           Variant{"matrix", RotationMethod::Matrix, HaarVariant::Refined},
+                                           Variant{"table", RotationMethod::Table, HaarVariant::Refined}};
+    const std::vector<int> truthLevels = o.quick ? std::vector<int>{4} : std::vector<int>{5, 6, 7};
+    auto runs = [&](int level, const Variant& v) { return level <= 6 || v.method == RotationMethod::Fused; };
+    std::size_t renders = 0, rendered = 0;
+    for (int level : truthLevels)
+      for (const Variant& v : variants) renders += runs(level, v) ? 1 : 0;
+    const std::string stage = "eval truth: methods";
+    progress.update(stage, 0, renders);
+    for (int level : truthLevels) {
+      for (const Variant& v : variants) {
+        if (!runs(level, v)) continue;
         render::RenderOptions opt = base;
         opt.interpolateSlices = v.name != "fused/nearest";
         opt.level = level;
@@ -308,25 +427,49 @@ nlohmann::json runEval(const EvalOptions& o, const std::function<void(const std:
         opt.method = v.method;
         opt.rotator.haarVariant = v.variant;
         const auto t = Clock::now();
-        const render::RenderResult r = render::renderCpu(scene, opt);
+        const render::RenderResult r = render::renderCpu(scene, opt, inner);
         const ErrorStats e = objectError(asResult, r.image, mc.objectMask);
-        report["truth"]["level" + std::to_string(level)][v.name] = {{"psnr", e.psnr}, {"mse", e.mse}, {"seconds", since(t)}};
+        report["truth"][levelKey(level)][v.name] = {{"psnr", e.psnr}, {"mse", e.mse}, {"seconds", since(t)}};
         log("truth level " + std::to_string(level) + " " + v.name + ": " + fmt(e.psnr) + " dB");
+        progress.update(stage, ++rendered, renders);
       }
     }
   }
   report["timings"]["truth_s"] = since(tTruth);
   report["timings"]["total_s"] = since(tStart);
 
-  // ---- report.md -------------------------------------------------------------
+  // ---- report.json, then the figures from it, then report.md ---------------
+  EvalResult result;
+  const fs::path jsonPath = fs::path(o.outDir) / "report.json";
+  std::ofstream(jsonPath) << report.dump(2) << '\n';
+  if (o.truthOnly) {
+    result.figures.problem = "--truth-only has no figures";
+  } else if (o.figures) {
+    // Unavailable is said by the command, last, where it is seen.
+    result.figures = drawReportFigures(jsonPath);
+    if (result.figures.status == FigureRun::Status::Drawn) {
+      log("figures drawn by " + result.figures.script + " (" + fmt(result.figures.seconds, 1) + " s)");
+    } else if (result.figures.status == FigureRun::Status::Failed) {
+      log("error: the figures failed: " + result.figures.problem);
+    }
+  } else {
+    result.figures.problem = "eval ran with --no-figures; draw them with `python3 tools/plot_report.py " +
+                             jsonPath.string() + "`";
+  }
+  const bool drawn = result.figures.status == FigureRun::Status::Drawn;
+
   std::ostringstream md;
   md << "# haarcast evaluation\n\nGenerated by `haarcast eval --data " << o.dataDir << " --out " << o.outDir
-     << (o.quick ? " --quick" : "") << "` in " << fmt(since(tStart), 0) << " s. Every number is also in report.json.\n\n";
+     << (o.quick ? " --quick" : "") << (o.truthOnly ? " --truth-only" : "") << "` in "
+     << formatDuration(report["timings"]["total_s"].get<double>())
+     << ". Every number is also in report.json; the figures are drawn from it by `tools/plot_report.py` "
+        "(matplotlib).\n\n";
   for (const auto& n : a.notes) md << "- Note: " << n << "\n";
+  if (!drawn && !o.truthOnly) md << "- **Figures not drawn:** " << result.figures.problem << ".\n";
   if (!o.truthOnly) {
   md << "\n## Tables 1–4: average seed PSNR (dB)\n\nSeed PSNR = PSNR of the `haar` render against the same render with "
         "`spatial` rotation, over the object's pixels (DESIGN.md), averaged over the models ("
-     << report["config"]["models"].dump() << ") × " << rotations << " random rotations each; frames " << frame << "², "
+     << listed(report["config"]["models"]) << ") × " << rotations << " random rotations each; frames " << frame << "², "
      << "all light coefficients. `refined` is haar's default, `faithful` the seed as written. The seed's own averages "
         "are for its environments ("
      << kSeedEnvironments << ").\n";
@@ -339,8 +482,7 @@ nlohmann::json runEval(const EvalOptions& o, const std::function<void(const std:
       for (const char* variant : {"refined", "faithful"}) {
         md << "\n| " << variant << " |";
         for (const auto& [envName, env] : a.environments)
-          md << ' ' << fmt(report["tables"]["level" + std::to_string(level)][matName][envName][variant].get<double>())
-             << " |";
+          md << ' ' << fmt(report["tables"][levelKey(level)][matName][envName][variant].get<double>()) << " |";
       }
       const auto seedIt = kSeedTables.find(matName);
       if (seedIt != kSeedTables.end() && seedIt->second.count(level)) {
@@ -348,30 +490,44 @@ nlohmann::json runEval(const EvalOptions& o, const std::function<void(const std:
         const auto& seed = seedIt->second.at(level);
         for (std::size_t e = 0; e < a.environments.size(); ++e) md << ' ' << (e < seed.size() ? fmt(seed[e]) : "") << " |";
       }
-      md << "\n\nMSE per model (groups, left to right: " << report["config"]["models"].dump()
-         << ") and environment (bars, in the order of the table's columns), log scale: ![refined](mse_level" << level
-         << "_" << matName << "_refined.png) ![faithful](mse_level" << level << "_" << matName << "_faithful.png)\n";
+      md << "\n";
+      if (drawn) {
+        const std::string file = report["figures"]["mse"][levelKey(level)][matName].get<std::string>();
+        md << "\n![MSE of haar against spatial, " << matName << ", level " << level << "](" << file << ")\n";
+      }
     }
   }
-  md << "\n## Glossiness\n\n![glossiness](glossiness.png)\n\nRows: 4, 16, 64, 256 light coefficients; columns: "
-     << report["glossiness"]["materials"].dump() << "; model " << report["glossiness"]["model"].get<std::string>()
-     << ", level " << report["glossiness"]["level"].get<int>() << ", environment "
-     << report["glossiness"]["environment"].get<std::string>() << ".\n";
+  if (drawn) {
+    md << "\nThe MSE figures share one logarithmic axis across variants, materials and levels, so that bar heights "
+          "compare between figures: `refined` sits near float rounding, `faithful` many decades above it.\n";
   }
-  md << "\n## Truth PSNR against Monte Carlo\n\n" << report["truth"]["config"].dump()
-     << "\n\nThe Monte Carlo render's own noise allows at most `mc_noise_floor_psnr`; figures near it measure the "
-        "noise, not the method.\n\n| level | method | truth PSNR (dB) | MSE | seconds |\n|---|---|---|---|---|\n";
+  const auto& g = report["glossiness"];
+  md << "\n## Glossiness\n\n";
+  if (drawn) md << "![glossiness](" << g["file"].get<std::string>() << ")\n\n";
+  md << "Rows: " << listed(g["light_coefficients"]) << " light coefficients; columns: " << listed(g["materials"])
+     << "; model " << g["model"].get<std::string>() << ", level " << g["level"].get<int>() << ", environment "
+     << g["environment"].get<std::string>() << "; " << g["frame_size"].get<int>() << "² renders cropped to the "
+     << g["tile_size"].get<int>() << "² square around the object (glossiness/).\n";
+  }
+  const auto& tc = report["truth"]["config"];
+  md << "\n## Truth PSNR against Monte Carlo\n\nModel " << tc["model"].get<std::string>() << ", environment "
+     << tc["environment"].get<std::string>() << ", material " << tc["material"].get<std::string>() << ", "
+     << tc["frame"].get<int>() << "² frames. The Monte Carlo render took " << tc["mc_samples"].get<int>()
+     << " samples per pixel; its half-images differ by " << fmt(tc["mc_half_error"].get<double>(), 4)
+     << ", so its own noise allows at most " << fmt(tc["mc_noise_floor_psnr"].get<double>())
+     << " dB: figures near that floor measure the noise, not the method.\n\n"
+        "| level | method | truth PSNR (dB) | MSE | seconds |\n|---|---|---:|---:|---:|\n";
   for (const auto& [key, methods] : report["truth"].items()) {
     if (key == "config") continue;
     for (const auto& [name, v] : methods.items()) {
       md << "| " << key.substr(5) << " | " << name << " | " << fmt(v["psnr"].get<double>()) << " | "
-         << v["mse"].get<double>() << " | " << fmt(v["seconds"].get<double>(), 2) << " |\n";
+         << fmtSig(v["mse"].get<double>()) << " | " << fmt(v["seconds"].get<double>(), 2) << " |\n";
     }
   }
-  md << "\n## Timings\n\n" << report["timings"].dump(2) << "\n";
+  md << "\n## Timings\n\n" << timingsTable(report["timings"]);
   std::ofstream(fs::path(o.outDir) / "report.md") << md.str();
-  std::ofstream(fs::path(o.outDir) / "report.json") << report.dump(2) << '\n';
-  return report;
+  result.report = std::move(report);
+  return result;
 }
 
 std::function<int()> addEvalCommand(CLI::App& app) {
@@ -382,15 +538,21 @@ std::function<int()> addEvalCommand(CLI::App& app) {
   c->add_option("--out", options->outDir, "Output folder")->capture_default_str();
   c->add_flag("--quick", options->quick, "The small version the test suite runs");
   c->add_flag("--truth-only", options->truthOnly, "Only the truth PSNR section (Monte Carlo against every method)");
+  c->add_flag("!--no-figures", options->figures,
+              "Do not run tools/plot_report.py (matplotlib) on report.json");
   c->add_flag("--json", *json, "Print report.json to stdout");
   c->add_option("--threads", options->threads, "Worker threads (0 = all cores)");
   return [c, options, json]() {
     if (!c->parsed()) return -1;
-    const nlohmann::json report =
-        runEval(*options, [](const std::string& line) { std::fprintf(stderr, "[eval] %s\n", line.c_str()); });
-    if (*json) std::cout << report.dump(2) << '\n';
-    std::fprintf(stderr, "wrote %s/report.md and report.json\n", options->outDir.c_str());
-    return 0;
+    StderrProgress progress;
+    const EvalResult result = runEval(*options, progress);
+    if (*json) std::cout << result.report.dump(2) << '\n';
+    std::fprintf(stderr, "wrote %s/report.md and report.json%s\n", options->outDir.c_str(),
+                 result.figures.status == FigureRun::Status::Drawn ? " and the figures" : "");
+    if (result.figures.status == FigureRun::Status::Unavailable && options->figures && !options->truthOnly) {
+      std::fprintf(stderr, "figures not drawn: %s\n", result.figures.problem.c_str());
+    }
+    return result.figures.status == FigureRun::Status::Failed ? 1 : 0;
   };
 }
 

@@ -6,9 +6,13 @@
 //                per environment, for two materials at two levels, over the
 //                models and random object rotations — for haar's default
 //                (refined) and the seed as written (faithful)
-//   MSE plots    per model and environment (PNG)
-//   glossiness   three materials × 4, 16, 64, 256 light coefficients (PNG)
+//   MSE data     per model and environment
+//   glossiness   three materials × 4, 16, 64, 256 light coefficients (one
+//                PNG per tile in glossiness/)
 //   truth        every rotation method against a converged Monte Carlo render
+//
+// The figures (MSE plots, the labelled glossiness sheet) are drawn from
+// report.json by tools/plot_report.py with matplotlib (report_figures.h).
 #pragma once
 
 #include <functional>
@@ -17,6 +21,9 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "progress.h"
+#include "report_figures.h"
+
 namespace haarcast::app {
 
 struct EvalOptions {
@@ -24,12 +31,19 @@ struct EvalOptions {
   std::string outDir = "eval";
   bool quick = false;   // the small version the test suite runs
   bool truthOnly = false;  // only the truth section (Monte Carlo and every method)
+  bool figures = true;     // run tools/plot_report.py on report.json
   unsigned threads = 0;
 };
 
-// Runs everything and writes outDir/report.md, outDir/report.json and the
-// PNGs; returns the JSON (keys "tables", "truth", "glossiness", "timings").
-nlohmann::json runEval(const EvalOptions& options, const std::function<void(const std::string&)>& log);
+struct EvalResult {
+  nlohmann::json report;  // keys "config", "tables", "mse", "figures", "glossiness", "truth", "timings"
+  FigureRun figures;      // whether the figures were drawn, and why not
+};
+
+// Runs everything and writes outDir/report.json, the figures from it (when
+// python3 has matplotlib) and outDir/report.md. Stages and result lines go
+// to `progress`.
+EvalResult runEval(const EvalOptions& options, ProgressReporter& progress);
 
 std::function<int()> addEvalCommand(CLI::App& app);
 

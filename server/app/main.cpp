@@ -10,6 +10,7 @@
 
 #include "bench_frame_command.h"
 #include "eval.h"
+#include "progress.h"
 #include "reference_command.h"
 #include "render_command.h"
 #include "rotation_report.h"
@@ -54,9 +55,10 @@ std::optional<std::string> unknownCommand(const CLI::App& app, int argc, char** 
 }
 
 int runReport(const haarcast::app::RotationReportOptions& options, bool json) {
-  const auto report = haarcast::app::runRotationReport(options, [](const std::string& line) {
-    std::fprintf(stderr, "[rotation-report] %s\n", line.c_str());
-  });
+  haarcast::app::StderrProgress progress;
+  const auto report = haarcast::app::runRotationReport(
+      options, [&progress](const std::string& line) { progress.message("[rotation-report] " + line); },
+      progress.callback());
   if (json) {
     std::cout << haarcast::app::toJson(report).dump(2) << '\n';
   } else {

@@ -2,7 +2,6 @@
 // with render's scene flags, converged until its two half-images agree.
 #include "reference_command.h"
 
-#include <chrono>
 #include <cstdio>
 #include <memory>
 #include <stdexcept>
@@ -10,6 +9,7 @@
 
 #include "haarcast/render/reference.h"
 #include "haarcast/render/scene.h"
+#include "progress.h"
 #include "scene_flags.h"
 
 namespace haarcast::app {
@@ -34,15 +34,11 @@ int run(ReferenceArgs& a) {
   checkOutputPath(a.scene);
   const render::Scene scene = sceneFromFlags(a.scene);
 
-  // Progress at most once a second (a pair of passes can take milliseconds).
-  auto last = std::chrono::steady_clock::now();
-  const render::ReferenceResult r = render::renderReference(scene, a.options, [&last](int samples, double error) {
-    const auto now = std::chrono::steady_clock::now();
-    if (now - last < std::chrono::seconds(1)) return;
-    last = now;
-    std::fprintf(stderr, "[reference] %d samples/pixel, half-image difference %.4f\n", samples, error);
-    std::fflush(stderr);
-  });
+  // The percentage of the samples it will take to reach the tolerance.
+  StderrProgress progress;
+  const render::ReferenceResult r = render::renderReference(
+      scene, a.options, monteCarloProgress(progress, "reference", a.options.tolerance, a.options.maxSamples));
+  progress.finish("reference");
 
   writeOutputImages(a.scene, r.image, r.objectMask);
   std::fprintf(stderr, "%d×%d, %s: %d samples/pixel, half-image difference %.4f (tolerance %.4f), %.2f s\n",

@@ -7,11 +7,10 @@
 #include <memory>
 #include <string>
 
-#include <unistd.h>
-
 #include "haarcast/gpu/backend.h"
 #include "haarcast/render/renderer.h"
 #include "haarcast/render/scene.h"
+#include "progress.h"
 #include "scene_flags.h"
 
 namespace haarcast::app {
@@ -30,29 +29,6 @@ std::string defaultCacheDir() {
   if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg) return (fs::path(xdg) / "haarcast").string();
   if (const char* home = std::getenv("HOME"); home && *home) return (fs::path(home) / ".cache" / "haarcast").string();
   return ".haarcast-cache";
-}
-
-// One line per stage, redrawn in place on a terminal: "[visibility bunny]
-// 42% (15000/35947)"; in a log only the start and the end of each stage.
-void showProgress(const std::string& stage, std::size_t done, std::size_t total) {
-  static const bool terminal = isatty(fileno(stderr)) != 0;
-  static std::string last;
-  static int lastPercent = -1;
-  const int percent = total ? static_cast<int>(100 * done / total) : 100;
-  if (stage == last && percent == lastPercent) return;
-  if (!terminal) {
-    if (stage != last) std::fprintf(stderr, "[%s] started (%zu items)\n", stage.c_str(), total);
-    if (done >= total) std::fprintf(stderr, "[%s] done\n", stage.c_str());
-    last = done >= total ? std::string() : stage;
-    lastPercent = percent;
-    return;
-  }
-  if (stage != last && !last.empty()) std::fputc('\n', stderr);
-  std::fprintf(stderr, "\r[%s] %3d%% (%zu/%zu)", stage.c_str(), percent, done, total);
-  if (done >= total) std::fputc('\n', stderr);
-  std::fflush(stderr);
-  last = done >= total ? std::string() : stage;
-  lastPercent = percent;
 }
 
 int run(RenderArgs& a) {
@@ -81,10 +57,11 @@ int run(RenderArgs& a) {
   // One renderer behind the shared interface: the same scene, request and
   // outputs whichever backend draws them.
   const auto t0 = std::chrono::steady_clock::now();
+  StderrProgress progress;  // slice tables and visibility: percentage and time left
   gpu::VulkanOptions vulkan;
   vulkan.device = a.device;
   vulkan.validation = a.validation;
-  const std::unique_ptr<render::Renderer> renderer = gpu::makeRenderer(a.backend, scene, a.options, vulkan, showProgress);
+  const std::unique_ptr<render::Renderer> renderer = gpu::makeRenderer(a.backend, scene, a.options, vulkan, progress.callback());
   const double prepare = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   render::FrameRequest request;
   request.width = a.options.width;

@@ -103,7 +103,8 @@ nlohmann::json scoresJson(const MethodScores& s) {
 
 }  // namespace
 
-RotationReport runRotationReport(const RotationReportOptions& o, const std::function<void(const std::string&)>& progress) {
+RotationReport runRotationReport(const RotationReportOptions& o, const std::function<void(const std::string&)>& progress,
+                                 const StageProgress& stages) {
   if (o.level < 2 || o.level > 7) {
     throw std::invalid_argument("rotation-report: --level must be between 2 and 7 (got " + std::to_string(o.level) + ")");
   }
@@ -113,6 +114,9 @@ RotationReport runRotationReport(const RotationReportOptions& o, const std::func
   }
   auto say = [&](const std::string& line) {
     if (progress) progress(line);
+  };
+  auto step = [&](const char* stage, std::size_t done, std::size_t total) {
+    if (stages) stages(stage, done, total);
   };
   const int level = o.level;
   const std::vector<Lobe> lobes = reportLobes();
@@ -127,6 +131,8 @@ RotationReport runRotationReport(const RotationReportOptions& o, const std::func
   // References, once: the analytic rotation and `spatial`.
   std::vector<std::vector<HaarMap>> exact(lobes.size()), spatial(lobes.size());
   const glm::dvec3 wo = sphericalToDirection(kLobeThetaOut, 0.0);
+  const std::size_t referenceCount = lobes.size() * rotations.size();
+  step("rotation-report references", 0, referenceCount);
   for (std::size_t l = 0; l < lobes.size(); ++l) {
     for (const EulerYXY& r : rotations) {
       const glm::dmat3 rt = glm::transpose(rotationMatrix(r));
@@ -135,10 +141,16 @@ RotationReport runRotationReport(const RotationReportOptions& o, const std::func
         return local.y > 0.0 ? lobes[l].brdf->evaluate(local, wo).x * local.y : 0.0;
       })));
       spatial[l].push_back(rotateSpatial(slices[l], r));
+      step("rotation-report references", l * rotations.size() + spatial[l].size(), referenceCount);
     }
   }
   say("references ready: " + std::to_string(rotations.size()) + " rotations × " + std::to_string(lobes.size()) + " lobes");
 
+  // Every method and every haar variant rotates every lobe by every rotation.
+  constexpr HaarVariant kVariants[] = {HaarVariant::Faithful, HaarVariant::Local, HaarVariant::Refined};
+  const std::size_t scoreCount = (std::size(kAllRotationMethods) + std::size(kVariants)) * referenceCount;
+  std::size_t scored = 0;
+  step("rotation-report scoring", 0, scoreCount);
   // Scores one rotator over every lobe and rotation.
   auto score = [&](const SliceRotator& rotator, std::map<std::string, MethodScores>& perLobe, double& ns) {
     double seconds = 0.0;
@@ -156,6 +168,7 @@ RotationReport runRotationReport(const RotationReportOptions& o, const std::func
         acc.renderTest.push_back(render(out));
         acc.renderExact.push_back(render(exact[l][k]));
         acc.renderSpatial.push_back(render(spatial[l][k]));
+        step("rotation-report scoring", ++scored, scoreCount);
       }
       perLobe[lobes[l].name] = acc.scores();
       seconds += acc.seconds;
@@ -189,7 +202,7 @@ RotationReport runRotationReport(const RotationReportOptions& o, const std::func
     std::snprintf(line, sizeof line, "%-8s done (precompute %.2f s, %.0f ns per rotation)", name.c_str(), setup, ns);
     say(line);
   }
-  for (HaarVariant v : {HaarVariant::Faithful, HaarVariant::Local, HaarVariant::Refined}) {
+  for (HaarVariant v : kVariants) {
     RotatorOptions ro = o.rotator;
     ro.haarVariant = v;
     const std::string name(variantName(v));

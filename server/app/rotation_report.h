@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "haarcast/core/rotation.h"
+#include "progress.h"
 
 namespace haarcast::app {
 
@@ -45,9 +46,12 @@ struct RotationReport {
 };
 
 // Throws std::invalid_argument naming the bad option. progress(message) gets
-// one line per finished stage (may be empty).
+// one line per finished method (may be empty); stages(stage, done, total)
+// counts the rotations of the two long stages, "rotation-report references"
+// and "rotation-report scoring" (may be empty).
 RotationReport runRotationReport(const RotationReportOptions& options,
-                                 const std::function<void(const std::string&)>& progress = {});
+                                 const std::function<void(const std::string&)>& progress = {},
+                                 const StageProgress& stages = {});
 
 nlohmann::json toJson(const RotationReport& report);
 std::string toText(const RotationReport& report);

@@ -19,6 +19,7 @@
 #include "haarcast/net/server.h"
 #include "haarcast/render/renderer.h"
 #include "haarcast/render/scene.h"
+#include "progress.h"
 #include "scene_flags.h"
 
 namespace haarcast::app {
@@ -196,7 +197,10 @@ int run(ServeArgs& a) {
     options.antialias = antialiasFor(antialias, c.backend);
     if (!quiet) std::fprintf(stderr, "[serve] preparing renderer %s\n", c.rendererKey().c_str());
     auto prepared = std::make_shared<net::PreparedRenderer>();
-    prepared->renderer = gpu::makeRenderer(c.backend, scene, options, vulkanOptions);
+    // Slice tables and visibility: lines, not a redrawn one (sessions log in between).
+    StderrProgress progress("[serve] ", false);
+    prepared->renderer =
+        gpu::makeRenderer(c.backend, scene, options, vulkanOptions, quiet ? StageProgress{} : progress.callback());
     if (!quiet) {
       std::fprintf(stderr, "[serve] renderer ready: %s on %s\n", prepared->renderer->backend().c_str(),
                    prepared->renderer->deviceName().c_str());

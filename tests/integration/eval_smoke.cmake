@@ -1,6 +1,8 @@
 # `haarcast eval --quick` runs and writes report.md, report.json (with the
-# keys the issue names) and its figures. -DHAARCAST=<binary> -DOUT=<dir>
-# [-DDATA=<data dir>]
+# keys the issue names), the glossiness tiles and, when python3 has
+# matplotlib, the figures drawn from report.json by tools/plot_report.py.
+# Without matplotlib it must still succeed and say what to install.
+# -DHAARCAST=<binary> -DOUT=<dir> [-DDATA=<data dir>]
 file(REMOVE_RECURSE "${OUT}")
 set(args eval --quick --out "${OUT}")
 if(DATA AND IS_DIRECTORY "${DATA}")
@@ -10,13 +12,13 @@ execute_process(COMMAND "${HAARCAST}" ${args} RESULT_VARIABLE rc OUTPUT_VARIABLE
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "eval --quick failed (${rc}):\n${err}")
 endif()
-foreach(f report.md report.json glossiness.png)
+foreach(f report.md report.json)
   if(NOT EXISTS "${OUT}/${f}")
     message(FATAL_ERROR "eval --quick did not write ${f}")
   endif()
 endforeach()
 file(READ "${OUT}/report.json" json)
-foreach(key tables truth timings glossiness)
+foreach(key tables truth timings glossiness figures)
   string(JSON type ERROR_VARIABLE e TYPE "${json}" ${key})
   if(e OR NOT type STREQUAL "OBJECT")
     message(FATAL_ERROR "report.json lacks the object \"${key}\"")
@@ -32,3 +34,56 @@ string(JSON refined GET "${json}" tables ${first} ${material} ${env} refined)
 if(refined LESS 120)
   message(FATAL_ERROR "refined seed PSNR ${refined} dB: haar no longer reproduces spatial")
 endif()
+
+# The glossiness tiles report.json names exist (eval writes them itself).
+string(JSON rows LENGTH "${json}" glossiness tiles)
+math(EXPR last_row "${rows} - 1")
+foreach(r RANGE ${last_row})
+  string(JSON columns LENGTH "${json}" glossiness tiles ${r})
+  math(EXPR last_column "${columns} - 1")
+  foreach(c RANGE ${last_column})
+    string(JSON tile GET "${json}" glossiness tiles ${r} ${c})
+    if(NOT EXISTS "${OUT}/${tile}")
+      message(FATAL_ERROR "report.json names the glossiness tile ${tile}, which eval did not write")
+    endif()
+  endforeach()
+endforeach()
+
+# The figures: drawn, or a message that names the package to install.
+string(JSON first_level MEMBER "${json}" figures mse 0)
+string(JSON first_material MEMBER "${json}" figures mse ${first_level} 0)
+string(JSON mse_plot GET "${json}" figures mse ${first_level} ${first_material})
+file(READ "${OUT}/report.md" md)
+if(err MATCHES "figures not drawn")
+  if(NOT err MATCHES "apt-get install python3-matplotlib" OR NOT md MATCHES "apt-get install python3-matplotlib")
+    message(FATAL_ERROR "eval drew no figures and did not say to install python3-matplotlib:\n${err}")
+  endif()
+  message(STATUS "no python3 with matplotlib here: the figures were not drawn, as eval said")
+else()
+  foreach(f glossiness.png ${mse_plot})
+    if(NOT EXISTS "${OUT}/${f}")
+      message(FATAL_ERROR "eval --quick says nothing about the figures but did not write ${f}:\n${err}")
+    endif()
+    if(NOT md MATCHES "\\(${f}\\)")
+      message(FATAL_ERROR "report.md does not show ${f}")
+    endif()
+  endforeach()
+endif()
+
+# No usable python3 (`false` stands in for one without matplotlib): eval still
+# succeeds, writes the report and names the package.
+file(REMOVE_RECURSE "${OUT}-no-python")
+list(TRANSFORM args REPLACE "^${OUT}$" "${OUT}-no-python")
+execute_process(COMMAND "${CMAKE_COMMAND}" -E env HAARCAST_PYTHON=false "${HAARCAST}" ${args}
+  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "eval --quick without matplotlib failed (${rc}) instead of skipping the figures:\n${err}")
+endif()
+if(NOT err MATCHES "figures not drawn: python3 has no matplotlib.*apt-get install python3-matplotlib")
+  message(FATAL_ERROR "eval --quick without matplotlib did not name the package to install:\n${err}")
+endif()
+foreach(f report.md report.json)
+  if(NOT EXISTS "${OUT}-no-python/${f}")
+    message(FATAL_ERROR "eval --quick without matplotlib did not write ${f}")
+  endif()
+endforeach()
