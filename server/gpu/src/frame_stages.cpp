@@ -1,0 +1,57 @@
+// What every frame does around its passes: the uniforms, and the stages
+// recorded, submitted and timed (timestamps on GPUs, host time on CPU devices).
+
+#include <array>
+#include <stdexcept>
+
+#include "vulkan_renderer_impl.h"
+
+namespace haarcast::gpu {
+
+void VulkanRenderer::Impl::runStages(const std::vector<FrameStage>& stages, render::Frame& frame) {
+  if (!useTimestamps) {
+    for (const auto& [name, record] : stages) {
+      const auto t = RendererClock::now();
+      context.submit([&](VkCommandBuffer cb) {
+        record(cb);
+        computeBarrier(cb);
+      });
+      frame.stages.push_back({name, secondsSince(t)});
+    }
+    return;
+  }
+  const auto count = static_cast<std::uint32_t>(stages.size());
+  if (count > kMaxTimedStages) throw std::logic_error("runStages: more stages than timestamp queries");
+  context.submit([&](VkCommandBuffer cb) {
+    vkCmdResetQueryPool(cb, queries, 0, count + 1);
+    vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, queries, 0);
+    for (std::uint32_t i = 0; i < count; ++i) {
+      stages[i].second(cb);
+      computeBarrier(cb);
+      vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, queries, i + 1);
+    }
+  });
+  std::array<std::uint64_t, kMaxTimedStages + 1> ticks{};
+  vkCheck(vkGetQueryPoolResults(context.device(), queries, 0, count + 1, (count + 1) * sizeof(std::uint64_t), ticks.data(),
+                                sizeof(std::uint64_t), VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
+          "vkGetQueryPoolResults");
+  // Only timestampValidBits of a tick count; differences are taken modulo that.
+  const std::uint64_t mask = context.timestampValidBits() >= 64 ? ~std::uint64_t{0}
+                                                                 : (std::uint64_t{1} << context.timestampValidBits()) - 1;
+  for (std::uint32_t i = 0; i < count; ++i) {
+    const std::uint64_t delta = (ticks[i + 1] - ticks[i]) & mask;
+    frame.stages.push_back({stages[i].first, static_cast<double>(delta) * context.timestampPeriodNs() * 1e-9});
+  }
+}
+
+void VulkanRenderer::Impl::uploadFrameUniforms(const render::FrameRequest& request) {
+  FrameParams params = makeFrameParams(request.camera, request.width, request.height, request.lightRotation,
+                                       request.exposureStops, options.environmentBackground,
+                                       prepared.background[0].level());
+  params.fusedGroups = fusedGroups;
+  frameParams.write(&params, sizeof params);
+  const std::array<float, 256> encoding = srgbThresholds(request.exposureStops);
+  thresholds.write(encoding.data(), sizeof encoding);
+}
+
+}  // namespace haarcast::gpu
