@@ -112,7 +112,7 @@ void VulkanRenderer::Impl::ensureResolution(int w, int h) {
   if (limits.batchSamples) batch = std::min(batch, limits.batchSamples);
   batch = std::max<std::size_t>(batch, 1);
   maxBatches = (pixels + batch - 1) / batch;
-  rotated = Buffer(context, batch * perSample);
+  rotated = Buffer(context, batch * perSample, kStorageUsage, MemoryUse::DeviceOnly);
 
   rotate->bind({&samples, &slices, &methodData, &rotated});
   tripleProduct->bind({&shade, &rotated, &light, &visibility, &radiance});

@@ -24,7 +24,7 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
   const std::size_t planeBytes = 3 * coefficients * sizeof(float);
   for (std::size_t i = 0; i < objectCount; ++i) {
     const render::ResolvedObject& o = resolved.objects[i];
-    light.write(o.fusedLight.planes.data(), planeBytes, i * planeBytes);
+    lightUpload.write(o.fusedLight.planes.data(), planeBytes, i * planeBytes);
     for (int c = 0; c < 3; ++c) objectInfo[i].rotation[c] = glm::vec4(glm::vec3(o.rotation[c]), 0.0f);
   }
   objects.write(objectInfo.data(), objectInfo.size() * sizeof(ObjectInfo));
@@ -38,6 +38,7 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
              {"rotation-input",
               [&](VkCommandBuffer cb) {
                 vkCmdFillBuffer(cb, counter.handle(), 0, VK_WHOLE_SIZE, 0u);
+                lightUpload.record(cb);  // where the light is staged: its copy into device memory
                 computeBarrier(cb);
                 rotationInput->dispatch(cb, {groupsOf(pixels, 64), 1, 1});
               }},

@@ -35,7 +35,7 @@ render::Frame VulkanRenderer::Impl::renderRotating(const render::FrameRequest& r
     for (int c = 0; c < 3; ++c) objectInfo[i].rotation[c] = glm::vec4(glm::vec3(rot[c]), 0.0f);
   }
   const std::vector<glm::uvec4> lightPacked = packSparseLists(lights, level);
-  light.write(lightPacked.data(), lightPacked.size() * sizeof(glm::uvec4));
+  lightUpload.write(lightPacked.data(), lightPacked.size() * sizeof(glm::uvec4));
   bytes += (lightPacked.size() - lights.size()) * sizeof(glm::uvec4);
   objects.write(objectInfo.data(), objectInfo.size() * sizeof(ObjectInfo));
   uploadFrameUniforms(request);
@@ -74,6 +74,7 @@ render::Frame VulkanRenderer::Impl::renderRotating(const render::FrameRequest& r
   // ---- rotation-input -----------------------------------------------------------
   timed(rotInput, [&](VkCommandBuffer cb) {
     vkCmdFillBuffer(cb, counter.handle(), 0, VK_WHOLE_SIZE, 0u);
+    lightUpload.record(cb);  // where the light is staged: its copy into device memory
     computeBarrier(cb);
     rotationInput->dispatch(cb, {groupsOf(pixels, 64), 1, 1});
   });

@@ -94,10 +94,14 @@ void VulkanRenderer::Impl::uploadScene() {
   totalTriangles = tri.size() / 3;
   rotationBytesPerChannel = n * sizeof(float);  // the slice, or for table the copy that replaces it
 
-  auto upload = [&](Buffer& b, const void* data, std::size_t bytes) {
-    b = Buffer(context, bytes);
-    b.write(data, bytes);
+  // Read-only inputs in device-local memory (buffer.h): written straight
+  // into their mapping, or staged and copied in one command buffer below.
+  std::vector<BufferUpload> uploads;
+  auto input = [&](Buffer& b, std::size_t bytes) -> BufferUpload& {
+    b = Buffer(context, bytes, kStorageUsage, MemoryUse::DeviceInput);
+    return uploads.emplace_back(context, b);
   };
+  auto upload = [&](Buffer& b, const void* data, std::size_t bytes) { input(b, bytes).write(data, bytes); };
   if (fused) {
     visibilityBlocks.resize(vis.size());
     for (std::size_t v = 0; v < vis.size(); ++v) visibilityBlocks[v] = vis[v].size();
@@ -108,10 +112,10 @@ void VulkanRenderer::Impl::uploadScene() {
     if (fusedVertexPlanes) {
       // Every vertex's visibility in pixel form (synthesised once here):
       // fused.comp blends three of them per direction.
-      visibility = Buffer(context, planeBytes);
+      BufferUpload& planes = input(visibility, planeBytes);
       for (std::size_t v = 0; v < vis.size(); ++v) {
         const SphereMap pixelsOf = inverseHaar(vis[v].toDense());
-        visibility.write(pixelsOf.values().data(), n * sizeof(float), v * n * sizeof(float));
+        planes.write(pixelsOf.values().data(), n * sizeof(float), v * n * sizeof(float));
       }
     } else {
       // The lists as they are: a (first, count) header per vertex, then
@@ -136,12 +140,22 @@ void VulkanRenderer::Impl::uploadScene() {
   std::vector<float> bg;
   for (const SphereMap& map : prepared.background) bg.insert(bg.end(), map.values().begin(), map.values().end());
   upload(background, bg.data(), bg.size() * sizeof(float));
+  if (fused) {
+    // The pixel-centre directions, as core fused builds them (double → float).
+    const std::vector<glm::vec4> dirs = pixelCentreDirections(level);
+    upload(directions, dirs.data(), dirs.size() * sizeof(glm::vec4));
+  }
+  submitUploads(context, uploads);
 
   objects = Buffer(context, objectCount * sizeof(ObjectInfo));
   // The light: per object and channel a header and at most (N − 1)/3 blocks;
   // for `fused` its pixel form, three planes of N floats per object.
-  light = Buffer(context, fused ? objectCount * 3 * n * sizeof(float)
-                                : objectCount * 3 * (1 + (n - 1) / 3) * sizeof(glm::uvec4));
+  // Written every frame, device-local like the other inputs: its upload (and
+  // staging buffer, where there is one) lives as long as the renderer.
+  light = Buffer(context,
+                 fused ? objectCount * 3 * n * sizeof(float) : objectCount * 3 * (1 + (n - 1) / 3) * sizeof(glm::uvec4),
+                 kStorageUsage, MemoryUse::DeviceInput);
+  lightUpload = BufferUpload(context, light);
   frameParams = Buffer(context, sizeof(FrameParams));
   thresholds = Buffer(context, 256 * sizeof(float));
 
@@ -165,11 +179,6 @@ void VulkanRenderer::Impl::uploadScene() {
 }
 
 void VulkanRenderer::Impl::createFusedPipeline(std::uint32_t local) {
-  // The pixel-centre directions, as core fused builds them (double → float).
-  const std::vector<glm::vec4> dirs = pixelCentreDirections(level);
-  directions = Buffer(context, dirs.size() * sizeof(glm::vec4));
-  directions.write(dirs.data(), dirs.size() * sizeof(glm::vec4));
-
   // Scratch: in shared memory where the device has room for it (and the
   // reduction's vec3 per invocation), else a slice of a global buffer per
   // workgroup, whose size bounds the workgroups in flight.
@@ -181,11 +190,11 @@ void VulkanRenderer::Impl::createFusedPipeline(std::uint32_t local) {
   const std::size_t maxGroups = lim.maxComputeWorkGroupCount[0];
   if (fusedShared) {
     fusedGroups = static_cast<std::uint32_t>(std::min<std::size_t>(maxGroups, 1u << 16));
-    scratch = Buffer(context, sizeof(float));
+    scratch = Buffer(context, sizeof(float), kStorageUsage, MemoryUse::DeviceOnly);
   } else {
     const std::size_t budget = std::min<std::size_t>(kFusedScratchBudget, lim.maxStorageBufferRange);
     fusedGroups = static_cast<std::uint32_t>(std::clamp<std::size_t>(budget / (floats * sizeof(float)), 1, maxGroups));
-    scratch = Buffer(context, std::size_t{fusedGroups} * floats * sizeof(float));
+    scratch = Buffer(context, std::size_t{fusedGroups} * floats * sizeof(float), kStorageUsage, MemoryUse::DeviceOnly);
   }
   if (limits.fusedGroups) fusedGroups = std::min(fusedGroups, limits.fusedGroups);
   fusedPass = std::make_unique<ComputePipeline>(

@@ -75,6 +75,9 @@ struct VulkanRenderer::Impl {
   std::vector<std::size_t> methodBytesPerChannel;  // per object: method data one rotation reads
   Buffer slices, methodData, positions, normals, triangles, visibility, background;
   Buffer objects, light, frameParams, thresholds;
+  // The light is device-local (buffer.h); each frame writes it here and
+  // records the copy, where it is staged, ahead of the pass that reads it.
+  BufferUpload lightUpload;
   // `fused`: the slices in pixel form (texels), the light in pixel form per
   // frame (in `light`), the pixel-centre directions and the workgroups' scratch.
   bool fused = false;

@@ -12,6 +12,7 @@
 
 #include <vulkan/vulkan.h>
 
+#include "haarcast/gpu/buffer.h"
 #include "haarcast/gpu/context.h"
 
 namespace haarcast::gpu {
