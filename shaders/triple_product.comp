@@ -57,16 +57,10 @@ float tripleProduct(uvec4 lightHeader, uint brdfBase, uvec4 visHeader) {
     uvec4 ec = ic < visHeader.y ? vis[visHeader.x + ic] : uvec4(kNone);
     uint key = min(ea.x, ec.x);  // merge of two pre-ordered lists
 
-    // Decode preorderKey: (Morton code of the block's top-left finest block) << 4 | l.
-    int l = int(key & 15u);
-    uint morton = key >> 4;
-    uint row = 0u, col = 0u;
-    for (int b = 0; b <= finest; ++b) {
-      row |= ((morton >> (2 * b + 1)) & 1u) << b;
-      col |= ((morton >> (2 * b)) & 1u) << b;
-    }
-    int bi = int(row >> (finest - l));
-    int bj = int(col >> (finest - l));
+    const HaarBlock block = haarPreorderBlock(uint(finest), key);
+    int l = int(block.level);
+    int bi = int(block.i);
+    int bj = int(block.j);
 
     // Deepest level shared with the current path, then descend to the block.
     int common_ = min(depth - 1, l);
@@ -74,7 +68,7 @@ float tripleProduct(uvec4 lightHeader, uint brdfBase, uvec4 visHeader) {
     for (int d = common_ + 1; d <= l; ++d) {
       int ci = bi >> (l - d);
       int cj = bj >> (l - d);
-      vec3 sign_ = childSign(2 * (ci & 1) + (cj & 1));
+      vec3 sign_ = haarChildSign(haarChildQuadrant(uint(ci), uint(cj)));
       vec3 detB = brdfDetails(brdfBase, d - 1, pathI[d - 1], pathJ[d - 1]);
       sA[d] = 0.5 * (sA[d - 1] + dot(sign_, detA[d - 1]));
       sB[d] = 0.5 * (sB[d - 1] + dot(sign_, detB));

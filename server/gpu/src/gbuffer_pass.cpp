@@ -9,6 +9,7 @@
 #include <glm/geometric.hpp>
 
 #include "haarcast/gpu/shaders.h"
+#include "haarcast/render/shading.h"
 
 #include "vulkan_renderer_impl.h"
 
@@ -178,7 +179,7 @@ namespace {
 // reversed, infinite-far Z (depth = near / distance, greatest wins), whose
 // float precision does not depend on the scene's depth range.
 glm::dmat4 viewProjection(const render::Camera& camera, int width, int height, double nearPlane) {
-  const CameraBasis basis = cameraBasis(camera);
+  const render::CameraBasis basis = render::cameraBasis(camera);
   const glm::dvec3 &f = basis.forward, &r = basis.right, &u = basis.up;
   const double tanHalf = basis.tanHalf;
   const double aspect = static_cast<double>(width) / height;

@@ -1,6 +1,7 @@
 #include "haarcast/gpu/passes.h"
 
 #include "haarcast/core/sphere_map.h"
+#include "haarcast/render/shading.h"
 
 #include <algorithm>
 #include <bit>
@@ -8,24 +9,11 @@
 #include <stdexcept>
 #include <string>
 
-#include <glm/geometric.hpp>
-#include <glm/trigonometric.hpp>
-
 namespace haarcast::gpu {
-
-CameraBasis cameraBasis(const render::Camera& camera) {
-  // The basis of render::CameraRays, computed the same way in double.
-  CameraBasis b;
-  b.forward = glm::normalize(camera.target - camera.eye);
-  b.right = glm::normalize(glm::cross(b.forward, camera.up));
-  b.up = glm::cross(b.right, b.forward);
-  b.tanHalf = std::tan(glm::radians(camera.fovYDegrees) * 0.5);
-  return b;
-}
 
 FrameParams makeFrameParams(const render::Camera& camera, int width, int height, const glm::dmat3& lightRotation,
                             double exposureStops, bool background, int backgroundLevel) {
-  const CameraBasis basis = cameraBasis(camera);
+  const render::CameraBasis basis = render::cameraBasis(camera);
   FrameParams f{};
   f.forward = glm::vec4(glm::vec3(basis.forward), 0.0f);
   f.right = glm::vec4(glm::vec3(basis.right), 0.0f);
@@ -98,20 +86,6 @@ std::vector<std::uint32_t> packVisibilityEntries(std::span<const SparseHaar> lis
   return out;
 }
 
-std::uint32_t preorderKey(int mapLevel, int l, int i, int j) {
-  // triple_product.cpp's key, which fits 32 bits for levels ≤ 14.
-  const int finest = mapLevel - 1;
-  const int shift = finest - l;
-  const auto row = static_cast<std::uint32_t>(i) << shift;
-  const auto col = static_cast<std::uint32_t>(j) << shift;
-  std::uint32_t morton = 0;
-  for (int b = 0; b <= finest; ++b) {
-    morton |= ((row >> b) & 1u) << (2 * b + 1);
-    morton |= ((col >> b) & 1u) << (2 * b);
-  }
-  return (morton << 4) | static_cast<std::uint32_t>(l);
-}
-
 namespace {
 struct Block {
   std::uint32_t key;
@@ -123,7 +97,9 @@ std::vector<Block> blocksOf(const SparseHaar& list) {
   for (std::size_t k = 0; k < list.size(); ++k) {
     const CoefficientPosition p = coefficientPosition(list.level, list.index[k]);
     if (p.isScaling) continue;
-    blocks.push_back({preorderKey(list.level, p.level, p.i, p.j), {0, 0, 0}});
+    blocks.push_back({shared::haarPreorderKey(static_cast<shared::uint>(list.level - 1), static_cast<shared::uint>(p.level),
+                                              static_cast<shared::uint>(p.i), static_cast<shared::uint>(p.j)),
+                      {0, 0, 0}});
     blocks.back().hvd[static_cast<int>(p.band)] = list.value[k];
   }
   std::stable_sort(blocks.begin(), blocks.end(), [](const Block& a, const Block& b) { return a.key < b.key; });

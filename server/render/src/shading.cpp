@@ -8,20 +8,26 @@
 
 namespace haarcast::render {
 
+CameraBasis cameraBasis(const Camera& camera) {
+  CameraBasis b;
+  b.forward = glm::normalize(camera.target - camera.eye);
+  b.right = glm::normalize(glm::cross(b.forward, camera.up));
+  b.up = glm::cross(b.right, b.forward);
+  b.tanHalf = std::tan(glm::radians(camera.fovYDegrees) * 0.5);
+  return b;
+}
+
 CameraRays::CameraRays(const Camera& camera, int width, int height)
     : eye_(camera.eye),
-      forward_(glm::normalize(camera.target - camera.eye)),
-      right_(glm::normalize(glm::cross(forward_, camera.up))),
-      up_(glm::cross(right_, forward_)),
-      tanHalf_(std::tan(glm::radians(camera.fovYDegrees) * 0.5)),
+      basis_(cameraBasis(camera)),
       aspect_(static_cast<double>(width) / height),
       width_(width),
       height_(height) {}
 
 glm::dvec3 CameraRays::direction(int x, int y) const {
-  const double sx = (2.0 * (x + 0.5) / width_ - 1.0) * tanHalf_ * aspect_;
-  const double sy = (1.0 - 2.0 * (y + 0.5) / height_) * tanHalf_;
-  return glm::normalize(forward_ + sx * right_ + sy * up_);
+  const double sx = (2.0 * (x + 0.5) / width_ - 1.0) * basis_.tanHalf * aspect_;
+  const double sy = (1.0 - 2.0 * (y + 0.5) / height_) * basis_.tanHalf;
+  return glm::normalize(basis_.forward + sx * basis_.right + sy * basis_.up);
 }
 
 glm::dmat3 shadingFrame(const glm::dvec3& n, const glm::dvec3& wo, double& thetaOut) {

@@ -28,16 +28,8 @@ using shared::ObjectInfo;
 using shared::RotationSample;
 using shared::ShadeSample;
 
-// render::CameraRays' pinhole basis, in double: forward, right, up. The frame
-// parameters (the compute passes' rays) and the G-buffer's projection both
-// take it from here.
-struct CameraBasis {
-  glm::dvec3 forward, right, up;
-  double tanHalf;  // tan(fovY / 2)
-};
-CameraBasis cameraBasis(const render::Camera& camera);
-
-// The camera of render::CameraRays and the frame's settings.
+// The camera of render::CameraRays (its basis from render::cameraBasis, as
+// the G-buffer's projection) and the frame's settings.
 FrameParams makeFrameParams(const render::Camera& camera, int width, int height, const glm::dmat3& lightRotation,
                             double exposureStops, bool background, int backgroundLevel);
 
@@ -48,16 +40,14 @@ std::array<float, 256> srgbThresholds(double exposureStops);
 
 // Sparse Haar lists in the triple-product shader's form: one 16-byte block
 // entry (preorder key, h, v, d bits) per block with a non-zero detail,
-// sorted in the pre-order of core triple_product.cpp, and a header per list
-// (first entry, entry count, scaling-coefficient bits, 0). Headers come
-// first, in list order; entry offsets count from the start of the buffer.
+// sorted by shared::haarPreorderKey (the walk's order, as on the CPU), and a
+// header per list (first entry, entry count, scaling-coefficient bits, 0).
+// Headers come first, in list order; entry offsets count from the start of
+// the buffer.
 // Throws std::invalid_argument when the lists' levels differ from `level`.
 std::vector<glm::uvec4> packSparseLists(std::span<const SparseHaar> lists, int level);
 // Entries (not headers) packSparseLists writes for one list.
 std::size_t blockCount(const SparseHaar& list);
-// The preorder key of triple_product.cpp: Morton code of the block's top-left
-// finest block, shifted left by 4, | l.
-std::uint32_t preorderKey(int mapLevel, int l, int i, int j);
 
 // `fused`'s visibility: per list a header (first word, entry count) and then
 // its (index, value bits) entries in list order, as uint pairs; entry
