@@ -105,6 +105,51 @@ void Buffer::read(void* data, std::size_t bytes, std::size_t offset) const {
   if (bytes) std::memcpy(data, static_cast<const char*>(mapped_) + offset, bytes);
 }
 
+// ---- TexelView ---------------------------------------------------------
+
+TexelView::TexelView(Context& context, const Buffer& buffer, VkFormat format, std::size_t texelBytes)
+    : context_(&context) {
+  VkFormatProperties properties{};
+  vkGetPhysicalDeviceFormatProperties(context.physicalDevice(), format, &properties);
+  if (!(properties.bufferFeatures & VK_FORMAT_FEATURE_UNIFORM_TEXEL_BUFFER_BIT)) {
+    throw std::runtime_error(context.info().name + " cannot read format " + std::to_string(format) +
+                             " from a uniform texel buffer");
+  }
+  const std::uint64_t texels = buffer.size() / texelBytes;
+  if (texels > context.properties().limits.maxTexelBufferElements) {
+    throw std::runtime_error("a texel buffer of " + std::to_string(texels) + " texels exceeds " + context.info().name +
+                             "'s maxTexelBufferElements (" +
+                             std::to_string(context.properties().limits.maxTexelBufferElements) + ")");
+  }
+  VkBufferViewCreateInfo v{};
+  v.sType = VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO;
+  v.buffer = buffer.handle();
+  v.format = format;
+  v.offset = 0;
+  v.range = VK_WHOLE_SIZE;
+  vkCheck(vkCreateBufferView(context.device(), &v, nullptr, &view_), "vkCreateBufferView");
+}
+
+TexelView::~TexelView() { release(); }
+
+TexelView::TexelView(TexelView&& other) noexcept
+    : context_(std::exchange(other.context_, nullptr)), view_(std::exchange(other.view_, VK_NULL_HANDLE)) {}
+
+TexelView& TexelView::operator=(TexelView&& other) noexcept {
+  if (this != &other) {
+    release();
+    context_ = std::exchange(other.context_, nullptr);
+    view_ = std::exchange(other.view_, VK_NULL_HANDLE);
+  }
+  return *this;
+}
+
+void TexelView::release() {
+  if (context_ && view_) vkDestroyBufferView(context_->device(), view_, nullptr);
+  context_ = nullptr;
+  view_ = VK_NULL_HANDLE;
+}
+
 // ---- BufferUpload ------------------------------------------------------
 
 BufferUpload::BufferUpload(Context& context, Buffer& target) : context_(&context), target_(&target) {

@@ -277,6 +277,13 @@ Context::Context(const VulkanOptions& options) : directInputs_(!options.stageInp
     physical_ = devices[static_cast<std::size_t>(chosen)];
     info_ = infos[static_cast<std::size_t>(chosen)];
     vkGetPhysicalDeviceProperties(physical_, &properties_);
+    VkPhysicalDeviceSubgroupProperties subgroup{};
+    subgroup.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES;
+    VkPhysicalDeviceProperties2 properties2{};
+    properties2.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2;
+    properties2.pNext = &subgroup;
+    vkGetPhysicalDeviceProperties2(physical_, &properties2);
+    subgroupSize_ = std::max<std::uint32_t>(subgroup.subgroupSize, 1);
     vkGetPhysicalDeviceMemoryProperties(physical_, &memory_);
     queueFamily_ = *findQueueFamily(physical_, &timestampValidBits_);
 

@@ -98,7 +98,8 @@ void VulkanRenderer::Impl::ensureResolution(int w, int h) {
   rotationInput->bind({&frameParams, &objects, &gbufIds, &gbufNormals, &triangles, &samples, &shade, &counter});
   tonemap->bind({&frameParams, &gbufIds, &radiance, &background, &rgba8, &thresholds});
   if (fused) {
-    fusedPass->bind({&samples, &shade, &objects, &slices, &light, &visibility, &directions, &scratch, &radiance, &counter});
+    fusedPass->bind({&samples, &shade, &objects, &sliceTexels, &lightTexels, &visibility, &directionTexels, &scratch,
+                     &radiance, &counter, &visibilityTexels});
     return;
   }
 

@@ -3,6 +3,7 @@
 // command buffer on devices with timestamps.
 
 #include <cstddef>
+#include <span>
 
 #include "haarcast/core/fused.h"
 
@@ -21,12 +22,12 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
   const render::ResolvedFrame resolved = render::resolveFrame(prepared, options, request);
   ensureResolution(request.width, request.height);
   const std::size_t objectCount = prepared.objects.size();
-  const std::size_t planeBytes = 3 * coefficients * sizeof(float);
   for (std::size_t i = 0; i < objectCount; ++i) {
     const render::ResolvedObject& o = resolved.objects[i];
-    lightUpload.write(o.fusedLight.planes.data(), planeBytes, i * planeBytes);
+    fusedLightTexels(o.fusedLight.planes, std::span<glm::vec4>(lightTexelData).subspan(i * coefficients, coefficients));
     for (int c = 0; c < 3; ++c) objectInfo[i].rotation[c] = glm::vec4(glm::vec3(o.rotation[c]), 0.0f);
   }
+  lightUpload.write(lightTexelData.data(), lightTexelData.size() * sizeof(glm::vec4));
   objects.write(objectInfo.data(), objectInfo.size() * sizeof(ObjectInfo));
   uploadFrameUniforms(request);
   frame.stages.push_back({"light", secondsSince(t0)});

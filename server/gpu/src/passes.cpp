@@ -52,6 +52,20 @@ void setFusedSkip(ObjectInfo& info, int level, int lastNonZeroRow) {
   info.blendRows = static_cast<std::uint32_t>(std::min(m, cutRow + 1));
 }
 
+std::vector<BindingKind> fusedBindings() {
+  using enum BindingKind;
+  return {Storage, Storage, Storage, Texels, Texels, Storage, Texels, Storage, Storage, Storage, Texels};
+}
+
+void fusedLightTexels(std::span<const float> planes, std::span<glm::vec4> out) {
+  const std::size_t n = out.size();
+  if (planes.size() != 3 * n) {
+    throw std::invalid_argument("fusedLightTexels: " + std::to_string(planes.size()) + " plane floats for " +
+                                std::to_string(n) + " texels");
+  }
+  for (std::size_t k = 0; k < n; ++k) out[k] = glm::vec4(planes[k], planes[n + k], planes[2 * n + k], 0.0f);
+}
+
 std::vector<glm::vec4> pixelCentreDirections(int level) {
   const int m = mapSize(level);
   std::vector<glm::vec4> out;

@@ -97,11 +97,16 @@ void VulkanRenderer::Impl::uploadScene() {
   // Read-only inputs in device-local memory (buffer.h): written straight
   // into their mapping, or staged and copied in one command buffer below.
   std::vector<BufferUpload> uploads;
-  auto input = [&](Buffer& b, std::size_t bytes) -> BufferUpload& {
-    b = Buffer(context, bytes, kStorageUsage, MemoryUse::DeviceInput);
+  // `fused` reads its large inputs as texel buffers (fused.comp), so they
+  // carry that usage too.
+  const VkBufferUsageFlags fusedUsage = fused ? kTexelUsage : kStorageUsage;
+  auto input = [&](Buffer& b, std::size_t bytes, VkBufferUsageFlags usage = kStorageUsage) -> BufferUpload& {
+    b = Buffer(context, bytes, usage, MemoryUse::DeviceInput);
     return uploads.emplace_back(context, b);
   };
-  auto upload = [&](Buffer& b, const void* data, std::size_t bytes) { input(b, bytes).write(data, bytes); };
+  auto upload = [&](Buffer& b, const void* data, std::size_t bytes, VkBufferUsageFlags usage = kStorageUsage) {
+    input(b, bytes, usage).write(data, bytes);
+  };
   if (fused) {
     visibilityBlocks.resize(vis.size());
     for (std::size_t v = 0; v < vis.size(); ++v) visibilityBlocks[v] = vis[v].size();
@@ -112,7 +117,7 @@ void VulkanRenderer::Impl::uploadScene() {
     if (fusedVertexPlanes) {
       // Every vertex's visibility in pixel form (synthesised once here):
       // fused.comp blends three of them per direction.
-      BufferUpload& planes = input(visibility, planeBytes);
+      BufferUpload& planes = input(visibility, planeBytes, kTexelUsage);
       for (std::size_t v = 0; v < vis.size(); ++v) {
         const SphereMap pixelsOf = inverseHaar(vis[v].toDense());
         planes.write(pixelsOf.values().data(), n * sizeof(float), v * n * sizeof(float));
@@ -129,7 +134,7 @@ void VulkanRenderer::Impl::uploadScene() {
     for (std::size_t v = 0; v < vis.size(); ++v) visibilityBlocks[v] = visPacked[v].y;
     upload(visibility, visPacked.data(), visPacked.size() * sizeof(glm::uvec4));
   }
-  upload(slices, sliceData.data(), sliceData.size() * sizeof(float));
+  upload(slices, sliceData.data(), sliceData.size() * sizeof(float), fusedUsage);
   if (method.empty()) method.push_back(0u);  // spatial: a 4-byte dummy (the contract)
   upload(methodData, method.data(), method.size() * sizeof(std::uint32_t));
   upload(positions, pos.data(), pos.size() * sizeof(glm::vec4));
@@ -143,18 +148,18 @@ void VulkanRenderer::Impl::uploadScene() {
   if (fused) {
     // The pixel-centre directions, as core fused builds them (double → float).
     const std::vector<glm::vec4> dirs = pixelCentreDirections(level);
-    upload(directions, dirs.data(), dirs.size() * sizeof(glm::vec4));
+    upload(directions, dirs.data(), dirs.size() * sizeof(glm::vec4), kTexelUsage);
   }
   submitUploads(context, uploads);
 
   objects = Buffer(context, objectCount * sizeof(ObjectInfo));
   // The light: per object and channel a header and at most (N − 1)/3 blocks;
-  // for `fused` its pixel form, three planes of N floats per object.
+  // for `fused` its pixel form, N RGB0 texels per object (fusedLightTexels).
   // Written every frame, device-local like the other inputs: its upload (and
   // staging buffer, where there is one) lives as long as the renderer.
   light = Buffer(context,
-                 fused ? objectCount * 3 * n * sizeof(float) : objectCount * 3 * (1 + (n - 1) / 3) * sizeof(glm::uvec4),
-                 kStorageUsage, MemoryUse::DeviceInput);
+                 fused ? objectCount * n * sizeof(glm::vec4) : objectCount * 3 * (1 + (n - 1) / 3) * sizeof(glm::uvec4),
+                 fusedUsage, MemoryUse::DeviceInput);
   lightUpload = BufferUpload(context, light);
   frameParams = Buffer(context, sizeof(FrameParams));
   thresholds = Buffer(context, 256 * sizeof(float));
@@ -168,7 +173,11 @@ void VulkanRenderer::Impl::uploadScene() {
   rotationInput = std::make_unique<ComputePipeline>(context, "rotation_input.comp", 8, 0);
   tonemap = std::make_unique<ComputePipeline>(context, "tonemap.comp", 6, 0);
   if (fused) {
-    createFusedPipeline(local);
+    // One SIMD group per workgroup on a CPU device: the workgroup's only
+    // barriers (the reduction's) then switch no coroutines (docs/gpu.md).
+    createFusedPipeline(limits.fusedLocalSize          ? limits.fusedLocalSize
+                        : context.info().type == "cpu" ? context.subgroupSize()
+                                                       : 256u);
     return;
   }
   rotate = std::make_unique<ComputePipeline>(
@@ -179,16 +188,26 @@ void VulkanRenderer::Impl::uploadScene() {
 }
 
 void VulkanRenderer::Impl::createFusedPipeline(std::uint32_t local) {
-  // Scratch: in shared memory where the device has room for it (and the
-  // reduction's vec3 per invocation), else a slice of a global buffer per
-  // workgroup, whose size bounds the workgroups in flight.
+  // The texel views fused.comp reads (RGBA32F slices, light and directions;
+  // R32F vertex planes, or a one-texel stand-in beside the lists).
+  sliceTexels = TexelView(context, slices, VK_FORMAT_R32G32B32A32_SFLOAT, sizeof(glm::vec4));
+  lightTexels = TexelView(context, light, VK_FORMAT_R32G32B32A32_SFLOAT, sizeof(glm::vec4));
+  directionTexels = TexelView(context, directions, VK_FORMAT_R32G32B32A32_SFLOAT, sizeof(glm::vec4));
+  if (!fusedVertexPlanes) texelStandIn = Buffer(context, sizeof(float), kTexelUsage, MemoryUse::DeviceOnly);
+  visibilityTexels = TexelView(context, fusedVertexPlanes ? visibility : texelStandIn, VK_FORMAT_R32_SFLOAT, sizeof(float));
+  lightTexelData.resize(prepared.objects.size() * coefficients);
+
+  // Scratch (the lists' synthesis only): in shared memory where the device
+  // has room for it (and the reduction's vec3 per invocation), else a slice
+  // of a global buffer per workgroup, whose size bounds the workgroups in
+  // flight. With vertex planes there is none.
   const VkPhysicalDeviceLimits& lim = context.properties().limits;
   const std::size_t floats = fusedScratchFloats(level, fusedVertexPlanes);
   fusedLocal = limits.fusedLocalSize ? limits.fusedLocalSize : local;
-  fusedShared = !limits.fusedGlobalScratch &&
+  fusedShared = floats > 0 && !limits.fusedGlobalScratch &&
                 floats * sizeof(float) + fusedLocal * 4 * sizeof(float) <= lim.maxComputeSharedMemorySize;
   const std::size_t maxGroups = lim.maxComputeWorkGroupCount[0];
-  if (fusedShared) {
+  if (floats == 0 || fusedShared) {
     fusedGroups = static_cast<std::uint32_t>(std::min<std::size_t>(maxGroups, 1u << 16));
     scratch = Buffer(context, sizeof(float), kStorageUsage, MemoryUse::DeviceOnly);
   } else {
@@ -198,7 +217,7 @@ void VulkanRenderer::Impl::createFusedPipeline(std::uint32_t local) {
   }
   if (limits.fusedGroups) fusedGroups = std::min(fusedGroups, limits.fusedGroups);
   fusedPass = std::make_unique<ComputePipeline>(
-      context, "fused.comp", 10, 0,
+      context, "fused.comp", fusedBindings(), 0,
       std::vector<SpecConstant>{{0, static_cast<std::uint32_t>(level)},
                                 {2, fusedLocal},
                                 {3, fusedShared ? static_cast<std::uint32_t>(floats) : 1u},

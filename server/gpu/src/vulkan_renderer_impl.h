@@ -82,6 +82,10 @@ struct VulkanRenderer::Impl {
   // frame (in `light`), the pixel-centre directions and the workgroups' scratch.
   bool fused = false;
   Buffer directions, scratch;
+  // fused.comp reads these through texel views (BindingKind::Texels).
+  Buffer texelStandIn;  // binding 10's stand-in where the visibility is lists
+  TexelView sliceTexels, lightTexels, directionTexels, visibilityTexels;
+  std::vector<glm::vec4> lightTexelData;  // this frame's light texels, before upload
   std::uint32_t fusedGroups = 0;     // the most workgroups of the fused dispatch
   std::uint32_t fusedLocal = 0;      // its local size
   bool fusedShared = false;          // scratch in shared memory (else in `scratch`)

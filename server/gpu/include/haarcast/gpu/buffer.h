@@ -26,6 +26,8 @@ namespace haarcast::gpu {
 // Storage, and both ends of transfers (uploads, fills, readback copies).
 inline constexpr VkBufferUsageFlags kStorageUsage =
     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+// The same, also readable as a uniform texel buffer (TexelView).
+inline constexpr VkBufferUsageFlags kTexelUsage = kStorageUsage | VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT;
 
 class Buffer {
  public:
@@ -96,6 +98,30 @@ class BufferUpload {
   Buffer* target_ = nullptr;
   Buffer staging_;
   std::size_t dirtyBegin_ = 0, dirtyEnd_ = 0;  // bytes of staging_ written since the last record()
+};
+
+// A buffer seen as an array of texels of one format (a VkBufferView over the
+// whole buffer), which a shader reads as a uniform texel buffer
+// (samplerBuffer, texelFetch). The buffer needs kTexelUsage and must outlive
+// the view. Throws std::runtime_error when the device cannot read the format
+// from a texel buffer or the buffer holds more texels than
+// maxTexelBufferElements allows.
+class TexelView {
+ public:
+  TexelView() = default;
+  TexelView(Context& context, const Buffer& buffer, VkFormat format, std::size_t texelBytes);
+  ~TexelView();
+  TexelView(TexelView&& other) noexcept;
+  TexelView& operator=(TexelView&& other) noexcept;
+  TexelView(const TexelView&) = delete;
+  TexelView& operator=(const TexelView&) = delete;
+
+  VkBufferView handle() const { return view_; }
+
+ private:
+  void release();
+  Context* context_ = nullptr;
+  VkBufferView view_ = VK_NULL_HANDLE;
 };
 
 // submit() for several uploads in one command buffer (the prepare step's).

@@ -98,6 +98,9 @@ class Context {
   std::uint32_t queueFamily() const { return queueFamily_; }
   const DeviceInfo& info() const { return info_; }
   const VkPhysicalDeviceProperties& properties() const { return properties_; }
+  // Invocations a subgroup runs together (VkPhysicalDeviceSubgroupProperties):
+  // the SIMD width on a CPU device (8 on lavapipe with AVX2).
+  std::uint32_t subgroupSize() const { return subgroupSize_; }
 
   // Timestamp queries: supported on the queue, and nanoseconds per tick.
   bool timestampsSupported() const { return timestampValidBits_ > 0 && properties_.limits.timestampPeriod > 0; }
@@ -138,6 +141,7 @@ class Context {
   VkFence fence_ = VK_NULL_HANDLE;
   std::uint32_t queueFamily_ = 0;
   std::uint32_t timestampValidBits_ = 0;
+  std::uint32_t subgroupSize_ = 1;
   bool directInputs_ = true;
   DeviceInfo info_;
   VkPhysicalDeviceProperties properties_{};

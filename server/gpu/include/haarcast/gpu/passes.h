@@ -15,6 +15,7 @@
 
 #include "haarcast/core/haar.h"
 #include "haarcast/core/shared_layout.h"
+#include "haarcast/gpu/compute.h"
 #include "haarcast/render/scene.h"
 
 namespace haarcast::gpu {
@@ -59,13 +60,24 @@ std::vector<std::uint32_t> packVisibilityEntries(std::span<const SparseHaar> lis
 // by row (w unused), computed in double as core fused's and rounded to float.
 std::vector<glm::vec4> pixelCentreDirections(int level);
 
-// Floats of fused.comp's scratch per workgroup: the θₒ-blended slice (3N),
-// after, without vertex planes, the per-pixel synthesis (the N merged
-// coefficients and the finest step's N values; shaders/fused.comp).
+// Floats of fused.comp's scratch per workgroup: none with vertex planes;
+// with the lists, the per-pixel synthesis (the N merged coefficients, the
+// finest step's N values and the step before's N/4; shaders/fused.comp).
 inline std::size_t fusedScratchFloats(int level, bool vertexPlanes) {
   const std::size_t n = std::size_t{1} << (2 * level);
-  return (vertexPlanes ? 0 : 2 * n) + 3 * n;
+  return vertexPlanes ? 0 : 2 * n + n / 4;
 }
+
+// fused.comp's bindings: 0 samples, 1 shade, 2 objects (storage); 3 slice
+// texels (RGBA32F texels); 4 light (RGBA32F texels, fusedLightTexels); 5
+// visibility lists (storage); 6 directions (RGBA32F texels); 7 scratch, 8
+// radiance, 9 counter (storage); 10 vertex visibility planes (R32F texels).
+std::vector<BindingKind> fusedBindings();
+
+// The light of one object as fused.comp reads it: texel k = (L_r, L_g, L_b, 0)
+// at direction k, from the three planes of core FusedLight (ΔΩ folded in),
+// written to out[0 … N).
+void fusedLightTexels(std::span<const float> planes, std::span<glm::vec4> out);
 
 // ObjectInfo's skipBelowY and blendRows for fused.comp, from the slices'
 // last non-zero row (core PixelSlices::lastNonZeroRow): directions whose

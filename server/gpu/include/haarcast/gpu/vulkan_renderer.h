@@ -37,7 +37,7 @@ struct VulkanRendererLimits {
   std::size_t batchSamples = 0;
   // Workgroup size of rotate_spatial.comp; 0 = 64 on CPU devices, 256 on GPUs.
   std::uint32_t spatialLocalSize = 0;
-  // `fused`: workgroup size (0 = 64 on CPU devices, 256 on GPUs), the most
+  // `fused`: workgroup size (0 = the subgroup size on CPU devices, 256 on GPUs), the most
   // workgroups in flight (0 = as the scratch allows), the per-pixel merge
   // and synthesis of the visibility lists even where every vertex's pixel
   // form would fit in memory, and that synthesis's scratch in global memory
