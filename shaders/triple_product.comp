@@ -14,7 +14,7 @@ const int N = M * M;
 
 layout(push_constant) uniform Push {
   uint first;   // global index of the batch's first sample
-  uint count;   // samples in the batch
+  uint count;   // samples in a full batch (this one may hold fewer: the covered count decides)
   uint pad0;
   uint pad1;
 } pc;
@@ -24,6 +24,7 @@ layout(std430, set = 0, binding = 1) readonly buffer Rotated { float rotated[]; 
 layout(std430, set = 0, binding = 2) readonly buffer Light { uvec4 light[]; };       // headers [object·3 + c], then blocks
 layout(std430, set = 0, binding = 3) readonly buffer Visibility { uvec4 vis[]; };    // headers [vertex], then blocks
 layout(std430, set = 0, binding = 4) buffer Radiance { vec4 radiance[]; };           // per pixel, linear RGB
+layout(std430, set = 0, binding = 5) readonly buffer Counter { CoverageCounter counter; };
 
 #define BRDF(i) rotated[i]
 #include "common/triple_product.glsl"
@@ -103,7 +104,11 @@ float tripleProduct(uvec4 lightHeader, uint brdfBase, uvec4 visHeader) {
 
 void main() {
   uint gid = gl_GlobalInvocationID.x;
-  if (gid >= pc.count * 3u) return;
+  // The batch's samples: the indirect dispatch (batch_args.comp) covers
+  // them in groups of 64, so the last group's extra invocations stop here.
+  const uint covered = counter.covered;
+  const uint count = covered > pc.first ? min(pc.count, covered - pc.first) : 0u;
+  if (gid >= count * 3u) return;
   uint local = gid / 3u;
   uint c = gid % 3u;
   ShadeSample s = shade[pc.first + local];

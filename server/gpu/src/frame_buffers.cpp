@@ -54,7 +54,8 @@ void VulkanRenderer::Impl::releaseResolution() {
   if (framebuffer) vkDestroyFramebuffer(device, framebuffer, nullptr);
   framebuffer = VK_NULL_HANDLE;
   for (DeviceImage* i : {&normalImage, &idsImage, &positionImage, &depthImage}) destroyImage(*i);
-  for (Buffer* b : {&gbufIds, &gbufNormals, &gbufPositions, &samples, &shade, &counter, &radiance, &rgba8, &rotated}) {
+  for (Buffer* b :
+       {&gbufIds, &gbufNormals, &gbufPositions, &samples, &shade, &counter, &radiance, &rgba8, &rotated, &batchArgs}) {
     *b = Buffer();
   }
   width = height = 0;
@@ -114,9 +115,12 @@ void VulkanRenderer::Impl::ensureResolution(int w, int h) {
   batch = std::max<std::size_t>(batch, 1);
   maxBatches = (pixels + batch - 1) / batch;
   rotated = Buffer(context, batch * perSample, kStorageUsage, MemoryUse::DeviceOnly);
+  batchArgs = Buffer(context, 2 * maxBatches * sizeof(DispatchArgs), kStorageUsage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT,
+                     MemoryUse::DeviceOnly);
 
   rotate->bind({&samples, &slices, &methodData, &rotated});
-  tripleProduct->bind({&shade, &rotated, &light, &visibility, &radiance});
+  tripleProduct->bind({&shade, &rotated, &light, &visibility, &radiance, &counter});
+  batchArgsPass->bind({&counter, &batchArgs});
 }
 
 }  // namespace haarcast::gpu

@@ -2,13 +2,36 @@
 // recorded, submitted and timed (timestamps on GPUs, host time on CPU devices).
 
 #include <array>
-#include <stdexcept>
+#include <vector>
 
 #include "vulkan_renderer_impl.h"
 
 namespace haarcast::gpu {
 
+void VulkanRenderer::Impl::ensureQueries(std::uint32_t count) {
+  if (count <= queryCapacity) return;
+  if (queries) vkDestroyQueryPool(context.device(), queries, nullptr);
+  queries = VK_NULL_HANDLE;
+  queryCapacity = 0;
+  VkQueryPoolCreateInfo q{};
+  q.sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO;
+  q.queryType = VK_QUERY_TYPE_TIMESTAMP;
+  q.queryCount = count;
+  vkCheck(vkCreateQueryPool(context.device(), &q, nullptr, &queries), "vkCreateQueryPool");
+  queryCapacity = count;
+}
+
 void VulkanRenderer::Impl::runStages(const std::vector<FrameStage>& stages, render::Frame& frame) {
+  const std::size_t first = frame.stages.size();
+  auto add = [&](const char* name, double seconds) {
+    for (std::size_t i = first; i < frame.stages.size(); ++i) {
+      if (frame.stages[i].name == name) {
+        frame.stages[i].seconds += seconds;
+        return;
+      }
+    }
+    frame.stages.push_back({name, seconds});
+  };
   if (!useTimestamps) {
     for (const auto& [name, record] : stages) {
       const auto t = RendererClock::now();
@@ -16,12 +39,12 @@ void VulkanRenderer::Impl::runStages(const std::vector<FrameStage>& stages, rend
         record(cb);
         computeBarrier(cb);
       });
-      frame.stages.push_back({name, secondsSince(t)});
+      add(name, secondsSince(t));
     }
     return;
   }
   const auto count = static_cast<std::uint32_t>(stages.size());
-  if (count > kMaxTimedStages) throw std::logic_error("runStages: more stages than timestamp queries");
+  ensureQueries(count + 1);
   context.submit([&](VkCommandBuffer cb) {
     vkCmdResetQueryPool(cb, queries, 0, count + 1);
     vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, queries, 0);
@@ -31,7 +54,7 @@ void VulkanRenderer::Impl::runStages(const std::vector<FrameStage>& stages, rend
       vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, queries, i + 1);
     }
   });
-  std::array<std::uint64_t, kMaxTimedStages + 1> ticks{};
+  std::vector<std::uint64_t> ticks(count + 1);
   vkCheck(vkGetQueryPoolResults(context.device(), queries, 0, count + 1, (count + 1) * sizeof(std::uint64_t), ticks.data(),
                                 sizeof(std::uint64_t), VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
           "vkGetQueryPoolResults");
@@ -40,7 +63,7 @@ void VulkanRenderer::Impl::runStages(const std::vector<FrameStage>& stages, rend
                                                                  : (std::uint64_t{1} << context.timestampValidBits()) - 1;
   for (std::uint32_t i = 0; i < count; ++i) {
     const std::uint64_t delta = (ticks[i + 1] - ticks[i]) & mask;
-    frame.stages.push_back({stages[i].first, static_cast<double>(delta) * context.timestampPeriodNs() * 1e-9});
+    add(stages[i].first, static_cast<double>(delta) * context.timestampPeriodNs() * 1e-9);
   }
 }
 

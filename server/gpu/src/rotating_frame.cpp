@@ -1,7 +1,8 @@
 // A frame of the rotating methods (haar, spatial, matrix, table): G-buffer,
-// rotation input, then rotation and triple product batch by batch (the batch
-// count comes from the covered-pixel count, read back after rotation input),
-// then tonemap; each stage its own submission.
+// rotation input (compaction, then every batch's indirect arguments), then
+// rotation and triple product batch by batch (vkCmdDispatchIndirect), then
+// tonemap — one command buffer on devices with timestamps, no readback of
+// the covered count until the frame is done.
 
 #include <algorithm>
 #include <functional>
@@ -43,61 +44,42 @@ render::Frame VulkanRenderer::Impl::renderRotating(const render::FrameRequest& r
 
   const glm::dmat4 viewProj = frameViewProjection(request);
 
+  // ---- the device's part: one command buffer (timestamps) or one per stage.
+  // Every batch the resolution can need is recorded; batch_args.comp sizes
+  // each from the covered count, and batches past it dispatch nothing, so
+  // the host does not read the count back mid-frame.
   const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
-  // Each stage is its own submission, timed as the member comment says.
-  auto timed = [&](double& seconds, const std::function<void(VkCommandBuffer)>& record) {
-    const auto t = RendererClock::now();
-    context.submit([&](VkCommandBuffer cb) {
-      if (useTimestamps) {
-        vkCmdResetQueryPool(cb, queries, 0, 2);
-        vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, queries, 0);
-      }
-      record(cb);
-      computeBarrier(cb);
-      if (useTimestamps) vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, queries, 1);
-    });
-    if (!useTimestamps) {
-      seconds += secondsSince(t);
-      return;
-    }
-    std::uint64_t ticks[2] = {0, 0};
-    vkCheck(vkGetQueryPoolResults(context.device(), queries, 0, 2, sizeof ticks, ticks, sizeof(std::uint64_t),
-                                  VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
-            "vkGetQueryPoolResults");
-    if (ticks[1] > ticks[0]) seconds += static_cast<double>(ticks[1] - ticks[0]) * context.timestampPeriodNs() * 1e-9;
-  };
-  double gbuffer = 0, rotInput = 0, rotation = 0, product = 0, tone = 0;
-
-  // ---- gbuffer ------------------------------------------------------------------
-  timed(gbuffer, [&](VkCommandBuffer cb) { recordGBuffer(cb, request, viewProj); });
-
-  // ---- rotation-input -----------------------------------------------------------
-  timed(rotInput, [&](VkCommandBuffer cb) {
+  std::vector<FrameStage> stages;
+  stages.emplace_back("gbuffer", [&](VkCommandBuffer cb) { recordGBuffer(cb, request, viewProj); });
+  stages.emplace_back("rotation-input", [&](VkCommandBuffer cb) {
     vkCmdFillBuffer(cb, counter.handle(), 0, VK_WHOLE_SIZE, 0u);
     lightUpload.record(cb);  // where the light is staged: its copy into device memory
     computeBarrier(cb);
     rotationInput->dispatch(cb, {groupsOf(pixels, 64), 1, 1});
+    computeBarrier(cb);
+    const std::uint32_t sizes[4] = {static_cast<std::uint32_t>(batch), static_cast<std::uint32_t>(maxBatches), 0, 0};
+    batchArgsPass->dispatch(cb, {groupsOf(maxBatches, 64), 1, 1}, sizes, sizeof sizes);  // batch_args.comp's push block
   });
+  std::vector<BatchPush> pushes(maxBatches);
+  for (std::size_t b = 0; b < maxBatches; ++b) {
+    pushes[b].first = static_cast<std::uint32_t>(b * batch);
+    pushes[b].count = static_cast<std::uint32_t>(batch);  // the shaders stop at the covered count
+    // The contract: one workgroup per (sample, channel).
+    stages.emplace_back("rotation", [&, b](VkCommandBuffer cb) {
+      rotate->dispatchIndirect(cb, batchArgs, b * sizeof(DispatchArgs), &pushes[b], sizeof(BatchPush));
+    });
+    stages.emplace_back("triple-product", [&, b](VkCommandBuffer cb) {
+      tripleProduct->dispatchIndirect(cb, batchArgs, (maxBatches + b) * sizeof(DispatchArgs), &pushes[b],
+                                      sizeof(BatchPush));
+    });
+  }
+  stages.emplace_back("tonemap", [&](VkCommandBuffer cb) { tonemap->dispatch(cb, {groupsOf(pixels, 64), 1, 1}); });
+  runStages(stages, frame);
+
   std::uint32_t covered = 0;
   counter.read(&covered, sizeof covered);
   if (covered > pixels) throw std::logic_error("rotation-input reported more covered pixels than the frame has");
-
-  // ---- rotation and triple-product, batch by batch --------------------------------
-  const std::size_t batches = (covered + batch - 1) / batch;
-  lastBatches = batches;
-  for (std::size_t b = 0; b < batches; ++b) {
-    BatchPush push;
-    push.first = static_cast<std::uint32_t>(b * batch);
-    push.count = static_cast<std::uint32_t>(std::min<std::size_t>(batch, covered - b * batch));
-    // The contract: one workgroup per (sample, channel).
-    timed(rotation, [&](VkCommandBuffer cb) { rotate->dispatch(cb, {push.count, 3, 1}, &push, sizeof push); });
-    timed(product, [&](VkCommandBuffer cb) {
-      tripleProduct->dispatch(cb, {groupsOf(3 * std::size_t{push.count}, 64), 1, 1}, &push, sizeof push);
-    });
-  }
-
-  // ---- tonemap ------------------------------------------------------------------
-  timed(tone, [&](VkCommandBuffer cb) { tonemap->dispatch(cb, {groupsOf(pixels, 64), 1, 1}); });
+  lastBatches = (covered + batch - 1) / batch;
 
   // ---- Results ---------------------------------------------------------------
   frame.image = io::makeImage(width, height);
@@ -112,12 +94,6 @@ render::Frame VulkanRenderer::Impl::renderRotating(const render::FrameRequest& r
     }
     rgba8.read(frame.rgba8.data(), frame.rgba8.size());
   }
-
-  frame.stages.push_back({"gbuffer", gbuffer});
-  frame.stages.push_back({"rotation-input", rotInput});
-  frame.stages.push_back({"rotation", rotation});
-  frame.stages.push_back({"triple-product", product});
-  frame.stages.push_back({"tonemap", tone});
 
   // Coefficient bytes read: the light lists (above), and per covered pixel and
   // channel the rotation's data and the three vertices' visibility lists, in

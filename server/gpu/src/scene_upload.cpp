@@ -183,8 +183,9 @@ void VulkanRenderer::Impl::uploadScene() {
   rotate = std::make_unique<ComputePipeline>(
       context, "rotate_" + methodName + ".comp", 4, 16,
       std::vector<SpecConstant>{{0, lvl}, {1, static_cast<std::uint32_t>(T)}, {2, local}});
-  tripleProduct = std::make_unique<ComputePipeline>(context, "triple_product.comp", 5, 16,
+  tripleProduct = std::make_unique<ComputePipeline>(context, "triple_product.comp", 6, 16,
                                                     std::vector<SpecConstant>{{0, lvl}});
+  batchArgsPass = std::make_unique<ComputePipeline>(context, "batch_args.comp", 2, 16);
 }
 
 void VulkanRenderer::Impl::createFusedPipeline(std::uint32_t local) {

@@ -40,13 +40,6 @@ VulkanRenderer::Impl::Impl(const render::Scene& scene, const render::RenderOptio
   createGraphicsPipeline();
   useTimestamps = context.timestampsSupported() && context.properties().limits.timestampComputeAndGraphics &&
                   context.info().type != "cpu";
-  if (useTimestamps) {
-    VkQueryPoolCreateInfo q{};
-    q.sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO;
-    q.queryType = VK_QUERY_TYPE_TIMESTAMP;
-    q.queryCount = kMaxTimedStages + 1;
-    vkCheck(vkCreateQueryPool(context.device(), &q, nullptr, &queries), "vkCreateQueryPool");
-  }
 }
 
 VulkanRenderer::Impl::~Impl() {

@@ -92,7 +92,7 @@ struct VulkanRenderer::Impl {
   bool fusedVertexPlanes = false;    // visibility uploaded per vertex in pixel form (else as lists)
 
   // ---- Pipelines ---------------------------------------------------------------
-  std::unique_ptr<ComputePipeline> rotate, rotationInput, tripleProduct, tonemap, fusedPass;
+  std::unique_ptr<ComputePipeline> rotate, rotationInput, tripleProduct, tonemap, fusedPass, batchArgsPass;
   VkRenderPass renderPass = VK_NULL_HANDLE;
   VkDescriptorSetLayout gbufferSetLayout = VK_NULL_HANDLE;
   VkPipelineLayout gbufferLayout = VK_NULL_HANDLE;
@@ -106,13 +106,16 @@ struct VulkanRenderer::Impl {
   DeviceImage normalImage, idsImage, positionImage, depthImage;
   VkFramebuffer framebuffer = VK_NULL_HANDLE;
   Buffer gbufIds, gbufNormals, gbufPositions, samples, shade, counter, radiance, rgba8, rotated;
+  // The rotating methods: per batch, the indirect arguments of its rotation
+  // and triple product (DispatchArgs, written by batch_args.comp).
+  Buffer batchArgs;
   // Stage timing: timestamps around each stage's submission on GPUs; on a
   // CPU device (lavapipe), the host's wall time of the submission, because
   // lavapipe's timestamps do not wait for compute dispatches (measured: 0.8 s
   // of timestamps in a 3.8 s submission). On a CPU device, host time is device time.
   bool useTimestamps = false;
-  static constexpr std::uint32_t kMaxTimedStages = 8;
   VkQueryPool queries = VK_NULL_HANDLE;
+  std::uint32_t queryCapacity = 0;  // timestamps the pool holds
 
   // vulkan_renderer.cpp
   Impl(const render::Scene& scene, const render::RenderOptions& o, const VulkanOptions& vulkan,
@@ -142,8 +145,11 @@ struct VulkanRenderer::Impl {
   void uploadFrameUniforms(const render::FrameRequest& request);
   // The stages of a frame, in order: with timestamps, recorded into one
   // command buffer (a timestamp after each) and submitted once; otherwise
-  // (a CPU device) one submission per stage, timed on the host.
+  // (a CPU device) one submission per stage, timed on the host. Stages of
+  // one name (the batches of rotation and triple-product) add up to one
+  // entry of frame.stages, at the place of the first.
   void runStages(const std::vector<FrameStage>& stages, render::Frame& frame);
+  void ensureQueries(std::uint32_t count);
 
   // fused_frame.cpp
   render::Frame renderFused(const render::FrameRequest& request);

@@ -297,6 +297,14 @@ TEST(VulkanRenderer, BatchingTheRotationDoesNotChangeTheImage) {
   EXPECT_GT(batched.batchesLastFrame(), 2u);
   EXPECT_EQ(a.objectMask, b.objectMask);
   EXPECT_EQ(a.image.rgb, b.image.rgb) << "every pixel is computed independently of its batch";
+  // Batches are sized on the device from the covered count (batch_args.comp):
+  // a frame with no covered pixel dispatches no rotation at all.
+  render::FrameRequest away = requestFor(scene, 40, 40);
+  away.camera.target = away.camera.eye + (away.camera.eye - scene.camera.target);
+  const render::Frame empty = batched.render(away);
+  EXPECT_EQ(std::count(empty.objectMask.begin(), empty.objectMask.end(), 1), 0);
+  EXPECT_EQ(batched.batchesLastFrame(), 0u);
+  EXPECT_EQ(batched.render(request).image.rgb, b.image.rgb) << "the frame after an empty one";
   testing::expectNoValidationMessages(batched.context());
 }
 

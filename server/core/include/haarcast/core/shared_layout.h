@@ -257,6 +257,16 @@ struct CoverageCounter {
   uint groups[3];
 };
 
+// The rotating methods' batches, sized on the device: batch_args.comp
+// writes, from the covered count, per batch b of `batch` samples with
+// count_b = clamp(covered − b·batch, 0, batch), the rotation's arguments
+// (count_b, 3, 1) at [b] and the triple product's (⌈3·count_b / 64⌉, 1, 1)
+// at [batches + b] (VkDispatchIndirectCommand, padded to 16 bytes).
+struct DispatchArgs {
+  uint groups[3];
+  uint pad;
+};
+
 // The G-buffer pass's push block (gbuffer.vert / .frag).
 struct GBufferPush {
   mat4 objectToClip;
@@ -276,6 +286,7 @@ static_assert(sizeof(RotationSample) == 32 && offsetof(RotationSample, alpha) ==
               offsetof(RotationSample, thetaOut) == 24);
 static_assert(sizeof(ShadeSample) == 32 && offsetof(ShadeSample, b) == 16 && offsetof(ShadeSample, pixel) == 28);
 static_assert(sizeof(CoverageCounter) == 16 && offsetof(CoverageCounter, groups) == 4);
+static_assert(sizeof(DispatchArgs) == 16 && offsetof(DispatchArgs, groups) == 0);
 static_assert(sizeof(GBufferPush) == 80 && offsetof(GBufferPush, objectId) == 64);
 #endif
 

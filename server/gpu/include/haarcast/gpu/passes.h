@@ -23,6 +23,7 @@ namespace haarcast::gpu {
 // The records the passes exchange, defined once for C++ and GLSL
 // (core/shared_layout.h, with their size and offset checks).
 using shared::CoverageCounter;
+using shared::DispatchArgs;
 using shared::FrameParams;
 using shared::GBufferPush;
 using shared::ObjectInfo;
