@@ -45,11 +45,9 @@ std::array<float, 256> srgbThresholds(double exposureStops) {
 
 void setFusedSkip(ObjectInfo& info, int level, int lastNonZeroRow) {
   // As fusedShade: beyond the last non-zero row + 1 every lookup reads zeros;
-  // one more row absorbs the rounding of θ'. The taps of the directions kept
-  // reach rows up to cutRow (r0 ≤ cutRow − 1, r1 = r0 + 1).
+  // one more row absorbs the rounding of θ'.
   const int m = mapSize(level), cutRow = lastNonZeroRow + 2;
   info.skipBelowY = cutRow < m ? static_cast<float>(std::cos(cutRow * kPi / m)) : -2.0f;
-  info.blendRows = static_cast<std::uint32_t>(std::min(m, cutRow + 1));
 }
 
 std::vector<BindingKind> fusedBindings() {

@@ -224,8 +224,8 @@ struct ObjectInfo {
   uint vertexBase;     // its vertex 0 in the global vertex numbering
   uint triangleBase;   // its triangle 0 in the global triangle numbering
   float skipBelowY;    // `fused`: directions with cos θ' below this read only zero texels
-  uint blendRows;      // `fused`: the slice rows such directions can reach (the last non-zero row + 3, ≤ M)
-  uint pad;
+  uint pad0;
+  uint pad1;
 };
 
 // Per covered pixel, what the rotation needs (the rotation contract's binding 0).
@@ -280,8 +280,7 @@ struct GBufferPush {
 static_assert(sizeof(FrameParams) == 128 && offsetof(FrameParams, tanHalf) == 96 &&
               offsetof(FrameParams, fusedGroups) == 124);
 static_assert(sizeof(ObjectInfo) == 80 && offsetof(ObjectInfo, sliceBase) == 48 &&
-              offsetof(ObjectInfo, skipBelowY) == 68 &&
-              offsetof(ObjectInfo, blendRows) == 72);
+              offsetof(ObjectInfo, skipBelowY) == 68);
 static_assert(sizeof(RotationSample) == 32 && offsetof(RotationSample, alpha) == 8 &&
               offsetof(RotationSample, thetaOut) == 24);
 static_assert(sizeof(ShadeSample) == 32 && offsetof(ShadeSample, b) == 16 && offsetof(ShadeSample, pixel) == 28);

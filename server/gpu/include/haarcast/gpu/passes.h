@@ -80,10 +80,9 @@ std::vector<BindingKind> fusedBindings();
 // written to out[0 … N).
 void fusedLightTexels(std::span<const float> planes, std::span<glm::vec4> out);
 
-// ObjectInfo's skipBelowY and blendRows for fused.comp, from the slices'
-// last non-zero row (core PixelSlices::lastNonZeroRow): directions whose
-// rotated cos θ' is below skipBelowY read only zero texels (fusedShade's
-// cut), and the others read rows below blendRows only.
+// ObjectInfo's skipBelowY for fused.comp, from the slices' last non-zero row
+// (core PixelSlices::lastNonZeroRow): directions whose rotated cos θ' is
+// below it read only zero texels (fusedShade's cut).
 void setFusedSkip(ObjectInfo& info, int level, int lastNonZeroRow);
 
 // The level range of the GPU passes: shared memory holds one level-6 map
