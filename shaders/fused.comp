@@ -8,23 +8,32 @@
 // compacted pixels (s = group, group + groups, …), so the dispatch is sized
 // by the rotation-input pass's indirect arguments and a bounded scratch
 // serves any number of pixels. Per pixel:
-//   1. the hit triangle's three vertex visibility lists, weighted by the
-//      barycentrics, are scattered into one dense coefficient array (vertex by
-//      vertex, in the CPU's order, so V's coefficients are the CPU's floats);
-//   2. V is synthesised (inverse Haar, haar.cpp's steps) into pixel form;
+//   1. (lists only) the hit triangle's three vertex visibility lists,
+//      weighted by the barycentrics, are scattered into one dense coefficient
+//      array (vertex by vertex, in the CPU's order, so V's coefficients are
+//      the CPU's floats);
+//   2. (lists only) V is synthesised (inverse Haar, haar.cpp's steps) into
+//      pixel form;
 //   3. the invocations stride over the directions: Rᵀω with R = Ry(α)Rx(β)Ry(γ)
-//      (γ only offsets the source column), θ', φ' with the precise atan2,
-//      ρ bilinear in the θₒ-blended slice texels exactly as bilinearTaps (θ
-//      clamped, φ wrapped), accumulated with W_c = L_c·V;
+//      (γ only offsets the source column), θ', φ' with the CPU kernel's
+//      atan2, ρ bilinear in the slice texels exactly as bilinearTaps (θ
+//      clamped, φ wrapped); with two θₒ slices each tap is blended,
+//      a + w·(b − a), as fusedShade blends texels; accumulated with W_c = L_c·V;
 //   4. the partial sums are reduced in invocation order; radiance[pixel] = Σ.
 //
 // With VERTEX_PLANES (the host's choice where every vertex's pixel form fits
 // in memory), V is instead blended from the vertices' pixel forms in step 3
 // and steps 1–2 and their barriers disappear.
 //
-// Scratch per workgroup: N coefficients, the finest synthesis step's N
-// values and the previous step's N/4 (steps alternate between the two), in
-// shared memory when SHARED_FLOATS holds them (the host checks
+// The large read-only arrays of step 3 (slice texels, light, directions,
+// vertex planes) are uniform texel buffers read with texelFetch: on a CPU
+// device (lavapipe) a fetch is one vector gather, where a storage-buffer
+// read at a per-invocation index goes lane by lane and component by
+// component, each behind a branch (docs/gpu.md, "fused on lavapipe").
+//
+// Scratch per workgroup (lists only): N coefficients, the finest synthesis
+// step's N values and the previous step's N/4 (steps alternate between the
+// two), in shared memory when SHARED_FLOATS holds them (the host checks
 // maxComputeSharedMemorySize), else in this group's slice of `scratch`.
 #extension GL_GOOGLE_include_directive : require
 #include "haarcast/core/shared_layout.h"
@@ -35,35 +44,32 @@ layout(local_size_x_id = 2) in;
 layout(constant_id = 0) const uint LEVEL = 5u;
 layout(constant_id = 3) const uint SHARED_FLOATS = 1u;  // 1: the scratch lives in the `scratch` buffer
 layout(constant_id = 4) const uint INTERPOLATE = 1u;    // RenderOptions::interpolateSlices
-// 1: binding 5 holds every vertex's visibility in pixel form (N floats per
+// 1: binding 10 holds every vertex's visibility in pixel form (N floats per
 // vertex, synthesised once at prepare), and V(ω) = Σ_v b_v·V_v(ω) is formed
 // in the direction loop: no merge, no synthesis, no scratch, no barrier but
-// the reduction's. 0: binding 5 holds the sparse lists (steps 1–2 below).
+// the reduction's. 0: binding 5 holds the sparse lists (steps 1–2).
 layout(constant_id = 5) const uint VERTEX_PLANES = 0u;
 
 const uint LOCAL = gl_WorkGroupSize.x;
 const uint M = 1u << LEVEL;
 const uint N = M * M;
-// Scratch layout: synthesis (lists only) [0, N) coefficients, [N, 2N) FINE,
-// [2N, 2.25N) COARSE; then the θₒ-blended slice, planar R, G, B of N each,
-// at BLEND (over COARSE, which is spent by then).
+// Scratch layout (lists only): [0, N) coefficients, [N, 2N) FINE, [2N, 2.25N) COARSE.
 const uint FINE = N;            // where the synthesis step n = M writes (V in pixel form, row stride M)
 const uint COARSE = 2u * N;     // where the step before it writes
-const uint BLEND = VERTEX_PLANES != 0u ? 0u : 2u * N;
-const uint SCRATCH = BLEND + 3u * N;
+const uint SCRATCH = VERTEX_PLANES != 0u ? 0u : 2u * N + N / 4u;
 
 layout(std430, set = 0, binding = 0) readonly buffer Samples { RotationSample samples[]; };
 layout(std430, set = 0, binding = 1) readonly buffer Shade { ShadeSample shade[]; };
 layout(std430, set = 0, binding = 2) readonly buffer Objects { ObjectInfo objects[]; };
-layout(std430, set = 0, binding = 3) readonly buffer Texels { vec4 texels[]; };      // slice s at s·N, RGB0
-layout(std430, set = 0, binding = 4) readonly buffer Light { float light[]; };       // object o, channel c at (3o + c)·N
-// VERTEX_PLANES = 0: per vertex (first, count), then (index, value bits) pairs;
-// VERTEX_PLANES = 1: vertex v's pixel form at v·N, as float bits.
-layout(std430, set = 0, binding = 5) readonly buffer Visibility { uint visibility[]; };
-layout(std430, set = 0, binding = 6) readonly buffer Directions { vec4 directions[]; };   // pixel-centre unit vectors
+layout(set = 0, binding = 3) uniform samplerBuffer texels;       // slice s, direction k at s·N + k: RGB0
+layout(set = 0, binding = 4) uniform samplerBuffer light;        // object o, direction k at o·N + k: (L·ΔΩ) RGB, 0
+// Per vertex (first, count), then (index, value bits) pairs (VERTEX_PLANES = 0).
+layout(std430, set = 0, binding = 5) readonly buffer VisibilityLists { uint visibilityLists[]; };
+layout(set = 0, binding = 6) uniform samplerBuffer directions;   // pixel-centre unit vectors (xyz)
 layout(std430, set = 0, binding = 7) coherent buffer Scratch { float scratch[]; };
 layout(std430, set = 0, binding = 8) buffer Radiance { vec4 radiance[]; };
 layout(std430, set = 0, binding = 9) readonly buffer Counter { CoverageCounter counter; };
+layout(set = 0, binding = 10) uniform samplerBuffer visibilityPlanes;  // vertex v, direction k at v·N + k (VERTEX_PLANES = 1)
 
 shared float sharedScratch[SHARED_FLOATS];
 shared vec3 partial[LOCAL];
@@ -87,7 +93,9 @@ void sync() {
 // What the direction loop needs of a pixel.
 struct PixelSetup {
   ShadeSample sh;
-  uint base0;              // the (first) slice's texel 0
+  uint base0, base1;       // the two slices' texel 0 (equal without a blend)
+  float weight;            // of the second slice
+  uint lightBase;          // the object's light texel 0
   float sinA, cosA, sinB, cosB;
   int shift;               // whole source columns of γ
   float fraction;          // and the fraction
@@ -95,10 +103,12 @@ struct PixelSetup {
   uint firstRow, endRow;   // the rows that can reach the slice's non-zero cap
 };
 
-// Texel `index` of ρ: the slice's own (nearest) or the blended copy in the scratch.
-vec3 texel(bool blended, uint base0, uint index) {
-  if (blended) return vec3(scratchGet(BLEND + index), scratchGet(BLEND + N + index), scratchGet(BLEND + 2u * N + index));
-  return texels[base0 + index].rgb;
+// Texel `index` of ρ: the slice's own, or the blend of the two slices.
+vec3 texel(const bool blended, PixelSetup p, uint index) {
+  const vec3 a = texelFetch(texels, int(p.base0 + index)).rgb;
+  if (!blended) return a;
+  const vec3 b = texelFetch(texels, int(p.base1 + index)).rgb;
+  return a + p.weight * (b - a);
 }
 
 // 3. Σ over the directions of this invocation (i ≡ lid mod LOCAL). Called
@@ -106,18 +116,17 @@ vec3 texel(bool blended, uint base0, uint index) {
 // kind of lookup (SIMD devices such as lavapipe would otherwise run both).
 vec3 sumDirections(const bool blended, PixelSetup p) {
   const float rowScale = float(M) / kPi, colScale = float(M) / kTwoPi;
-  const uint lightBase = 3u * p.sh.object * N;
   const int mask = int(M) - 1;
   vec3 acc = vec3(0.0);
   for (uint i = p.firstRow * M + gl_LocalInvocationID.x; i < p.endRow * M; i += LOCAL) {
-    const vec3 w0 = directions[i].xyz;
+    const vec3 w0 = texelFetch(directions, int(i)).xyz;
     const float x1 = p.cosA * w0.x - p.sinA * w0.z;  // R_y(−α)
     const float z1 = p.sinA * w0.x + p.cosA * w0.z;
     const float y2 = p.cosB * w0.y + p.sinB * z1;    // R_x(−β)
     if (y2 < p.skipBelowY) continue;  // reads only zero texels
     const float z2 = p.cosB * z1 - p.sinB * w0.y;
-    const float theta = atan2Precise(sqrt(x1 * x1 + z2 * z2), y2);
-    const float phi = atan2Precise(x1, z2);
+    const float theta = atan2Fast(sqrt(x1 * x1 + z2 * z2), y2);
+    const float phi = atan2Fast(x1, z2);
     const float rowPos = min(max(theta * rowScale - 0.5, 0.0), float(M - 1u));
     const float colPos = phi * colScale - p.fraction;
     const float rowFloor = floor(rowPos), colFloor = floor(colPos);
@@ -126,19 +135,19 @@ vec3 sumDirections(const bool blended, PixelSetup p) {
     const uint r1 = min(r0 + 1u, M - 1u);
     const uint c0 = uint((int(colFloor) - p.shift) & mask);
     const uint c1 = (c0 + 1u) & uint(mask);
-    const vec3 a = texel(blended, p.base0, r0 * M + c0);
-    const vec3 b = texel(blended, p.base0, r0 * M + c1);
-    const vec3 c = texel(blended, p.base0, r1 * M + c0);
-    const vec3 e = texel(blended, p.base0, r1 * M + c1);
+    const vec3 a = texel(blended, p, r0 * M + c0);
+    const vec3 b = texel(blended, p, r0 * M + c1);
+    const vec3 c = texel(blended, p, r1 * M + c0);
+    const vec3 e = texel(blended, p, r1 * M + c1);
     const vec3 top = tCol * (b - a) + a;
     const vec3 bottom = tCol * (e - c) + c;
     const vec3 rho = tRow * (bottom - top) + top;
     const float vis = VERTEX_PLANES != 0u
-                          ? p.sh.b[0] * uintBitsToFloat(visibility[p.sh.vertex[0] * N + i]) +
-                                p.sh.b[1] * uintBitsToFloat(visibility[p.sh.vertex[1] * N + i]) +
-                                p.sh.b[2] * uintBitsToFloat(visibility[p.sh.vertex[2] * N + i])
+                          ? p.sh.b[0] * texelFetch(visibilityPlanes, int(p.sh.vertex[0] * N + i)).r +
+                                p.sh.b[1] * texelFetch(visibilityPlanes, int(p.sh.vertex[1] * N + i)).r +
+                                p.sh.b[2] * texelFetch(visibilityPlanes, int(p.sh.vertex[2] * N + i)).r
                           : scratchGet(FINE + i);
-    const vec3 w = vec3(light[lightBase + i], light[lightBase + N + i], light[lightBase + 2u * N + i]) * vis;
+    const vec3 w = texelFetch(light, int(p.lightBase + i)).rgb * vis;
     acc += w * rho;
   }
   return acc;
@@ -151,10 +160,10 @@ void synthesizeVisibility(ShadeSample sh) {
   for (uint i = lid; i < N; i += LOCAL) scratchSet(i, 0.0);
   sync();
   for (uint v = 0u; v < 3u; ++v) {
-    const uint first = visibility[2u * sh.vertex[v]], count = visibility[2u * sh.vertex[v] + 1u];
+    const uint first = visibilityLists[2u * sh.vertex[v]], count = visibilityLists[2u * sh.vertex[v] + 1u];
     for (uint e = lid; e < count; e += LOCAL) {
-      const uint index = visibility[2u * (first + e)];
-      scratchSet(index, scratchGet(index) + sh.b[v] * uintBitsToFloat(visibility[2u * (first + e) + 1u]));
+      const uint index = visibilityLists[2u * (first + e)];
+      scratchSet(index, scratchGet(index) + sh.b[v] * uintBitsToFloat(visibilityLists[2u * (first + e) + 1u]));
     }
     sync();
   }
@@ -195,6 +204,9 @@ void shadePixel(uint s) {
   PixelSetup p;
   p.sh = sh;
   p.base0 = (o.sliceBase + blend.first) * N;
+  p.base1 = (o.sliceBase + blend.second) * N;
+  p.weight = blend.weight;
+  p.lightBase = sh.object * N;
   const vec2 sa = sinCosPrecise(rs.alpha), sb = sinCosPrecise(rs.beta);
   p.sinA = sa.x;
   p.cosA = sa.y;
@@ -225,20 +237,10 @@ void shadePixel(uint s) {
     p.endRow = uint(clamp(ceil((axis + reach) * rowScale - 0.5) + 1.0, 0.0, float(M)));
   }
 
-  // Two slices: blend the rows a lookup can reach (o.blendRows) once into
-  // the scratch, a + w·(b − a) as fusedShade blends, rather than reading
-  // both slices at every tap.
+  // Two slices: each tap blends its two texels (ρ is linear in the slice),
+  // with no pass over the slice first and no scratch.
   vec3 acc;
   if (blend.weight != 0.0 && blend.second != blend.first) {
-    const uint base1 = (o.sliceBase + blend.second) * N;
-    for (uint k = lid; k < o.blendRows * M; k += LOCAL) {
-      const vec3 a = texels[p.base0 + k].rgb, b = texels[base1 + k].rgb;
-      const vec3 t = a + blend.weight * (b - a);
-      scratchSet(BLEND + k, t.r);
-      scratchSet(BLEND + N + k, t.g);
-      scratchSet(BLEND + 2u * N + k, t.b);
-    }
-    sync();
     acc = sumDirections(true, p);
   } else {
     acc = sumDirections(false, p);

@@ -14,7 +14,7 @@ const int N = M * M;
 
 layout(push_constant) uniform Push {
   uint first;   // global index of the batch's first sample
-  uint count;   // samples in the batch
+  uint count;   // samples in a full batch (this one may hold fewer: the covered count decides)
   uint pad0;
   uint pad1;
 } pc;
@@ -24,6 +24,7 @@ layout(std430, set = 0, binding = 1) readonly buffer Rotated { float rotated[]; 
 layout(std430, set = 0, binding = 2) readonly buffer Light { uvec4 light[]; };       // headers [object·3 + c], then blocks
 layout(std430, set = 0, binding = 3) readonly buffer Visibility { uvec4 vis[]; };    // headers [vertex], then blocks
 layout(std430, set = 0, binding = 4) buffer Radiance { vec4 radiance[]; };           // per pixel, linear RGB
+layout(std430, set = 0, binding = 5) readonly buffer Counter { CoverageCounter counter; };
 
 #define BRDF(i) rotated[i]
 #include "common/triple_product.glsl"
@@ -57,16 +58,10 @@ float tripleProduct(uvec4 lightHeader, uint brdfBase, uvec4 visHeader) {
     uvec4 ec = ic < visHeader.y ? vis[visHeader.x + ic] : uvec4(kNone);
     uint key = min(ea.x, ec.x);  // merge of two pre-ordered lists
 
-    // Decode preorderKey: (Morton code of the block's top-left finest block) << 4 | l.
-    int l = int(key & 15u);
-    uint morton = key >> 4;
-    uint row = 0u, col = 0u;
-    for (int b = 0; b <= finest; ++b) {
-      row |= ((morton >> (2 * b + 1)) & 1u) << b;
-      col |= ((morton >> (2 * b)) & 1u) << b;
-    }
-    int bi = int(row >> (finest - l));
-    int bj = int(col >> (finest - l));
+    const HaarBlock block = haarPreorderBlock(uint(finest), key);
+    int l = int(block.level);
+    int bi = int(block.i);
+    int bj = int(block.j);
 
     // Deepest level shared with the current path, then descend to the block.
     int common_ = min(depth - 1, l);
@@ -74,7 +69,7 @@ float tripleProduct(uvec4 lightHeader, uint brdfBase, uvec4 visHeader) {
     for (int d = common_ + 1; d <= l; ++d) {
       int ci = bi >> (l - d);
       int cj = bj >> (l - d);
-      vec3 sign_ = childSign(2 * (ci & 1) + (cj & 1));
+      vec3 sign_ = haarChildSign(haarChildQuadrant(uint(ci), uint(cj)));
       vec3 detB = brdfDetails(brdfBase, d - 1, pathI[d - 1], pathJ[d - 1]);
       sA[d] = 0.5 * (sA[d - 1] + dot(sign_, detA[d - 1]));
       sB[d] = 0.5 * (sB[d - 1] + dot(sign_, detB));
@@ -109,7 +104,11 @@ float tripleProduct(uvec4 lightHeader, uint brdfBase, uvec4 visHeader) {
 
 void main() {
   uint gid = gl_GlobalInvocationID.x;
-  if (gid >= pc.count * 3u) return;
+  // The batch's samples: the indirect dispatch (batch_args.comp) covers
+  // them in groups of 64, so the last group's extra invocations stop here.
+  const uint covered = counter.covered;
+  const uint count = covered > pc.first ? min(pc.count, covered - pc.first) : 0u;
+  if (gid >= count * 3u) return;
   uint local = gid / 3u;
   uint c = gid % 3u;
   ShadeSample s = shade[pc.first + local];

@@ -11,34 +11,17 @@ HaarMap::HaarMap(int level) : level_(level) {
 }
 
 CoefficientPosition coefficientPosition(int mapLevel, std::size_t index) {
-  const int m = mapSize(mapLevel);
-  const int row = static_cast<int>(index / static_cast<std::size_t>(m));
-  const int col = static_cast<int>(index % static_cast<std::size_t>(m));
   CoefficientPosition p;
-  if (row == 0 && col == 0) {
+  if (index == 0) {
     p.isScaling = true;
     return p;
   }
-  // The detail level is that of the larger of row and column: both lie in
-  // [0, 2^(l+1)) and at least one in [2^l, 2^(l+1)).
-  const int top = std::max(row, col);
-  int l = 0;
-  while ((2 << l) <= top) ++l;
-  const int half = 1 << l;
-  p.level = l;
-  if (row < half) {
-    p.band = Band::Horizontal;
-    p.i = row;
-    p.j = col - half;
-  } else if (col < half) {
-    p.band = Band::Vertical;
-    p.i = row - half;
-    p.j = col;
-  } else {
-    p.band = Band::Diagonal;
-    p.i = row - half;
-    p.j = col - half;
-  }
+  const shared::HaarDetailPosition d =
+      shared::haarDetailPosition(static_cast<shared::uint>(mapLevel), static_cast<shared::uint>(index));
+  p.band = static_cast<Band>(d.band);
+  p.level = static_cast<int>(d.level);
+  p.i = static_cast<int>(d.i);
+  p.j = static_cast<int>(d.j);
   return p;
 }
 

@@ -3,10 +3,10 @@
 // that prepares both operands on every call, the brute-force reference, and
 // the barycentric merge of per-vertex visibility.
 #include <algorithm>
-#include <bit>
 #include <stdexcept>
 #include <string>
 
+#include "haarcast/core/shared_layout.h"
 #include "haarcast/core/triple_product.h"
 
 namespace haarcast {
@@ -14,52 +14,11 @@ namespace {
 
 using Details = std::array<double, 3>;
 
-// Signs of (h, v, d) in the synthesis of child quadrant 2·rowBit + colBit
-// (haar.cpp, synthesisStep): top-left, top-right, bottom-left, bottom-right.
-constexpr std::array<Details, 4> kChildSign{{{1, 1, 1}, {-1, 1, -1}, {1, -1, -1}, {-1, -1, 1}}};
-
-// S_child = (S_parent ± h ± v ± d) / 2: one synthesis step.
-double childScaling(double parent, const Details& details, int quadrant) {
-  const Details& sign = kChildSign[static_cast<std::size_t>(quadrant)];
-  return 0.5 * (parent + sign[0] * details[0] + sign[1] * details[1] + sign[2] * details[2]);
-}
-
-// Spreads the low 16 bits of x to the even bits.
-std::uint64_t spreadBits(std::uint64_t x) {
-  x &= 0xFFFFu;
-  x = (x | (x << 8)) & 0x00FF00FFu;
-  x = (x | (x << 4)) & 0x0F0F0F0Fu;
-  x = (x | (x << 2)) & 0x33333333u;
-  x = (x | (x << 1)) & 0x55555555u;
-  return x;
-}
-
-// Position of block (l, i, j) in a pre-order walk of the block quadtree: the
-// Morton code of its top-left finest block (row bits odd, column bits even),
-// ties (a block and its top-left descendants) broken coarser first. A block's
-// descendants then follow it contiguously, so its ancestors are always
-// visited before it.
-std::uint64_t preorderKey(int finestLevel, int l, int i, int j) {
-  const int shift = finestLevel - l;
-  const std::uint64_t morton = (spreadBits(static_cast<std::uint64_t>(i) << shift) << 1) |
-                               spreadBits(static_cast<std::uint64_t>(j) << shift);
-  return (morton << 4) | static_cast<std::uint64_t>(l);
-}
-
-// coefficientPosition of a detail index (index ≥ 1) without a loop: the
-// detail level is that of the larger of row and column, the band which of
-// them lies in the upper half.
-struct DetailPosition {
-  std::uint32_t band;
-  int level, i, j;
-};
-DetailPosition detailPosition(int n, std::uint32_t index) {
-  const std::uint32_t row = index >> n, col = index & ((1u << n) - 1u);
-  const int l = std::bit_width(std::max(row, col)) - 1;
-  const auto half = static_cast<std::uint32_t>(1u << l);
-  if (row < half) return {0u, l, static_cast<int>(row), static_cast<int>(col - half)};
-  if (col < half) return {1u, l, static_cast<int>(row - half), static_cast<int>(col)};
-  return {2u, l, static_cast<int>(row - half), static_cast<int>(col - half)};
+// S_child = (S_parent ± h ± v ± d) / 2: one synthesis step, with the signs
+// of child `quadrant` (shared_layout.h haarChildSign, as the shader).
+double childScaling(double parent, const Details& details, shared::uint quadrant) {
+  const shared::vec3 sign = shared::haarChildSign(quadrant);
+  return 0.5 * (parent + sign.x * details[0] + sign.y * details[1] + sign.z * details[2]);
 }
 
 // Sort word of one detail coefficient: key, then band, then its position in
@@ -68,6 +27,7 @@ constexpr int kListBits = 2 * kMaxLevel;  // an index of a level-kMaxLevel map
 constexpr int kBandShift = kListBits;
 constexpr int kKeyShift = kListBits + 2;
 static_assert(kKeyShift + 2 * kMaxLevel + 4 <= 64, "sort word overflows");
+static_assert(kMaxLevel <= static_cast<int>(shared::kMaxPreorderLevel), "preorder keys overflow 32 bits");
 
 }  // namespace
 
@@ -99,8 +59,9 @@ void PreparedSparseHaar::assign(const SparseHaar& x, const char* what) {
       scaling_ = x.value[k];
       continue;
     }
-    const DetailPosition p = detailPosition(n, index);
-    const std::uint64_t key = preorderKey(n - 1, p.level, p.i, p.j);
+    // The walk's order, shared with triple_product.comp (shared_layout.h).
+    const shared::HaarDetailPosition p = shared::haarDetailPosition(static_cast<shared::uint>(n), index);
+    const std::uint64_t key = shared::haarPreorderKey(static_cast<shared::uint>(n - 1), p.level, p.i, p.j);
     order_.push_back((key << kKeyShift) | (std::uint64_t{p.band} << kBandShift) | k);
   }
   std::sort(order_.begin(), order_.end());
@@ -112,8 +73,8 @@ void PreparedSparseHaar::assign(const SparseHaar& x, const char* what) {
     const auto band = static_cast<std::size_t>((word >> kBandShift) & 3u);
     const auto k = static_cast<std::size_t>(word & kListMask);
     if (blocks_.empty() || blocks_.back().key != key) {
-      const DetailPosition p = detailPosition(n, x.index[k]);
-      blocks_.push_back({key, p.level, p.i, p.j, {}});
+      const shared::HaarDetailPosition p = shared::haarDetailPosition(static_cast<shared::uint>(n), x.index[k]);
+      blocks_.push_back({key, static_cast<int>(p.level), static_cast<int>(p.i), static_cast<int>(p.j), {}});
     }
     blocks_.back().details[band] = x.value[k];
   }
@@ -174,7 +135,7 @@ double tripleProduct(const PreparedLight& light, const HaarMap& brdf, const Prep
       const auto child = static_cast<std::size_t>(d);
       const int ci = block.i >> (l - d);
       const int cj = block.j >> (l - d);
-      const int quadrant = 2 * (ci & 1) + (cj & 1);
+      const shared::uint quadrant = shared::haarChildQuadrant(static_cast<shared::uint>(ci), static_cast<shared::uint>(cj));
       sA[child] = childScaling(sA[parent], detA[parent], quadrant);
       sB[child] = childScaling(sB[parent], brdfDetails(d - 1, pathI[parent], pathJ[parent]), quadrant);
       sC[child] = childScaling(sC[parent], detC[parent], quadrant);

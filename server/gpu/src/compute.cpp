@@ -1,6 +1,8 @@
 #include "haarcast/gpu/compute.h"
 
+#include <algorithm>
 #include <stdexcept>
+#include <utility>
 #include <string>
 
 #include "haarcast/gpu/shaders.h"
@@ -23,13 +25,24 @@ VkShaderModule createShaderModule(Context& context, std::string_view name) {
   return module;
 }
 
+namespace {
+VkDescriptorType descriptorType(BindingKind kind) {
+  return kind == BindingKind::Texels ? VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+}
+}  // namespace
+
 ComputePipeline::ComputePipeline(Context& context, std::string_view shaderName, std::uint32_t storageBuffers,
                                  std::uint32_t pushConstantBytes, std::vector<SpecConstant> specialization)
-    : context_(context), name_(shaderName), bindings_(storageBuffers), pushBytes_(pushConstantBytes) {
+    : ComputePipeline(context, shaderName, std::vector<BindingKind>(storageBuffers, BindingKind::Storage),
+                      pushConstantBytes, std::move(specialization)) {}
+
+ComputePipeline::ComputePipeline(Context& context, std::string_view shaderName, std::vector<BindingKind> bindings,
+                                 std::uint32_t pushConstantBytes, std::vector<SpecConstant> specialization)
+    : context_(context), name_(shaderName), bindings_(std::move(bindings)), pushBytes_(pushConstantBytes) {
   VkDevice device = context.device();
   VkShaderModule module = createShaderModule(context, shaderName);
   try {
-    setLayout_ = createStorageSetLayout(device, storageBuffers, VK_SHADER_STAGE_COMPUTE_BIT);
+    setLayout_ = createSetLayout(device, bindings_, VK_SHADER_STAGE_COMPUTE_BIT);
 
     VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, pushConstantBytes};
     VkPipelineLayoutCreateInfo pl{};
@@ -62,7 +75,7 @@ ComputePipeline::ComputePipeline(Context& context, std::string_view shaderName, 
     cp.layout = layout_;
     vkCheck(vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &cp, nullptr, &pipeline_), "vkCreateComputePipelines");
 
-    allocateStorageSet(device, setLayout_, storageBuffers, pool_, set_);
+    allocateSet(device, setLayout_, bindings_, pool_, set_);
   } catch (...) {
     vkDestroyShaderModule(device, module, nullptr);
     destroy();  // the destructor does not run for a constructor that throws
@@ -85,24 +98,36 @@ void ComputePipeline::destroy() {
   setLayout_ = VK_NULL_HANDLE;
 }
 
-void ComputePipeline::bind(std::initializer_list<const Buffer*> buffers) {
-  if (buffers.size() != bindings_) {
-    throw std::invalid_argument(name_ + ": bind() got " + std::to_string(buffers.size()) + " buffers for " +
-                                std::to_string(bindings_) + " bindings");
+void ComputePipeline::bind(std::initializer_list<Bound> resources) {
+  if (resources.size() != bindings_.size()) {
+    throw std::invalid_argument(name_ + ": bind() got " + std::to_string(resources.size()) + " resources for " +
+                                std::to_string(bindings_.size()) + " bindings");
   }
-  std::vector<VkDescriptorBufferInfo> infos;
-  for (const Buffer* b : buffers) {
-    if (!b || !b->handle()) throw std::invalid_argument(name_ + ": bind() got an empty buffer");
-    infos.push_back({b->handle(), 0, VK_WHOLE_SIZE});
-  }
-  std::vector<VkWriteDescriptorSet> writes(infos.size());
-  for (std::size_t i = 0; i < infos.size(); ++i) {
+  std::vector<VkDescriptorBufferInfo> infos(resources.size());
+  std::vector<VkBufferView> views(resources.size());
+  std::vector<VkWriteDescriptorSet> writes(resources.size());
+  std::size_t i = 0;
+  for (const Bound& r : resources) {
+    const BindingKind kind = bindings_[i];
     writes[i].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
     writes[i].dstSet = set_;
     writes[i].dstBinding = static_cast<std::uint32_t>(i);
     writes[i].descriptorCount = 1;
-    writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    writes[i].pBufferInfo = &infos[i];
+    writes[i].descriptorType = descriptorType(kind);
+    if (kind == BindingKind::Texels) {
+      if (!r.texels || !r.texels->handle()) {
+        throw std::invalid_argument(name_ + ": binding " + std::to_string(i) + " takes a texel view");
+      }
+      views[i] = r.texels->handle();
+      writes[i].pTexelBufferView = &views[i];
+    } else {
+      if (!r.buffer || !r.buffer->handle()) {
+        throw std::invalid_argument(name_ + ": binding " + std::to_string(i) + " takes a buffer");
+      }
+      infos[i] = {r.buffer->handle(), 0, VK_WHOLE_SIZE};
+      writes[i].pBufferInfo = &infos[i];
+    }
+    ++i;
   }
   vkUpdateDescriptorSets(context_.device(), static_cast<std::uint32_t>(writes.size()), writes.data(), 0, nullptr);
 }
@@ -141,31 +166,40 @@ void computeBarrier(VkCommandBuffer cb) {
                        0, 1, &m, 0, nullptr, 0, nullptr);
 }
 
-VkDescriptorSetLayout createStorageSetLayout(VkDevice device, std::uint32_t storageBuffers, VkShaderStageFlags stages) {
-  std::vector<VkDescriptorSetLayoutBinding> bindings(storageBuffers);
-  for (std::uint32_t i = 0; i < storageBuffers; ++i) {
-    bindings[i].binding = i;
-    bindings[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+VkDescriptorSetLayout createSetLayout(VkDevice device, const std::vector<BindingKind>& kinds, VkShaderStageFlags stages) {
+  std::vector<VkDescriptorSetLayoutBinding> bindings(kinds.size());
+  for (std::size_t i = 0; i < kinds.size(); ++i) {
+    bindings[i].binding = static_cast<std::uint32_t>(i);
+    bindings[i].descriptorType = descriptorType(kinds[i]);
     bindings[i].descriptorCount = 1;
     bindings[i].stageFlags = stages;
   }
   VkDescriptorSetLayoutCreateInfo sl{};
   sl.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
-  sl.bindingCount = storageBuffers;
+  sl.bindingCount = static_cast<std::uint32_t>(bindings.size());
   sl.pBindings = bindings.data();
   VkDescriptorSetLayout layout = VK_NULL_HANDLE;
   vkCheck(vkCreateDescriptorSetLayout(device, &sl, nullptr, &layout), "vkCreateDescriptorSetLayout");
   return layout;
 }
 
-void allocateStorageSet(VkDevice device, VkDescriptorSetLayout layout, std::uint32_t storageBuffers,
-                        VkDescriptorPool& pool, VkDescriptorSet& set) {
-  VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, std::max<std::uint32_t>(storageBuffers, 1)};
+VkDescriptorSetLayout createStorageSetLayout(VkDevice device, std::uint32_t storageBuffers, VkShaderStageFlags stages) {
+  return createSetLayout(device, std::vector<BindingKind>(storageBuffers, BindingKind::Storage), stages);
+}
+
+void allocateSet(VkDevice device, VkDescriptorSetLayout layout, const std::vector<BindingKind>& kinds,
+                 VkDescriptorPool& pool, VkDescriptorSet& set) {
+  std::vector<VkDescriptorPoolSize> sizes;
+  for (const BindingKind kind : {BindingKind::Storage, BindingKind::Texels}) {
+    const auto count = static_cast<std::uint32_t>(std::count(kinds.begin(), kinds.end(), kind));
+    if (count) sizes.push_back({descriptorType(kind), count});
+  }
+  if (sizes.empty()) sizes.push_back({VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1});
   VkDescriptorPoolCreateInfo dp{};
   dp.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
   dp.maxSets = 1;
-  dp.poolSizeCount = 1;
-  dp.pPoolSizes = &size;
+  dp.poolSizeCount = static_cast<std::uint32_t>(sizes.size());
+  dp.pPoolSizes = sizes.data();
   vkCheck(vkCreateDescriptorPool(device, &dp, nullptr, &pool), "vkCreateDescriptorPool");
   VkDescriptorSetAllocateInfo da{};
   da.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
@@ -173,6 +207,11 @@ void allocateStorageSet(VkDevice device, VkDescriptorSetLayout layout, std::uint
   da.descriptorSetCount = 1;
   da.pSetLayouts = &layout;
   vkCheck(vkAllocateDescriptorSets(device, &da, &set), "vkAllocateDescriptorSets");
+}
+
+void allocateStorageSet(VkDevice device, VkDescriptorSetLayout layout, std::uint32_t storageBuffers,
+                        VkDescriptorPool& pool, VkDescriptorSet& set) {
+  allocateSet(device, layout, std::vector<BindingKind>(storageBuffers, BindingKind::Storage), pool, set);
 }
 
 }  // namespace haarcast::gpu

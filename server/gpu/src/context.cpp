@@ -219,7 +219,7 @@ std::string describeDevices(const std::vector<DeviceInfo>& devices) {
   return s;
 }
 
-Context::Context(const VulkanOptions& options) {
+Context::Context(const VulkanOptions& options) : directInputs_(!options.stageInputs) {
   const bool validation = options.validation && validationLayerInstalled() &&
                           instanceExtensionAvailable(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
   instance_ = createInstance(validation);
@@ -277,6 +277,13 @@ Context::Context(const VulkanOptions& options) {
     physical_ = devices[static_cast<std::size_t>(chosen)];
     info_ = infos[static_cast<std::size_t>(chosen)];
     vkGetPhysicalDeviceProperties(physical_, &properties_);
+    VkPhysicalDeviceSubgroupProperties subgroup{};
+    subgroup.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES;
+    VkPhysicalDeviceProperties2 properties2{};
+    properties2.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2;
+    properties2.pNext = &subgroup;
+    vkGetPhysicalDeviceProperties2(physical_, &properties2);
+    subgroupSize_ = std::max<std::uint32_t>(subgroup.subgroupSize, 1);
     vkGetPhysicalDeviceMemoryProperties(physical_, &memory_);
     queueFamily_ = *findQueueFamily(physical_, &timestampValidBits_);
 
@@ -398,81 +405,6 @@ void Context::clearValidationMessages() {
 void Context::addValidationMessage(std::string message) {
   std::lock_guard lock(messagesMutex_);
   messages_.push_back(std::move(message));
-}
-
-// ---- Buffer ------------------------------------------------------------
-
-Buffer::Buffer(Context& context, VkDeviceSize bytes, VkBufferUsageFlags usage) : context_(&context) {
-  size_ = std::max<VkDeviceSize>(4, (bytes + 3) / 4 * 4);
-  VkBufferCreateInfo b{};
-  b.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
-  b.size = size_;
-  b.usage = usage;
-  b.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
-  VkDevice device = context.device();
-  vkCheck(vkCreateBuffer(device, &b, nullptr, &buffer_), "vkCreateBuffer");
-  try {
-    VkMemoryRequirements req{};
-    vkGetBufferMemoryRequirements(device, buffer_, &req);
-    const std::uint32_t type = context.memoryType(req.memoryTypeBits,
-                                                  VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
-                                                  VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-    memory_ = context.allocate(req.size, type);
-    vkCheck(vkBindBufferMemory(device, buffer_, memory_, 0), "vkBindBufferMemory");
-    vkCheck(vkMapMemory(device, memory_, 0, VK_WHOLE_SIZE, 0, &mapped_), "vkMapMemory");
-  } catch (...) {
-    release();
-    throw;
-  }
-}
-
-Buffer::~Buffer() { release(); }
-
-Buffer::Buffer(Buffer&& other) noexcept
-    : context_(std::exchange(other.context_, nullptr)),
-      buffer_(std::exchange(other.buffer_, VK_NULL_HANDLE)),
-      memory_(std::exchange(other.memory_, VK_NULL_HANDLE)),
-      size_(std::exchange(other.size_, 0)),
-      mapped_(std::exchange(other.mapped_, nullptr)) {}
-
-Buffer& Buffer::operator=(Buffer&& other) noexcept {
-  if (this != &other) {
-    release();
-    context_ = std::exchange(other.context_, nullptr);
-    buffer_ = std::exchange(other.buffer_, VK_NULL_HANDLE);
-    memory_ = std::exchange(other.memory_, VK_NULL_HANDLE);
-    size_ = std::exchange(other.size_, 0);
-    mapped_ = std::exchange(other.mapped_, nullptr);
-  }
-  return *this;
-}
-
-void Buffer::release() {
-  if (!context_) return;
-  VkDevice device = context_->device();
-  if (mapped_) vkUnmapMemory(device, memory_);
-  if (buffer_) vkDestroyBuffer(device, buffer_, nullptr);
-  context_->free(memory_);
-  mapped_ = nullptr;
-  buffer_ = VK_NULL_HANDLE;
-  memory_ = VK_NULL_HANDLE;
-  context_ = nullptr;
-}
-
-void Buffer::write(const void* data, std::size_t bytes, std::size_t offset) {
-  if (offset > size_ || bytes > size_ - offset) {
-    throw std::out_of_range("Buffer::write of " + std::to_string(bytes) + " bytes at " + std::to_string(offset) +
-                            " passes the end of a " + std::to_string(size_) + "-byte buffer");
-  }
-  if (bytes) std::memcpy(static_cast<char*>(mapped_) + offset, data, bytes);
-}
-
-void Buffer::read(void* data, std::size_t bytes, std::size_t offset) const {
-  if (offset > size_ || bytes > size_ - offset) {
-    throw std::out_of_range("Buffer::read of " + std::to_string(bytes) + " bytes at " + std::to_string(offset) +
-                            " passes the end of a " + std::to_string(size_) + "-byte buffer");
-  }
-  if (bytes) std::memcpy(data, static_cast<const char*>(mapped_) + offset, bytes);
 }
 
 }  // namespace haarcast::gpu

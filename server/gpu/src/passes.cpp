@@ -1,6 +1,7 @@
 #include "haarcast/gpu/passes.h"
 
 #include "haarcast/core/sphere_map.h"
+#include "haarcast/render/shading.h"
 
 #include <algorithm>
 #include <bit>
@@ -8,33 +9,18 @@
 #include <stdexcept>
 #include <string>
 
-#include <glm/geometric.hpp>
-#include <glm/trigonometric.hpp>
-
-#include "haarcast/render/shading.h"
-
 namespace haarcast::gpu {
-
-CameraBasis cameraBasis(const render::Camera& camera) {
-  // The basis of render::CameraRays, computed the same way in double.
-  CameraBasis b;
-  b.forward = glm::normalize(camera.target - camera.eye);
-  b.right = glm::normalize(glm::cross(b.forward, camera.up));
-  b.up = glm::cross(b.right, b.forward);
-  b.tanHalf = std::tan(glm::radians(camera.fovYDegrees) * 0.5);
-  return b;
-}
 
 FrameParams makeFrameParams(const render::Camera& camera, int width, int height, const glm::dmat3& lightRotation,
                             double exposureStops, bool background, int backgroundLevel) {
-  const CameraBasis basis = cameraBasis(camera);
+  const render::CameraBasis basis = render::cameraBasis(camera, width, height);
   FrameParams f{};
   f.forward = glm::vec4(glm::vec3(basis.forward), 0.0f);
   f.right = glm::vec4(glm::vec3(basis.right), 0.0f);
   f.up = glm::vec4(glm::vec3(basis.up), 0.0f);
   const glm::dmat3 lt = glm::transpose(lightRotation);
   for (int c = 0; c < 3; ++c) f.lightRotT[c] = glm::vec4(glm::vec3(lt[c]), 0.0f);
-  f.tanHalf = static_cast<float>(render::verticalTanHalf(camera, width, height));
+  f.tanHalf = static_cast<float>(basis.tanHalf);
   f.aspect = static_cast<float>(static_cast<double>(width) / height);
   f.gain = static_cast<float>(std::exp2(exposureStops));
   f.background = background ? 1u : 0u;
@@ -46,11 +32,23 @@ FrameParams makeFrameParams(const render::Camera& camera, int width, int height,
 
 void setFusedSkip(ObjectInfo& info, int level, int lastNonZeroRow) {
   // As fusedShade: beyond the last non-zero row + 1 every lookup reads zeros;
-  // one more row absorbs the rounding of θ'. The taps of the directions kept
-  // reach rows up to cutRow (r0 ≤ cutRow − 1, r1 = r0 + 1).
+  // one more row absorbs the rounding of θ'.
   const int m = mapSize(level), cutRow = lastNonZeroRow + 2;
   info.skipBelowY = cutRow < m ? static_cast<float>(std::cos(cutRow * kPi / m)) : -2.0f;
-  info.blendRows = static_cast<std::uint32_t>(std::min(m, cutRow + 1));
+}
+
+std::vector<BindingKind> fusedBindings() {
+  using enum BindingKind;
+  return {Storage, Storage, Storage, Texels, Texels, Storage, Texels, Storage, Storage, Storage, Texels};
+}
+
+void fusedLightTexels(std::span<const float> planes, std::span<glm::vec4> out) {
+  const std::size_t n = out.size();
+  if (planes.size() != 3 * n) {
+    throw std::invalid_argument("fusedLightTexels: " + std::to_string(planes.size()) + " plane floats for " +
+                                std::to_string(n) + " texels");
+  }
+  for (std::size_t k = 0; k < n; ++k) out[k] = glm::vec4(planes[k], planes[n + k], planes[2 * n + k], 0.0f);
 }
 
 std::vector<glm::vec4> pixelCentreDirections(int level) {
@@ -87,20 +85,6 @@ std::vector<std::uint32_t> packVisibilityEntries(std::span<const SparseHaar> lis
   return out;
 }
 
-std::uint32_t preorderKey(int mapLevel, int l, int i, int j) {
-  // triple_product.cpp's key, which fits 32 bits for levels ≤ 14.
-  const int finest = mapLevel - 1;
-  const int shift = finest - l;
-  const auto row = static_cast<std::uint32_t>(i) << shift;
-  const auto col = static_cast<std::uint32_t>(j) << shift;
-  std::uint32_t morton = 0;
-  for (int b = 0; b <= finest; ++b) {
-    morton |= ((row >> b) & 1u) << (2 * b + 1);
-    morton |= ((col >> b) & 1u) << (2 * b);
-  }
-  return (morton << 4) | static_cast<std::uint32_t>(l);
-}
-
 namespace {
 struct Block {
   std::uint32_t key;
@@ -112,7 +96,9 @@ std::vector<Block> blocksOf(const SparseHaar& list) {
   for (std::size_t k = 0; k < list.size(); ++k) {
     const CoefficientPosition p = coefficientPosition(list.level, list.index[k]);
     if (p.isScaling) continue;
-    blocks.push_back({preorderKey(list.level, p.level, p.i, p.j), {0, 0, 0}});
+    blocks.push_back({shared::haarPreorderKey(static_cast<shared::uint>(list.level - 1), static_cast<shared::uint>(p.level),
+                                              static_cast<shared::uint>(p.i), static_cast<shared::uint>(p.j)),
+                      {0, 0, 0}});
     blocks.back().hvd[static_cast<int>(p.band)] = list.value[k];
   }
   std::stable_sort(blocks.begin(), blocks.end(), [](const Block& a, const Block& b) { return a.key < b.key; });

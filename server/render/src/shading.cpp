@@ -13,12 +13,18 @@ double verticalTanHalf(const Camera& camera, int width, int height) {
   return width < height ? tanHalf * static_cast<double>(height) / width : tanHalf;
 }
 
+CameraBasis cameraBasis(const Camera& camera, int width, int height) {
+  CameraBasis b;
+  b.forward = glm::normalize(camera.target - camera.eye);
+  b.right = glm::normalize(glm::cross(b.forward, camera.up));
+  b.up = glm::cross(b.right, b.forward);
+  b.tanHalf = verticalTanHalf(camera, width, height);
+  return b;
+}
+
 CameraRays::CameraRays(const Camera& camera, int width, int height)
     : eye_(camera.eye),
-      forward_(glm::normalize(camera.target - camera.eye)),
-      right_(glm::normalize(glm::cross(forward_, camera.up))),
-      up_(glm::cross(right_, forward_)),
-      tanHalf_(verticalTanHalf(camera, width, height)),
+      basis_(cameraBasis(camera, width, height)),
       aspect_(static_cast<double>(width) / height),
       width_(width),
       height_(height) {}
@@ -26,9 +32,9 @@ CameraRays::CameraRays(const Camera& camera, int width, int height)
 glm::dvec3 CameraRays::direction(int x, int y) const { return directionAt(x + 0.5, y + 0.5); }
 
 glm::dvec3 CameraRays::directionAt(double px, double py) const {
-  const double sx = (2.0 * px / width_ - 1.0) * tanHalf_ * aspect_;
-  const double sy = (1.0 - 2.0 * py / height_) * tanHalf_;
-  return glm::normalize(forward_ + sx * right_ + sy * up_);
+  const double sx = (2.0 * px / width_ - 1.0) * basis_.tanHalf * aspect_;
+  const double sy = (1.0 - 2.0 * py / height_) * basis_.tanHalf;
+  return glm::normalize(basis_.forward + sx * basis_.right + sy * basis_.up);
 }
 
 glm::dmat3 shadingFrame(const glm::dvec3& n, const glm::dvec3& wo, double& thetaOut) {

@@ -3,12 +3,16 @@
 #include <gtest/gtest.h>
 
 #include <numeric>
+#include <optional>
+#include <span>
 #include <stdexcept>
 #include <vector>
 
 #include "gpu_test_util.h"
+#include "haarcast/gpu/buffer.h"
 #include "haarcast/gpu/compute.h"
 #include "haarcast/gpu/context.h"
+#include "haarcast/gpu/memory.h"
 #include "haarcast/gpu/shaders.h"
 
 namespace haarcast::gpu {
@@ -75,6 +79,49 @@ TEST(VulkanContext, BufferRoundTripAndBoundsCheck) {
   EXPECT_EQ(in, out);
   EXPECT_THROW(b.write(in.data(), 64, 4), std::out_of_range);
   EXPECT_THROW(ComputePipeline(context, "missing.comp", 1, 0), std::invalid_argument);
+  testing::expectNoValidationMessages(context);
+}
+
+// Device inputs (buffer.h): mapped where the host sees all of device-local
+// memory (lavapipe does), else staged; the staged path, forced on any device,
+// delivers what was written, piece by piece, and refuses host access.
+TEST(VulkanContext, DeviceInputsMappedOrStaged) {
+  HAARCAST_REQUIRE_VULKAN();
+  Context direct(testing::testOptions());
+  const std::optional<MemoryPlacement> where =
+      chooseMemory(direct.memoryProperties(), ~0u, MemoryUse::DeviceInput);
+  ASSERT_TRUE(where.has_value());
+  Buffer mapped(direct, 64, kStorageUsage, MemoryUse::DeviceInput);
+  EXPECT_EQ(mapped.staged(), where->staged);
+  EXPECT_EQ(mapped.mapped() != nullptr, where->mapped);
+
+  VulkanOptions options = testing::testOptions();
+  options.stageInputs = true;
+  Context context(options);
+  Buffer target(context, 64, kStorageUsage, MemoryUse::DeviceInput);
+  EXPECT_TRUE(target.staged());
+  EXPECT_EQ(target.mapped(), nullptr);
+  std::vector<float> in(16), out(16, -1.0f);
+  std::iota(in.begin(), in.end(), 1.0f);
+  EXPECT_THROW(target.write(in.data(), 4), std::logic_error);
+  BufferUpload upload(context, target);
+  EXPECT_TRUE(upload.staged());
+  EXPECT_FALSE(upload.pending());
+  upload.write(in.data() + 8, 32, 32);  // the second half first
+  upload.write(in.data(), 32, 0);
+  EXPECT_TRUE(upload.pending());
+  EXPECT_THROW(upload.write(in.data(), 64, 4), std::out_of_range);
+  upload.submit();
+  EXPECT_FALSE(upload.pending());
+  Buffer readback(context, 64);
+  context.submit([&](VkCommandBuffer cb) {
+    const VkBufferCopy all{0, 0, 64};
+    vkCmdCopyBuffer(cb, target.handle(), readback.handle(), 1, &all);
+    computeBarrier(cb);
+  });
+  readback.download(std::span<float>(out));
+  EXPECT_EQ(in, out);
+  testing::expectNoValidationMessages(direct);
   testing::expectNoValidationMessages(context);
 }
 

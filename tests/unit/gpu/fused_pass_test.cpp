@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -67,7 +68,8 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
   std::vector<PixelSlices> slices;
   std::vector<FusedLight> lights;
   std::vector<ObjectInfo> objects(2);
-  std::vector<float> texels, lightPlanes;
+  std::vector<float> texels;
+  std::vector<glm::vec4> lightTexels;
   for (std::size_t o = 0; o < 2; ++o) {
     slices.push_back(PixelSlices::synthesize(randomTable(level, kThetaSamples, o == 1, rng)));
     std::array<SparseHaar, 3> light;
@@ -77,7 +79,8 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
     objects[o].thetaSamples = kThetaSamples;
     setFusedSkip(objects[o], level, slices[o].lastNonZeroRow());
     texels.insert(texels.end(), slices[o].texels().begin(), slices[o].texels().end());
-    lightPlanes.insert(lightPlanes.end(), lights[o].planes.begin(), lights[o].planes.end());
+    lightTexels.resize(lightTexels.size() + lights[o].planes.size() / 3);
+    fusedLightTexels(lights[o].planes, std::span<glm::vec4>(lightTexels).last(lights[o].planes.size() / 3));
   }
 
   // Pixels: three vertex lists each, a rotation, θₒ.
@@ -123,7 +126,7 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
     GTEST_SKIP() << "the device's shared memory does not hold a level-" << level << " scratch";
   }
   auto upload = [&](const void* data, std::size_t bytes) {
-    Buffer b(context, bytes);
+    Buffer b(context, bytes, kTexelUsage);
     b.write(data, bytes);
     return b;
   };
@@ -131,19 +134,24 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
   Buffer shadeBuf = upload(shade.data(), shade.size() * sizeof(ShadeSample));
   Buffer objectBuf = upload(objects.data(), objects.size() * sizeof(ObjectInfo));
   Buffer texelBuf = upload(texels.data(), texels.size() * sizeof(float));
-  Buffer lightBuf = upload(lightPlanes.data(), lightPlanes.size() * sizeof(float));
+  Buffer lightBuf = upload(lightTexels.data(), lightTexels.size() * sizeof(glm::vec4));
   Buffer visBuf = upload(visWords.data(), visWords.size() * sizeof(std::uint32_t));
   Buffer dirBuf = upload(dirs.data(), dirs.size() * sizeof(glm::vec4));
   Buffer scratch(context, pc.sharedScratch ? 4 : kGroups * floats * sizeof(float));
   Buffer radiance(context, kPixels * sizeof(glm::vec4));
   Buffer counterBuf = upload(&counter, sizeof counter);
-  ComputePipeline p(context, "fused.comp", 10, 0,
+  const TexelView texelView(context, texelBuf, VK_FORMAT_R32G32B32A32_SFLOAT, sizeof(glm::vec4));
+  const TexelView lightView(context, lightBuf, VK_FORMAT_R32G32B32A32_SFLOAT, sizeof(glm::vec4));
+  const TexelView dirView(context, dirBuf, VK_FORMAT_R32G32B32A32_SFLOAT, sizeof(glm::vec4));
+  const TexelView planeView(context, visBuf, VK_FORMAT_R32_SFLOAT, sizeof(float));  // read only with planes
+  ComputePipeline p(context, "fused.comp", fusedBindings(), 0,
                     {{0, static_cast<std::uint32_t>(level)},
                      {2, local},
-                     {3, pc.sharedScratch ? static_cast<std::uint32_t>(floats) : 1u},
+                     {3, pc.sharedScratch && floats > 0 ? static_cast<std::uint32_t>(floats) : 1u},
                      {4, pc.interpolate ? 1u : 0u},
                      {5, pc.vertexPlanes ? 1u : 0u}});
-  p.bind({&sampleBuf, &shadeBuf, &objectBuf, &texelBuf, &lightBuf, &visBuf, &dirBuf, &scratch, &radiance, &counterBuf});
+  p.bind({&sampleBuf, &shadeBuf, &objectBuf, &texelView, &lightView, &visBuf, &dirView, &scratch, &radiance, &counterBuf,
+          &planeView});
   context.submit([&](VkCommandBuffer cb) { p.dispatch(cb, {kGroups, 1, 1}); });
   std::vector<glm::vec4> got(kPixels);
   radiance.read(got.data(), got.size() * sizeof(glm::vec4));

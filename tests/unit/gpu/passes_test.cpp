@@ -165,8 +165,14 @@ TEST(TripleProductPass, MatchesCoreTripleProductOnRandomSparseInputs) {
     lightBuf.upload(std::span<const glm::uvec4>(lightPacked));
     visBuf.upload(std::span<const glm::uvec4>(visPacked));
     radBuf.upload(std::span<const float>(radianceInit));
-    ComputePipeline p(context, "triple_product.comp", 5, 16, {{0, static_cast<std::uint32_t>(level)}});
-    p.bind({&shadeBuf, &rotBuf, &lightBuf, &visBuf, &radBuf});
+    // The batch holds kSamples, the frame covered one fewer: the last
+    // sample's invocations stop at the covered count (batch_args.comp sizes
+    // the dispatch in whole groups of 64).
+    const CoverageCounter covered{kSamples - 1, {0, 0, 0}};
+    Buffer counterBuf(context, sizeof covered);
+    counterBuf.write(&covered, sizeof covered);
+    ComputePipeline p(context, "triple_product.comp", 6, 16, {{0, static_cast<std::uint32_t>(level)}});
+    p.bind({&shadeBuf, &rotBuf, &lightBuf, &visBuf, &radBuf, &counterBuf});
     const std::uint32_t push[4] = {0, kSamples, 0, 0};
     context.submit([&](VkCommandBuffer cb) { p.dispatch(cb, {1, 1, 1}, push, 16); });
     std::vector<float> radiance(radianceInit.size());
@@ -175,6 +181,10 @@ TEST(TripleProductPass, MatchesCoreTripleProductOnRandomSparseInputs) {
     double worst = 0.0;
     for (int s = 0; s < kSamples; ++s) {
       const ShadeSample& sh = shade[static_cast<std::size_t>(s)];
+      if (s == kSamples - 1) {
+        for (int c = 0; c < 4; ++c) EXPECT_EQ(radiance[sh.pixel * 4 + static_cast<std::size_t>(c)], -7.0f) << "not covered";
+        continue;
+      }
       for (int c = 0; c < 3; ++c) {
         double expected = 0.0, magnitude = 0.0;
         for (int v = 0; v < 3; ++v) {
@@ -194,6 +204,39 @@ TEST(TripleProductPass, MatchesCoreTripleProductOnRandomSparseInputs) {
     std::printf("triple product, level %d: max relative error %.3g\n", level, worst);
     testing::expectNoValidationMessages(context);
   }
+}
+
+// batch_args.comp: every batch's indirect arguments from the covered count,
+// a partial last batch and empty batches after it included.
+TEST(BatchArgsPass, SizesEveryBatchFromTheCoveredCount) {
+  HAARCAST_REQUIRE_VULKAN();
+  constexpr std::uint32_t kBatch = 97, kBatches = 7;
+  Context context(testing::testOptions());
+  Buffer counterBuf(context, sizeof(CoverageCounter)), args(context, 2 * kBatches * sizeof(DispatchArgs));
+  ComputePipeline p(context, "batch_args.comp", 2, 16);
+  p.bind({&counterBuf, &args});
+  for (const std::uint32_t covered : {0u, 1u, 96u, 97u, 98u, 500u, kBatch * kBatches}) {
+    const CoverageCounter c{covered, {0, 0, 0}};
+    counterBuf.write(&c, sizeof c);
+    const std::uint32_t push[4] = {kBatch, kBatches, 0, 0};
+    context.submit([&](VkCommandBuffer cb) {
+      p.dispatch(cb, {1, 1, 1}, push, sizeof push);
+      computeBarrier(cb);
+    });
+    std::vector<DispatchArgs> got(2 * kBatches);
+    args.read(got.data(), got.size() * sizeof(DispatchArgs));
+    for (std::uint32_t b = 0; b < kBatches; ++b) {
+      const std::uint32_t first = b * kBatch;
+      const std::uint32_t count = covered > first ? std::min(kBatch, covered - first) : 0u;
+      EXPECT_EQ(got[b].groups[0], count) << "covered " << covered << ", batch " << b;
+      EXPECT_EQ(got[b].groups[1], 3u);
+      EXPECT_EQ(got[b].groups[2], 1u);
+      EXPECT_EQ(got[kBatches + b].groups[0], (3 * count + 63) / 64) << "covered " << covered << ", batch " << b;
+      EXPECT_EQ(got[kBatches + b].groups[1], 1u);
+      EXPECT_EQ(got[kBatches + b].groups[2], 1u);
+    }
+  }
+  testing::expectNoValidationMessages(context);
 }
 
 TEST(TonemapPass, BackdropAndEncodingMatchTheCpuDefinitions) {

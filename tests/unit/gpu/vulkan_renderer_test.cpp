@@ -251,6 +251,45 @@ TEST(VulkanRenderer, FusedDispatchShapeAndReadback) {
   testing::expectNoValidationMessages(looped.context());
 }
 
+// Scene data and the light in device-local memory reached only through
+// staging copies (the discrete-GPU path, forced here): the same frames, bit
+// for bit, as with mapped memory, over frames whose light and poses change
+// (each frame's light copy recorded again); frames allocate nothing.
+void expectStagedInputsChangeNothing(RotationMethod method) {
+  const render::Scene scene = render::defaultScene();
+  const render::RenderOptions o = frameOptions(method, true);
+  VulkanOptions stagedOptions = testing::testOptions();
+  stagedOptions.stageInputs = true;
+  VulkanRenderer direct(scene, o, testing::testOptions());
+  VulkanRenderer staged(scene, o, stagedOptions);
+  render::FrameRequest request = requestFor(scene, 32, 32);
+  const render::Frame first = staged.render(request);
+  EXPECT_EQ(first.image.rgb, direct.render(request).image.rgb);
+  const std::uint64_t allocations = staged.context().allocationCount();
+  request.poses = {scene.objects[0].pose, scene.objects[1].pose};
+  request.poses[1].rotateDegrees += glm::dvec3(10.0, 25.0, -5.0);
+  request.lightRotation = rotationMatrix({0.3, -0.4, 0.1});
+  const render::Frame a = direct.render(request);
+  const render::Frame b = staged.render(request);
+  EXPECT_EQ(staged.context().allocationCount(), allocations) << "a staged frame allocated device memory";
+  EXPECT_EQ(a.objectMask, b.objectMask);
+  EXPECT_EQ(a.image.rgb, b.image.rgb);
+  EXPECT_EQ(a.rgba8, b.rgba8);
+  EXPECT_NE(a.image.rgb, first.image.rgb) << "the turned light changes the frame";
+  testing::expectNoValidationMessages(direct.context());
+  testing::expectNoValidationMessages(staged.context());
+}
+
+TEST(VulkanRenderer, StagedInputsChangeNothingFused) {
+  HAARCAST_REQUIRE_VULKAN();
+  expectStagedInputsChangeNothing(RotationMethod::Fused);
+}
+
+TEST(VulkanRenderer, StagedInputsChangeNothingHaar) {
+  HAARCAST_REQUIRE_VULKAN();
+  expectStagedInputsChangeNothing(RotationMethod::Haar);
+}
+
 TEST(VulkanRenderer, AllocatesDeviceMemoryOncePerResolution) {
   HAARCAST_REQUIRE_VULKAN();
   const render::Scene scene = render::defaultScene();
@@ -288,6 +327,14 @@ TEST(VulkanRenderer, BatchingTheRotationDoesNotChangeTheImage) {
   EXPECT_GT(batched.batchesLastFrame(), 2u);
   EXPECT_EQ(a.objectMask, b.objectMask);
   EXPECT_EQ(a.image.rgb, b.image.rgb) << "every pixel is computed independently of its batch";
+  // Batches are sized on the device from the covered count (batch_args.comp):
+  // a frame with no covered pixel dispatches no rotation at all.
+  render::FrameRequest away = requestFor(scene, 40, 40);
+  away.camera.target = away.camera.eye + (away.camera.eye - scene.camera.target);
+  const render::Frame empty = batched.render(away);
+  EXPECT_EQ(std::count(empty.objectMask.begin(), empty.objectMask.end(), 1), 0);
+  EXPECT_EQ(batched.batchesLastFrame(), 0u);
+  EXPECT_EQ(batched.render(request).image.rgb, b.image.rgb) << "the frame after an empty one";
   testing::expectNoValidationMessages(batched.context());
 }
 

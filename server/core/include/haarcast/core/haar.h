@@ -18,6 +18,7 @@
 #include <span>
 #include <vector>
 
+#include "haarcast/core/shared_layout.h"
 #include "haarcast/core/sphere_map.h"
 
 namespace haarcast {
@@ -50,11 +51,10 @@ class HaarMap {
   float detail(Band band, int l, int i, int j) const { return coeffs_[detailIndex(band, l, i, j)]; }
   float& detail(Band band, int l, int i, int j) { return coeffs_[detailIndex(band, l, i, j)]; }
 
+  // shared_layout.h haarDetailIndex: the layout the shaders use.
   static std::size_t detailIndexOf(int size, Band band, int l, int i, int j) {
-    const int half = 1 << l;
-    const int row = i + (band == Band::Horizontal ? 0 : half);
-    const int col = j + (band == Band::Vertical ? 0 : half);
-    return static_cast<std::size_t>(row) * static_cast<std::size_t>(size) + static_cast<std::size_t>(col);
+    return shared::haarDetailIndex(static_cast<shared::uint>(size), static_cast<shared::uint>(band),
+                                   static_cast<shared::uint>(l), static_cast<shared::uint>(i), static_cast<shared::uint>(j));
   }
 
  private:

@@ -2,30 +2,41 @@
 // header compiled both as C++ (namespace haarcast::shared) and as GLSL
 // (shaders include it with GL_GOOGLE_include_directive, -I server/core/include).
 // Write only what both languages read alike: plain structs of uint, float and
-// vec4, `const` numbers, and functions built from floor/min/clamp. The GPU
-// tests check the shaders' results against the C++ use of the same lines.
+// vec3/vec4, `const` numbers, and functions built from floor/min/max/clamp,
+// integer bit operations and findMSB. The GPU tests check the shaders'
+// results against the C++ use of the same lines (SharedLayout.*).
 #ifndef HAARCAST_CORE_SHARED_LAYOUT_H
 #define HAARCAST_CORE_SHARED_LAYOUT_H
 
 #ifdef __cplusplus
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 
 #include <glm/mat4x4.hpp>
+#include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
 namespace haarcast::shared {
 using uint = std::uint32_t;
+using vec3 = glm::vec3;
 using vec4 = glm::vec4;
 using mat4 = glm::mat4;
 using std::clamp;
 using std::floor;
+using std::max;
 using std::min;
+// GLSL's findMSB: the index of the highest set bit, −1 for 0.
+inline constexpr int findMSB(uint x) { return static_cast<int>(std::bit_width(x)) - 1; }
 #define HC_CONST inline constexpr
+#define HC_FUNCTION inline
+#define HC_CONSTEXPR inline constexpr
 #else
 #define HC_CONST const
+#define HC_FUNCTION
+#define HC_CONSTEXPR
 #endif
 
 // π in float, for the float paths (CPU kernels and shaders alike).
@@ -62,10 +73,7 @@ struct SliceBlend {
   float weight;
 };
 
-#ifdef __cplusplus
-inline
-#endif
-SliceBlend sliceBlendAt(float thetaOut, uint thetaSamples, uint interpolate) {
+HC_FUNCTION SliceBlend sliceBlendAt(float thetaOut, uint thetaSamples, uint interpolate) {
   const float cells = float(thetaSamples);
   const float u = clamp(thetaOut, 0.0f, 0.5f * kPiF) * (cells / (0.5f * kPiF));  // in cells, [0, T]
   SliceBlend b;
@@ -83,17 +91,117 @@ SliceBlend sliceBlendAt(float thetaOut, uint thetaSamples, uint interpolate) {
   return b;
 }
 
+// ---- The Haar quadrant layout and the block quadtree (DESIGN.md "Haar",
+// core/haar.h). Detail level l of an m×m map is a 2^l × 2^l grid of
+// blocks; band 0 = horizontal (h), 1 = vertical (v), 2 = diagonal (d).
+
 // Index of a detail coefficient in the quadrant layout of an m×m Haar map
-// (HaarMap::detailIndexOf): band 0 = horizontal, 1 = vertical, 2 = diagonal;
-// level l, block (i, j).
-#ifdef __cplusplus
-inline constexpr
-#endif
-uint haarDetailIndex(uint m, uint band, uint l, uint i, uint j) {
+// (HaarMap::detailIndexOf): level l, block (i, j); h at rows [0, 2^l),
+// columns [2^l, 2^(l+1)); v below the scaling block; d diagonally.
+HC_CONSTEXPR uint haarDetailIndex(uint m, uint band, uint l, uint i, uint j) {
   const uint blocks = 1u << l;
   const uint row = i + (band == 0u ? 0u : blocks);
   const uint col = j + (band == 1u ? 0u : blocks);
   return row * m + col;
+}
+
+// Where detail coefficient `index` (≥ 1; 0 is the scaling coefficient) of a
+// level-n map sits: the inverse of haarDetailIndex. The detail level is that
+// of the larger of row and column, the band says which of them lies in the
+// upper half of [0, 2^(l+1)).
+struct HaarDetailPosition {
+  uint band;
+  uint level;
+  uint i;
+  uint j;
+};
+
+HC_CONSTEXPR HaarDetailPosition haarDetailPosition(uint mapLevel, uint index) {
+  const uint row = index >> mapLevel;
+  const uint col = index & ((1u << mapLevel) - 1u);
+  const uint l = uint(findMSB(max(row, col)));
+  const uint blocks = 1u << l;
+  HaarDetailPosition p;
+  p.level = l;
+  if (row < blocks) {
+    p.band = 0u;
+    p.i = row;
+    p.j = col - blocks;
+  } else if (col < blocks) {
+    p.band = 1u;
+    p.i = row - blocks;
+    p.j = col;
+  } else {
+    p.band = 2u;
+    p.i = row - blocks;
+    p.j = col - blocks;
+  }
+  return p;
+}
+
+// The quadrant of block (i, j) within its parent: 2·rowBit + colBit
+// (0 top-left, 1 top-right, 2 bottom-left, 3 bottom-right).
+HC_CONSTEXPR uint haarChildQuadrant(uint i, uint j) { return 2u * (i & 1u) + (j & 1u); }
+
+// Signs of (h, v, d) in the synthesis of child `quadrant` from its parent
+// (haar.cpp synthesisStep): S_child = (S + s_h·h + s_v·v + s_d·d) / 2. h
+// differs along φ (minus on the right), v along θ (minus at the bottom),
+// d is their product.
+HC_FUNCTION vec3 haarChildSign(uint quadrant) {
+  const float h = 1.0f - 2.0f * float(quadrant & 1u);
+  const float v = 1.0f - 2.0f * float(quadrant >> 1u);
+  return vec3(h, v, h * v);
+}
+
+// The low 16 bits of x moved to the even bits (bit b → bit 2b), and back.
+HC_CONSTEXPR uint haarSpreadBits(uint x) {
+  x &= 0xFFFFu;
+  x = (x | (x << 8u)) & 0x00FF00FFu;
+  x = (x | (x << 4u)) & 0x0F0F0F0Fu;
+  x = (x | (x << 2u)) & 0x33333333u;
+  x = (x | (x << 1u)) & 0x55555555u;
+  return x;
+}
+HC_CONSTEXPR uint haarGatherBits(uint x) {
+  x &= 0x55555555u;
+  x = (x | (x >> 1u)) & 0x33333333u;
+  x = (x | (x >> 2u)) & 0x0F0F0F0Fu;
+  x = (x | (x >> 4u)) & 0x00FF00FFu;
+  x = (x | (x >> 8u)) & 0x0000FFFFu;
+  return x;
+}
+
+// Map levels whose preorder keys fit 32 bits: the Morton code of a finest
+// block takes 2(n − 1) bits and the level 4 more.
+HC_CONST uint kMaxPreorderLevel = 15u;
+
+// Position of block (l, i, j) of a level-n map (finestLevel = n − 1) in a
+// pre-order walk of the block quadtree: the Morton code of its top-left
+// finest block (row bits odd, column bits even), shifted left by 4 with l
+// below, so that a block comes before its descendants and ties (a block and
+// its top-left descendants) put the coarser first. The triple product walks
+// sparse lists in this order (core triple_product.cpp, triple_product.comp).
+HC_CONSTEXPR uint haarPreorderKey(uint finestLevel, uint l, uint i, uint j) {
+  const uint shift = finestLevel - l;
+  const uint morton = (haarSpreadBits(i << shift) << 1u) | haarSpreadBits(j << shift);
+  return (morton << 4u) | l;
+}
+
+// The block a preorder key names (the inverse of haarPreorderKey).
+struct HaarBlock {
+  uint level;
+  uint i;
+  uint j;
+};
+
+HC_CONSTEXPR HaarBlock haarPreorderBlock(uint finestLevel, uint key) {
+  HaarBlock b;
+  b.level = key & 15u;
+  const uint morton = key >> 4u;
+  const uint shift = finestLevel - b.level;
+  b.i = haarGatherBits(morton >> 1u) >> shift;
+  b.j = haarGatherBits(morton) >> shift;
+  return b;
 }
 
 // ---- Records the Vulkan passes exchange (std430; the C++ side checks sizes
@@ -126,8 +234,8 @@ struct ObjectInfo {
   uint vertexBase;     // its vertex 0 in the global vertex numbering
   uint triangleBase;   // its triangle 0 in the global triangle numbering
   float skipBelowY;    // `fused`: directions with cos θ' below this read only zero texels
-  uint blendRows;      // `fused`: the slice rows such directions can reach (the last non-zero row + 3, ≤ M)
-  uint pad;
+  uint pad0;
+  uint pad1;
 };
 
 // Per covered pixel, what the rotation needs (the rotation contract's binding 0).
@@ -159,6 +267,16 @@ struct CoverageCounter {
   uint groups[3];
 };
 
+// The rotating methods' batches, sized on the device: batch_args.comp
+// writes, from the covered count, per batch b of `batch` samples with
+// count_b = clamp(covered − b·batch, 0, batch), the rotation's arguments
+// (count_b, 3, 1) at [b] and the triple product's (⌈3·count_b / 64⌉, 1, 1)
+// at [batches + b] (VkDispatchIndirectCommand, padded to 16 bytes).
+struct DispatchArgs {
+  uint groups[3];
+  uint pad;
+};
+
 // The G-buffer pass's push block (gbuffer.vert / .frag).
 struct GBufferPush {
   mat4 objectToClip;
@@ -172,18 +290,20 @@ struct GBufferPush {
 static_assert(sizeof(FrameParams) == 128 && offsetof(FrameParams, tanHalf) == 96 &&
               offsetof(FrameParams, fusedGroups) == 124);
 static_assert(sizeof(ObjectInfo) == 80 && offsetof(ObjectInfo, sliceBase) == 48 &&
-              offsetof(ObjectInfo, skipBelowY) == 68 &&
-              offsetof(ObjectInfo, blendRows) == 72);
+              offsetof(ObjectInfo, skipBelowY) == 68);
 static_assert(sizeof(RotationSample) == 32 && offsetof(RotationSample, alpha) == 8 &&
               offsetof(RotationSample, thetaOut) == 24);
 static_assert(sizeof(ShadeSample) == 32 && offsetof(ShadeSample, b) == 16 && offsetof(ShadeSample, pixel) == 28);
 static_assert(sizeof(CoverageCounter) == 16 && offsetof(CoverageCounter, groups) == 4);
+static_assert(sizeof(DispatchArgs) == 16 && offsetof(DispatchArgs, groups) == 0);
 static_assert(sizeof(GBufferPush) == 80 && offsetof(GBufferPush, objectId) == 64);
 #endif
 
 #ifdef __cplusplus
 }  // namespace haarcast::shared
 #undef HC_CONST
+#undef HC_FUNCTION
+#undef HC_CONSTEXPR
 #endif
 
 #endif  // HAARCAST_CORE_SHARED_LAYOUT_H

@@ -1,6 +1,7 @@
 // A compute pipeline built from an embedded shader (shaders.h): storage
-// buffers at set 0, bindings 0 … n−1, an optional push-constant block, and
-// 32-bit specialization constants (sizes such as the map level).
+// buffers or uniform texel buffers at set 0, bindings 0 … n−1, an optional
+// push-constant block, and 32-bit specialization constants (sizes such as
+// the map level).
 #pragma once
 
 #include <array>
@@ -12,6 +13,7 @@
 
 #include <vulkan/vulkan.h>
 
+#include "haarcast/gpu/buffer.h"
 #include "haarcast/gpu/context.h"
 
 namespace haarcast::gpu {
@@ -19,6 +21,25 @@ namespace haarcast::gpu {
 struct SpecConstant {
   std::uint32_t id = 0;     // constant_id in the shader
   std::uint32_t value = 0;  // int/uint value (or a float's bits)
+};
+
+// What one binding of set 0 holds.
+enum class BindingKind {
+  Storage,  // a storage buffer (a std430 block)
+  // A uniform texel buffer (samplerBuffer, texelFetch) through a TexelView.
+  // On a CPU device (lavapipe) a texel fetch is a vector gather, while a
+  // storage-buffer read at a per-invocation index runs lane by lane and
+  // component by component, each behind a branch: large read-only arrays
+  // read in a hot loop belong here.
+  Texels,
+};
+
+// One resource to bind: a storage buffer or a texel view.
+struct Bound {
+  Bound(const Buffer* b) : buffer(b) {}      // NOLINT: implicit, so that bind({&a, &b}) reads naturally
+  Bound(const TexelView* t) : texels(t) {}   // NOLINT
+  const Buffer* buffer = nullptr;
+  const TexelView* texels = nullptr;
 };
 
 // A VkShaderModule from the embedded SPIR-V of shaders/<name>; throws
@@ -31,14 +52,18 @@ class ComputePipeline {
   // buffer. pushConstantBytes: 0 or the size of the shader's push block.
   ComputePipeline(Context& context, std::string_view shaderName, std::uint32_t storageBuffers,
                   std::uint32_t pushConstantBytes, std::vector<SpecConstant> specialization = {});
+  // bindings: what binding i holds, for i = 0 … bindings.size() − 1.
+  ComputePipeline(Context& context, std::string_view shaderName, std::vector<BindingKind> bindings,
+                  std::uint32_t pushConstantBytes, std::vector<SpecConstant> specialization = {});
   ~ComputePipeline();
   ComputePipeline(const ComputePipeline&) = delete;
   ComputePipeline& operator=(const ComputePipeline&) = delete;
 
-  // Points binding i at buffers[i] (whole buffer). Must not be called while a
-  // submitted command buffer that uses this pipeline is still running
-  // (Context::submit waits, so between submits is fine).
-  void bind(std::initializer_list<const Buffer*> buffers);
+  // Points binding i at resources[i] (a whole buffer, or a texel view for a
+  // Texels binding). Must not be called while a submitted command buffer
+  // that uses this pipeline is still running (Context::submit waits, so
+  // between submits is fine).
+  void bind(std::initializer_list<Bound> resources);
   // Binds the pipeline and its descriptor set, pushes `push` and dispatches.
   void dispatch(VkCommandBuffer cb, std::array<std::uint32_t, 3> groups, const void* push = nullptr,
                 std::uint32_t pushBytes = 0) const;
@@ -55,7 +80,7 @@ class ComputePipeline {
   void bindForDispatch(VkCommandBuffer cb, const void* push, std::uint32_t pushBytes) const;
   Context& context_;
   std::string name_;
-  std::uint32_t bindings_ = 0;
+  std::vector<BindingKind> bindings_;
   std::uint32_t pushBytes_ = 0;
   VkDescriptorSetLayout setLayout_ = VK_NULL_HANDLE;
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
@@ -69,12 +94,18 @@ class ComputePipeline {
 // passes of one command buffer).
 void computeBarrier(VkCommandBuffer cb);
 
-// A set layout of `storageBuffers` storage buffers at bindings 0…count−1,
-// visible to `stages`. The caller destroys it.
+// A set layout with binding i of kind bindings[i], visible to `stages`. The
+// caller destroys it.
+VkDescriptorSetLayout createSetLayout(VkDevice device, const std::vector<BindingKind>& bindings,
+                                      VkShaderStageFlags stages);
+// The same for `storageBuffers` storage buffers.
 VkDescriptorSetLayout createStorageSetLayout(VkDevice device, std::uint32_t storageBuffers, VkShaderStageFlags stages);
 
-// One descriptor set of `storageBuffers` storage buffers with `layout`, from
-// a pool of its own (sized for exactly that set). The caller destroys the pool.
+// One descriptor set for `bindings` with `layout`, from a pool of its own
+// (sized for exactly that set). The caller destroys the pool.
+void allocateSet(VkDevice device, VkDescriptorSetLayout layout, const std::vector<BindingKind>& bindings,
+                 VkDescriptorPool& pool, VkDescriptorSet& set);
+// The same for `storageBuffers` storage buffers.
 void allocateStorageSet(VkDevice device, VkDescriptorSetLayout layout, std::uint32_t storageBuffers,
                         VkDescriptorPool& pool, VkDescriptorSet& set);
 

@@ -1,5 +1,5 @@
 // The Vulkan device every GPU pass runs on: instance, device selection,
-// one queue, host-visible buffers and one-shot command submission.
+// one queue, memory and one-shot command submission (buffers: buffer.h).
 //
 // Selection (no --device): the first usable device in the order discrete GPU,
 // integrated GPU, virtual GPU, CPU device (Mesa's lavapipe), other. A device
@@ -14,7 +14,7 @@
 //
 // Minimal use (what helper code and tests do):
 //   gpu::Context ctx;                                   // auto-selects a device
-//   gpu::Buffer in(ctx, bytes), out(ctx, bytes);
+//   gpu::Buffer in(ctx, bytes), out(ctx, bytes);         // buffer.h
 //   in.upload(std::span<const float>(data));
 //   gpu::ComputePipeline p(ctx, "rotate_spatial.comp", 4, 16, {{0, level}, {1, T}});  // compute.h
 //   p.bind({&a, &b, &c, &d});
@@ -27,7 +27,6 @@
 #include <cstdint>
 #include <functional>
 #include <mutex>
-#include <span>
 #include <string>
 #include <vector>
 
@@ -50,6 +49,10 @@ struct VulkanOptions {
   // Context::validationEnabled() tells). Any message of severity warning or
   // error is recorded (Context::validationMessages()).
   bool validation = kValidationByDefault;
+  // Upload MemoryUse::DeviceInput buffers through a staging buffer even
+  // where their memory could be mapped (buffer.h): the path of a discrete
+  // GPU, run on any device (tests).
+  bool stageInputs = false;
 };
 
 // "VK_ERROR_OUT_OF_DEVICE_MEMORY" etc., or the number for unknown codes.
@@ -95,6 +98,9 @@ class Context {
   std::uint32_t queueFamily() const { return queueFamily_; }
   const DeviceInfo& info() const { return info_; }
   const VkPhysicalDeviceProperties& properties() const { return properties_; }
+  // Invocations a subgroup runs together (VkPhysicalDeviceSubgroupProperties):
+  // the SIMD width on a CPU device (8 on lavapipe with AVX2).
+  std::uint32_t subgroupSize() const { return subgroupSize_; }
 
   // Timestamp queries: supported on the queue, and nanoseconds per tick.
   bool timestampsSupported() const { return timestampValidBits_ > 0 && properties_.limits.timestampPeriod > 0; }
@@ -109,6 +115,9 @@ class Context {
   // (preferring `preferred` on top of `required`); throws when none fits.
   std::uint32_t memoryType(std::uint32_t typeBits, VkMemoryPropertyFlags required,
                            VkMemoryPropertyFlags preferred = 0) const;
+  const VkPhysicalDeviceMemoryProperties& memoryProperties() const { return memory_; }
+  // False when VulkanOptions::stageInputs asks for staged uploads everywhere.
+  bool directInputs() const { return directInputs_; }
   // vkAllocateMemory through the context, so that allocations can be counted
   // (the renderer must not allocate per frame; a test checks it).
   VkDeviceMemory allocate(VkDeviceSize bytes, std::uint32_t typeIndex);
@@ -132,55 +141,14 @@ class Context {
   VkFence fence_ = VK_NULL_HANDLE;
   std::uint32_t queueFamily_ = 0;
   std::uint32_t timestampValidBits_ = 0;
+  std::uint32_t subgroupSize_ = 1;
+  bool directInputs_ = true;
   DeviceInfo info_;
   VkPhysicalDeviceProperties properties_{};
   VkPhysicalDeviceMemoryProperties memory_{};
   std::atomic<std::uint64_t> allocations_{0};
   mutable std::mutex messagesMutex_;
   std::vector<std::string> messages_;
-};
-
-// A storage buffer in host-visible, coherent memory (device-local too where
-// the device has such a type), mapped for its whole life. On lavapipe and
-// integrated GPUs all memory is like this; on a discrete GPU it is the
-// resizable-BAR heap or system memory (docs/gpu.md, "Limits").
-class Buffer {
- public:
-  Buffer() = default;
-  // bytes is rounded up to 4 and to at least 4 (Vulkan forbids empty buffers).
-  Buffer(Context& context, VkDeviceSize bytes,
-         VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
-                                    VK_BUFFER_USAGE_TRANSFER_DST_BIT);
-  ~Buffer();
-  Buffer(Buffer&& other) noexcept;
-  Buffer& operator=(Buffer&& other) noexcept;
-  Buffer(const Buffer&) = delete;
-  Buffer& operator=(const Buffer&) = delete;
-
-  VkBuffer handle() const { return buffer_; }
-  VkDeviceSize size() const { return size_; }
-  void* mapped() const { return mapped_; }
-
-  // Byte copies in and out of the mapping; throw std::out_of_range when the
-  // range passes the end.
-  void write(const void* data, std::size_t bytes, std::size_t offset = 0);
-  void read(void* data, std::size_t bytes, std::size_t offset = 0) const;
-  template <class T>
-  void upload(std::span<const T> values, std::size_t offset = 0) {
-    write(values.data(), values.size_bytes(), offset);
-  }
-  template <class T>
-  void download(std::span<T> values, std::size_t offset = 0) const {
-    read(values.data(), values.size_bytes(), offset);
-  }
-
- private:
-  void release();
-  Context* context_ = nullptr;
-  VkBuffer buffer_ = VK_NULL_HANDLE;
-  VkDeviceMemory memory_ = VK_NULL_HANDLE;
-  VkDeviceSize size_ = 0;
-  void* mapped_ = nullptr;
 };
 
 }  // namespace haarcast::gpu

@@ -15,6 +15,7 @@
 
 #include "haarcast/core/haar.h"
 #include "haarcast/core/shared_layout.h"
+#include "haarcast/gpu/compute.h"
 #include "haarcast/render/scene.h"
 
 namespace haarcast::gpu {
@@ -22,38 +23,29 @@ namespace haarcast::gpu {
 // The records the passes exchange, defined once for C++ and GLSL
 // (core/shared_layout.h, with their size and offset checks).
 using shared::CoverageCounter;
+using shared::DispatchArgs;
 using shared::FrameParams;
 using shared::GBufferPush;
 using shared::ObjectInfo;
 using shared::RotationSample;
 using shared::ShadeSample;
 
-// render::CameraRays' pinhole basis, in double: forward, right, up. The frame
-// parameters (the compute passes' rays) and the G-buffer's projection both
-// take it from here.
-struct CameraBasis {
-  glm::dvec3 forward, right, up;
-  double tanHalf;  // tan(fovY / 2)
-};
-CameraBasis cameraBasis(const render::Camera& camera);
-
-// The camera of render::CameraRays and the frame's settings.
+// The camera of render::CameraRays (its basis from render::cameraBasis, as
+// the G-buffer's projection) and the frame's settings.
 FrameParams makeFrameParams(const render::Camera& camera, int width, int height, const glm::dmat3& lightRotation,
                             double exposureStops, bool background, int backgroundLevel);
 
 
 // Sparse Haar lists in the triple-product shader's form: one 16-byte block
 // entry (preorder key, h, v, d bits) per block with a non-zero detail,
-// sorted in the pre-order of core triple_product.cpp, and a header per list
-// (first entry, entry count, scaling-coefficient bits, 0). Headers come
-// first, in list order; entry offsets count from the start of the buffer.
+// sorted by shared::haarPreorderKey (the walk's order, as on the CPU), and a
+// header per list (first entry, entry count, scaling-coefficient bits, 0).
+// Headers come first, in list order; entry offsets count from the start of
+// the buffer.
 // Throws std::invalid_argument when the lists' levels differ from `level`.
 std::vector<glm::uvec4> packSparseLists(std::span<const SparseHaar> lists, int level);
 // Entries (not headers) packSparseLists writes for one list.
 std::size_t blockCount(const SparseHaar& list);
-// The preorder key of triple_product.cpp: Morton code of the block's top-left
-// finest block, shifted left by 4, | l.
-std::uint32_t preorderKey(int mapLevel, int l, int i, int j);
 
 // `fused`'s visibility: per list a header (first word, entry count) and then
 // its (index, value bits) entries in list order, as uint pairs; entry
@@ -65,18 +57,28 @@ std::vector<std::uint32_t> packVisibilityEntries(std::span<const SparseHaar> lis
 // by row (w unused), computed in double as core fused's and rounded to float.
 std::vector<glm::vec4> pixelCentreDirections(int level);
 
-// Floats of fused.comp's scratch per workgroup: the θₒ-blended slice (3N),
-// after, without vertex planes, the per-pixel synthesis (the N merged
-// coefficients and the finest step's N values; shaders/fused.comp).
+// Floats of fused.comp's scratch per workgroup: none with vertex planes;
+// with the lists, the per-pixel synthesis (the N merged coefficients, the
+// finest step's N values and the step before's N/4; shaders/fused.comp).
 inline std::size_t fusedScratchFloats(int level, bool vertexPlanes) {
   const std::size_t n = std::size_t{1} << (2 * level);
-  return (vertexPlanes ? 0 : 2 * n) + 3 * n;
+  return vertexPlanes ? 0 : 2 * n + n / 4;
 }
 
-// ObjectInfo's skipBelowY and blendRows for fused.comp, from the slices'
-// last non-zero row (core PixelSlices::lastNonZeroRow): directions whose
-// rotated cos θ' is below skipBelowY read only zero texels (fusedShade's
-// cut), and the others read rows below blendRows only.
+// fused.comp's bindings: 0 samples, 1 shade, 2 objects (storage); 3 slice
+// texels (RGBA32F texels); 4 light (RGBA32F texels, fusedLightTexels); 5
+// visibility lists (storage); 6 directions (RGBA32F texels); 7 scratch, 8
+// radiance, 9 counter (storage); 10 vertex visibility planes (R32F texels).
+std::vector<BindingKind> fusedBindings();
+
+// The light of one object as fused.comp reads it: texel k = (L_r, L_g, L_b, 0)
+// at direction k, from the three planes of core FusedLight (ΔΩ folded in),
+// written to out[0 … N).
+void fusedLightTexels(std::span<const float> planes, std::span<glm::vec4> out);
+
+// ObjectInfo's skipBelowY for fused.comp, from the slices' last non-zero row
+// (core PixelSlices::lastNonZeroRow): directions whose rotated cos θ' is
+// below it read only zero texels (fusedShade's cut).
 void setFusedSkip(ObjectInfo& info, int level, int lastNonZeroRow);
 
 // The level range of the GPU passes: shared memory holds one level-6 map

@@ -3,16 +3,20 @@
 // under the shared stage names of renderer.h:
 //   light           host: render::lightInObjectFrame per object, uploaded
 //   gbuffer         graphics pipeline, offscreen: normal, ids + barycentrics, position
-//   rotation-input  compute: slice index and Y-X-Y angles per covered pixel, compacted
+//   rotation-input  compute: slice index and Y-X-Y angles per covered pixel, compacted;
+//                   then every batch's indirect arguments (batch_args.comp)
 //   rotation        compute: shaders/rotate_<method>.comp, in batches of covered pixels
 //   triple-product  compute: light × rotated slice × interpolated visibility
 //   fused           `fused` only, in place of the two above: shaders/fused.comp,
-//                   one indirect dispatch sized by rotation-input; the frame is
-//                   one command buffer (timestamps per stage on GPUs)
+//                   one indirect dispatch sized by rotation-input
 //   tonemap         compute: backdrop, linear image kept, RGBA8
+// Every method records its frame as one command buffer (timestamps per stage
+// on GPUs; one submission per stage, host-timed, on CPU devices) and reads
+// the covered count back only when the frame is done.
 // Scene data (slices, method data, meshes, visibility, backdrop) is uploaded
-// once; frame buffers are allocated once per resolution and reused, so a
-// frame at an unchanged resolution allocates no device memory.
+// once, into device-local memory (staged where the host cannot map it);
+// frame buffers are allocated once per resolution and reused, so a frame at
+// an unchanged resolution allocates no device memory.
 #pragma once
 
 #include <cstddef>
@@ -37,7 +41,7 @@ struct VulkanRendererLimits {
   std::size_t batchSamples = 0;
   // Workgroup size of rotate_spatial.comp; 0 = 64 on CPU devices, 256 on GPUs.
   std::uint32_t spatialLocalSize = 0;
-  // `fused`: workgroup size (0 = 64 on CPU devices, 256 on GPUs), the most
+  // `fused`: workgroup size (0 = the subgroup size on CPU devices, 256 on GPUs), the most
   // workgroups in flight (0 = as the scratch allows), the per-pixel merge
   // and synthesis of the visibility lists even where every vertex's pixel
   // form would fit in memory, and that synthesis's scratch in global memory

@@ -15,6 +15,15 @@ namespace haarcast::render {
 // its vertical field instead of cropping the sides).
 double verticalTanHalf(const Camera& camera, int width, int height);
 
+// A pinhole camera's orthonormal basis in the world frame and tan(½ vertical
+// field of view) for a width × height frame: one definition for CameraRays,
+// the Vulkan passes' rays (gpu makeFrameParams) and the G-buffer's projection.
+struct CameraBasis {
+  glm::dvec3 forward, right, up;
+  double tanHalf;
+};
+CameraBasis cameraBasis(const Camera& camera, int width, int height);
+
 // A pinhole camera's rays through pixel centres (row 0 at the top).
 class CameraRays {
  public:
@@ -26,8 +35,9 @@ class CameraRays {
   const glm::dvec3& origin() const { return eye_; }
 
  private:
-  glm::dvec3 eye_, forward_, right_, up_;
-  double tanHalf_, aspect_;
+  glm::dvec3 eye_;
+  CameraBasis basis_;
+  double aspect_;
   int width_, height_;
 };
 

@@ -1,0 +1,126 @@
+// The images and buffers of one resolution, allocated when it changes and
+// reused by every frame at it (a frame allocates no device memory).
+
+#include <algorithm>
+
+#include "vulkan_renderer_impl.h"
+
+namespace haarcast::gpu {
+
+DeviceImage VulkanRenderer::Impl::createImage(VkFormat format, VkImageUsageFlags usage, VkImageAspectFlags aspect) {
+  VkDevice device = context.device();
+  DeviceImage out;
+  VkImageCreateInfo ic{};
+  ic.sType = VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO;
+  ic.imageType = VK_IMAGE_TYPE_2D;
+  ic.format = format;
+  ic.extent = {static_cast<std::uint32_t>(width), static_cast<std::uint32_t>(height), 1};
+  ic.mipLevels = 1;
+  ic.arrayLayers = 1;
+  ic.samples = VK_SAMPLE_COUNT_1_BIT;
+  ic.tiling = VK_IMAGE_TILING_OPTIMAL;
+  ic.usage = usage;
+  ic.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+  vkCheck(vkCreateImage(device, &ic, nullptr, &out.image), "vkCreateImage");
+  try {
+    VkMemoryRequirements req{};
+    vkGetImageMemoryRequirements(device, out.image, &req);
+    out.memory = context.allocate(req.size, context.memoryType(req.memoryTypeBits, 0, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT));
+    vkCheck(vkBindImageMemory(device, out.image, out.memory, 0), "vkBindImageMemory");
+    VkImageViewCreateInfo vc{};
+    vc.sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO;
+    vc.image = out.image;
+    vc.viewType = VK_IMAGE_VIEW_TYPE_2D;
+    vc.format = format;
+    vc.subresourceRange = {aspect, 0, 1, 0, 1};
+    vkCheck(vkCreateImageView(device, &vc, nullptr, &out.view), "vkCreateImageView");
+  } catch (...) {
+    destroyImage(out);
+    throw;
+  }
+  return out;
+}
+
+void VulkanRenderer::Impl::destroyImage(DeviceImage& image) {
+  VkDevice device = context.device();
+  if (image.view) vkDestroyImageView(device, image.view, nullptr);
+  if (image.image) vkDestroyImage(device, image.image, nullptr);
+  context.free(image.memory);
+  image = DeviceImage{};
+}
+
+void VulkanRenderer::Impl::releaseResolution() {
+  VkDevice device = context.device();
+  if (framebuffer) vkDestroyFramebuffer(device, framebuffer, nullptr);
+  framebuffer = VK_NULL_HANDLE;
+  for (DeviceImage* i : {&normalImage, &idsImage, &positionImage, &depthImage}) destroyImage(*i);
+  for (Buffer* b :
+       {&gbufIds, &gbufNormals, &gbufPositions, &samples, &shade, &counter, &radiance, &rgba8, &rotated, &batchArgs}) {
+    *b = Buffer();
+  }
+  width = height = 0;
+  batch = maxBatches = 0;
+}
+
+void VulkanRenderer::Impl::ensureResolution(int w, int h) {
+  if (w == width && h == height) return;
+  releaseResolution();
+  width = w;
+  height = h;
+  const std::size_t pixels = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
+  constexpr VkImageUsageFlags colourUsage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+  normalImage = createImage(kNormalFormat, colourUsage, VK_IMAGE_ASPECT_COLOR_BIT);
+  idsImage = createImage(kIdsFormat, colourUsage, VK_IMAGE_ASPECT_COLOR_BIT);
+  positionImage = createImage(kPositionFormat, colourUsage, VK_IMAGE_ASPECT_COLOR_BIT);
+  depthImage = createImage(kDepthFormat, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, VK_IMAGE_ASPECT_DEPTH_BIT);
+  const VkImageView views[4] = {normalImage.view, idsImage.view, positionImage.view, depthImage.view};
+  VkFramebufferCreateInfo fb{};
+  fb.sType = VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO;
+  fb.renderPass = renderPass;
+  fb.attachmentCount = 4;
+  fb.pAttachments = views;
+  fb.width = static_cast<std::uint32_t>(w);
+  fb.height = static_cast<std::uint32_t>(h);
+  fb.layers = 1;
+  vkCheck(vkCreateFramebuffer(context.device(), &fb, nullptr, &framebuffer), "vkCreateFramebuffer");
+
+  gbufIds = Buffer(context, pixels * sizeof(glm::uvec4));
+  gbufNormals = Buffer(context, pixels * sizeof(glm::vec4));
+  gbufPositions = Buffer(context, pixels * sizeof(glm::vec4));
+  samples = Buffer(context, pixels * sizeof(RotationSample));
+  shade = Buffer(context, pixels * sizeof(ShadeSample));
+  // The covered-pixel count and `fused`'s indirect dispatch arguments.
+  counter = Buffer(context, sizeof(CoverageCounter),
+                   VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
+                       VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
+  radiance = Buffer(context, pixels * sizeof(glm::vec4));
+  rgba8 = Buffer(context, pixels * sizeof(std::uint32_t));
+
+  rotationInput->bind({&frameParams, &objects, &gbufIds, &gbufNormals, &triangles, &samples, &shade, &counter});
+  tonemap->bind({&frameParams, &gbufIds, &radiance, &background, &rgba8, &thresholds});
+  if (fused) {
+    fusedPass->bind({&samples, &shade, &objects, &sliceTexels, &lightTexels, &visibility, &directionTexels, &scratch,
+                     &radiance, &counter, &visibilityTexels});
+    return;
+  }
+
+  // The batch: as many covered pixels as the rotated buffer holds within the
+  // budget, the device's storage-buffer range and one dispatch's group count.
+  const VkPhysicalDeviceLimits& lim = context.properties().limits;
+  const std::size_t perSample = 3 * coefficients * sizeof(float);
+  const std::size_t range = std::min<std::size_t>(kRotatedBudget, lim.maxStorageBufferRange);
+  batch = std::min({pixels, range / perSample, static_cast<std::size_t>(lim.maxComputeWorkGroupCount[0]),
+                    static_cast<std::size_t>(lim.maxComputeWorkGroupCount[0]) * 64 / 3});
+  if (limits.batchSamples) batch = std::min(batch, limits.batchSamples);
+  batch = std::max<std::size_t>(batch, 1);
+  maxBatches = (pixels + batch - 1) / batch;
+  rotated = Buffer(context, batch * perSample, kStorageUsage, MemoryUse::DeviceOnly);
+  batchArgs = Buffer(context, 2 * maxBatches * sizeof(DispatchArgs), kStorageUsage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT,
+                     MemoryUse::DeviceOnly);
+
+  rotate->bind({&samples, &slices, &methodData, &rotated});
+  tripleProduct->bind({&shade, &rotated, &light, &visibility, &radiance, &counter});
+  batchArgsPass->bind({&counter, &batchArgs});
+}
+
+}  // namespace haarcast::gpu

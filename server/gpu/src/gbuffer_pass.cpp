@@ -1,0 +1,262 @@
+// The G-buffer pass: its render pass and graphics pipeline, the projection of
+// render::CameraRays' pinhole, and the recording of one frame's raster.
+
+#include <algorithm>
+#include <array>
+#include <limits>
+#include <stdexcept>
+
+#include <glm/geometric.hpp>
+
+#include "haarcast/gpu/shaders.h"
+#include "haarcast/render/shading.h"
+
+#include "vulkan_renderer_impl.h"
+
+namespace haarcast::gpu {
+
+void VulkanRenderer::Impl::createGraphicsPipeline() {
+  VkDevice device = context.device();
+  VkFormatProperties depth{};
+  vkGetPhysicalDeviceFormatProperties(context.physicalDevice(), kDepthFormat, &depth);
+  if (!(depth.optimalTilingFeatures & VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT)) {
+    throw std::runtime_error(context.info().name + " cannot use VK_FORMAT_D32_SFLOAT as a depth attachment");
+  }
+
+  // Render pass: three colour attachments and depth, cleared, then read by
+  // transfers (copied into buffers for the compute passes).
+  std::array<VkAttachmentDescription, 4> att{};
+  const VkFormat formats[4] = {kNormalFormat, kIdsFormat, kPositionFormat, kDepthFormat};
+  for (std::size_t i = 0; i < 4; ++i) {
+    att[i].format = formats[i];
+    att[i].samples = VK_SAMPLE_COUNT_1_BIT;
+    att[i].loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+    att[i].storeOp = i < 3 ? VK_ATTACHMENT_STORE_OP_STORE : VK_ATTACHMENT_STORE_OP_DONT_CARE;
+    att[i].stencilLoadOp = VK_ATTACHMENT_LOAD_OP_DONT_CARE;
+    att[i].stencilStoreOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
+    att[i].initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+    att[i].finalLayout = i < 3 ? VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL : VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
+  }
+  const VkAttachmentReference colour[3] = {{0, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL},
+                                           {1, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL},
+                                           {2, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL}};
+  const VkAttachmentReference depthRef{3, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL};
+  VkSubpassDescription subpass{};
+  subpass.pipelineBindPoint = VK_PIPELINE_BIND_POINT_GRAPHICS;
+  subpass.colorAttachmentCount = 3;
+  subpass.pColorAttachments = colour;
+  subpass.pDepthStencilAttachment = &depthRef;
+  std::array<VkSubpassDependency, 2> deps{};
+  // Earlier transfers (last frame's copies) before this frame's writes …
+  deps[0].srcSubpass = VK_SUBPASS_EXTERNAL;
+  deps[0].dstSubpass = 0;
+  deps[0].srcStageMask = VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT;
+  deps[0].dstStageMask = VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT | VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT;
+  deps[0].srcAccessMask = VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
+  deps[0].dstAccessMask = VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT |
+                          VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT;
+  // … and the attachments written before the copies read them.
+  deps[1].srcSubpass = 0;
+  deps[1].dstSubpass = VK_SUBPASS_EXTERNAL;
+  deps[1].srcStageMask = VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT;
+  deps[1].dstStageMask = VK_PIPELINE_STAGE_TRANSFER_BIT;
+  deps[1].srcAccessMask = VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT;
+  deps[1].dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
+  VkRenderPassCreateInfo rp{};
+  rp.sType = VK_STRUCTURE_TYPE_RENDER_PASS_CREATE_INFO;
+  rp.attachmentCount = static_cast<std::uint32_t>(att.size());
+  rp.pAttachments = att.data();
+  rp.subpassCount = 1;
+  rp.pSubpasses = &subpass;
+  rp.dependencyCount = static_cast<std::uint32_t>(deps.size());
+  rp.pDependencies = deps.data();
+  vkCheck(vkCreateRenderPass(device, &rp, nullptr, &renderPass), "vkCreateRenderPass");
+
+  // Set 0: positions, normals, triangles (vertex stage storage buffers).
+  gbufferSetLayout = createStorageSetLayout(device, 3, VK_SHADER_STAGE_VERTEX_BIT);
+  VkPushConstantRange range{VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(GBufferPush)};
+  VkPipelineLayoutCreateInfo pl{};
+  pl.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
+  pl.setLayoutCount = 1;
+  pl.pSetLayouts = &gbufferSetLayout;
+  pl.pushConstantRangeCount = 1;
+  pl.pPushConstantRanges = &range;
+  vkCheck(vkCreatePipelineLayout(device, &pl, nullptr, &gbufferLayout), "vkCreatePipelineLayout");
+
+  VkShaderModule vert = createShaderModule(context, "gbuffer.vert");
+  VkShaderModule frag = VK_NULL_HANDLE;
+  try {
+    frag = createShaderModule(context, "gbuffer.frag");
+    std::array<VkPipelineShaderStageCreateInfo, 2> stages{};
+    stages[0].sType = stages[1].sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
+    stages[0].stage = VK_SHADER_STAGE_VERTEX_BIT;
+    stages[0].module = vert;
+    stages[0].pName = "main";
+    stages[1].stage = VK_SHADER_STAGE_FRAGMENT_BIT;
+    stages[1].module = frag;
+    stages[1].pName = "main";
+    VkPipelineVertexInputStateCreateInfo vi{};
+    vi.sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO;
+    VkPipelineInputAssemblyStateCreateInfo ia{};
+    ia.sType = VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO;
+    ia.topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
+    VkPipelineViewportStateCreateInfo vp{};
+    vp.sType = VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO;
+    vp.viewportCount = 1;
+    vp.scissorCount = 1;
+    VkPipelineRasterizationStateCreateInfo rs{};
+    rs.sType = VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO;
+    rs.polygonMode = VK_POLYGON_MODE_FILL;
+    rs.cullMode = VK_CULL_MODE_NONE;  // rays hit back faces too (Embree, the CPU G-buffer)
+    rs.frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE;
+    rs.lineWidth = 1.0f;
+    VkPipelineMultisampleStateCreateInfo ms{};
+    ms.sType = VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO;
+    ms.rasterizationSamples = VK_SAMPLE_COUNT_1_BIT;  // one sample at the pixel centre, like a primary ray
+    VkPipelineDepthStencilStateCreateInfo ds{};
+    ds.sType = VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO;
+    ds.depthTestEnable = VK_TRUE;
+    ds.depthWriteEnable = VK_TRUE;
+    ds.depthCompareOp = VK_COMPARE_OP_GREATER;  // reversed Z: depth = near / distance
+    std::array<VkPipelineColorBlendAttachmentState, 3> blend{};
+    for (auto& a : blend) {
+      a.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT |
+                         VK_COLOR_COMPONENT_A_BIT;
+    }
+    VkPipelineColorBlendStateCreateInfo cb{};
+    cb.sType = VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO;
+    cb.attachmentCount = 3;
+    cb.pAttachments = blend.data();
+    const VkDynamicState dynamic[2] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
+    VkPipelineDynamicStateCreateInfo dy{};
+    dy.sType = VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO;
+    dy.dynamicStateCount = 2;
+    dy.pDynamicStates = dynamic;
+    VkGraphicsPipelineCreateInfo gp{};
+    gp.sType = VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO;
+    gp.stageCount = 2;
+    gp.pStages = stages.data();
+    gp.pVertexInputState = &vi;
+    gp.pInputAssemblyState = &ia;
+    gp.pViewportState = &vp;
+    gp.pRasterizationState = &rs;
+    gp.pMultisampleState = &ms;
+    gp.pDepthStencilState = &ds;
+    gp.pColorBlendState = &cb;
+    gp.pDynamicState = &dy;
+    gp.layout = gbufferLayout;
+    gp.renderPass = renderPass;
+    vkCheck(vkCreateGraphicsPipelines(device, VK_NULL_HANDLE, 1, &gp, nullptr, &gbufferPipeline),
+            "vkCreateGraphicsPipelines");
+  } catch (...) {
+    vkDestroyShaderModule(device, vert, nullptr);
+    if (frag) vkDestroyShaderModule(device, frag, nullptr);
+    throw;
+  }
+  vkDestroyShaderModule(device, vert, nullptr);
+  vkDestroyShaderModule(device, frag, nullptr);
+
+  allocateStorageSet(device, gbufferSetLayout, 3, gbufferPool, gbufferSet);
+  const VkDescriptorBufferInfo infos[3] = {{positions.handle(), 0, VK_WHOLE_SIZE},
+                                           {normals.handle(), 0, VK_WHOLE_SIZE},
+                                           {triangles.handle(), 0, VK_WHOLE_SIZE}};
+  std::array<VkWriteDescriptorSet, 3> writes{};
+  for (std::uint32_t i = 0; i < 3; ++i) {
+    writes[i].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+    writes[i].dstSet = gbufferSet;
+    writes[i].dstBinding = i;
+    writes[i].descriptorCount = 1;
+    writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    writes[i].pBufferInfo = &infos[i];
+  }
+  vkUpdateDescriptorSets(device, 3, writes.data(), 0, nullptr);
+}
+
+namespace {
+
+// Clip coordinates of a world point for render::CameraRays' pinhole: x right,
+// y down (Vulkan's framebuffer has row 0 at the top, as the image does), and
+// reversed, infinite-far Z (depth = near / distance, greatest wins), whose
+// float precision does not depend on the scene's depth range.
+glm::dmat4 viewProjection(const render::Camera& camera, int width, int height, double nearPlane) {
+  const render::CameraBasis basis = render::cameraBasis(camera, width, height);
+  const glm::dvec3 &f = basis.forward, &r = basis.right, &u = basis.up;
+  const double tanHalf = basis.tanHalf;
+  const double aspect = static_cast<double>(width) / height;
+  const glm::dvec3& e = camera.eye;
+  glm::dmat4 m(0.0);  // m[column][row]
+  const double sx = 1.0 / (tanHalf * aspect), sy = -1.0 / tanHalf;
+  for (int c = 0; c < 3; ++c) {
+    m[c][0] = sx * r[c];
+    m[c][1] = sy * u[c];
+    m[c][2] = 0.0;
+    m[c][3] = f[c];
+  }
+  m[3][0] = -sx * glm::dot(r, e);
+  m[3][1] = -sy * glm::dot(u, e);
+  m[3][2] = nearPlane;
+  m[3][3] = -glm::dot(f, e);
+  return m;
+}
+
+}  // namespace
+
+const render::Pose& VulkanRenderer::Impl::poseOf(const render::FrameRequest& request, std::size_t i) const {
+  return request.poses.empty() ? prepared.objects[i].pose : request.poses[i];
+}
+
+glm::dmat4 VulkanRenderer::Impl::frameViewProjection(const render::FrameRequest& request) const {
+  // Near plane: a fraction of the nearest object's bounding-sphere distance.
+  double nearest = std::numeric_limits<double>::infinity(), farthest = 0.0;
+  for (std::size_t i = 0; i < prepared.objects.size(); ++i) {
+    const Bounds b = prepared.objects[i].mesh->bounds();
+    const glm::dvec3 centre = glm::dvec3(poseOf(request, i).objectToWorld() * glm::dvec4(b.centre(), 1.0));
+    const double radius = b.radius() * poseOf(request, i).scale;
+    const double d = glm::length(centre - request.camera.eye);
+    nearest = std::min(nearest, d - radius);
+    farthest = std::max(farthest, d + radius);
+  }
+  const double nearPlane = nearest > 0.0 ? std::max(0.5 * nearest, 1e-6 * farthest) : 1e-6 * std::max(farthest, 1.0);
+  return viewProjection(request.camera, request.width, request.height, nearPlane);
+}
+
+// The G-buffer: every object rasterised, then the attachments copied to the
+// storage buffers the compute passes read.
+void VulkanRenderer::Impl::recordGBuffer(VkCommandBuffer cb, const render::FrameRequest& request,
+                                         const glm::dmat4& viewProj) {
+  std::array<VkClearValue, 4> clear{};
+  clear[3].depthStencil = {0.0f, 0};  // reversed Z: 0 is infinitely far
+  VkRenderPassBeginInfo rb{};
+  rb.sType = VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO;
+  rb.renderPass = renderPass;
+  rb.framebuffer = framebuffer;
+  rb.renderArea = {{0, 0}, {static_cast<std::uint32_t>(width), static_cast<std::uint32_t>(height)}};
+  rb.clearValueCount = 4;
+  rb.pClearValues = clear.data();
+  vkCmdBeginRenderPass(cb, &rb, VK_SUBPASS_CONTENTS_INLINE);
+  const VkViewport viewport{0.0f, 0.0f, static_cast<float>(width), static_cast<float>(height), 0.0f, 1.0f};
+  const VkRect2D scissor{{0, 0}, {static_cast<std::uint32_t>(width), static_cast<std::uint32_t>(height)}};
+  vkCmdSetViewport(cb, 0, 1, &viewport);
+  vkCmdSetScissor(cb, 0, 1, &scissor);
+  vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, gbufferPipeline);
+  vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, gbufferLayout, 0, 1, &gbufferSet, 0, nullptr);
+  for (std::size_t i = 0; i < prepared.objects.size(); ++i) {
+    GBufferPush push;
+    push.objectToClip = glm::mat4(viewProj * poseOf(request, i).objectToWorld());
+    push.objectId = static_cast<std::uint32_t>(i);
+    push.triangleBase = objectInfo[i].triangleBase;
+    vkCmdPushConstants(cb, gbufferLayout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof push,
+                       &push);
+    vkCmdDraw(cb, 3 * triangleCount[i], 1, 0, 0);
+  }
+  vkCmdEndRenderPass(cb);
+  VkBufferImageCopy region{};
+  region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+  region.imageExtent = {static_cast<std::uint32_t>(width), static_cast<std::uint32_t>(height), 1};
+  vkCmdCopyImageToBuffer(cb, normalImage.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, gbufNormals.handle(), 1, &region);
+  vkCmdCopyImageToBuffer(cb, idsImage.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, gbufIds.handle(), 1, &region);
+  vkCmdCopyImageToBuffer(cb, positionImage.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, gbufPositions.handle(), 1,
+                         &region);
+}
+
+}  // namespace haarcast::gpu

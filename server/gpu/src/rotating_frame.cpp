@@ -1,0 +1,116 @@
+// A frame of the rotating methods (haar, spatial, matrix, table): G-buffer,
+// rotation input (compaction, then every batch's indirect arguments), then
+// rotation and triple product batch by batch (vkCmdDispatchIndirect), then
+// tonemap — one command buffer on devices with timestamps, no readback of
+// the covered count until the frame is done.
+
+#include <algorithm>
+#include <functional>
+#include <stdexcept>
+#include <vector>
+
+#include "vulkan_renderer_impl.h"
+
+namespace haarcast::gpu {
+
+render::Frame VulkanRenderer::Impl::renderRotating(const render::FrameRequest& request) {
+  render::checkFrameRequest(request, prepared.objects.size());
+  const auto start = RendererClock::now();
+  ensureResolution(request.width, request.height);
+  const std::size_t objectCount = prepared.objects.size();
+  const std::size_t k = request.lightCoefficients ? request.lightCoefficients : options.lightCoefficients;
+  render::Frame frame;
+  frame.width = request.width;
+  frame.height = request.height;
+  std::size_t bytes = 0;
+
+  // ---- light (host): the same code as the CPU backend ----------------------
+  auto t0 = RendererClock::now();
+  std::vector<SparseHaar> lights;
+  lights.reserve(objectCount * 3);
+  for (std::size_t i = 0; i < objectCount; ++i) {
+    const glm::dmat3 rot = poseOf(request, i).rotation();
+    for (SparseHaar& s : render::lightInObjectFrame(prepared.light, rot, request.lightRotation, k)) {
+      lights.push_back(std::move(s));
+    }
+    for (int c = 0; c < 3; ++c) objectInfo[i].rotation[c] = glm::vec4(glm::vec3(rot[c]), 0.0f);
+  }
+  const std::vector<glm::uvec4> lightPacked = packSparseLists(lights, level);
+  lightUpload.write(lightPacked.data(), lightPacked.size() * sizeof(glm::uvec4));
+  bytes += (lightPacked.size() - lights.size()) * sizeof(glm::uvec4);
+  objects.write(objectInfo.data(), objectInfo.size() * sizeof(ObjectInfo));
+  uploadFrameUniforms(request);
+  frame.stages.push_back({"light", secondsSince(t0)});
+
+  const glm::dmat4 viewProj = frameViewProjection(request);
+
+  // ---- the device's part: one command buffer (timestamps) or one per stage.
+  // Every batch the resolution can need is recorded; batch_args.comp sizes
+  // each from the covered count, and batches past it dispatch nothing, so
+  // the host does not read the count back mid-frame.
+  const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  std::vector<FrameStage> stages;
+  stages.emplace_back("gbuffer", [&](VkCommandBuffer cb) { recordGBuffer(cb, request, viewProj); });
+  stages.emplace_back("rotation-input", [&](VkCommandBuffer cb) {
+    vkCmdFillBuffer(cb, counter.handle(), 0, VK_WHOLE_SIZE, 0u);
+    lightUpload.record(cb);  // where the light is staged: its copy into device memory
+    computeBarrier(cb);
+    rotationInput->dispatch(cb, {groupsOf(pixels, 64), 1, 1});
+    computeBarrier(cb);
+    const std::uint32_t sizes[4] = {static_cast<std::uint32_t>(batch), static_cast<std::uint32_t>(maxBatches), 0, 0};
+    batchArgsPass->dispatch(cb, {groupsOf(maxBatches, 64), 1, 1}, sizes, sizeof sizes);  // batch_args.comp's push block
+  });
+  std::vector<BatchPush> pushes(maxBatches);
+  for (std::size_t b = 0; b < maxBatches; ++b) {
+    pushes[b].first = static_cast<std::uint32_t>(b * batch);
+    pushes[b].count = static_cast<std::uint32_t>(batch);  // the shaders stop at the covered count
+    // The contract: one workgroup per (sample, channel).
+    stages.emplace_back("rotation", [&, b](VkCommandBuffer cb) {
+      rotate->dispatchIndirect(cb, batchArgs, b * sizeof(DispatchArgs), &pushes[b], sizeof(BatchPush));
+    });
+    stages.emplace_back("triple-product", [&, b](VkCommandBuffer cb) {
+      tripleProduct->dispatchIndirect(cb, batchArgs, (maxBatches + b) * sizeof(DispatchArgs), &pushes[b],
+                                      sizeof(BatchPush));
+    });
+  }
+  stages.emplace_back("tonemap", [&](VkCommandBuffer cb) { tonemap->dispatch(cb, {groupsOf(pixels, 64), 1, 1}); });
+  runStages(stages, frame);
+
+  std::uint32_t covered = 0;
+  counter.read(&covered, sizeof covered);
+  if (covered > pixels) throw std::logic_error("rotation-input reported more covered pixels than the frame has");
+  lastBatches = (covered + batch - 1) / batch;
+
+  // ---- Results ---------------------------------------------------------------
+  frame.image = io::makeImage(width, height);
+  frame.objectMask.assign(pixels, 0);
+  frame.rgba8.resize(pixels * 4);
+  {
+    const auto* rad = static_cast<const glm::vec4*>(radiance.mapped());
+    const auto* ids = static_cast<const glm::uvec4*>(gbufIds.mapped());
+    for (std::size_t p = 0; p < pixels; ++p) {
+      for (std::size_t c = 0; c < 3; ++c) frame.image.rgb[3 * p + c] = rad[p][static_cast<int>(c)];
+      frame.objectMask[p] = ids[p].x != 0 ? 1 : 0;
+    }
+    rgba8.read(frame.rgba8.data(), frame.rgba8.size());
+  }
+  finishExposure(request, frame);
+
+  // Coefficient bytes read: the light lists (above), and per covered pixel and
+  // channel the rotation's data and the three vertices' visibility lists, in
+  // the GPU's own formats (16-byte blocks).
+  {
+    const auto* sh = static_cast<const ShadeSample*>(shade.mapped());
+    for (std::uint32_t i = 0; i < covered; ++i) {
+      std::size_t visBlocks = 0;
+      for (std::uint32_t v : sh[i].vertex) visBlocks += v < visibilityBlocks.size() ? visibilityBlocks[v] : 0;
+      const std::size_t object = sh[i].object < objectCount ? sh[i].object : 0;
+      bytes += 3 * (rotationBytesPerChannel + methodBytesPerChannel[object] + visBlocks * sizeof(glm::uvec4));
+    }
+  }
+  frame.coefficientBytes = bytes;
+  frame.seconds = secondsSince(start);
+  return frame;
+}
+
+}  // namespace haarcast::gpu

@@ -1,0 +1,229 @@
+// The scene data a VulkanRenderer uploads once (slices, method data, meshes,
+// visibility, backdrop) and the compute pipelines that read it.
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "haarcast/core/fused.h"
+#include "haarcast/gpu/rotation_data.h"
+
+#include "vulkan_renderer_impl.h"
+
+namespace haarcast::gpu {
+
+void VulkanRenderer::Impl::uploadScene() {
+  const std::size_t objectCount = prepared.objects.size();
+  const auto T = static_cast<std::size_t>(options.thetaSamples);
+  const std::size_t n = coefficients;
+
+  // Slices: global slice s = object's base + t, channel c at (s·3 + c)·N
+  // (the rotation contract's binding 1).
+  std::vector<float> sliceData;
+  std::vector<std::uint32_t> method;
+  std::vector<glm::vec4> pos, nor;
+  std::vector<std::uint32_t> tri;
+  std::vector<SparseHaar> vis;
+  objectInfo.resize(objectCount);
+  for (std::size_t k = 0; k < objectCount; ++k) {
+    const render::PreparedObject& p = prepared.objects[k];
+    ObjectInfo& info = objectInfo[k];
+    if (static_cast<std::size_t>(p.table.thetaSamples()) != T || p.table.level() != level) {
+      throw std::logic_error("Vulkan backend: object " + p.name + " has a slice table unlike the options");
+    }
+    info.thetaSamples = static_cast<std::uint32_t>(T);
+    if (fused) {
+      // The slices in pixel form, RGB0 texels (core PixelSlices), slice s at s·N texels.
+      const PixelSlices pixelSlices = PixelSlices::synthesize(p.table);
+      info.sliceBase = static_cast<std::uint32_t>(sliceData.size() / (shared::kTexelFloats * n));
+      sliceData.insert(sliceData.end(), pixelSlices.texels().begin(), pixelSlices.texels().end());
+      setFusedSkip(info, level, pixelSlices.lastNonZeroRow());
+    } else {
+      info.sliceBase = static_cast<std::uint32_t>(sliceData.size() / (3 * n));
+      for (std::size_t t = 0; t < T; ++t) {
+        for (int c = 0; c < 3; ++c) {
+          const auto coeffs = p.table.slice(c, static_cast<int>(t)).coefficients();
+          sliceData.insert(sliceData.end(), coeffs.begin(), coeffs.end());
+        }
+      }
+    }
+    const std::size_t before = method.size();
+    info.methodBase = options.method == RotationMethod::Spatial || fused
+                          ? static_cast<std::uint32_t>(method.size())
+                          : appendRotationData(options.method, p.table, info.sliceBase, method, options.rotator);
+    const std::size_t blockWords = method.size() - before;
+    // Bytes of method data one rotation of one channel reads: haar reads its
+    // map's differences ((2M−1)·M words); table reads one copy instead of the
+    // slice; matrix reads two of its K elevation matrices.
+    std::size_t methodBytes = 0;
+    const std::size_t m = static_cast<std::size_t>(mapSize(level));
+    switch (options.method) {
+      case RotationMethod::Haar: methodBytes = (2 * m - 1) * m * 4; break;
+      case RotationMethod::Table: methodBytes = 0; break;
+      case RotationMethod::Matrix: {
+        const std::size_t matrices = std::max<std::size_t>(1, method.size() > before ? method[before] : 1);
+        methodBytes = 2 * (blockWords * 4) / matrices;
+        break;
+      }
+      case RotationMethod::Spatial:
+      case RotationMethod::Fused: break;
+    }
+    methodBytesPerChannel.push_back(methodBytes);
+
+    info.vertexBase = static_cast<std::uint32_t>(pos.size());
+    info.triangleBase = static_cast<std::uint32_t>(tri.size() / 3);
+    const Mesh& mesh = *p.mesh;
+    for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
+      pos.emplace_back(mesh.positions[v], 1.0f);
+      nor.emplace_back(mesh.normals[v], 0.0f);
+    }
+    for (const glm::uvec3& t : mesh.triangles) {
+      tri.push_back(info.vertexBase + t.x);
+      tri.push_back(info.vertexBase + t.y);
+      tri.push_back(info.vertexBase + t.z);
+    }
+    triangleCount.push_back(static_cast<std::uint32_t>(mesh.triangles.size()));
+    if (p.visibility.size() != mesh.positions.size()) {
+      throw std::logic_error("Vulkan backend: object " + p.name + " has " + std::to_string(p.visibility.size()) +
+                             " visibility maps for " + std::to_string(mesh.positions.size()) + " vertices");
+    }
+    vis.insert(vis.end(), p.visibility.begin(), p.visibility.end());
+  }
+  vertexCount = pos.size();
+  totalTriangles = tri.size() / 3;
+  rotationBytesPerChannel = n * sizeof(float);  // the slice, or for table the copy that replaces it
+
+  // Read-only inputs in device-local memory (buffer.h): written straight
+  // into their mapping, or staged and copied in one command buffer below.
+  std::vector<BufferUpload> uploads;
+  // `fused` reads its large inputs as texel buffers (fused.comp), so they
+  // carry that usage too.
+  const VkBufferUsageFlags fusedUsage = fused ? kTexelUsage : kStorageUsage;
+  auto input = [&](Buffer& b, std::size_t bytes, VkBufferUsageFlags usage = kStorageUsage) -> BufferUpload& {
+    b = Buffer(context, bytes, usage, MemoryUse::DeviceInput);
+    return uploads.emplace_back(context, b);
+  };
+  auto upload = [&](Buffer& b, const void* data, std::size_t bytes, VkBufferUsageFlags usage = kStorageUsage) {
+    input(b, bytes, usage).write(data, bytes);
+  };
+  if (fused) {
+    visibilityBlocks.resize(vis.size());
+    for (std::size_t v = 0; v < vis.size(); ++v) visibilityBlocks[v] = vis[v].size();
+    const std::size_t planeBytes = vis.size() * n * sizeof(float);
+    fusedVertexPlanes = !limits.fusedVisibilityLists &&
+                        planeBytes <= std::min<std::size_t>(kFusedPlanesBudget,
+                                                            context.properties().limits.maxStorageBufferRange);
+    if (fusedVertexPlanes) {
+      // Every vertex's visibility in pixel form (synthesised once here):
+      // fused.comp blends three of them per direction.
+      BufferUpload& planes = input(visibility, planeBytes, kTexelUsage);
+      for (std::size_t v = 0; v < vis.size(); ++v) {
+        const SphereMap pixelsOf = inverseHaar(vis[v].toDense());
+        planes.write(pixelsOf.values().data(), n * sizeof(float), v * n * sizeof(float));
+      }
+    } else {
+      // The lists as they are: a (first, count) header per vertex, then
+      // (index, value bits) entries; fused.comp merges and synthesises them.
+      const std::vector<std::uint32_t> words = packVisibilityEntries(vis, level);
+      upload(visibility, words.data(), words.size() * sizeof(std::uint32_t));
+    }
+  } else {
+    const std::vector<glm::uvec4> visPacked = packSparseLists(vis, level);
+    visibilityBlocks.resize(vis.size());
+    for (std::size_t v = 0; v < vis.size(); ++v) visibilityBlocks[v] = visPacked[v].y;
+    upload(visibility, visPacked.data(), visPacked.size() * sizeof(glm::uvec4));
+  }
+  upload(slices, sliceData.data(), sliceData.size() * sizeof(float), fusedUsage);
+  if (method.empty()) method.push_back(0u);  // spatial: a 4-byte dummy (the contract)
+  upload(methodData, method.data(), method.size() * sizeof(std::uint32_t));
+  upload(positions, pos.data(), pos.size() * sizeof(glm::vec4));
+  upload(normals, nor.data(), nor.size() * sizeof(glm::vec4));
+  upload(triangles, tri.data(), tri.size() * sizeof(std::uint32_t));
+
+  // Backdrop maps, [channel][row][col].
+  std::vector<float> bg;
+  for (const SphereMap& map : prepared.background) bg.insert(bg.end(), map.values().begin(), map.values().end());
+  upload(background, bg.data(), bg.size() * sizeof(float));
+  if (fused) {
+    // The pixel-centre directions, as core fused builds them (double → float).
+    const std::vector<glm::vec4> dirs = pixelCentreDirections(level);
+    upload(directions, dirs.data(), dirs.size() * sizeof(glm::vec4), kTexelUsage);
+  }
+  submitUploads(context, uploads);
+
+  objects = Buffer(context, objectCount * sizeof(ObjectInfo));
+  // The light: per object and channel a header and at most (N − 1)/3 blocks;
+  // for `fused` its pixel form, N RGB0 texels per object (fusedLightTexels).
+  // Written every frame, device-local like the other inputs: its upload (and
+  // staging buffer, where there is one) lives as long as the renderer.
+  light = Buffer(context,
+                 fused ? objectCount * n * sizeof(glm::vec4) : objectCount * 3 * (1 + (n - 1) / 3) * sizeof(glm::uvec4),
+                 fusedUsage, MemoryUse::DeviceInput);
+  lightUpload = BufferUpload(context, light);
+  frameParams = Buffer(context, sizeof(FrameParams));
+  thresholds = Buffer(context, 256 * sizeof(float));
+
+  const auto lvl = static_cast<std::uint32_t>(level);
+  // Constant 2 is rotate_spatial.comp's local size (the other methods'
+  // shaders fix theirs and ignore it): on a CPU device fewer invocations per
+  // workgroup make each barrier cheaper (docs/gpu.md, "Performance").
+  std::uint32_t local = context.info().type == "cpu" ? 64u : 256u;
+  if (limits.spatialLocalSize) local = limits.spatialLocalSize;
+  rotationInput = std::make_unique<ComputePipeline>(context, "rotation_input.comp", 8, 0);
+  tonemap = std::make_unique<ComputePipeline>(context, "tonemap.comp", 6, 0);
+  if (fused) {
+    // One SIMD group per workgroup on a CPU device: the workgroup's only
+    // barriers (the reduction's) then switch no coroutines (docs/gpu.md).
+    createFusedPipeline(limits.fusedLocalSize          ? limits.fusedLocalSize
+                        : context.info().type == "cpu" ? context.subgroupSize()
+                                                       : 256u);
+    return;
+  }
+  rotate = std::make_unique<ComputePipeline>(
+      context, "rotate_" + methodName + ".comp", 4, 16,
+      std::vector<SpecConstant>{{0, lvl}, {1, static_cast<std::uint32_t>(T)}, {2, local}});
+  tripleProduct = std::make_unique<ComputePipeline>(context, "triple_product.comp", 6, 16,
+                                                    std::vector<SpecConstant>{{0, lvl}});
+  batchArgsPass = std::make_unique<ComputePipeline>(context, "batch_args.comp", 2, 16);
+}
+
+void VulkanRenderer::Impl::createFusedPipeline(std::uint32_t local) {
+  // The texel views fused.comp reads (RGBA32F slices, light and directions;
+  // R32F vertex planes, or a one-texel stand-in beside the lists).
+  sliceTexels = TexelView(context, slices, VK_FORMAT_R32G32B32A32_SFLOAT, sizeof(glm::vec4));
+  lightTexels = TexelView(context, light, VK_FORMAT_R32G32B32A32_SFLOAT, sizeof(glm::vec4));
+  directionTexels = TexelView(context, directions, VK_FORMAT_R32G32B32A32_SFLOAT, sizeof(glm::vec4));
+  if (!fusedVertexPlanes) texelStandIn = Buffer(context, sizeof(float), kTexelUsage, MemoryUse::DeviceOnly);
+  visibilityTexels = TexelView(context, fusedVertexPlanes ? visibility : texelStandIn, VK_FORMAT_R32_SFLOAT, sizeof(float));
+  lightTexelData.resize(prepared.objects.size() * coefficients);
+
+  // Scratch (the lists' synthesis only): in shared memory where the device
+  // has room for it (and the reduction's vec3 per invocation), else a slice
+  // of a global buffer per workgroup, whose size bounds the workgroups in
+  // flight. With vertex planes there is none.
+  const VkPhysicalDeviceLimits& lim = context.properties().limits;
+  const std::size_t floats = fusedScratchFloats(level, fusedVertexPlanes);
+  fusedLocal = limits.fusedLocalSize ? limits.fusedLocalSize : local;
+  fusedShared = floats > 0 && !limits.fusedGlobalScratch &&
+                floats * sizeof(float) + fusedLocal * 4 * sizeof(float) <= lim.maxComputeSharedMemorySize;
+  const std::size_t maxGroups = lim.maxComputeWorkGroupCount[0];
+  if (floats == 0 || fusedShared) {
+    fusedGroups = static_cast<std::uint32_t>(std::min<std::size_t>(maxGroups, 1u << 16));
+    scratch = Buffer(context, sizeof(float), kStorageUsage, MemoryUse::DeviceOnly);
+  } else {
+    const std::size_t budget = std::min<std::size_t>(kFusedScratchBudget, lim.maxStorageBufferRange);
+    fusedGroups = static_cast<std::uint32_t>(std::clamp<std::size_t>(budget / (floats * sizeof(float)), 1, maxGroups));
+    scratch = Buffer(context, std::size_t{fusedGroups} * floats * sizeof(float), kStorageUsage, MemoryUse::DeviceOnly);
+  }
+  if (limits.fusedGroups) fusedGroups = std::min(fusedGroups, limits.fusedGroups);
+  fusedPass = std::make_unique<ComputePipeline>(
+      context, "fused.comp", fusedBindings(), 0,
+      std::vector<SpecConstant>{{0, static_cast<std::uint32_t>(level)},
+                                {2, fusedLocal},
+                                {3, fusedShared ? static_cast<std::uint32_t>(floats) : 1u},
+                                {4, options.interpolateSlices ? 1u : 0u},
+                                {5, fusedVertexPlanes ? 1u : 0u}});
+}
+
+}  // namespace haarcast::gpu

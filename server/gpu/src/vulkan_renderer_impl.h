@@ -1,0 +1,167 @@
+// VulkanRenderer's state and the steps that build and use it, private to
+// server/gpu/src. One file per idea:
+//   vulkan_renderer.cpp   construction, the facade, the diagnostics readback
+//   scene_upload.cpp      scene data uploaded once, the compute pipelines
+//   gbuffer_pass.cpp      the G-buffer's render pass, pipeline, projection, recording
+//   frame_buffers.cpp     the per-resolution images and buffers
+//   frame_stages.cpp      a frame's uniforms, its stages recorded, submitted and timed
+//   fused_frame.cpp       a `fused` frame: one command buffer, indirect dispatch
+//   rotating_frame.cpp    a frame of the rotating methods: rotation and triple product in batches
+#pragma once
+
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <glm/mat4x4.hpp>
+
+#include "haarcast/gpu/compute.h"
+#include "haarcast/gpu/vulkan_renderer.h"
+
+namespace haarcast::gpu {
+
+using RendererClock = std::chrono::steady_clock;
+inline double secondsSince(RendererClock::time_point t) {
+  return std::chrono::duration<double>(RendererClock::now() - t).count();
+}
+
+inline constexpr VkFormat kNormalFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
+inline constexpr VkFormat kIdsFormat = VK_FORMAT_R32G32B32A32_UINT;
+inline constexpr VkFormat kPositionFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
+inline constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
+inline constexpr std::size_t kRotatedBudget = 256u << 20;       // bytes of rotated coefficients per batch, at most
+inline constexpr std::size_t kFusedScratchBudget = 256u << 20;  // bytes of `fused` scratch in global memory, at most
+inline constexpr std::size_t kFusedPlanesBudget = 256u << 20;   // bytes of vertex visibility in pixel form, at most
+
+inline std::uint32_t groupsOf(std::size_t items, std::uint32_t local) {
+  return static_cast<std::uint32_t>((items + local - 1) / local);
+}
+
+// The rotation contract's push block (rotate_*.comp, triple_product.comp).
+struct BatchPush {
+  std::uint32_t first = 0, count = 0, pad0 = 0, pad1 = 0;
+};
+
+// An image with its memory and view.
+struct DeviceImage {
+  VkImage image = VK_NULL_HANDLE;
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  VkImageView view = VK_NULL_HANDLE;
+};
+
+// A stage of a frame: its name (renderer.h) and what it records.
+using FrameStage = std::pair<const char*, std::function<void(VkCommandBuffer)>>;
+
+struct VulkanRenderer::Impl {
+  render::RenderOptions options;
+  VulkanRendererLimits limits;
+  render::PreparedScene prepared;
+  Context context;
+  int level = 0;
+  std::size_t coefficients = 0;  // N = 4^level
+  std::string methodName;
+
+  // ---- Scene data, uploaded once --------------------------------------------
+  std::vector<ObjectInfo> objectInfo;
+  std::vector<std::uint32_t> triangleCount;
+  std::size_t vertexCount = 0, totalTriangles = 0;
+  std::vector<std::size_t> visibilityBlocks;  // per global vertex, for the bytes-read count
+  std::size_t rotationBytesPerChannel = 0;    // coefficient bytes one rotation reads (per object: same level)
+  std::vector<std::size_t> methodBytesPerChannel;  // per object: method data one rotation reads
+  Buffer slices, methodData, positions, normals, triangles, visibility, background;
+  Buffer objects, light, frameParams, thresholds;
+  // The light is device-local (buffer.h); each frame writes it here and
+  // records the copy, where it is staged, ahead of the pass that reads it.
+  BufferUpload lightUpload;
+  // `fused`: the slices in pixel form (texels), the light in pixel form per
+  // frame (in `light`), the pixel-centre directions and the workgroups' scratch.
+  bool fused = false;
+  Buffer directions, scratch;
+  // fused.comp reads these through texel views (BindingKind::Texels).
+  Buffer texelStandIn;  // binding 10's stand-in where the visibility is lists
+  TexelView sliceTexels, lightTexels, directionTexels, visibilityTexels;
+  std::vector<glm::vec4> lightTexelData;  // this frame's light texels, before upload
+  std::uint32_t fusedGroups = 0;     // the most workgroups of the fused dispatch
+  std::uint32_t fusedLocal = 0;      // its local size
+  bool fusedShared = false;          // scratch in shared memory (else in `scratch`)
+  bool fusedVertexPlanes = false;    // visibility uploaded per vertex in pixel form (else as lists)
+
+  // ---- Pipelines ---------------------------------------------------------------
+  std::unique_ptr<ComputePipeline> rotate, rotationInput, tripleProduct, tonemap, fusedPass, batchArgsPass;
+  VkRenderPass renderPass = VK_NULL_HANDLE;
+  VkDescriptorSetLayout gbufferSetLayout = VK_NULL_HANDLE;
+  VkPipelineLayout gbufferLayout = VK_NULL_HANDLE;
+  VkPipeline gbufferPipeline = VK_NULL_HANDLE;
+  VkDescriptorPool gbufferPool = VK_NULL_HANDLE;
+  VkDescriptorSet gbufferSet = VK_NULL_HANDLE;
+
+  // ---- Per resolution --------------------------------------------------------
+  int width = 0, height = 0;
+  std::size_t batch = 0, maxBatches = 0, lastBatches = 0;
+  DeviceImage normalImage, idsImage, positionImage, depthImage;
+  VkFramebuffer framebuffer = VK_NULL_HANDLE;
+  Buffer gbufIds, gbufNormals, gbufPositions, samples, shade, counter, radiance, rgba8, rotated;
+  // The rotating methods: per batch, the indirect arguments of its rotation
+  // and triple product (DispatchArgs, written by batch_args.comp).
+  Buffer batchArgs;
+  // Stage timing: timestamps around each stage's submission on GPUs; on a
+  // CPU device (lavapipe), the host's wall time of the submission, because
+  // lavapipe's timestamps do not wait for compute dispatches (measured: 0.8 s
+  // of timestamps in a 3.8 s submission). On a CPU device, host time is device time.
+  bool useTimestamps = false;
+  VkQueryPool queries = VK_NULL_HANDLE;
+  std::uint32_t queryCapacity = 0;  // timestamps the pool holds
+
+  // vulkan_renderer.cpp
+  Impl(const render::Scene& scene, const render::RenderOptions& o, const VulkanOptions& vulkan,
+       const render::RenderProgress& progress, const VulkanRendererLimits& l);
+  ~Impl();
+  render::Frame render(const render::FrameRequest& request);
+
+  // scene_upload.cpp
+  void uploadScene();
+  void createFusedPipeline(std::uint32_t local);
+
+  // gbuffer_pass.cpp
+  void createGraphicsPipeline();
+  const render::Pose& poseOf(const render::FrameRequest& request, std::size_t i) const;
+  glm::dmat4 frameViewProjection(const render::FrameRequest& request) const;
+  void recordGBuffer(VkCommandBuffer cb, const render::FrameRequest& request, const glm::dmat4& viewProj);
+
+  // frame_buffers.cpp
+  void ensureResolution(int w, int h);
+  void releaseResolution();
+  DeviceImage createImage(VkFormat format, VkImageUsageFlags usage, VkImageAspectFlags aspect);
+  void destroyImage(DeviceImage& image);
+
+  // frame_stages.cpp
+  // The frame's uniforms (camera, light turn, exposure, the fused dispatch's
+  // workgroup count) and the sRGB thresholds of its exposure.
+  void uploadFrameUniforms(const render::FrameRequest& request);
+  // Auto exposure: the frame was tonemapped on the device with the previous
+  // frame's exposure (or the fixed one); measure the lit object pixels
+  // (mapped radiance and ids) and, when the exposure they call for differs,
+  // tonemap again on the host (the same thresholds, so the same bytes the
+  // device would give).
+  void finishExposure(const render::FrameRequest& request, render::Frame& frame);
+  // The stages of a frame, in order: with timestamps, recorded into one
+  // command buffer (a timestamp after each) and submitted once; otherwise
+  // (a CPU device) one submission per stage, timed on the host. Stages of
+  // one name (the batches of rotation and triple-product) add up to one
+  // entry of frame.stages, at the place of the first.
+  void runStages(const std::vector<FrameStage>& stages, render::Frame& frame);
+  void ensureQueries(std::uint32_t count);
+
+  // fused_frame.cpp
+  render::Frame renderFused(const render::FrameRequest& request);
+
+  // rotating_frame.cpp
+  render::Frame renderRotating(const render::FrameRequest& request);
+};
+
+}  // namespace haarcast::gpu

@@ -1,0 +1,94 @@
+// The Haar numbers of core/shared_layout.h read as GLSL (shaders/
+// shared_layout_check.comp) against the same lines read as C++: the preorder
+// key and its decoding, the child quadrant and signs, the detail index and
+// its inverse, for every block and band of levels 1–7 and sampled blocks up
+// to the largest level whose keys fit 32 bits. Bit for bit.
+#include <gtest/gtest.h>
+
+#include <bit>
+#include <random>
+#include <span>
+#include <vector>
+
+#include <glm/vec4.hpp>
+
+#include "gpu_test_util.h"
+#include "haarcast/core/shared_layout.h"
+#include "haarcast/gpu/compute.h"
+
+namespace haarcast::gpu {
+namespace {
+
+using shared::uint;
+
+glm::uvec4 packCase(uint n, uint band, uint l, uint i, uint j) { return {n, band * 256 + l, i, j}; }
+
+// The C++ reading of what the shader writes for one case.
+std::array<glm::uvec4, 3> expected(const glm::uvec4& c) {
+  const uint n = c.x, band = c.y >> 8, l = c.y & 255u, i = c.z, j = c.w;
+  const uint key = shared::haarPreorderKey(n - 1, l, i, j);
+  const shared::HaarBlock block = shared::haarPreorderBlock(n - 1, key);
+  const uint quadrant = shared::haarChildQuadrant(i, j);
+  const shared::vec3 sign = shared::haarChildSign(quadrant);
+  const uint index = shared::haarDetailIndex(1u << n, band, l, i, j);
+  const shared::HaarDetailPosition p = shared::haarDetailPosition(n, index);
+  return {glm::uvec4(key, block.level, block.i, block.j),
+          glm::uvec4(std::bit_cast<uint>(sign.x), std::bit_cast<uint>(sign.y), std::bit_cast<uint>(sign.z), quadrant),
+          glm::uvec4(index, p.band, p.level, (p.i << 16) | p.j)};
+}
+
+TEST(SharedLayout, ShaderAndCppAgreeOnTheHaarNumbers) {
+  HAARCAST_REQUIRE_VULKAN();
+  std::vector<glm::uvec4> cases;
+  for (uint n = 1; n <= shared::kFusedMaxLevel; ++n) {
+    for (uint l = 0; l < n; ++l) {
+      for (uint i = 0; i < (1u << l); ++i) {
+        for (uint j = 0; j < (1u << l); ++j) {
+          for (uint band = 0; band < 3; ++band) cases.push_back(packCase(n, band, l, i, j));
+        }
+      }
+    }
+  }
+  // Larger maps (detail index up to 2^(2n)): random blocks and the far corner.
+  std::mt19937 rng(10);
+  for (uint n : {8u, 10u, 12u, 15u}) {
+    for (uint l = 0; l < n; ++l) {
+      std::uniform_int_distribution<uint> block(0, (1u << l) - 1);
+      for (int s = 0; s < 16; ++s) cases.push_back(packCase(n, static_cast<uint>(s % 3), l, block(rng), block(rng)));
+      cases.push_back(packCase(n, 2, l, (1u << l) - 1, (1u << l) - 1));
+    }
+  }
+
+  Context context(testing::testOptions());
+  Buffer in(context, cases.size() * sizeof(glm::uvec4)), out(context, 3 * cases.size() * sizeof(glm::uvec4));
+  in.upload(std::span<const glm::uvec4>(cases));
+  ComputePipeline check(context, "shared_layout_check.comp", 2, 4);
+  check.bind({&in, &out});
+  const auto count = static_cast<uint>(cases.size());
+  context.submit([&](VkCommandBuffer cb) {
+    check.dispatch(cb, {(count + 63) / 64, 1, 1}, &count, sizeof count);
+    computeBarrier(cb);
+  });
+  std::vector<glm::uvec4> got(3 * cases.size());
+  out.download(std::span<glm::uvec4>(got));
+
+  std::size_t wrong = 0;
+  for (std::size_t k = 0; k < cases.size(); ++k) {
+    const std::array<glm::uvec4, 3> want = expected(cases[k]);
+    for (std::size_t r = 0; r < 3; ++r) {
+      if (got[3 * k + r] == want[r]) continue;
+      if (++wrong <= 10) {
+        const glm::uvec4& g = got[3 * k + r];
+        ADD_FAILURE() << "case (n " << cases[k].x << ", band " << (cases[k].y >> 8) << ", l " << (cases[k].y & 255u)
+                      << ", i " << cases[k].z << ", j " << cases[k].w << ") result " << r << ": GLSL (" << g.x << ", "
+                      << g.y << ", " << g.z << ", " << g.w << "), C++ (" << want[r].x << ", " << want[r].y << ", "
+                      << want[r].z << ", " << want[r].w << ")";
+      }
+    }
+  }
+  EXPECT_EQ(wrong, 0u) << "of " << 3 * cases.size() << " results";
+  testing::expectNoValidationMessages(context);
+}
+
+}  // namespace
+}  // namespace haarcast::gpu
