@@ -92,6 +92,7 @@ class CpuRenderer final : public Renderer {
     std::vector<std::optional<Sample>> centre;
     std::vector<std::uint32_t> edge;
     std::vector<std::array<std::optional<Sample>, shared::kSubsamples>> sub;
+    std::size_t rows = 0;
   };
   // gbuffer: traces the centres, finds the edge pixels, traces their
   // sub-samples. rotation-input: each sample's slice and Euler angles.
@@ -149,6 +150,7 @@ void CpuRenderer::traceGBuffer(const CameraRays& camera, int w, int h, GBuffer& 
     return s;
   };
   g.centre.assign(pixels, std::nullopt);
+  g.rows = static_cast<std::size_t>(h);
   parallelFor(static_cast<std::size_t>(h), [&](std::size_t y) {
     for (int x = 0; x < w; ++x) g.centre[y * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)] = trace(camera.direction(x, static_cast<int>(y)));
   }, {}, options_.threads);
@@ -200,12 +202,17 @@ void CpuRenderer::fillInputs(const ResolvedFrame& resolved, GBuffer& g) const {
     const glm::dvec3 wo = glm::transpose(resolved.objects[s.object].rotation) * -s.direction;
     in.rotation = rotationInput(n, wo, p.table);
   };
-  parallelFor(g.centre.size(), [&](std::size_t i) {
-    if (g.centre[i]) fill(*g.centre[i]);
+  // In rows (and runs of 64 edge pixels): one task per pixel would cost
+  // more in scheduling than the work.
+  const std::size_t w = g.centre.size() / std::max<std::size_t>(1, g.rows);
+  parallelFor(g.rows, [&](std::size_t y) {
+    for (std::size_t i = y * w; i < (y + 1) * w; ++i)
+      if (g.centre[i]) fill(*g.centre[i]);
   }, {}, options_.threads);
-  parallelFor(g.sub.size(), [&](std::size_t e) {
-    for (auto& s : g.sub[e])
-      if (s) fill(*s);
+  parallelFor((g.sub.size() + 63) / 64, [&](std::size_t run) {
+    for (std::size_t e = run * 64; e < std::min(g.sub.size(), run * 64 + 64); ++e)
+      for (auto& s : g.sub[e])
+        if (s) fill(*s);
   }, {}, options_.threads);
 }
 
