@@ -178,6 +178,9 @@ std::uint32_t appendRotationData(RotationMethod method, const BrdfSliceTable& ta
       }
       return appendRotationData(rotators, table, sliceBase, methodData);
     }
+    case RotationMethod::Fused:
+      // fused keeps no rotation data: it samples the slices' pixel form.
+      throw std::invalid_argument("appendRotationData: fused rotates nothing ahead (it samples the slices' pixel form)");
   }
   throw std::invalid_argument("appendRotationData: unknown rotation method");
 }
