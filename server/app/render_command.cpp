@@ -2,7 +2,6 @@
 
 #include <chrono>
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -11,6 +10,7 @@
 #include "haarcast/render/renderer.h"
 #include "haarcast/render/scene.h"
 #include "progress.h"
+#include "app_paths.h"
 #include "scene_flags.h"
 
 namespace haarcast::app {
@@ -24,12 +24,6 @@ struct RenderArgs {
   bool validation = gpu::kValidationByDefault;
   render::RenderOptions options;
 };
-
-std::string defaultCacheDir() {
-  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg) return (fs::path(xdg) / "haarcast").string();
-  if (const char* home = std::getenv("HOME"); home && *home) return (fs::path(home) / ".cache" / "haarcast").string();
-  return ".haarcast-cache";
-}
 
 int run(RenderArgs& a) {
   if (a.backend != "cpu" && a.backend != "vulkan") {
@@ -46,7 +40,7 @@ int run(RenderArgs& a) {
   a.options.height = a.scene.height;
   a.options.environmentBackground = environmentBackground(a.scene);
   a.options.antialias = antialiasFor(a.antialias, a.backend);
-  a.options.cacheDir = a.cacheDir.empty() ? defaultCacheDir() : (a.cacheDir == "none" ? "" : a.cacheDir);
+  a.options.cacheDir = cacheDirFromFlag(a.cacheDir);
   render::checkRenderOptions(a.options);
   checkOutputPath(a.scene);
 

@@ -10,6 +10,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "app_paths.h"
+
 extern char** environ;
 
 namespace haarcast::app {
@@ -46,12 +48,6 @@ int runProgram(const std::vector<std::string>& argv, bool quiet) {
   return WIFSIGNALED(status) ? 128 + WTERMSIG(status) : kSpawnFailed;
 }
 
-fs::path executableDir() {
-  std::error_code ec;
-  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  return ec ? fs::current_path() : exe.parent_path();
-}
-
 std::string joined(const std::vector<std::string>& v) {
   std::string out;
   for (const auto& s : v) out += (out.empty() ? "" : ", ") + s;
@@ -61,14 +57,7 @@ std::string joined(const std::vector<std::string>& v) {
 }  // namespace
 
 fs::path findPlotScript() {
-  std::error_code ec;
-  const fs::path source = fs::path(HAARCAST_SOURCE_DIR) / "tools" / "plot_report.py";
-  if (fs::is_regular_file(source, ec)) return source;
-  for (const char* relative : {"../share/haarcast/plot_report.py", "plot_report.py"}) {
-    const fs::path p = executableDir() / relative;
-    if (fs::is_regular_file(p, ec)) return fs::weakly_canonical(p, ec);
-  }
-  return {};
+  return findShipped("tools/plot_report.py", {"../share/haarcast/plot_report.py", "plot_report.py"});
 }
 
 std::vector<std::string> pythonCandidates() {

@@ -19,6 +19,7 @@
 #include "haarcast/net/server.h"
 #include "haarcast/render/renderer.h"
 #include "haarcast/render/scene.h"
+#include "app_paths.h"
 #include "progress.h"
 #include "scene_flags.h"
 
@@ -43,32 +44,6 @@ struct ServeArgs {
 
 // The analytic materials every server offers (MERL files come from --materials-dir).
 const std::vector<std::string> kBuiltinMaterials = {"lambert", "phong:16", "phong:64", "phong:256", "ggx:0.1", "ggx:0.3"};
-
-std::string defaultCacheDir() {
-  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg) return (fs::path(xdg) / "haarcast").string();
-  if (const char* home = std::getenv("HOME"); home && *home) return (fs::path(home) / ".cache" / "haarcast").string();
-  return ".haarcast-cache";
-}
-
-fs::path executableDir() {
-  std::error_code ec;
-  const auto exe = fs::read_symlink("/proc/self/exe", ec);
-  return ec ? fs::current_path() : exe.parent_path();
-}
-
-// The source tree's copy (a build folder's binary), else beside the
-// executable (an installed or containerised one: <prefix>/bin/haarcast with
-// <prefix>/share/haarcast/…), else next to it.
-fs::path findShipped(const fs::path& relative, const std::vector<fs::path>& installed) {
-  std::error_code ec;
-  const fs::path source = fs::path(HAARCAST_SOURCE_DIR) / relative;
-  if (fs::exists(source, ec)) return source;
-  for (const auto& candidate : installed) {
-    const fs::path p = executableDir() / candidate;
-    if (fs::exists(p, ec)) return fs::weakly_canonical(p, ec);
-  }
-  return {};
-}
 
 struct SceneSource {
   std::string name;
@@ -171,7 +146,7 @@ int run(ServeArgs& a) {
   // The renderer builder: a config's scene with its materials, through the
   // backend factory. Runs on the render service's builder thread.
   render::RenderOptions base;
-  base.cacheDir = a.cacheDir.empty() ? defaultCacheDir() : (a.cacheDir == "none" ? "" : a.cacheDir);
+  base.cacheDir = cacheDirFromFlag(a.cacheDir);
   base.threads = a.renderThreads;
   const gpu::VulkanOptions vulkanOptions{a.vulkanDevice, a.vulkanValidation};
   auto sharedScenes = std::make_shared<std::vector<SceneSource>>(std::move(scenes));

@@ -76,7 +76,7 @@ double provisionalStops(const render::ExposureControl& exposure) {
 
 void VulkanRenderer::Impl::uploadFrameUniforms(const render::FrameRequest& request) {
   const double stops = provisionalStops(request.exposure);
-  FrameParams params = makeFrameParams(request.camera, request.width, request.height, request.lightRotation, stops,
+  FrameParams params = makeFrameParams(request.camera, request.width, request.height, request.lightRotation,
                                        options.environmentBackground, prepared.background[0].level());
   params.fusedGroups = fusedGroups;
   frameParams.write(&params, sizeof params);
@@ -88,15 +88,17 @@ void VulkanRenderer::Impl::finishExposure(const render::FrameRequest& request, r
   const double provisional = provisionalStops(request.exposure);
   frame.exposureStops = provisional;
   if (!request.exposure.automatic) return;
-  const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
-  io::RgbImage linear = frame.image;
-  if (linear.rgb.empty()) {
-    linear = io::makeImage(width, height);
+  // The linear image the frame read back, else a copy of the mapped radiance.
+  io::RgbImage mapped;
+  if (frame.image.rgb.empty()) {
+    const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+    mapped = io::makeImage(width, height);
     const auto* rad = static_cast<const glm::vec4*>(radiance.mapped());
     for (std::size_t p = 0; p < pixels; ++p) {
-      for (std::size_t c = 0; c < 3; ++c) linear.rgb[3 * p + c] = rad[p][static_cast<int>(c)];
+      for (std::size_t c = 0; c < 3; ++c) mapped.rgb[3 * p + c] = rad[p][static_cast<int>(c)];
     }
   }
+  const io::RgbImage& linear = frame.image.rgb.empty() ? mapped : frame.image;
   frame.logAverageLuminance = render::frameLogAverage(linear, frame.objectMask);
   frame.exposureStops = render::applyExposure(request.exposure, frame.logAverageLuminance);
   if (frame.exposureStops != provisional) frame.rgba8 = render::tonemapRgba8(linear, frame.exposureStops);

@@ -12,7 +12,7 @@
 namespace haarcast::gpu {
 
 FrameParams makeFrameParams(const render::Camera& camera, int width, int height, const glm::dmat3& lightRotation,
-                            double exposureStops, bool background, int backgroundLevel) {
+                            bool background, int backgroundLevel) {
   const render::CameraBasis basis = render::cameraBasis(camera, width, height);
   FrameParams f{};
   f.forward = glm::vec4(glm::vec3(basis.forward), 0.0f);
@@ -22,7 +22,6 @@ FrameParams makeFrameParams(const render::Camera& camera, int width, int height,
   for (int c = 0; c < 3; ++c) f.lightRotT[c] = glm::vec4(glm::vec3(lt[c]), 0.0f);
   f.tanHalf = static_cast<float>(basis.tanHalf);
   f.aspect = static_cast<float>(static_cast<double>(width) / height);
-  f.gain = static_cast<float>(std::exp2(exposureStops));
   f.background = background ? 1u : 0u;
   f.width = static_cast<std::uint32_t>(width);
   f.height = static_cast<std::uint32_t>(height);

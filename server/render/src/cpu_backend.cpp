@@ -80,7 +80,6 @@ class CpuRenderer final : public Renderer {
   // One shaded sample: the centre of a covered pixel, or a covered
   // sub-sample of an edge pixel (shared::kSubsamples of them).
   struct Sample {
-    std::size_t object = 0;
     Hit hit;
     glm::dvec3 direction{0.0};  // of the camera ray, world frame
     PixelInput input;           // filled by the rotation-input stage
@@ -92,7 +91,7 @@ class CpuRenderer final : public Renderer {
     std::vector<std::optional<Sample>> centre;
     std::vector<std::uint32_t> edge;
     std::vector<std::array<std::optional<Sample>, shared::kSubsamples>> sub;
-    std::size_t rows = 0;
+    std::size_t width = 0, height = 0;
   };
   // gbuffer: traces the centres, finds the edge pixels, traces their
   // sub-samples. rotation-input: each sample's slice and Euler angles.
@@ -144,13 +143,13 @@ void CpuRenderer::traceGBuffer(const CameraRays& camera, int w, int h, GBuffer& 
     const std::optional<Hit> hit = rays.intersect(r);
     if (!hit) return std::nullopt;
     Sample s;
-    s.object = hit->object;
     s.hit = *hit;
     s.direction = direction;
     return s;
   };
   g.centre.assign(pixels, std::nullopt);
-  g.rows = static_cast<std::size_t>(h);
+  g.width = static_cast<std::size_t>(w);
+  g.height = static_cast<std::size_t>(h);
   parallelFor(static_cast<std::size_t>(h), [&](std::size_t y) {
     for (int x = 0; x < w; ++x) g.centre[y * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)] = trace(camera.direction(x, static_cast<int>(y)));
   }, {}, options_.threads);
@@ -161,7 +160,7 @@ void CpuRenderer::traceGBuffer(const CameraRays& camera, int w, int h, GBuffer& 
   if (!options_.antialias) return;
   auto id = [&](int x, int y) -> std::size_t {
     const auto& c = g.centre[static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)];
-    return c ? c->object + 1 : 0;
+    return c ? c->hit.object + 1 : 0;
   };
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
@@ -187,7 +186,7 @@ void CpuRenderer::traceGBuffer(const CameraRays& camera, int w, int h, GBuffer& 
 void CpuRenderer::fillInputs(const ResolvedFrame& resolved, GBuffer& g) const {
   // The interpolated normal and the view direction in the object's frame.
   auto fill = [&](Sample& s) {
-    const PreparedObject& p = prepared_.objects[s.object];
+    const PreparedObject& p = prepared_.objects[s.hit.object];
     const Mesh& mesh = *p.mesh;
     const glm::uvec3 tri = mesh.triangles[s.hit.triangle];
     PixelInput& in = s.input;
@@ -199,14 +198,13 @@ void CpuRenderer::fillInputs(const ResolvedFrame& resolved, GBuffer& g) const {
     in.vertex[2] = tri.z;
     const glm::dvec3 n = glm::normalize(in.b[0] * glm::dvec3(mesh.normals[tri.x]) + in.b[1] * glm::dvec3(mesh.normals[tri.y]) +
                                         in.b[2] * glm::dvec3(mesh.normals[tri.z]));
-    const glm::dvec3 wo = glm::transpose(resolved.objects[s.object].rotation) * -s.direction;
+    const glm::dvec3 wo = glm::transpose(resolved.objects[s.hit.object].rotation) * -s.direction;
     in.rotation = rotationInput(n, wo, p.table);
   };
   // In rows (and runs of 64 edge pixels): one task per pixel would cost
   // more in scheduling than the work.
-  const std::size_t w = g.centre.size() / std::max<std::size_t>(1, g.rows);
-  parallelFor(g.rows, [&](std::size_t y) {
-    for (std::size_t i = y * w; i < (y + 1) * w; ++i)
+  parallelFor(g.height, [&](std::size_t y) {
+    for (std::size_t i = y * g.width; i < (y + 1) * g.width; ++i)
       if (g.centre[i]) fill(*g.centre[i]);
   }, {}, options_.threads);
   parallelFor((g.sub.size() + 63) / 64, [&](std::size_t run) {
@@ -322,7 +320,7 @@ std::size_t CpuRenderer::shadeRotating(const ResolvedFrame& resolved, const GBuf
       PreparedVisibility visibility;
     };
     thread_local Scratch s;
-    const std::size_t object = sample.object;
+    const std::size_t object = sample.hit.object;
     const PreparedObject& p = prepared_.objects[object];
     const PixelInput& in = sample.input;
     const auto a = Clock::now();
@@ -360,7 +358,7 @@ std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const GBuffer
   const std::size_t bytes = shadePixels(g, request, camera, frame, [&](const Sample& sample, std::array<float, 3>& rgb) {
     // Per worker thread, kept across pixels: no allocation per pixel.
     thread_local FusedScratch scratch;
-    const PreparedObject& p = prepared_.objects[sample.object];
+    const PreparedObject& p = prepared_.objects[sample.hit.object];
     const PixelInput& in = sample.input;
     std::array<WeightedVisibility, 3> vis;
     std::size_t entries = 0;
@@ -368,11 +366,11 @@ std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const GBuffer
       vis[v] = {&p.visibility[in.vertex[v]], static_cast<float>(in.b[v])};
       entries += vis[v].list->size();
     }
-    const PixelSlices& slices = pixelSlices_[sample.object];
+    const PixelSlices& slices = pixelSlices_[sample.hit.object];
     const shared::SliceBlend blend = shared::sliceBlendAt(static_cast<float>(in.rotation.thetaOut),
                                                           static_cast<shared::uint>(slices.thetaSamples()),
                                                           options_.interpolateSlices ? 1u : 0u);
-    rgb = fusedShade(slices, blend, in.rotation.euler, resolved.objects[sample.object].fusedLight, vis, scratch);
+    rgb = fusedShade(slices, blend, in.rotation.euler, resolved.objects[sample.hit.object].fusedLight, vis, scratch);
     return fusedPixelBytes(slices.level(), blend.weight != 0.0f, entries);
   });
   frame.stages.push_back({"fused", since(t0)});

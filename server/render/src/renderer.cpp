@@ -18,8 +18,9 @@ namespace haarcast::render {
 
 void checkRenderOptions(const RenderOptions& o) {
   auto bad = [](const std::string& what) { throw std::invalid_argument("render options: " + what); };
-  if (o.width < 1 || o.height < 1 || o.width > 8192 || o.height > 8192) {
-    bad("resolution " + std::to_string(o.width) + "×" + std::to_string(o.height) + " is outside 1..8192");
+  if (o.width < 1 || o.height < 1 || o.width > kMaxFrameSide || o.height > kMaxFrameSide) {
+    bad("resolution " + std::to_string(o.width) + "×" + std::to_string(o.height) + " is outside 1.." +
+        std::to_string(kMaxFrameSide));
   }
   if (o.level < kMinRenderLevel || o.level > kMaxRenderLevel) {
     bad("level " + std::to_string(o.level) + " is outside " + std::to_string(kMinRenderLevel) + ".." +

@@ -266,7 +266,7 @@ TEST(TonemapPass, BackdropAndEncodingMatchTheCpuDefinitions) {
   }
   std::vector<float> bg;
   for (const auto& map : background) bg.insert(bg.end(), map.values().begin(), map.values().end());
-  const FrameParams params = makeFrameParams(camera, w, h, lightRotation, exposure, true, bgLevel);
+  const FrameParams params = makeFrameParams(camera, w, h, lightRotation, true, bgLevel);
 
   Context context(testing::testOptions());
   Buffer paramBuf(context, sizeof params), idBuf(context, pixels * 16), radBuf(context, pixels * 16),

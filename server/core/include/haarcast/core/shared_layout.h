@@ -214,9 +214,9 @@ struct FrameParams {
   vec4 right;          // xyz
   vec4 up;             // xyz
   vec4 lightRotT[3];   // columns of lightRotationᵀ (xyz)
-  float tanHalf;       // tan(fovY / 2)
+  float tanHalf;       // tan(½ vertical field of view) of this frame (render::cameraBasis)
   float aspect;        // width / height
-  float gain;          // 2^exposureStops
+  uint pad0;           // (the exposure travels in the tonemap thresholds)
   uint background;     // 1: the environment behind the objects, 0: black
   uint width;
   uint height;

@@ -31,9 +31,10 @@ using shared::RotationSample;
 using shared::ShadeSample;
 
 // The camera of render::CameraRays (its basis from render::cameraBasis, as
-// the G-buffer's projection) and the frame's settings.
+// the G-buffer's projection) and the frame's settings. The exposure is not
+// among them: it travels in the tonemap pass's thresholds.
 FrameParams makeFrameParams(const render::Camera& camera, int width, int height, const glm::dmat3& lightRotation,
-                            double exposureStops, bool background, int backgroundLevel);
+                            bool background, int backgroundLevel);
 
 
 // Sparse Haar lists in the triple-product shader's form: one 16-byte block
