@@ -22,8 +22,9 @@ unset HAARCAST_TOKEN HAARCAST_ALLOW_NO_TOKEN
 rc=0
 timeout 30 "$entrypoint" serve --port 0 --bind 127.0.0.1 >"$work/out" 2>"$work/err" || rc=$?
 ((rc == 64)) || fail "serve without a token exited $rc, expected 64"
-grep -q HAARCAST_TOKEN "$work/err" && grep -q HAARCAST_ALLOW_NO_TOKEN "$work/err" ||
+if ! grep -q HAARCAST_TOKEN "$work/err" || ! grep -q HAARCAST_ALLOW_NO_TOKEN "$work/err"; then
   fail "the refusal does not name HAARCAST_TOKEN and HAARCAST_ALLOW_NO_TOKEN: $(cat "$work/err")"
+fi
 [[ ! -s "$work/out" ]] || fail "the server started anyway: $(cat "$work/out")"
 echo "no token: refused (64): $(cat "$work/err")"
 
