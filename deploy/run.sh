@@ -10,7 +10,13 @@
 #   deploy/run.sh bench [args]   the speed table (bench-frame, fused: 128², 256², 512² at
 #                                 levels 4-6, fps per backend), then build/bin/haarcast-bench [args]
 #                                 e.g. deploy/run.sh bench -- --benchmark_filter=Rotate
-#   deploy/run.sh build          install and build only (the container image uses it)
+#   deploy/run.sh build          install and build only
+#   deploy/run.sh install ROLE…  install the packages of these roles (build, runtime, test)
+#                                 and nothing else: the container image's stages use it
+#   deploy/run.sh packages ROLE… print the packages of these roles, one per line
+#
+# Packages: build and demo and bench install the build and runtime roles, test
+# installs all three.
 #
 # A leading "--" in [args] is dropped. Environment: HAARCAST_JOBS (build jobs,
 # default nproc), HAARCAST_BUILD_DIR (default build), HAARCAST_PORT (demo's
@@ -20,9 +26,14 @@
 # (CI): no prompts, no stdin.
 set -euo pipefail
 
-# Debian packages the build needs. Later steps (Vulkan, Embree, OpenEXR,
-# Boost, protobuf, …) add their packages here, and nowhere else.
-PACKAGES=(
+# Debian packages, one list per role, and nowhere else: the container image's
+# stages install them through `deploy/run.sh install ROLE`, and
+# tests/deploy/runtime_packages_test.py checks the runtime list against the
+# libraries the built binaries load.
+#
+# build: compilers, headers and generators; Node.js vendors the browser
+# client's one runtime package (protobufjs) from its lock file.
+BUILD_PACKAGES=(
   build-essential
   cmake
   ninja-build
@@ -37,25 +48,46 @@ PACKAGES=(
   libembree-dev
   libtinyobjloader-dev
   libpng-dev
-  # Step 3: Vulkan on Mesa's lavapipe (a CPU device) where no GPU exists;
-  # glslang compiles the shaders at build time.
+  # Step 3: Vulkan; glslang compiles the shaders at build time.
   libvulkan-dev
-  mesa-vulkan-drivers
-  vulkan-tools
-  vulkan-validationlayers
   glslang-tools
-  # Step 4: the wire contract, the service (Asio + Beast) and its encoders;
-  # Debian's Chromium and Node.js for the browser client's end-to-end test.
+  # Step 4: the wire contract, the service (Asio + Beast) and its encoders.
   libprotobuf-dev
   protobuf-compiler
   libboost-dev
   libturbojpeg0-dev
-  chromium
   nodejs
   # Step 5: Google Highway for the fused kernel's SIMD (runtime dispatch).
   libhwy-dev
-  # eval's figures: matplotlib draws them from report.json (tools/plot_report.py).
+)
+# runtime: the shared libraries `haarcast` and `haarcast-client` name as
+# NEEDED (readelf -d), the Vulkan loader and Mesa's Vulkan drivers (lavapipe:
+# the device where no GPU is passed in; they are loaded with dlopen, so no
+# NEEDED entry names them), and vulkaninfo to see which devices a container
+# has. libc6 and libgcc-s1 are in every Debian image (Priority: required).
+RUNTIME_PACKAGES=(
+  libstdc++6
+  libembree3-3
+  libopenexr-3-1-30
+  libimath-3-1-29
+  libpng16-16
+  libtinyobjloader2rc10
+  libprotobuf32
+  libturbojpeg0
+  libhwy1
+  libvulkan1
+  mesa-vulkan-drivers
+  vulkan-tools
+)
+# test: the validation layers (GPU tests run with them on), Debian's Chromium
+# for the browser client's end-to-end test, matplotlib for eval's figures
+# (tools/plot_report.py), PyYAML and kubectl for the Kubernetes manifests' test.
+TEST_PACKAGES=(
+  vulkan-validationlayers
+  chromium
   python3-matplotlib
+  python3-yaml
+  kubernetes-client
 )
 
 # Build folder, relative to the repository root (HAARCAST_BUILD_DIR overrides).
@@ -69,16 +101,38 @@ usage() {
 
 log() { printf '==> %s\n' "$*"; }
 
+# The packages of the roles named (build, runtime, test), one per line.
+role_packages() {
+  local role
+  for role in "$@"; do
+    case "$role" in
+      build) printf '%s\n' "${BUILD_PACKAGES[@]}" ;;
+      runtime) printf '%s\n' "${RUNTIME_PACKAGES[@]}" ;;
+      test) printf '%s\n' "${TEST_PACKAGES[@]}" ;;
+      *)
+        echo "error: unknown package role '$role' (valid: build, runtime, test)" >&2
+        exit 2
+        ;;
+    esac
+  done
+}
+
+# Installs the packages of the roles named that are not installed yet.
 install_packages() {
-  local missing=() pkg
-  for pkg in "${PACKAGES[@]}"; do
+  local missing=() pkg packages
+  packages="$(role_packages "$@")" || exit 2
+  for pkg in $packages; do
+    # A kubectl already on PATH (a newer one, often from another package that
+    # owns /usr/bin/kubectl) stands in for Debian's kubernetes-client, which
+    # would conflict with it.
+    [[ "$pkg" == kubernetes-client ]] && command -v kubectl >/dev/null 2>&1 && continue
     if [[ "$(dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null || true)" != "install ok installed" ]]; then
       missing+=("$pkg")
     fi
   done
   # npm ships inside NodeSource's nodejs; Debian's own nodejs needs the npm
   # package beside it (installing that over NodeSource's would conflict).
-  command -v npm >/dev/null 2>&1 || missing+=(npm)
+  if grep -qx nodejs <<<"$packages"; then command -v npm >/dev/null 2>&1 || missing+=(npm); fi
   ((${#missing[@]} == 0)) && return 0
 
   log "installing ${missing[*]}"
@@ -113,7 +167,7 @@ command="$1"
 shift
 [[ "${1:-}" == "--" ]] && shift
 case "$command" in
-  demo | test | bench | build) ;;
+  demo | test | bench | build | install | packages) ;;
   -h | --help | help) usage ;;
   *)
     echo "error: unknown command '$command'" >&2
@@ -139,7 +193,20 @@ vendor_web_client() {
   touch "$web/node_modules"
 }
 
-install_packages
+case "$command" in
+  packages)
+    (($# >= 1)) || { echo "error: packages needs a role (build, runtime, test)" >&2; exit 2; }
+    role_packages "$@"
+    exit 0
+    ;;
+  install)
+    (($# >= 1)) || { echo "error: install needs a role (build, runtime, test)" >&2; exit 2; }
+    install_packages "$@"
+    exit 0
+    ;;
+  test) install_packages build runtime test ;;
+  *) install_packages build runtime ;;
+esac
 configure_and_build
 vendor_web_client
 
