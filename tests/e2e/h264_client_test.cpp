@@ -7,6 +7,9 @@
 // there; one joining between keyframes gets an error, not a picture.
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -153,6 +156,36 @@ TEST(H264Client, DecodedFramesAreWrittenAsPng) {
   const std::vector<std::uint8_t> png = encodePng(image);
   const Rgba8Image back = decodeFrame(v1::ENCODING_PNG, png, kSide, kSide);
   EXPECT_EQ(back.pixels, image.pixels);
+}
+
+// Not a check of its own: writes the orbit's stream for the browser's
+// WebCodecs check (h264_webcodecs.mjs, run by run_h264_webcodecs.sh) when
+// HAARCAST_H264_STREAM_DIR names a folder: orbit.h264 (the access units
+// back to back), orbit.json (each unit's offset, size and keyframe flag) and
+// the last source frame as raw RGBA8, which the browser's picture must match.
+TEST(H264Client, WritesTheOrbitForTheBrowserCheck) {
+  const char* dir = std::getenv("HAARCAST_H264_STREAM_DIR");
+  if (!dir) GTEST_SKIP() << "HAARCAST_H264_STREAM_DIR is not set";
+  const Stream s = encodeOrbit(30);
+  const std::filesystem::path out(dir);
+  std::filesystem::create_directories(out);
+  std::ofstream stream(out / "orbit.h264", std::ios::binary);
+  std::ofstream index(out / "orbit.json");
+  index << "{\"width\": " << kSide << ", \"height\": " << kSide << ", \"min_psnr_db\": " << kMinPsnrDb
+        << ", \"units\": [";
+  std::size_t offset = 0;
+  for (std::size_t i = 0; i < s.units.size(); ++i) {
+    const std::string& au = s.units[i].annexB;
+    stream.write(au.data(), static_cast<std::streamsize>(au.size()));
+    index << (i ? ", " : "") << "{\"offset\": " << offset << ", \"size\": " << au.size()
+          << ", \"key\": " << (s.units[i].keyframe ? "true" : "false") << "}";
+    offset += au.size();
+  }
+  index << "]}\n";
+  std::ofstream last(out / "last-source.rgba", std::ios::binary);
+  last.write(reinterpret_cast<const char*>(s.sources.back().data()),
+             static_cast<std::streamsize>(s.sources.back().size()));
+  ASSERT_TRUE(stream && index && last) << "cannot write under " << out;
 }
 
 }  // namespace
