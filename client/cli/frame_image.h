@@ -1,7 +1,8 @@
 // Decoding a Frame's payload back to pixels, for the not-blank check and for
 // writing raw frames as viewable files. JPEG via libjpeg-turbo, PNG via
 // libpng, RAW as is, EXR via OpenEXR (half-float RGB, tone-mapped to 8 bits
-// only for the statistics).
+// only for the statistics), H.264 via libavcodec through a session's
+// FrameDecoder (h264_decoder.h).
 #pragma once
 
 #include <cstdint>

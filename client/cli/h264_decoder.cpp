@@ -1,5 +1,6 @@
 #include "h264_decoder.h"
 
+#include <mutex>
 #include <stdexcept>
 #include <string>
 
@@ -41,7 +42,8 @@ struct H264Decoder::Codec {
 H264Decoder::H264Decoder() : codec_(std::make_unique<Codec>()) {
   // libavcodec logs every damaged slice on stderr; the errors that matter
   // come back from decode() as exceptions with the frame's number.
-  av_log_set_level(AV_LOG_FATAL);
+  static std::once_flag quiet;  // --clients N decoders start on several threads
+  std::call_once(quiet, [] { av_log_set_level(AV_LOG_FATAL); });
   const AVCodec* h264 = avcodec_find_decoder(AV_CODEC_ID_H264);
   if (!h264) throw std::runtime_error("H.264: this libavcodec has no h264 decoder");
   codec_->context = avcodec_alloc_context3(h264);

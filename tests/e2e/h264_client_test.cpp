@@ -20,13 +20,14 @@
 #include "frame_image.h"
 #include "haarcast/net/encode.h"
 #include "haarcast/net/h264_encoder.h"
+#include "haarcast/net/protocol.h"
 
 namespace haarcast::client {
 namespace {
 
 constexpr int kSide = 256;
 constexpr int kFrames = 60;
-constexpr int kJpegQuality = 85;        // the server's default (docs/service.md "Encodings")
+const int kJpegQuality = net::Defaults{}.jpegQuality;  // the server's default (85)
 constexpr double kMinPsnrDb = 30.0;
 constexpr double kMaxBytesRatioToJpeg = 0.5;  // "well below": at most half
 
