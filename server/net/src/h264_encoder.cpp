@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <mutex>
+#include <sstream>
 #include <stdexcept>
 
 extern "C" {
@@ -32,10 +33,17 @@ std::string averrorText(int code) {
                            std::to_string(code) + ")");
 }
 
+// Shortest form: "4096", "0.01", not std::to_string's "4096.000000".
+std::string numberText(double v) {
+  std::ostringstream text;
+  text << v;
+  return text.str();
+}
+
 void checkRange(const char* field, double value, double lo, double hi) {
   if (!(value >= lo && value <= hi)) {
-    throw std::invalid_argument("h264: " + std::string(field) + " " + std::to_string(value) + " is outside " +
-                                std::to_string(lo) + ".." + std::to_string(hi));
+    throw std::invalid_argument("h264: " + std::string(field) + " " + numberText(value) + " is outside " +
+                                numberText(lo) + ".." + numberText(hi));
   }
 }
 

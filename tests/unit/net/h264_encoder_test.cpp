@@ -148,7 +148,8 @@ TEST(H264Encoder, RefusesOddSizesAndSettingsOutsideTheirRanges) {
   EXPECT_NE(message(settings(0, 48)).find("width"), std::string::npos);
   H264Settings s = settings(64, 48);
   s.bitrateKbps = 1;
-  EXPECT_NE(message(s).find("bitrate"), std::string::npos) << message(s);
+  const std::string range = std::to_string(kMinH264BitrateKbps) + ".." + std::to_string(kMaxH264BitrateKbps);
+  EXPECT_NE(message(s).find("bitrate (kbit/s) 1 is outside " + range), std::string::npos) << message(s);
   s = settings(64, 48);
   s.keyframeInterval = 0;
   EXPECT_NE(message(s).find("keyframe interval"), std::string::npos) << message(s);
