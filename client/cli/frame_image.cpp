@@ -12,6 +12,8 @@
 #include <png.h>
 #include <turbojpeg.h>
 
+#include "h264_decoder.h"
+
 namespace haarcast::client {
 
 namespace {
@@ -134,9 +136,22 @@ Rgba8Image decodeFrame(v1::Encoding encoding, std::span<const std::uint8_t> data
       }
       return {width, height, std::vector<std::uint8_t>(data.begin(), data.end())};
     }
+    case v1::ENCODING_H264:
+      throw std::runtime_error("H.264 frames depend on the ones before them: decode them in order with the "
+                               "session's FrameDecoder");
     default:
       throw std::runtime_error("frame has unknown encoding " + std::to_string(static_cast<int>(encoding)));
   }
+}
+
+FrameDecoder::FrameDecoder() = default;
+FrameDecoder::~FrameDecoder() = default;
+
+Rgba8Image FrameDecoder::decode(v1::Encoding encoding, std::span<const std::uint8_t> data, std::uint32_t width,
+                                std::uint32_t height) {
+  if (encoding != v1::ENCODING_H264) return decodeFrame(encoding, data, width, height);
+  if (!h264_) h264_ = std::make_unique<H264Decoder>();
+  return h264_->decode(data, width, height);
 }
 
 PixelStats pixelStats(const Rgba8Image& image) {
@@ -161,6 +176,26 @@ std::vector<std::uint8_t> encodePam(const Rgba8Image& image) {
                              "\nDEPTH 4\nMAXVAL 255\nTUPLTYPE RGB_ALPHA\nENDHDR\n";
   std::vector<std::uint8_t> out(header.begin(), header.end());
   out.insert(out.end(), image.pixels.begin(), image.pixels.end());
+  return out;
+}
+
+std::vector<std::uint8_t> encodePng(const Rgba8Image& image) {
+  png_image png;
+  std::memset(&png, 0, sizeof png);
+  png.version = PNG_IMAGE_VERSION;
+  png.width = image.width;
+  png.height = image.height;
+  png.format = PNG_FORMAT_RGBA;
+  // The simplified API sizes the buffer on a first call without one.
+  png_alloc_size_t size = 0;
+  if (!png_image_write_to_memory(&png, nullptr, &size, 0, image.pixels.data(), 0, nullptr)) {
+    throw std::runtime_error(std::string("PNG: encode failed: ") + png.message);
+  }
+  std::vector<std::uint8_t> out(size);
+  if (!png_image_write_to_memory(&png, out.data(), &size, 0, image.pixels.data(), 0, nullptr)) {
+    throw std::runtime_error(std::string("PNG: encode failed: ") + png.message);
+  }
+  out.resize(size);
   return out;
 }
 
