@@ -59,6 +59,10 @@ BUILD_PACKAGES=(
   nodejs
   # Step 5: Google Highway for the fused kernel's SIMD (runtime dispatch).
   libhwy-dev
+  # H.264 frames: libx264 through libavcodec, RGBA ↔ YUV through libswscale.
+  libavcodec-dev
+  libavutil-dev
+  libswscale-dev
 )
 # runtime: the shared libraries `haarcast` and `haarcast-client` name as
 # NEEDED (readelf -d), the Vulkan loader and Mesa's Vulkan drivers (lavapipe:
@@ -75,6 +79,9 @@ RUNTIME_PACKAGES=(
   libprotobuf32
   libturbojpeg0
   libhwy1
+  libavcodec59
+  libavutil57
+  libswscale6
   libvulkan1
   mesa-vulkan-drivers
   vulkan-tools
