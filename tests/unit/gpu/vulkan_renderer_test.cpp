@@ -350,14 +350,6 @@ TEST(VulkanRenderer, RejectsWhatTheGpuCannotDoByName) {
     EXPECT_NE(std::string(e.what()).find("levels 2 to 6"), std::string::npos) << e.what();
   }
   o.level = 4;
-  o.antialias = true;
-  try {
-    VulkanRenderer gpu(scene, o, testing::testOptions());
-    FAIL() << "antialias accepted";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("antialiasing"), std::string::npos) << e.what();
-  }
-  o.antialias = false;
   VulkanRenderer gpu(scene, o, testing::testOptions());
   render::FrameRequest bad = requestFor(scene, 16, 16);
   bad.poses.resize(5);
