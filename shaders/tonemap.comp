@@ -1,30 +1,28 @@
 #version 450
-// The "tonemap" pass: uncovered pixels get the backdrop (bilinear in the
-// level-kBackgroundLevel maps at lightRotationᵀ·direction, as
-// render::backgroundRadiance) or black; every pixel is then encoded as
-// render::tonemapRgba8 does (render/tonemap.h): × 2^exposure, Reinhard's
-// extended curve (white kToneWhite), sRGB transfer (IEC 61966-2-1), rounded,
-// alpha 255. The linear image stays in `radiance` for EXR output. Local size
-// 64, one invocation per pixel.
+// The "tonemap" stage's encoding: every pixel's linear radiance (resolve.comp)
+// encoded as render::tonemapRgba8 does (render/tonemap.h): × 2^exposure,
+// Reinhard's extended curve (white kToneWhite), sRGB transfer
+// (IEC 61966-2-1), rounded, alpha 255. Local size 64, one invocation per
+// pixel.
 //
 // The encoding is not evaluated with pow (loose on Vulkan: lavapipe's
 // differs from the CPU's in 0.6% of bytes) but by counting thresholds: code
 // ≥ k exactly when the linear value ≥ threshold[k], the transform's inverse
 // at the rounding boundary (k − ½)/255, which the host computes in double
 // (render::tonemapThresholds) and the CPU counts the same way. So both give
-// the same byte for every float.
+// the same byte for every float. A fixed exposure is in the thresholds
+// (gain 1); an automatic one, chosen on the device by exposure.comp, is the
+// gain 2^stops applied to the value before the count (thresholds of 0 stops).
 #extension GL_GOOGLE_include_directive : require
 #include "common/frame.glsl"
-#include "common/sphere.glsl"
 
 layout(local_size_x = 64) in;
 
 layout(std430, set = 0, binding = 0) readonly buffer Frame { FrameParams frame; };
-layout(std430, set = 0, binding = 1) readonly buffer Ids { uvec4 ids[]; };
-layout(std430, set = 0, binding = 2) buffer Radiance { vec4 radiance[]; };
-layout(std430, set = 0, binding = 3) readonly buffer Background { float background[]; };  // [channel][row][col]
-layout(std430, set = 0, binding = 4) writeonly buffer Rgba8 { uint rgba8[]; };
-layout(std430, set = 0, binding = 5) readonly buffer Thresholds { float threshold[256]; };  // [k], k = 1 … 255
+layout(std430, set = 0, binding = 1) readonly buffer Radiance { vec4 radiance[]; };
+layout(std430, set = 0, binding = 2) writeonly buffer Rgba8 { uint rgba8[]; };
+layout(std430, set = 0, binding = 3) readonly buffer Thresholds { float threshold[256]; };  // [k], k = 1 … 255
+layout(std430, set = 0, binding = 4) readonly buffer Exposure { ExposureResult exposure; };
 
 // Binary search for the largest k with value ≥ threshold[k] (0 when none,
 // and for NaN, whose comparisons are false).
@@ -40,28 +38,7 @@ uint encodeSrgb(float value) {
 void main() {
   uint p = gl_GlobalInvocationID.x;
   if (p >= frame.width * frame.height) return;
-  vec3 rgb;
-  if (ids[p].x != 0u) {
-    rgb = radiance[p].rgb;
-  } else if (frame.background != 0u) {
-    uint x = p % frame.width, y = p / frame.width;
-    mat3 lightRotT = mat3(frame.lightRotT[0].xyz, frame.lightRotT[1].xyz, frame.lightRotT[2].xyz);
-    vec2 tp = directionToSpherical(lightRotT * cameraDirection(frame, x, y));
-    int level = int(frame.backgroundLevel);
-    int m = 1 << level;
-    Taps t = bilinearTaps(level, tp.x, tp.y);
-    for (int c = 0; c < 3; ++c) {
-      uint base = uint(c * m * m);
-      float top = (1.0 - t.t.y) * background[base + uint(t.rc.x * m + t.rc.z)] +
-                  t.t.y * background[base + uint(t.rc.x * m + t.rc.w)];
-      float bottom = (1.0 - t.t.y) * background[base + uint(t.rc.y * m + t.rc.z)] +
-                     t.t.y * background[base + uint(t.rc.y * m + t.rc.w)];
-      rgb[c] = (1.0 - t.t.x) * top + t.t.x * bottom;
-    }
-    radiance[p] = vec4(rgb, 1.0);
-  } else {
-    rgb = vec3(0.0);
-    radiance[p] = vec4(rgb, 1.0);
-  }
+  vec3 rgb = radiance[p].rgb;
+  if (exposure.gain != 1.0) rgb *= exposure.gain;
   rgba8[p] = encodeSrgb(rgb.r) | (encodeSrgb(rgb.g) << 8) | (encodeSrgb(rgb.b) << 16) | (255u << 24);
 }

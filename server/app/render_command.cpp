@@ -90,7 +90,7 @@ std::function<int()> addRenderCommand(CLI::App& app) {
   c->add_option("--visibility-coeffs", args->options.visibility.keep, "Visibility coefficients kept per vertex")
       ->capture_default_str();
   c->add_option("--backend", args->backend, "cpu|vulkan")->capture_default_str();
-  c->add_option("--antialias", args->antialias, "auto|on|off: edge pixels as the mean of 4 sub-samples (auto: on for cpu)")
+  c->add_option("--antialias", args->antialias, "auto|on|off: edge pixels as the mean of 4 sub-samples (auto: on)")
       ->capture_default_str();
   c->add_option("--device", args->device, "Vulkan device: an index or a name substring (default: discrete > integrated > CPU)");
   c->add_flag("--validation,!--no-validation", args->validation, "Vulkan validation layers (when installed)")

@@ -37,8 +37,8 @@ render::Scene sceneFromFlags(const SceneFlags& flags);
 // --background env|black, validated.
 bool environmentBackground(const SceneFlags& flags);
 
-// --antialias auto|on|off for a backend: auto is on where the backend draws
-// it (the CPU) and off elsewhere; on for a backend that cannot is an error.
+// --antialias auto|on|off for a backend: auto is on (the cpu and vulkan
+// backends both draw it); a flag outside the three is an error.
 bool antialiasFor(const std::string& flag, const std::string& backend);
 
 // --out ends in .exr or .png and its folder exists and is writable: checked

@@ -208,7 +208,7 @@ std::function<int()> addServeCommand(CLI::App& app) {
   c->add_option("--bind", o.bindAddress, "Address to listen on")->capture_default_str();
   c->add_option("--token", a->token, "Required token (?token=T or Authorization: Bearer T); default $HAARCAST_TOKEN");
   c->add_option("--backend", a->backend, "Default backend: cpu|vulkan")->capture_default_str();
-  c->add_option("--antialias", a->antialias, "auto|on|off: edge pixels as the mean of 4 sub-samples (auto: on for cpu)")
+  c->add_option("--antialias", a->antialias, "auto|on|off: edge pixels as the mean of 4 sub-samples (auto: on)")
       ->capture_default_str();
   c->add_option("--level", a->level, "Default map level n (M = 2^n), within the session limits (--max-level)")
       ->capture_default_str();

@@ -7,14 +7,15 @@
 
 namespace haarcast::gpu {
 
-DeviceImage VulkanRenderer::Impl::createImage(VkFormat format, VkImageUsageFlags usage, VkImageAspectFlags aspect) {
+DeviceImage VulkanRenderer::Impl::createImage(VkFormat format, VkImageUsageFlags usage, VkImageAspectFlags aspect,
+                                              std::uint32_t w, std::uint32_t h) {
   VkDevice device = context.device();
   DeviceImage out;
   VkImageCreateInfo ic{};
   ic.sType = VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO;
   ic.imageType = VK_IMAGE_TYPE_2D;
   ic.format = format;
-  ic.extent = {static_cast<std::uint32_t>(width), static_cast<std::uint32_t>(height), 1};
+  ic.extent = {w, h, 1};
   ic.mipLevels = 1;
   ic.arrayLayers = 1;
   ic.samples = VK_SAMPLE_COUNT_1_BIT;
@@ -49,17 +50,48 @@ void VulkanRenderer::Impl::destroyImage(DeviceImage& image) {
   image = DeviceImage{};
 }
 
+VulkanRenderer::Impl::GBufferTarget VulkanRenderer::Impl::createTarget(std::uint32_t w, std::uint32_t h) {
+  GBufferTarget t;
+  t.width = w;
+  t.height = h;
+  try {
+    constexpr VkImageUsageFlags colourUsage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+    t.normal = createImage(kNormalFormat, colourUsage, VK_IMAGE_ASPECT_COLOR_BIT, w, h);
+    t.ids = createImage(kIdsFormat, colourUsage, VK_IMAGE_ASPECT_COLOR_BIT, w, h);
+    t.position = createImage(kPositionFormat, colourUsage, VK_IMAGE_ASPECT_COLOR_BIT, w, h);
+    t.depth = createImage(kDepthFormat, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, VK_IMAGE_ASPECT_DEPTH_BIT, w, h);
+    const VkImageView views[4] = {t.normal.view, t.ids.view, t.position.view, t.depth.view};
+    VkFramebufferCreateInfo fb{};
+    fb.sType = VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO;
+    fb.renderPass = renderPass;
+    fb.attachmentCount = 4;
+    fb.pAttachments = views;
+    fb.width = w;
+    fb.height = h;
+    fb.layers = 1;
+    vkCheck(vkCreateFramebuffer(context.device(), &fb, nullptr, &t.framebuffer), "vkCreateFramebuffer");
+  } catch (...) {
+    destroyTarget(t);
+    throw;
+  }
+  return t;
+}
+
+void VulkanRenderer::Impl::destroyTarget(GBufferTarget& t) {
+  if (t.framebuffer) vkDestroyFramebuffer(context.device(), t.framebuffer, nullptr);
+  for (DeviceImage* i : {&t.normal, &t.ids, &t.position, &t.depth}) destroyImage(*i);
+  t = GBufferTarget{};
+}
+
 void VulkanRenderer::Impl::releaseResolution() {
-  VkDevice device = context.device();
-  if (framebuffer) vkDestroyFramebuffer(device, framebuffer, nullptr);
-  framebuffer = VK_NULL_HANDLE;
-  for (DeviceImage* i : {&normalImage, &idsImage, &positionImage, &depthImage}) destroyImage(*i);
-  for (Buffer* b :
-       {&gbufIds, &gbufNormals, &gbufPositions, &samples, &shade, &counter, &radiance, &rgba8, &rotated, &batchArgs}) {
+  destroyTarget(target);
+  destroyTarget(subTarget);
+  for (Buffer* b : {&gbufIds, &gbufNormals, &gbufPositions, &samples, &shade, &counter, &radiance, &rgba8, &rotated,
+                    &batchArgs, &subIds, &subNormals, &edges}) {
     *b = Buffer();
   }
   width = height = 0;
-  batch = maxBatches = 0;
+  batch = maxBatches = sampleCapacity = 0;
 }
 
 void VulkanRenderer::Impl::ensureResolution(int w, int h) {
@@ -68,36 +100,38 @@ void VulkanRenderer::Impl::ensureResolution(int w, int h) {
   width = w;
   height = h;
   const std::size_t pixels = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
-  constexpr VkImageUsageFlags colourUsage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
-  normalImage = createImage(kNormalFormat, colourUsage, VK_IMAGE_ASPECT_COLOR_BIT);
-  idsImage = createImage(kIdsFormat, colourUsage, VK_IMAGE_ASPECT_COLOR_BIT);
-  positionImage = createImage(kPositionFormat, colourUsage, VK_IMAGE_ASPECT_COLOR_BIT);
-  depthImage = createImage(kDepthFormat, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, VK_IMAGE_ASPECT_DEPTH_BIT);
-  const VkImageView views[4] = {normalImage.view, idsImage.view, positionImage.view, depthImage.view};
-  VkFramebufferCreateInfo fb{};
-  fb.sType = VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO;
-  fb.renderPass = renderPass;
-  fb.attachmentCount = 4;
-  fb.pAttachments = views;
-  fb.width = static_cast<std::uint32_t>(w);
-  fb.height = static_cast<std::uint32_t>(h);
-  fb.layers = 1;
-  vkCheck(vkCreateFramebuffer(context.device(), &fb, nullptr, &framebuffer), "vkCreateFramebuffer");
-
+  const auto uw = static_cast<std::uint32_t>(w), uh = static_cast<std::uint32_t>(h);
+  target = createTarget(uw, uh);
   gbufIds = Buffer(context, pixels * sizeof(glm::uvec4));
   gbufNormals = Buffer(context, pixels * sizeof(glm::vec4));
   gbufPositions = Buffer(context, pixels * sizeof(glm::vec4));
-  samples = Buffer(context, pixels * sizeof(RotationSample));
-  shade = Buffer(context, pixels * sizeof(ShadeSample));
+  edges = Buffer(context, pixels * sizeof(std::uint32_t));
+  if (options.antialias) {
+    // The sub-samples: the pixel centres of the frame at twice the resolution (shared_layout.h).
+    subTarget = createTarget(2 * uw, 2 * uh);
+    subIds = Buffer(context, shared::kSubsamples * pixels * sizeof(glm::uvec4), kStorageUsage, MemoryUse::DeviceOnly);
+    subNormals = Buffer(context, shared::kSubsamples * pixels * sizeof(glm::vec4), kStorageUsage, MemoryUse::DeviceOnly);
+    sampleCapacity = shared::kSubsamples * pixels;
+  } else {
+    subIds = Buffer(context, sizeof(std::uint32_t), kStorageUsage, MemoryUse::DeviceOnly);
+    subNormals = Buffer(context, sizeof(std::uint32_t), kStorageUsage, MemoryUse::DeviceOnly);
+    sampleCapacity = pixels;
+  }
+  samples = Buffer(context, sampleCapacity * sizeof(RotationSample));
+  shade = Buffer(context, sampleCapacity * sizeof(ShadeSample));
   // The covered-pixel count and `fused`'s indirect dispatch arguments.
   counter = Buffer(context, sizeof(CoverageCounter),
                    VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
                        VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
-  radiance = Buffer(context, pixels * sizeof(glm::vec4));
+  // Per pixel, then (antialiasing) per sub-sample slot (shared_layout.h subsampleSlot).
+  radiance = Buffer(context, (options.antialias ? 1 + shared::kSubsamples : 1) * pixels * sizeof(glm::vec4));
   rgba8 = Buffer(context, pixels * sizeof(std::uint32_t));
 
-  rotationInput->bind({&frameParams, &objects, &gbufIds, &gbufNormals, &triangles, &samples, &shade, &counter});
-  tonemap->bind({&frameParams, &gbufIds, &radiance, &background, &rgba8, &thresholds});
+  rotationInput->bind({&frameParams, &objects, &gbufIds, &gbufNormals, &triangles, &samples, &shade, &counter, &subIds,
+                       &subNormals, &edges});
+  resolve->bind({&frameParams, &gbufIds, &radiance, &background, &edges});
+  exposure->bind({&frameParams, &gbufIds, &radiance, &exposureResult});
+  tonemap->bind({&frameParams, &radiance, &rgba8, &thresholds, &exposureResult});
   if (fused) {
     fusedPass->bind({&samples, &shade, &objects, &sliceTexels, &lightTexels, &visibility, &directionTexels, &scratch,
                      &radiance, &counter, &visibilityTexels});
@@ -109,11 +143,11 @@ void VulkanRenderer::Impl::ensureResolution(int w, int h) {
   const VkPhysicalDeviceLimits& lim = context.properties().limits;
   const std::size_t perSample = 3 * coefficients * sizeof(float);
   const std::size_t range = std::min<std::size_t>(kRotatedBudget, lim.maxStorageBufferRange);
-  batch = std::min({pixels, range / perSample, static_cast<std::size_t>(lim.maxComputeWorkGroupCount[0]),
+  batch = std::min({sampleCapacity, range / perSample, static_cast<std::size_t>(lim.maxComputeWorkGroupCount[0]),
                     static_cast<std::size_t>(lim.maxComputeWorkGroupCount[0]) * 64 / 3});
   if (limits.batchSamples) batch = std::min(batch, limits.batchSamples);
   batch = std::max<std::size_t>(batch, 1);
-  maxBatches = (pixels + batch - 1) / batch;
+  maxBatches = (sampleCapacity + batch - 1) / batch;
   rotated = Buffer(context, batch * perSample, kStorageUsage, MemoryUse::DeviceOnly);
   batchArgs = Buffer(context, 2 * maxBatches * sizeof(DispatchArgs), kStorageUsage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT,
                      MemoryUse::DeviceOnly);

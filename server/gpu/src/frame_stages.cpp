@@ -68,40 +68,43 @@ void VulkanRenderer::Impl::runStages(const std::vector<FrameStage>& stages, rend
   }
 }
 
-namespace {
-double provisionalStops(const render::ExposureControl& exposure) {
-  return exposure.automatic ? exposure.previousStops.value_or(0.0) : exposure.stops;
-}
-}  // namespace
-
 void VulkanRenderer::Impl::uploadFrameUniforms(const render::FrameRequest& request) {
-  const double stops = provisionalStops(request.exposure);
   FrameParams params = makeFrameParams(request.camera, request.width, request.height, request.lightRotation,
                                        options.environmentBackground, prepared.background[0].level());
   params.fusedGroups = fusedGroups;
+  params.antialias = options.antialias ? 1u : 0u;
   frameParams.write(&params, sizeof params);
-  const std::array<float, 256> encoding = render::tonemapThresholds(stops);
+  // A fixed exposure is encoded in the thresholds; an automatic one is a
+  // gain the device chooses (exposure.comp) over the thresholds of 0 stops.
+  const render::ExposureControl& e = request.exposure;  // checked by render::checkFrameRequest
+  const std::array<float, 256> encoding = render::tonemapThresholds(e.automatic ? 0.0 : e.stops);
   thresholds.write(encoding.data(), sizeof encoding);
 }
 
-void VulkanRenderer::Impl::finishExposure(const render::FrameRequest& request, render::Frame& frame) {
-  const double provisional = provisionalStops(request.exposure);
-  frame.exposureStops = provisional;
-  if (!request.exposure.automatic) return;
-  // The linear image the frame read back, else a copy of the mapped radiance.
-  io::RgbImage mapped;
-  if (frame.image.rgb.empty()) {
-    const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
-    mapped = io::makeImage(width, height);
-    const auto* rad = static_cast<const glm::vec4*>(radiance.mapped());
-    for (std::size_t p = 0; p < pixels; ++p) {
-      for (std::size_t c = 0; c < 3; ++c) mapped.rgb[3 * p + c] = rad[p][static_cast<int>(c)];
-    }
-  }
-  const io::RgbImage& linear = frame.image.rgb.empty() ? mapped : frame.image;
-  frame.logAverageLuminance = render::frameLogAverage(linear, frame.objectMask);
-  frame.exposureStops = render::applyExposure(request.exposure, frame.logAverageLuminance);
-  if (frame.exposureStops != provisional) frame.rgba8 = render::tonemapRgba8(linear, frame.exposureStops);
+void VulkanRenderer::Impl::recordTonemap(VkCommandBuffer cb, const render::FrameRequest& request) {
+  const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  resolve->dispatch(cb, {groupsOf(pixels, 64), 1, 1});
+  computeBarrier(cb);
+  const render::ExposureControl& e = request.exposure;
+  ExposurePush push{};
+  push.automatic = e.automatic ? 1u : 0u;
+  push.hasPrevious = e.previousStops ? 1u : 0u;
+  push.previousStops = static_cast<float>(e.previousStops.value_or(0.0));
+  push.adaptation = static_cast<float>(e.adaptation);
+  push.fixedStops = static_cast<float>(e.stops);
+  push.key = static_cast<float>(render::kExposureKey);
+  push.maxStops = static_cast<float>(render::kMaxExposureStops);
+  exposure->dispatch(cb, {1, 1, 1}, &push, sizeof push);  // one workgroup reduces the frame
+  computeBarrier(cb);
+  tonemap->dispatch(cb, {groupsOf(pixels, 64), 1, 1});
+}
+
+void VulkanRenderer::Impl::finishExposure(const render::FrameRequest& request, render::Frame& frame) const {
+  ExposureResult r{};
+  exposureResult.read(&r, sizeof r);
+  frame.logAverageLuminance = r.logAverage;
+  // A fixed exposure is reported as asked (the device holds it in float).
+  frame.exposureStops = request.exposure.automatic ? static_cast<double>(r.stops) : request.exposure.stops;
 }
 
 }  // namespace haarcast::gpu

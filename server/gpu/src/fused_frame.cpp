@@ -47,7 +47,7 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
               [&](VkCommandBuffer cb) {
                 fusedPass->dispatchIndirect(cb, counter, offsetof(CoverageCounter, groups));
               }},
-             {"tonemap", [&](VkCommandBuffer cb) { tonemap->dispatch(cb, {groupsOf(pixels, 64), 1, 1}); }}},
+             {"tonemap", [&](VkCommandBuffer cb) { recordTonemap(cb, request); }}},
             frame);
 
   // ---- Results: RGBA8 always, the linear image only when asked for ----------
@@ -66,14 +66,14 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
   finishExposure(request, frame);
 
   // Coefficient bytes read, counted as the CPU backend counts them: the light
-  // lists, and per covered pixel core fusedPixelBytes (one slice or two, the
+  // lists, and per shaded sample core fusedPixelBytes (one slice or two, the
   // light planes, the three vertices' entries).
   std::size_t bytes = resolved.lightBytes;
   CoverageCounter count{};
   counter.read(&count, sizeof count);
   const auto* rs = static_cast<const RotationSample*>(samples.mapped());
   const auto* sh = static_cast<const ShadeSample*>(shade.mapped());
-  for (std::uint32_t i = 0; i < count.covered && i < pixels; ++i) {
+  for (std::uint32_t i = 0; i < count.covered && i < sampleCapacity; ++i) {
     std::size_t entries = 0;
     for (std::uint32_t v : sh[i].vertex) entries += v < visibilityBlocks.size() ? visibilityBlocks[v] : 0;
     const shared::SliceBlend blend =

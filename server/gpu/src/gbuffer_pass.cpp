@@ -220,22 +220,25 @@ glm::dmat4 VulkanRenderer::Impl::frameViewProjection(const render::FrameRequest&
   return viewProjection(request.camera, request.width, request.height, nearPlane);
 }
 
-// The G-buffer: every object rasterised, then the attachments copied to the
-// storage buffers the compute passes read.
-void VulkanRenderer::Impl::recordGBuffer(VkCommandBuffer cb, const render::FrameRequest& request,
-                                         const glm::dmat4& viewProj) {
+// Every object rasterised into `t`, then the attachments copied to the
+// storage buffers the compute passes read. The projection is the frame's at
+// any scale: at twice the resolution the pixel centres land on the
+// sub-samples (shared_layout.h).
+void VulkanRenderer::Impl::rasterise(VkCommandBuffer cb, const render::FrameRequest& request,
+                                     const glm::dmat4& viewProj, const GBufferTarget& t, const Buffer& ids,
+                                     const Buffer& normalsOut, const Buffer* positionsOut) {
   std::array<VkClearValue, 4> clear{};
   clear[3].depthStencil = {0.0f, 0};  // reversed Z: 0 is infinitely far
   VkRenderPassBeginInfo rb{};
   rb.sType = VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO;
   rb.renderPass = renderPass;
-  rb.framebuffer = framebuffer;
-  rb.renderArea = {{0, 0}, {static_cast<std::uint32_t>(width), static_cast<std::uint32_t>(height)}};
+  rb.framebuffer = t.framebuffer;
+  rb.renderArea = {{0, 0}, {t.width, t.height}};
   rb.clearValueCount = 4;
   rb.pClearValues = clear.data();
   vkCmdBeginRenderPass(cb, &rb, VK_SUBPASS_CONTENTS_INLINE);
-  const VkViewport viewport{0.0f, 0.0f, static_cast<float>(width), static_cast<float>(height), 0.0f, 1.0f};
-  const VkRect2D scissor{{0, 0}, {static_cast<std::uint32_t>(width), static_cast<std::uint32_t>(height)}};
+  const VkViewport viewport{0.0f, 0.0f, static_cast<float>(t.width), static_cast<float>(t.height), 0.0f, 1.0f};
+  const VkRect2D scissor{{0, 0}, {t.width, t.height}};
   vkCmdSetViewport(cb, 0, 1, &viewport);
   vkCmdSetScissor(cb, 0, 1, &scissor);
   vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, gbufferPipeline);
@@ -252,11 +255,19 @@ void VulkanRenderer::Impl::recordGBuffer(VkCommandBuffer cb, const render::Frame
   vkCmdEndRenderPass(cb);
   VkBufferImageCopy region{};
   region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-  region.imageExtent = {static_cast<std::uint32_t>(width), static_cast<std::uint32_t>(height), 1};
-  vkCmdCopyImageToBuffer(cb, normalImage.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, gbufNormals.handle(), 1, &region);
-  vkCmdCopyImageToBuffer(cb, idsImage.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, gbufIds.handle(), 1, &region);
-  vkCmdCopyImageToBuffer(cb, positionImage.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, gbufPositions.handle(), 1,
-                         &region);
+  region.imageExtent = {t.width, t.height, 1};
+  vkCmdCopyImageToBuffer(cb, t.normal.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, normalsOut.handle(), 1, &region);
+  vkCmdCopyImageToBuffer(cb, t.ids.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, ids.handle(), 1, &region);
+  if (positionsOut) {
+    vkCmdCopyImageToBuffer(cb, t.position.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, positionsOut->handle(), 1,
+                           &region);
+  }
+}
+
+void VulkanRenderer::Impl::recordGBuffer(VkCommandBuffer cb, const render::FrameRequest& request,
+                                         const glm::dmat4& viewProj) {
+  rasterise(cb, request, viewProj, target, gbufIds, gbufNormals, &gbufPositions);
+  if (options.antialias) rasterise(cb, request, viewProj, subTarget, subIds, subNormals, nullptr);
 }
 
 }  // namespace haarcast::gpu

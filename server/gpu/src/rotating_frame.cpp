@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <functional>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "vulkan_renderer_impl.h"
@@ -73,12 +74,15 @@ render::Frame VulkanRenderer::Impl::renderRotating(const render::FrameRequest& r
                                       sizeof(BatchPush));
     });
   }
-  stages.emplace_back("tonemap", [&](VkCommandBuffer cb) { tonemap->dispatch(cb, {groupsOf(pixels, 64), 1, 1}); });
+  stages.emplace_back("tonemap", [&](VkCommandBuffer cb) { recordTonemap(cb, request); });
   runStages(stages, frame);
 
   std::uint32_t covered = 0;
   counter.read(&covered, sizeof covered);
-  if (covered > pixels) throw std::logic_error("rotation-input reported more covered pixels than the frame has");
+  if (covered > sampleCapacity) {
+    throw std::logic_error("rotation-input reported " + std::to_string(covered) + " samples, more than the " +
+                           std::to_string(sampleCapacity) + " the frame can have");
+  }
   lastBatches = (covered + batch - 1) / batch;
 
   // ---- Results ---------------------------------------------------------------

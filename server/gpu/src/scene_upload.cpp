@@ -163,6 +163,7 @@ void VulkanRenderer::Impl::uploadScene() {
   lightUpload = BufferUpload(context, light);
   frameParams = Buffer(context, sizeof(FrameParams));
   thresholds = Buffer(context, 256 * sizeof(float));
+  exposureResult = Buffer(context, sizeof(ExposureResult));
 
   const auto lvl = static_cast<std::uint32_t>(level);
   // Constant 2 is rotate_spatial.comp's local size (the other methods'
@@ -170,8 +171,10 @@ void VulkanRenderer::Impl::uploadScene() {
   // workgroup make each barrier cheaper (docs/gpu.md, "Performance").
   std::uint32_t local = context.info().type == "cpu" ? 64u : 256u;
   if (limits.spatialLocalSize) local = limits.spatialLocalSize;
-  rotationInput = std::make_unique<ComputePipeline>(context, "rotation_input.comp", 8, 0);
-  tonemap = std::make_unique<ComputePipeline>(context, "tonemap.comp", 6, 0);
+  rotationInput = std::make_unique<ComputePipeline>(context, "rotation_input.comp", 11, 0);
+  resolve = std::make_unique<ComputePipeline>(context, "resolve.comp", 5, 0);
+  exposure = std::make_unique<ComputePipeline>(context, "exposure.comp", 4, sizeof(ExposurePush));
+  tonemap = std::make_unique<ComputePipeline>(context, "tonemap.comp", 5, 0);
   if (fused) {
     // One SIMD group per workgroup on a CPU device: the workgroup's only
     // barriers (the reduction's) then switch no coroutines (docs/gpu.md).

@@ -18,9 +18,6 @@ VulkanRenderer::Impl::Impl(const render::Scene& scene, const render::RenderOptio
                            const render::RenderProgress& progress, const VulkanRendererLimits& l)
     : options(o), limits(l), prepared(), context(vulkan) {
   render::checkRenderOptions(options);
-  if (options.antialias) {
-    throw std::invalid_argument("antialiasing is drawn by the CPU backend only: the Vulkan backend takes one sample per pixel");
-  }
   fused = options.method == RotationMethod::Fused;
   if (fused) {
     checkFusedLevel(options.level);  // 2–7: its scratch need not fit in shared memory
@@ -106,6 +103,10 @@ std::vector<ShadeSample> VulkanRenderer::shadeSamples() const {
   std::uint32_t covered = 0;
   if (impl_->counter.handle()) impl_->counter.read(&covered, sizeof covered);
   return readAll<ShadeSample>(impl_->shade, covered);
+}
+std::vector<std::uint32_t> VulkanRenderer::edgeWords() const {
+  if (!impl_->options.antialias) return {};
+  return readAll<std::uint32_t>(impl_->edges, static_cast<std::size_t>(impl_->width) * static_cast<std::size_t>(impl_->height));
 }
 
 std::unique_ptr<render::Renderer> makeVulkanRenderer(const render::Scene& scene, const render::RenderOptions& options,

@@ -75,6 +75,8 @@ struct VulkanRenderer::Impl {
   std::vector<std::size_t> methodBytesPerChannel;  // per object: method data one rotation reads
   Buffer slices, methodData, positions, normals, triangles, visibility, background;
   Buffer objects, light, frameParams, thresholds;
+  // Auto exposure's outcome (exposure.comp), read by the tonemap pass and the host.
+  Buffer exposureResult;
   // The light is device-local (buffer.h); each frame writes it here and
   // records the copy, where it is staged, ahead of the pass that reads it.
   BufferUpload lightUpload;
@@ -92,7 +94,8 @@ struct VulkanRenderer::Impl {
   bool fusedVertexPlanes = false;    // visibility uploaded per vertex in pixel form (else as lists)
 
   // ---- Pipelines ---------------------------------------------------------------
-  std::unique_ptr<ComputePipeline> rotate, rotationInput, tripleProduct, tonemap, fusedPass, batchArgsPass;
+  std::unique_ptr<ComputePipeline> rotate, rotationInput, tripleProduct, resolve, exposure, tonemap, fusedPass,
+      batchArgsPass;
   VkRenderPass renderPass = VK_NULL_HANDLE;
   VkDescriptorSetLayout gbufferSetLayout = VK_NULL_HANDLE;
   VkPipelineLayout gbufferLayout = VK_NULL_HANDLE;
@@ -103,9 +106,21 @@ struct VulkanRenderer::Impl {
   // ---- Per resolution --------------------------------------------------------
   int width = 0, height = 0;
   std::size_t batch = 0, maxBatches = 0, lastBatches = 0;
-  DeviceImage normalImage, idsImage, positionImage, depthImage;
-  VkFramebuffer framebuffer = VK_NULL_HANDLE;
+  // Shaded samples a frame may have: one per pixel, or with antialiasing
+  // kSubsamples per pixel (an edge pixel has no centre sample).
+  std::size_t sampleCapacity = 0;
+  // The G-buffer's attachments and framebuffer at one scale of the frame.
+  struct GBufferTarget {
+    DeviceImage normal, ids, position, depth;
+    VkFramebuffer framebuffer = VK_NULL_HANDLE;
+    std::uint32_t width = 0, height = 0;
+  };
+  GBufferTarget target;     // the pixel centres
+  GBufferTarget subTarget;  // antialiasing: the sub-samples, at twice the resolution
   Buffer gbufIds, gbufNormals, gbufPositions, samples, shade, counter, radiance, rgba8, rotated;
+  // Antialiasing: the sub-samples' ids and normals (else 4-byte stand-ins),
+  // and each pixel's edge word (shared_layout.h kEdgeFlag).
+  Buffer subIds, subNormals, edges;
   // The rotating methods: per batch, the indirect arguments of its rotation
   // and triple product (DispatchArgs, written by batch_args.comp).
   Buffer batchArgs;
@@ -131,24 +146,31 @@ struct VulkanRenderer::Impl {
   void createGraphicsPipeline();
   const render::Pose& poseOf(const render::FrameRequest& request, std::size_t i) const;
   glm::dmat4 frameViewProjection(const render::FrameRequest& request) const;
+  // Rasterises every object into `t` and copies the attachments to the
+  // buffers given (positions: null to skip).
+  void rasterise(VkCommandBuffer cb, const render::FrameRequest& request, const glm::dmat4& viewProj,
+                 const GBufferTarget& t, const Buffer& ids, const Buffer& normals, const Buffer* positions);
+  // The frame's G-buffer, and with antialiasing the sub-samples' as well.
   void recordGBuffer(VkCommandBuffer cb, const render::FrameRequest& request, const glm::dmat4& viewProj);
 
   // frame_buffers.cpp
   void ensureResolution(int w, int h);
   void releaseResolution();
-  DeviceImage createImage(VkFormat format, VkImageUsageFlags usage, VkImageAspectFlags aspect);
+  DeviceImage createImage(VkFormat format, VkImageUsageFlags usage, VkImageAspectFlags aspect, std::uint32_t w,
+                          std::uint32_t h);
   void destroyImage(DeviceImage& image);
+  GBufferTarget createTarget(std::uint32_t w, std::uint32_t h);
+  void destroyTarget(GBufferTarget& t);
 
   // frame_stages.cpp
   // The frame's uniforms (camera, light turn, exposure, the fused dispatch's
   // workgroup count) and the sRGB thresholds of its exposure.
   void uploadFrameUniforms(const render::FrameRequest& request);
-  // Auto exposure: the frame was tonemapped on the device with the previous
-  // frame's exposure (or the fixed one); measure the lit object pixels
-  // (mapped radiance and ids) and, when the exposure they call for differs,
-  // tonemap again on the host (the same thresholds, so the same bytes the
-  // device would give).
-  void finishExposure(const render::FrameRequest& request, render::Frame& frame);
+  // The "tonemap" stage: resolve (backdrop, antialiased edge pixels), the
+  // exposure (measured and chosen on the device, exposure.comp), encoding.
+  void recordTonemap(VkCommandBuffer cb, const render::FrameRequest& request);
+  // The exposure the device measured and used (Frame::logAverageLuminance, exposureStops).
+  void finishExposure(const render::FrameRequest& request, render::Frame& frame) const;
   // The stages of a frame, in order: with timestamps, recorded into one
   // command buffer (a timestamp after each) and submitted once; otherwise
   // (a CPU device) one submission per stage, timed on the host. Stages of

@@ -270,16 +270,26 @@ TEST(TonemapPass, BackdropAndEncodingMatchTheCpuDefinitions) {
 
   Context context(testing::testOptions());
   Buffer paramBuf(context, sizeof params), idBuf(context, pixels * 16), radBuf(context, pixels * 16),
-      bgBuf(context, bg.size() * 4), rgbaBuf(context, pixels * 4), thresholdBuf(context, 256 * 4);
+      bgBuf(context, bg.size() * 4), rgbaBuf(context, pixels * 4), thresholdBuf(context, 256 * 4),
+      edgeBuf(context, pixels * 4), exposureBuf(context, sizeof(ExposureResult));
+  // A fixed exposure: in the thresholds, gain 1 (exposure.comp's choice for it).
+  ExposureResult fixed{};
+  fixed.gain = 1.0f;
+  exposureBuf.write(&fixed, sizeof fixed);
   const auto thresholds = render::tonemapThresholds(exposure);
   thresholdBuf.upload(std::span<const float>(thresholds));
   paramBuf.write(&params, sizeof params);
   idBuf.upload(std::span<const glm::uvec4>(ids));
   radBuf.upload(std::span<const glm::vec4>(radiance));
   bgBuf.upload(std::span<const float>(bg));
-  ComputePipeline pass(context, "tonemap.comp", 6, 0);
-  pass.bind({&paramBuf, &idBuf, &radBuf, &bgBuf, &rgbaBuf, &thresholdBuf});
-  context.submit([&](VkCommandBuffer cb) { pass.dispatch(cb, {static_cast<std::uint32_t>((pixels + 63) / 64), 1, 1}); });
+  ComputePipeline resolve(context, "resolve.comp", 5, 0), encode(context, "tonemap.comp", 5, 0);
+  resolve.bind({&paramBuf, &idBuf, &radBuf, &bgBuf, &edgeBuf});
+  encode.bind({&paramBuf, &radBuf, &rgbaBuf, &thresholdBuf, &exposureBuf});
+  context.submit([&](VkCommandBuffer cb) {
+    resolve.dispatch(cb, {static_cast<std::uint32_t>((pixels + 63) / 64), 1, 1});
+    computeBarrier(cb);
+    encode.dispatch(cb, {static_cast<std::uint32_t>((pixels + 63) / 64), 1, 1});
+  });
   std::vector<glm::vec4> linear(pixels);
   std::vector<std::uint8_t> rgba(pixels * 4);
   radBuf.download(std::span<glm::vec4>(linear));

@@ -11,6 +11,7 @@
 #include <memory>
 #include <string>
 
+#include "frame_compare.h"
 #include "gpu_test_util.h"
 #include "haarcast/gpu/vulkan_renderer.h"
 #include "haarcast/render/renderer.h"
@@ -18,77 +19,12 @@
 namespace haarcast::gpu {
 namespace {
 
-// One cache in the build tree for every test process (CTest runs each test
-// in its own): slice tables and visibility are computed once and then read
-// back. The cache writes atomically and checks what it reads, so parallel
-// test processes may share it.
-const std::string& cacheDir() {
-  static const std::string path = HAARCAST_GPU_TEST_CACHE;
-  return path;
-}
-
-// Vulkan fused vs CPU fused, whole frames (measured: see docs/gpu.md).
-constexpr double kFusedPsnrFloor = 115.0;  // measured 127.7–135.5 dB on lavapipe (float rounding only)
-
-render::RenderOptions frameOptions(RotationMethod method, bool background) {
-  render::RenderOptions o;
-  o.width = o.height = 64;
-  o.level = 4;
-  o.method = method;
-  o.environmentBackground = background;
-  o.cacheDir = cacheDir();
-  o.threads = 0;
-  return o;
-}
-
-render::FrameRequest requestFor(const render::Scene& scene, int width, int height) {
-  render::FrameRequest r;
-  r.width = width;
-  r.height = height;
-  r.camera = scene.camera;
-  // A fixed exposure, so that the device's tonemap pass makes the bytes
-  // compared below (auto exposure has its own test).
-  r.exposure.automatic = false;
-  r.exposure.stops = -0.5;
-  return r;
-}
-
-struct Comparison {
-  double psnr = 0.0;
-  double mse = 0.0;
-  std::size_t compared = 0;       // pixels covered identically
-  std::size_t objectPixels = 0;   // covered by either
-  std::size_t mismatched = 0;     // covered by one only
-};
-
-// PSNR over the pixels both backends cover identically (object or
-// background), peak = the reference's maximum over its object pixels
-// (DESIGN.md "Measurements"); coverage mismatches counted separately.
-Comparison compare(const render::Frame& reference, const render::Frame& test) {
-  Comparison c;
-  double peak = 0.0, sum = 0.0;
-  const std::size_t pixels = reference.objectMask.size();
-  for (std::size_t p = 0; p < pixels; ++p) {
-    const bool a = reference.objectMask[p] != 0, b = test.objectMask[p] != 0;
-    if (a || b) ++c.objectPixels;
-    if (a != b) {
-      ++c.mismatched;
-      continue;
-    }
-    ++c.compared;
-    for (std::size_t k = 0; k < 3; ++k) {
-      const double r = reference.image.rgb[3 * p + k], t = test.image.rgb[3 * p + k];
-      if (a) peak = std::max(peak, r);
-      sum += (r - t) * (r - t);
-    }
-  }
-  c.mse = c.compared ? sum / (3.0 * static_cast<double>(c.compared)) : 0.0;
-  // A NaN anywhere makes the MSE NaN: that is the worst result, not a perfect one.
-  c.psnr = std::isnan(c.mse)  ? -std::numeric_limits<double>::infinity()
-           : c.mse > 0.0      ? 10.0 * std::log10(peak * peak / c.mse)
-                              : std::numeric_limits<double>::infinity();
-  return c;
-}
+using testing::cacheDir;
+using testing::compare;
+using testing::Comparison;
+using testing::frameOptions;
+using testing::kFusedPsnrFloor;
+using testing::requestFor;
 
 // The stages in pipeline order under the shared names, some coefficient
 // bytes read, and RGBA8 equal to the CPU encoding of the frame's own linear
@@ -350,14 +286,6 @@ TEST(VulkanRenderer, RejectsWhatTheGpuCannotDoByName) {
     EXPECT_NE(std::string(e.what()).find("levels 2 to 6"), std::string::npos) << e.what();
   }
   o.level = 4;
-  o.antialias = true;
-  try {
-    VulkanRenderer gpu(scene, o, testing::testOptions());
-    FAIL() << "antialias accepted";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("antialiasing"), std::string::npos) << e.what();
-  }
-  o.antialias = false;
   VulkanRenderer gpu(scene, o, testing::testOptions());
   render::FrameRequest bad = requestFor(scene, 16, 16);
   bad.poses.resize(5);

@@ -57,6 +57,21 @@ HC_CONST uint kFusedMaxLevel = 7u;
 HC_CONST uint kSubsamples = 4u;
 HC_CONST float kSubsampleOffset = 0.25f;
 
+// The Vulkan backend's antialiasing (rotation_input.comp, resolve.comp).
+// Sub-sample k of pixel (x, y) is pixel (2x + (k & 1), 2y + (k >> 1)) of the
+// G-buffer rasterised at twice the resolution: its centre lies at
+// (x + ½ ± ¼, y + ½ ± ¼), the sub-sample above. A shaded sample's radiance
+// goes to slot y·width + x (a pixel's centre) or, for sub-sample k of an
+// edge pixel, to pixels + kSubsamples·(y·width + x) + k. The per-pixel edge
+// word is 0 for an interior pixel, else kEdgeFlag | bit k for each covered k.
+HC_CONST uint kEdgeFlag = 16u;
+
+HC_FUNCTION uint subsampleSlot(uint pixels, uint pixel, uint k) { return pixels + kSubsamples * pixel + k; }
+
+HC_FUNCTION uint subsampleRasterIndex(uint width, uint x, uint y, uint k) {
+  return (2u * y + (k >> 1u)) * (2u * width) + 2u * x + (k & 1u);
+}
+
 // A BRDF slice in pixel form, as `fused` samples it: texel (row, col) of
 // slice t at ((t·M + row)·M + col)·kTexelFloats, holding R, G, B and a zero.
 HC_CONST uint kTexelFloats = 4u;
@@ -216,7 +231,7 @@ struct FrameParams {
   vec4 lightRotT[3];   // columns of lightRotationᵀ (xyz)
   float tanHalf;       // tan(½ vertical field of view) of this frame (render::cameraBasis)
   float aspect;        // width / height
-  uint pad0;           // (the exposure travels in the tonemap thresholds)
+  uint antialias;      // 1: edge pixels take kSubsamples sub-samples (above)
   uint background;     // 1: the environment behind the objects, 0: black
   uint width;
   uint height;
@@ -245,7 +260,7 @@ struct RotationSample {
   float alpha;         // Y-X-Y Euler angles: R = Ry(α) Rx(β) Ry(γ) (core/rotation.h)
   float beta;
   float gamma;
-  uint pixel;          // y·width + x
+  uint pixel;          // its radiance slot: y·width + x, or subsampleSlot (above)
   float thetaOut;      // θₒ, for the slice blend of `fused`
   uint pad;
 };
@@ -255,7 +270,7 @@ struct ShadeSample {
   uint object;
   uint vertex[3];      // global vertex ids of the hit triangle
   float b[3];          // barycentrics (b0 = 1 − u − v, b1 = u, b2 = v)
-  uint pixel;          // y·width + x
+  uint pixel;          // its radiance slot, as RotationSample::pixel
 };
 
 // The rotation-input pass's counter, followed by the indirect dispatch
@@ -277,6 +292,29 @@ struct DispatchArgs {
   uint pad;
 };
 
+// Auto exposure on the device (exposure.comp): the push block carries the
+// request's render::ExposureControl and the constants of render/tonemap.h;
+// the pass leaves its measure and choice in ExposureResult, which the
+// tonemap pass reads (x = gain · L, gain = 2^stops when automatic, else 1
+// because the thresholds then hold the fixed exposure) and the host reads back.
+struct ExposurePush {
+  uint automatic;      // 1: key exposure of the frame, eased from previousStops
+  uint hasPrevious;    // 1: previousStops holds the stream's last exposure
+  float previousStops;
+  float adaptation;    // 0 … 1, the easing towards the target
+  float fixedStops;    // the exposure when not automatic
+  float key;           // render::kExposureKey
+  float maxStops;      // render::kMaxExposureStops
+  uint pad0;
+};
+
+struct ExposureResult {
+  float logAverage;    // render::frameLogAverage of the resolved frame (0: nothing lit)
+  float stops;         // render::applyExposure
+  float gain;          // what the tonemap pass multiplies by
+  uint lit;            // pixels measured
+};
+
 // The G-buffer pass's push block (gbuffer.vert / .frag).
 struct GBufferPush {
   mat4 objectToClip;
@@ -296,6 +334,7 @@ static_assert(sizeof(RotationSample) == 32 && offsetof(RotationSample, alpha) ==
 static_assert(sizeof(ShadeSample) == 32 && offsetof(ShadeSample, b) == 16 && offsetof(ShadeSample, pixel) == 28);
 static_assert(sizeof(CoverageCounter) == 16 && offsetof(CoverageCounter, groups) == 4);
 static_assert(sizeof(DispatchArgs) == 16 && offsetof(DispatchArgs, groups) == 0);
+static_assert(sizeof(ExposurePush) == 32 && sizeof(ExposureResult) == 16);
 static_assert(sizeof(GBufferPush) == 80 && offsetof(GBufferPush, objectId) == 64);
 #endif
 

@@ -24,6 +24,8 @@ namespace haarcast::gpu {
 // (core/shared_layout.h, with their size and offset checks).
 using shared::CoverageCounter;
 using shared::DispatchArgs;
+using shared::ExposurePush;
+using shared::ExposureResult;
 using shared::FrameParams;
 using shared::GBufferPush;
 using shared::ObjectInfo;

@@ -9,7 +9,14 @@
 //   triple-product  compute: light × rotated slice × interpolated visibility
 //   fused           `fused` only, in place of the two above: shaders/fused.comp,
 //                   one indirect dispatch sized by rotation-input
-//   tonemap         compute: backdrop, linear image kept, RGBA8
+//   tonemap         compute: backdrop and antialiased edge pixels (resolve.comp),
+//                   auto exposure measured and chosen (exposure.comp), RGBA8;
+//                   the linear image kept
+// Antialiasing (RenderOptions::antialias) follows the CPU backend's rule
+// (shared_layout.h): the G-buffer is also rasterised at twice the
+// resolution, whose pixel centres are the sub-samples; rotation-input
+// shades the covered sub-samples of edge pixels in place of their centres,
+// so every method shades them through the same sample list.
 // Every method records its frame as one command buffer (timestamps per stage
 // on GPUs; one submission per stage, host-timed, on CPU devices) and reads
 // the covered count back only when the frame is done.
@@ -78,6 +85,9 @@ class VulkanRenderer final : public render::Renderer {
   // The compacted covered pixels, in the order the GPU wrote them.
   std::vector<RotationSample> rotationSamples() const;
   std::vector<ShadeSample> shadeSamples() const;
+  // With antialiasing, each pixel's edge word (shared_layout.h kEdgeFlag);
+  // empty without.
+  std::vector<std::uint32_t> edgeWords() const;
   std::size_t batchSamples() const;  // the batch size in use (0 before the first frame)
   std::size_t batchesLastFrame() const;
 
