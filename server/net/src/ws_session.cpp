@@ -293,6 +293,7 @@ void WsSession::onTick() {
   const auto& o = server_.options;
   const auto now = Clock::now();
   if (writing_ && secondsBetween(writeStarted_, now) > o.writeStallSeconds) {
+    server_.metrics.addError(errorLabel(v1::ERROR_CODE_TIMEOUT));  // no Error can reach a client that does not read
     server_.metrics.addTimeout("write");
     server_.metrics.addCut("write_stall");
     hardClose("a write has not completed for too long (the client stopped reading)");
