@@ -34,6 +34,7 @@ struct ServeArgs {
   int port = 8080;  // checked, then narrowed into server.port
   std::string antialias = "auto";
   std::string backend = "cpu", method = "fused", encoding = "jpeg";
+  std::vector<std::string> backends;  // enabled for clients; empty: just --backend
   int level = 4;
   std::size_t lightCoefficients = 256;
   std::vector<std::string> sceneFiles;
@@ -89,12 +90,21 @@ int run(ServeArgs& a) {
     }
     catalog.scenes.push_back(std::move(entry));
   }
-  catalog.backends = gpu::availableBackends();
-  if (!catalog.offersBackend(a.backend)) {
-    std::string offered;
-    for (const auto& b : catalog.backends) offered += (offered.empty() ? "" : ", ") + b;
-    throw std::invalid_argument("--backend " + a.backend + " is not one this server offers (valid: " + offered + ")");
-  }
+  // Backends: those built into this binary; clients may use only the ones
+  // the operator enabled (--backends, else just --backend).
+  const std::vector<std::string> built = gpu::availableBackends();
+  std::string builtNames;
+  for (const auto& b : built) builtNames += (builtNames.empty() ? "" : ", ") + b;
+  const auto enable = [&](const std::string& flag, const std::string& name) {
+    const auto backend = net::parseBackend(name);
+    if (!backend || std::find(built.begin(), built.end(), name) == built.end()) {
+      throw std::invalid_argument(flag + " " + name + " is not one this server offers (valid: " + builtNames + ")");
+    }
+    if (!catalog.offersBackend(*backend)) catalog.backends.push_back(*backend);
+    return *backend;
+  };
+  const net::Backend defaultBackend = enable("--backend", a.backend);
+  for (const auto& b : a.backends) enable("--backends", b);
 
   const auto method = parseRotationMethod(a.method);
   if (!method) throw std::invalid_argument("--method must be one of " + pixelMethodNames() + " (got \"" + a.method + "\")");
@@ -102,7 +112,7 @@ int run(ServeArgs& a) {
   d.method = *method;
   d.level = a.level;
   d.lightCoefficients = a.lightCoefficients;
-  d.backend = a.backend;
+  d.backend = defaultBackend;
   if (a.encoding == "jpeg") d.encoding = net::FrameEncoding::Jpeg;
   else if (a.encoding == "png") d.encoding = net::FrameEncoding::Png;
   else if (a.encoding == "raw") d.encoding = net::FrameEncoding::RawRgba8;
@@ -118,7 +128,14 @@ int run(ServeArgs& a) {
     throw std::invalid_argument("--level " + std::to_string(a.level) + " is outside " + std::to_string(limits.minLevel) +
                                 ".." + std::to_string(limits.maxLevel) + " (see --max-level)");
   }
-  if (limits.maxSessions < 1) throw std::invalid_argument("--max-sessions must be at least 1");
+  const auto& admission = a.server.admission;
+  for (const auto& [flag, value] : {std::pair{"--max-sessions", admission.sessions},
+                                    {"--max-sessions-per-address", admission.sessionsPerAddress},
+                                    {"--max-connections-per-address", admission.connectionsPerAddress},
+                                    {"--max-pending", admission.pending},
+                                    {"--max-pending-per-address", admission.pendingPerAddress}}) {
+    if (value < 1) throw std::invalid_argument(std::string(flag) + " must be at least 1 (got " + std::to_string(value) + ")");
+  }
   if (!(limits.maxFps > 0)) throw std::invalid_argument("--max-fps must be positive");
   limits.defaultFps = std::min(limits.defaultFps, limits.maxFps);
 
@@ -134,7 +151,7 @@ int run(ServeArgs& a) {
                                   " (it takes the browser client's folder, client/web in the source tree)");
     }
   }
-  if (!a.protoFile.empty() && !fs::is_regular_file(a.server.protoFile)) {
+  if (!a.protoFile.empty() && !fs::is_regular_file(fs::path(a.protoFile))) {
     throw std::invalid_argument("--proto-file " + a.protoFile + ": no such file");
   }
   a.server.protoFile = !a.protoFile.empty()
@@ -169,13 +186,14 @@ int run(ServeArgs& a) {
     options.level = c.level;
     options.method = c.method;
     options.lightCoefficients = c.lightCoefficients;
-    options.antialias = antialiasFor(antialias, c.backend);
+    const std::string backend(net::backendName(c.backend));
+    options.antialias = antialiasFor(antialias, backend);
     if (!quiet) std::fprintf(stderr, "[serve] preparing renderer %s\n", c.rendererKey().c_str());
     auto prepared = std::make_shared<net::PreparedRenderer>();
     // Slice tables and visibility: lines, not a redrawn one (sessions log in between).
     StderrProgress progress("[serve] ", false);
     prepared->renderer =
-        gpu::makeRenderer(c.backend, scene, options, vulkanOptions, quiet ? StageProgress{} : progress.callback());
+        gpu::makeRenderer(backend, scene, options, vulkanOptions, quiet ? StageProgress{} : progress.callback());
     if (!quiet) {
       std::fprintf(stderr, "[serve] renderer ready: %s on %s\n", prepared->renderer->backend().c_str(),
                    prepared->renderer->deviceName().c_str());
@@ -184,6 +202,8 @@ int run(ServeArgs& a) {
   };
 
   net::Server server(a.server, std::move(catalog), std::move(builder));
+  // Said even with --quiet: an open port without a token is the operator's to know.
+  if (const auto warning = net::exposureWarning(a.server); warning && a.quiet) std::fprintf(stderr, "%s\n", warning->c_str());
   // The line scripts and clients wait for: the bound port, flushed.
   std::printf("listening on http://127.0.0.1:%u/\n", static_cast<unsigned>(server.port()));
   std::fflush(stdout);
@@ -205,9 +225,15 @@ std::function<int()> addServeCommand(CLI::App& app) {
   c->add_option("--port", a->port, "TCP port 0..65535 (0 = any free one; the bound one is printed)")
       ->capture_default_str()
       ->check(CLI::Range(0, 65535));
-  c->add_option("--bind", o.bindAddress, "Address to listen on")->capture_default_str();
+  c->add_option("--bind", o.bindAddress,
+                 "Address to listen on (0.0.0.0: every interface; then set a token, a warning says so)")
+      ->capture_default_str();
+  c->add_option("--allow-origin", o.allowOrigins,
+                 "A web origin (https://app.example.com) whose pages may open sessions, besides this server's own "
+                 "(repeatable)");
   c->add_option("--token", a->token, "Required token (?token=T or Authorization: Bearer T); default $HAARCAST_TOKEN");
   c->add_option("--backend", a->backend, "Default backend: cpu|vulkan")->capture_default_str();
+  c->add_option("--backends", a->backends, "Backends clients may choose (default: only --backend)")->delimiter(',');
   c->add_option("--antialias", a->antialias, "auto|on|off: edge pixels as the mean of 4 sub-samples (auto: on)")
       ->capture_default_str();
   c->add_option("--level", a->level, "Default map level n (M = 2^n), within the session limits (--max-level)")
@@ -220,7 +246,18 @@ std::function<int()> addServeCommand(CLI::App& app) {
   c->add_option("--web-root", a->webRoot, "The browser client's files (default: the source tree's client/web)");
   c->add_option("--proto-file", a->protoFile, "Served at /haarcast.proto (default: the source tree's)");
   c->add_option("--cache-dir", a->cacheDir, "Slice-table and visibility cache (default $XDG_CACHE_HOME/haarcast; 'none')");
-  c->add_option("--max-sessions", o.limits.maxSessions, "Concurrent WebSocket sessions")->capture_default_str();
+  c->add_option("--max-sessions", o.admission.sessions, "Concurrent sessions (counted from a valid Hello)")
+      ->capture_default_str();
+  c->add_option("--max-sessions-per-address", o.admission.sessionsPerAddress, "Concurrent sessions per client address")
+      ->capture_default_str();
+  c->add_option("--max-connections-per-address", o.admission.connectionsPerAddress,
+                "Open TCP connections per client address (HTTP and WebSocket)")
+      ->capture_default_str();
+  c->add_option("--max-pending", o.admission.pending, "WebSocket connections waiting for their Hello, server-wide")
+      ->capture_default_str();
+  c->add_option("--max-pending-per-address", o.admission.pendingPerAddress,
+                "WebSocket connections waiting for their Hello, per client address")
+      ->capture_default_str();
   c->add_option("--max-width", o.limits.maxWidth, "Largest frame width")->capture_default_str();
   c->add_option("--max-height", o.limits.maxHeight, "Largest frame height")->capture_default_str();
   c->add_option("--max-fps", o.limits.maxFps, "Largest frame rate per session")->capture_default_str();

@@ -4,6 +4,39 @@
 #include <sstream>
 
 namespace haarcast::net {
+namespace {
+
+// The labelled counter families: name, label key, help.
+struct Family {
+  const char* name;
+  const char* label;
+  const char* help;
+};
+constexpr Family kHttpResponses{"haarcast_http_responses_total", "status", "HTTP responses sent, by status."};
+constexpr Family kTimeouts{"haarcast_timeouts_total", "phase",
+                           "Connections ended for a timeout, by phase (http_request, hello, idle, write, close)."};
+constexpr Family kCuts{"haarcast_session_cuts_total", "reason",
+                       "WebSocket connections the server ended, by reason (the fatal Error's code, or the transport's)."};
+constexpr Family kViolations{"haarcast_websocket_violations_total", "kind",
+                             "WebSocket protocol violations by clients (frames Beast refused)."};
+constexpr Family kRefusals{"haarcast_refusals_total", "reason",
+                           "Connections and upgrades turned away (origin, token, per-address and server budgets)."};
+constexpr Family kFamilies[] = {kHttpResponses, kTimeouts, kCuts, kViolations, kRefusals};
+
+}  // namespace
+
+void Metrics::addLabelled(std::string_view family, std::string_view label) {
+  std::lock_guard lock(mutex_);
+  auto it = labelled_.find(family);
+  if (it == labelled_.end()) it = labelled_.emplace(std::string(family), std::map<std::string, std::uint64_t>{}).first;
+  ++it->second[std::string(label)];
+}
+
+void Metrics::addHttpResponse(int status) { addLabelled(kHttpResponses.name, std::to_string(status)); }
+void Metrics::addTimeout(std::string_view phase) { addLabelled(kTimeouts.name, phase); }
+void Metrics::addCut(std::string_view reason) { addLabelled(kCuts.name, reason); }
+void Metrics::addWebSocketViolation(std::string_view kind) { addLabelled(kViolations.name, kind); }
+void Metrics::addRefusal(std::string_view reason) { addLabelled(kRefusals.name, reason); }
 
 void Metrics::addStages(const std::vector<render::StageTime>& stages) {
   std::lock_guard lock(mutex_);
@@ -24,8 +57,18 @@ std::string Metrics::prometheusText() const {
   auto metric = [&](const char* name, const char* type, const char* help) {
     out << "# HELP " << name << ' ' << help << "\n# TYPE " << name << ' ' << type << '\n';
   };
-  metric("haarcast_sessions", "gauge", "WebSocket sessions open now.");
+  metric("haarcast_sessions", "gauge", "WebSocket sessions open now (counted from a valid Hello).");
   out << "haarcast_sessions " << sessions.load() << '\n';
+  metric("haarcast_pending_connections", "gauge", "WebSocket connections waiting for their Hello.");
+  out << "haarcast_pending_connections " << pending.load() << '\n';
+  // Capacity and budget in use, one series per budget, so that a pixel
+  // budget joins as budget="pixels".
+  metric("haarcast_capacity", "gauge", "What each budget allows (sessions: --max-sessions).");
+  out << "haarcast_capacity{budget=\"sessions\"} " << sessionCapacity.load() << '\n';
+  metric("haarcast_budget_in_use", "gauge", "How much of each budget is taken now.");
+  out << "haarcast_budget_in_use{budget=\"sessions\"} " << sessions.load() << '\n';
+  metric("haarcast_draining", "gauge", "1 while the server drains for shutdown.");
+  out << "haarcast_draining " << (draining.load() ? 1 : 0) << '\n';
   metric("haarcast_sessions_total", "counter", "WebSocket sessions accepted since start.");
   out << "haarcast_sessions_total " << sessionsTotal.load() << '\n';
   metric("haarcast_frames_total", "counter", "Frames sent to clients.");
@@ -50,6 +93,12 @@ std::string Metrics::prometheusText() const {
   }
   metric("haarcast_errors_total", "counter", "Protocol errors sent to clients, by code.");
   for (const auto& [code, n] : errors_) out << "haarcast_errors_total{code=\"" << code << "\"} " << n << '\n';
+  for (const Family& f : kFamilies) {
+    metric(f.name, "counter", f.help);
+    const auto it = labelled_.find(std::string_view(f.name));
+    if (it == labelled_.end()) continue;
+    for (const auto& [label, n] : it->second) out << f.name << '{' << f.label << "=\"" << label << "\"} " << n << '\n';
+  }
   return out.str();
 }
 

@@ -85,20 +85,24 @@ std::optional<ProtocolError> mergeSettings(SessionConfig& config, const v1::Rend
     next.lightCoefficients = s.light_coefficients();
   }
   if (s.backend() != v1::BACKEND_UNSPECIFIED) {
-    const std::string name = s.backend() == v1::BACKEND_CPU      ? "cpu"
-                             : s.backend() == v1::BACKEND_VULKAN ? "vulkan"
-                                                                 : "";
-    if (name.empty()) {
+    const std::optional<Backend> backend = s.backend() == v1::BACKEND_CPU      ? std::optional(Backend::Cpu)
+                                           : s.backend() == v1::BACKEND_VULKAN ? std::optional(Backend::Vulkan)
+                                                                               : std::nullopt;
+    if (!backend) {
       return error(v1::ERROR_CODE_BAD_SETTINGS,
-                   "unknown backend " + std::to_string(s.backend()) + " (this server offers " + joined(catalog.backends) + ")",
+                   "unknown backend " + std::to_string(s.backend()) + " (this server enables " +
+                       joined(catalog.backendNames()) + ")",
                    fatal);
     }
-    if (!catalog.offersBackend(name)) {
+    // Only the operator's backends: a `--backend cpu` server never builds a
+    // Vulkan renderer for a client that asks for one.
+    if (!catalog.offersBackend(*backend)) {
       return error(v1::ERROR_CODE_BAD_SETTINGS,
-                   "backend " + name + " is not available on this server (it offers " + joined(catalog.backends) + ")",
+                   "backend " + std::string(backendName(*backend)) + " is not enabled on this server (it enables " +
+                       joined(catalog.backendNames()) + ")",
                    fatal);
     }
-    next.backend = name;
+    next.backend = *backend;
   }
   switch (s.exposure_mode()) {
     case v1::EXPOSURE_MODE_UNSPECIFIED: break;  // unchanged (a Hello starts with auto)
@@ -174,15 +178,36 @@ bool Catalog::offersMaterial(std::string_view spec) const {
   return std::find(materials.begin(), materials.end(), spec) != materials.end();
 }
 
-bool Catalog::offersBackend(std::string_view backend) const {
+bool Catalog::offersBackend(Backend backend) const {
   return std::find(backends.begin(), backends.end(), backend) != backends.end();
+}
+
+std::vector<std::string> Catalog::backendNames() const {
+  std::vector<std::string> names;
+  for (const Backend b : backends) names.emplace_back(backendName(b));
+  return names;
+}
+
+std::string_view backendName(Backend backend) {
+  switch (backend) {
+    case Backend::Cpu: return "cpu";
+    case Backend::Vulkan: return "vulkan";
+  }
+  return "?";
+}
+
+std::optional<Backend> parseBackend(std::string_view name) {
+  for (const Backend b : kAllBackends) {
+    if (backendName(b) == name) return b;
+  }
+  return std::nullopt;
 }
 
 std::string SessionConfig::rendererKey() const {
   std::ostringstream key;
   key << "scene=" << scene << ";materials=";
   for (const auto& m : materials) key << m << ',';
-  key << ";level=" << level << ";method=" << methodName(method) << ";backend=" << backend;
+  key << ";level=" << level << ";method=" << methodName(method) << ";backend=" << backendName(backend);
   return key.str();
 }
 
@@ -355,9 +380,11 @@ v1::RotationMethod toWire(RotationMethod method) {
   return v1::ROTATION_METHOD_UNSPECIFIED;
 }
 
-v1::Backend backendToWire(std::string_view backend) {
-  if (backend == "cpu") return v1::BACKEND_CPU;
-  if (backend == "vulkan") return v1::BACKEND_VULKAN;
+v1::Backend toWire(Backend backend) {
+  switch (backend) {
+    case Backend::Cpu: return v1::BACKEND_CPU;
+    case Backend::Vulkan: return v1::BACKEND_VULKAN;
+  }
   return v1::BACKEND_UNSPECIFIED;
 }
 
@@ -366,7 +393,7 @@ v1::RenderSettings settingsToWire(const SessionConfig& config) {
   s.set_method(toWire(config.method));
   s.set_level(static_cast<std::uint32_t>(config.level));
   s.set_light_coefficients(static_cast<std::uint32_t>(config.lightCoefficients));
-  s.set_backend(backendToWire(config.backend));
+  s.set_backend(toWire(config.backend));
   s.set_exposure_mode(config.autoExposure ? v1::EXPOSURE_MODE_AUTO : v1::EXPOSURE_MODE_FIXED);
   s.set_exposure_stops(config.exposureStops);
   return s;
@@ -422,13 +449,5 @@ std::string serialize(const v1::ServerMessage& message) {
   return bytes;
 }
 
-std::string errorMessage(const ProtocolError& e) {
-  v1::ServerMessage m;
-  auto* err = m.mutable_error();
-  err->set_code(e.code);
-  err->set_message(e.message);
-  err->set_fatal(e.fatal);
-  return serialize(m);
-}
 
 }  // namespace haarcast::net

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cctype>
+#include <fstream>
+#include <stdexcept>
 #include <system_error>
 
 namespace haarcast::net {
@@ -74,6 +76,42 @@ std::optional<fs::path> resolveStaticFile(const fs::path& root, std::string_view
   if (rootEnd != base.end()) return std::nullopt;
   if (!fs::is_regular_file(file, ec)) return std::nullopt;
   return file;
+}
+
+WebRoot WebRoot::load(const fs::path& root) {
+  WebRoot web;
+  web.root = root;
+  const fs::path list = root / kServedFilesName;
+  std::ifstream in(list);
+  if (!in) {
+    throw std::invalid_argument("web root " + root.string() + " has no " + kServedFilesName +
+                                " (the list of the client's files to serve, one per line)");
+  }
+  std::string line;
+  for (int number = 1; std::getline(in, line); ++number) {
+    while (!line.empty() && std::isspace(static_cast<unsigned char>(line.back()))) line.pop_back();
+    if (line.empty() || line.front() == '#') continue;
+    const std::string where = list.string() + ":" + std::to_string(number) + ": \"" + line + "\" ";
+    const fs::path relative(line);
+    if (relative.is_absolute()) throw std::invalid_argument(where + "is absolute (paths are relative to the web root)");
+    for (const auto& part : relative) {
+      if (part.string().empty() || part.string().front() == '.') {
+        throw std::invalid_argument(where + "has a '.'-component (no dotfiles, no '..')");
+      }
+    }
+    web.files.insert(relative.generic_string());
+  }
+  if (!web.files.count("index.html")) throw std::invalid_argument(list.string() + " does not list index.html");
+  return web;
+}
+
+std::optional<fs::path> WebRoot::resolve(std::string_view path) const {
+  const auto decoded = percentDecode(path);
+  if (!decoded || decoded->empty() || decoded->front() != '/') return std::nullopt;
+  std::string relative = decoded->substr(1);
+  if (relative.empty()) relative = "index.html";
+  if (!files.count(relative)) return std::nullopt;
+  return resolveStaticFile(root, "/" + relative);
 }
 
 std::string_view contentType(const fs::path& file) {

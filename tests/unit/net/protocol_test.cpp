@@ -10,7 +10,7 @@ Catalog testCatalog() {
   c.scenes.push_back({"default", {"phong:64", "lambert"}, render::Camera{}, {render::Pose{}, render::Pose{}}, {"ball", "ring"}});
   c.scenes.push_back({"other", {"ggx:0.3"}, render::Camera{}, {render::Pose{}}, {"teapot"}});
   c.materials = {"lambert", "phong:64", "ggx:0.3", "merl:steel"};
-  c.backends = {"cpu"};
+  c.backends = {Backend::Cpu};
   return c;
 }
 
@@ -148,7 +148,7 @@ TEST(Protocol, BadHellosNameWhatIsWrong) {
   e = helloError(h);
   EXPECT_EQ(e.code, v1::ERROR_CODE_BAD_SETTINGS);
   EXPECT_NE(e.message.find("vulkan"), std::string::npos);
-  EXPECT_NE(e.message.find("offers cpu"), std::string::npos) << e.message;
+  EXPECT_NE(e.message.find("enables cpu"), std::string::npos) << e.message;
 
   h = goodHello();
   h.mutable_settings()->set_method(static_cast<v1::RotationMethod>(42));

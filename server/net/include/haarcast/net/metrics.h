@@ -9,6 +9,7 @@
 #include <map>
 #include <mutex>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "haarcast/render/renderer.h"
@@ -17,7 +18,10 @@ namespace haarcast::net {
 
 class Metrics {
  public:
-  std::atomic<std::int64_t> sessions{0};           // gauge: WebSocket sessions open now
+  std::atomic<std::int64_t> sessions{0};           // gauge: sessions open now (after a valid Hello)
+  std::atomic<std::int64_t> pending{0};            // gauge: WebSocket connections waiting for their Hello
+  std::atomic<std::int64_t> sessionCapacity{0};    // gauge: --max-sessions
+  std::atomic<bool> draining{false};               // stop() called: /readyz answers 503
   std::atomic<std::uint64_t> sessionsTotal{0};     // accepted since start
   std::atomic<std::uint64_t> framesTotal{0};       // frames sent
   std::atomic<std::uint64_t> framesDropped{0};     // rendered, replaced before sending
@@ -29,6 +33,13 @@ class Metrics {
   void addStages(const std::vector<render::StageTime>& stages);
   // An Error sent (label: the ErrorCode's name without its prefix, "bad_message").
   void addError(const std::string& code);
+  // One per event, by label (the labels are fixed words of the server's,
+  // never client text, so the series stay few):
+  void addHttpResponse(int status);               // every HTTP response, by status ("404")
+  void addTimeout(std::string_view phase);        // "http_request", "hello", "idle", "write", "close"
+  void addCut(std::string_view reason);           // a session the server ended, by why
+  void addWebSocketViolation(std::string_view kind);  // a frame Beast refused ("message_too_big", "protocol")
+  void addRefusal(std::string_view reason);       // a connection or upgrade turned away ("origin", "token_rate" …)
 
   // The exposition: HELP and TYPE lines, then samples.
   std::string prometheusText() const;
@@ -37,6 +48,9 @@ class Metrics {
   mutable std::mutex mutex_;
   std::map<std::string, std::pair<double, std::uint64_t>> stages_;  // name → (sum seconds, count)
   std::map<std::string, std::uint64_t> errors_;
+  // family name → label value → count
+  std::map<std::string, std::map<std::string, std::uint64_t>, std::less<>> labelled_;
+  void addLabelled(std::string_view family, std::string_view label);
 };
 
 }  // namespace haarcast::net

@@ -2,7 +2,8 @@
 // Hello and later settings against the server's limits and catalogue, and
 // turning pose updates into render requests. Pure functions over bytes and
 // messages, so every rule here is tested without a network (and the session
-// code in server.cpp only moves bytes and timers).
+// code in render_session.cpp applies them; ws_session.cpp only moves bytes
+// and timers).
 #pragma once
 
 #include <cstddef>
@@ -24,6 +25,13 @@ namespace haarcast::net {
 inline constexpr std::uint32_t kProtocolVersion = 1;
 inline constexpr const char* kServerVersion = "haarcast 0.1.0";
 
+// The renderer backends a session may run on (haarcast/gpu/backend.h builds
+// them); the operator enables a subset (Catalog::backends).
+enum class Backend { Cpu, Vulkan };
+inline constexpr Backend kAllBackends[] = {Backend::Cpu, Backend::Vulkan};
+std::string_view backendName(Backend backend);                 // "cpu", "vulkan"
+std::optional<Backend> parseBackend(std::string_view name);    // nullopt: not a backend name
+
 // What the server allows; every limit is a clear Error when exceeded.
 struct Limits {
   int maxWidth = 2048;
@@ -34,7 +42,6 @@ struct Limits {
   int maxLevel = 6;  // ≤ render::kMaxRenderLevel; a level-7 scene takes minutes to prepare
   std::size_t maxLightCoefficients = 4096;
   std::size_t maxMessageBytes = 64 * 1024;  // client → server; poses are ~100 bytes
-  int maxSessions = 64;
   int maxBadMessages = 3;  // non-fatal BAD_MESSAGE errors before the server closes
 };
 
@@ -47,7 +54,7 @@ struct Defaults {
   RotationMethod method = RotationMethod::Haar;
   int level = 5;
   std::size_t lightCoefficients = 256;
-  std::string backend = "cpu";
+  Backend backend = Backend::Cpu;
 };
 
 // What the server offers: scene names (with their object counts, so that
@@ -63,12 +70,13 @@ struct Catalog {
   };
   std::vector<SceneEntry> scenes;             // the first is the default
   std::vector<std::string> materials;         // offered specs: "lambert", "phong:64", MERL names …
-  std::vector<std::string> backends;          // "cpu", "vulkan"
+  std::vector<Backend> backends;              // those the operator enabled
 
   const SceneEntry* findScene(std::string_view name) const;  // "" = the default
   std::vector<std::string> sceneNames() const;
   bool offersMaterial(std::string_view spec) const;
-  bool offersBackend(std::string_view backend) const;
+  bool offersBackend(Backend backend) const;
+  std::vector<std::string> backendNames() const;
 };
 
 struct ProtocolError {
@@ -90,7 +98,7 @@ struct SessionConfig {
   RotationMethod method = RotationMethod::Haar;
   int level = 5;
   std::size_t lightCoefficients = 256;
-  std::string backend = "cpu";
+  Backend backend = Backend::Cpu;
   bool autoExposure = true;   // else exposureStops
   double exposureStops = 0.0;
 
@@ -140,14 +148,13 @@ render::FrameRequest frameRequest(const PoseState& pose, const SessionConfig& co
 // Wire enums ↔ ours.
 v1::Encoding toWire(FrameEncoding encoding);
 v1::RotationMethod toWire(RotationMethod method);
-v1::Backend backendToWire(std::string_view backend);
+v1::Backend toWire(Backend backend);
 v1::RenderSettings settingsToWire(const SessionConfig& config);
 v1::ServerLimits limitsToWire(const Limits& limits);
 // The config's scene, its objects (named by the catalog) and their materials.
 v1::SceneInfo sceneInfo(const SessionConfig& config, const Catalog& catalog);
 
-// Serialised ServerMessages.
+// Serialised ServerMessages (the builders of each message: messages.h).
 std::string serialize(const v1::ServerMessage& message);
-std::string errorMessage(const ProtocolError& error);
 
 }  // namespace haarcast::net

@@ -1,25 +1,40 @@
 // The haarcast service on one port (Boost.Asio + Beast):
 //
-//   GET /                 the browser client (the web root's index.html and its files)
+//   GET /                 the browser client (the files the web root's
+//                         served_files.txt names, index.html first)
 //   GET /haarcast.proto   the wire contract, for the browser client
-//   GET /healthz          200 "ok"
+//   GET /healthz          200 "ok" while the process serves (liveness)
+//   GET /readyz           200 "ready", or 503 at capacity or draining (readiness)
 //   GET /metrics          Prometheus text (metrics.h)
 //   /ws                   WebSocket: one protobuf message per binary message,
 //                         ClientMessage in, ServerMessage out (proto/haarcast.proto)
 //
-// The token (if set) is checked at the upgrade, from `?token=T` or
-// `Authorization: Bearer T`: a wrong one gets HTTP 401 and no WebSocket.
-// Each session runs on its own strand with one write in flight, a bounded
-// queue of control messages and a one-frame slot (latest frame wins). See
-// docs/service.md for the protocol, limits and operations.
+// At the upgrade: the Origin (access.h: same host or --allow-origin, else
+// 403), the token if set (`?token=T` or `Authorization: Bearer T`, else
+// 401; repeated wrong tokens from one address: 429 for a while) and the
+// pre-Hello budget. A session counts toward the session budget from its
+// valid Hello. The pieces, as in Beast's examples:
+//
+//   listener.cpp      accept (with back-off), per-address connection slots,
+//                     start and stop (drain)
+//   http_session.cpp  HTTP requests and the upgrade's checks
+//   ws_session.cpp    the WebSocket transport: reads, the write queue
+//                     (one in flight, bounded control queue, one frame slot),
+//                     timers, close
+//   render_session.h  the application: Hello, settings, scene, poses, pacing
+//
+// docs/service.md has the protocol, limits and operations.
 #pragma once
 
 #include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
+#include <vector>
 
+#include "haarcast/net/access.h"
 #include "haarcast/net/metrics.h"
 #include "haarcast/net/protocol.h"
 #include "haarcast/net/render_service.h"
@@ -27,13 +42,20 @@
 namespace haarcast::net {
 
 struct ServerOptions {
-  std::string bindAddress = "0.0.0.0";
+  // Loopback by default: a server reachable from other machines is an
+  // operator's choice (--bind 0.0.0.0), and should come with a token.
+  std::string bindAddress = "127.0.0.1";
   std::uint16_t port = 8080;  // 0: any free port (see Server::port())
   std::string token;          // empty: no authentication
+  // Origins besides the serving host whose pages may open a WebSocket
+  // ("https://app.example.com"); see originAllowed().
+  std::vector<std::string> allowOrigins;
   std::filesystem::path webRoot;    // the browser client's files; empty: none served
   std::filesystem::path protoFile;  // served at /haarcast.proto; empty: 404
   Limits limits;
   Defaults defaults;
+  Admission::Limits admission;      // sessions (--max-sessions), per address, pre-Hello
+  TokenGuard::Options tokenGuard;
   double handshakeSeconds = 10.0;   // HTTP request and Hello, each within this
   double idleSeconds = 120.0;       // no client message for this long → TIMEOUT
   double writeStallSeconds = 10.0;  // one write in flight this long → the client is not reading: close
@@ -47,11 +69,15 @@ struct ServerOptions {
   bool handleSignals = false;
 };
 
+// The start-up warning for a server other machines can reach without a
+// token, or nullopt.
+std::optional<std::string> exposureWarning(const ServerOptions& options);
+
 class Server {
  public:
   // Binds and listens at once; throws std::runtime_error naming the address
-  // when it cannot. The renderers come from `builder` (haarcast/gpu/backend.h
-  // in `haarcast serve`).
+  // when it cannot. The renderers come from `builder` (the app layer's
+  // backend factory in `haarcast serve`).
   Server(ServerOptions options, Catalog catalog, RendererBuilder builder);
   ~Server();  // stop() and wait()
   Server(const Server&) = delete;
@@ -64,16 +90,21 @@ class Server {
   void start();
   void run();
   // Graceful shutdown, from any thread (a signal handler's strand included):
-  // stop accepting, send Error SHUTTING_DOWN to each session, let writes in
-  // flight finish, close; after drainSeconds whatever is left is cut.
-  // Idempotent.
+  // /readyz turns 503, upgrades are refused, each session gets Error
+  // SHUTTING_DOWN, writes in flight finish, sessions close; after
+  // drainSeconds whatever is left is cut and the port closes. Idempotent.
   void stop();
   // Joins the background threads (after start()).
   void wait();
 
+  // True when a load balancer should send no new clients here (/readyz 503):
+  // the session budget is full or the server is draining. (The one place a
+  // further budget, such as rendered pixels, joins.)
+  bool atCapacity() const;
+
   const Metrics& metrics() const;
 
-  struct Impl;  // defined in server.cpp
+  struct Impl;  // server_impl.h
 
  private:
   std::shared_ptr<Impl> impl_;

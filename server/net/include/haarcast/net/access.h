@@ -1,0 +1,148 @@
+// Who may connect and how much they may hold: the Origin check at the
+// WebSocket upgrade, the token's Authorization scheme, a per-address limit
+// on token guesses, the connection / pre-Hello / session slots (server-wide
+// and per address), and the accept loop's back-off when file descriptors
+// run out. Plain classes over strings and clocks, tested without sockets.
+#pragma once
+
+#include <chrono>
+#include <cstddef>
+#include <array>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace haarcast::net {
+
+using Clock = std::chrono::steady_clock;
+
+// The Origin rule (RFC 6454; as gorilla/websocket's checkSameOrigin and
+// Selkies do): no Origin header is a non-browser client and is allowed; an
+// Origin whose host[:port] equals the request's Host (case-insensitive) is
+// the page the server itself served; otherwise the Origin must be on the
+// operator's allow-list ("https://app.example.com", compared without case
+// and without a trailing '/'). Everything else — "null" included — is a
+// page on another site (cross-site WebSocket hijacking) and gets 403.
+bool originAllowed(std::string_view origin, std::string_view host, const std::vector<std::string>& allowList);
+
+// The token of an `Authorization: Bearer T` header; the scheme is
+// case-insensitive (RFC 7235 §2.1). "" when the header is another scheme.
+std::string bearerToken(std::string_view authorization);
+
+// Equal-time comparison: the token check does not leak how much matched.
+bool tokensEqual(std::string_view given, std::string_view expected);
+
+// True for 127.0.0.0/8, ::1 and an IPv4-mapped loopback; false for anything
+// else, "0.0.0.0" and "::" included (they listen on every interface).
+bool isLoopbackAddress(std::string_view address);
+
+// Token guesses per address: after `maxFailures` wrong tokens within
+// `windowSeconds`, the address is refused (HTTP 429) for `lockoutSeconds`.
+class TokenGuard {
+ public:
+  struct Options {
+    int maxFailures = 5;
+    double windowSeconds = 60.0;
+    double lockoutSeconds = 60.0;
+  };
+  explicit TokenGuard(Options options);
+
+  bool locked(const std::string& address, Clock::time_point now);
+  void failed(const std::string& address, Clock::time_point now);
+
+ private:
+  struct Entry {
+    Clock::time_point windowStart;
+    int failures = 0;
+    Clock::time_point lockedUntil;
+  };
+  void prune(Clock::time_point now);  // keeps the table bounded under a spray of addresses
+  Options options_;
+  std::mutex mutex_;
+  std::map<std::string, Entry> entries_;
+};
+
+// Slots, counted server-wide and per peer address. A connection slot is held
+// from accept to close; a pending slot from the upgrade to the Hello (the
+// pre-Hello budget); a session slot from a valid Hello to close — only then
+// does a client count toward --max-sessions.
+enum class SlotKind { Connection, Pending, Session };
+std::string_view slotKindName(SlotKind kind);  // "connection", "pending", "session"
+
+class Admission {
+ public:
+  struct Limits {
+    int connectionsPerAddress = 32;
+    int pending = 64;
+    int pendingPerAddress = 8;
+    int sessions = 64;
+    int sessionsPerAddress = 16;
+  };
+
+  // Releases its slot when destroyed. Move-only; an empty Slot holds none.
+  class Slot {
+   public:
+    Slot() = default;
+    Slot(Slot&& other) noexcept;
+    Slot& operator=(Slot&& other) noexcept;
+    ~Slot();
+    explicit operator bool() const { return owner_ != nullptr; }
+    void release();
+
+   private:
+    friend class Admission;
+    Slot(Admission* owner, SlotKind kind, std::string address);
+    Admission* owner_ = nullptr;
+    SlotKind kind_ = SlotKind::Connection;
+    std::string address_;
+  };
+
+  // Why a slot was refused: "" when taken.
+  struct Refusal {
+    bool perAddress = false;  // the address's own cap (429), else the server's (503)
+    std::string reason;       // names the limit and its value
+  };
+
+  explicit Admission(Limits limits);
+  // The slot, or why not. The Admission must outlive its slots.
+  std::optional<Slot> take(SlotKind kind, const std::string& address, Refusal* refusal = nullptr);
+
+  int count(SlotKind kind) const;                                   // server-wide
+  int count(SlotKind kind, const std::string& address) const;       // one address
+  const Limits& limits() const { return limits_; }
+
+ private:
+  void give(SlotKind kind, const std::string& address);
+  Limits limits_;
+  mutable std::mutex mutex_;
+  int total_[3] = {0, 0, 0};
+  std::map<std::string, std::array<int, 3>> perAddress_;
+};
+
+// The accept loop's pause after an error: EMFILE, ENFILE, ENOBUFS and
+// ENOMEM mean a retry at once fails again (a busy loop that floods the log),
+// so the pause doubles from 50 ms to 1 s; other errors retry at once. One
+// log line per episode: `onError` says whether this error started one.
+class AcceptBackoff {
+ public:
+  static constexpr std::chrono::milliseconds kFirst{50};
+  static constexpr std::chrono::milliseconds kMost{1000};
+
+  struct Step {
+    std::chrono::milliseconds pause{0};
+    bool episodeStarted = false;  // the first resource error since the last good accept: log it
+  };
+  Step onError(int errnoValue);  // the failed accept's errno (0: not a system error)
+  // A good accept; returns true when it ended an episode (log the recovery).
+  bool onSuccess();
+  int errorsInEpisode() const { return errors_; }
+
+ private:
+  std::chrono::milliseconds pause_{0};
+  int errors_ = 0;
+};
+
+}  // namespace haarcast::net

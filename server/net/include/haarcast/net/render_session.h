@@ -1,0 +1,149 @@
+// One client's session without a socket: the application state machine.
+//
+//   Hello      → token, config (protocol.h), a session slot (SessionPort::admit),
+//                a renderer (prepare) → Welcome
+//   Settings / SceneChoice → a new config; a new renderer when its key
+//                changed; SceneInfo for an accepted SceneChoice
+//   PoseUpdate → the latest pose wins; a frame is rendered at most once per
+//                1/fps (pacing), one at a time
+//   Ping       → Pong;  ticks → Hello and idle timeouts, Stats
+//
+// It emits bytes and requests through a SessionPort: ws_session.cpp
+// implements it on a WebSocket, the unit tests with a recorder, so every
+// rule here is tested (and fuzzed) without a network. All calls are made on
+// one strand, except takeRequest(), which a render worker calls.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "haarcast/net/messages.h"
+#include "haarcast/net/metrics.h"
+#include "haarcast/net/protocol.h"
+#include "haarcast/net/render_service.h"
+#include "haarcast/net/server.h"
+
+namespace haarcast::net {
+
+// What a frame job read when its worker started it; the strand reads it back
+// when the frame is done.
+struct FrameContext {
+  std::uint64_t poseSequence = 0;
+  double clientTimeMs = 0.0;
+  Clock::time_point poseReceived;
+  SessionConfig config;
+};
+
+// One frame to render: the transport turns it into a RenderJob whose take()
+// is RenderSession::takeRequest(*context).
+struct FrameOrder {
+  std::shared_ptr<PreparedRenderer> renderer;
+  FrameEncoding encoding = FrameEncoding::Jpeg;
+  int jpegQuality = 85;
+  std::shared_ptr<FrameContext> context;
+};
+
+class SessionPort {
+ public:
+  virtual ~SessionPort() = default;
+  // A control message, sent in order before any frame.
+  virtual void send(std::string bytes) = 0;
+  // The frame slot: returns true when it replaced a frame not yet sent.
+  virtual bool sendFrame(std::string bytes, std::size_t payloadBytes) = 0;
+  // Control messages waiting to be written (Stats are skipped behind a backlog).
+  virtual std::size_t backlog() const = 0;
+  // The end: `error` (a serialised Error) after the messages queued, then a
+  // close frame with `code` and `reason`. Nothing is sent after it.
+  virtual void close(std::string error, CloseCode code, std::string reason) = 0;
+  // Call RenderSession::onPace at `at` (one armed at a time).
+  virtual void armPace(Clock::time_point at) = 0;
+  // Build or find the renderer for a config → RenderSession::onPrepared.
+  virtual void prepare(const SessionConfig& config) = 0;
+  // Render → RenderSession::onRendered(order.context, …).
+  virtual void render(FrameOrder order) = 0;
+  // A session slot for a valid Hello, or the fatal error saying why not.
+  virtual std::optional<ProtocolError> admit() = 0;
+  // A Hello carried a wrong auth_token: one guess for the address's limit.
+  virtual void tokenRejected() = 0;
+  virtual void log(const std::string& line) = 0;
+};
+
+class RenderSession {
+ public:
+  RenderSession(const ServerOptions& options, const Catalog& catalog, Metrics& metrics, SessionPort& port,
+                std::string id, Clock::time_point opened);
+
+  void onMessage(std::string_view bytes, bool binary, Clock::time_point now);
+  void onPrepared(const std::string& key, std::shared_ptr<PreparedRenderer> renderer, const std::string& error,
+                  Clock::time_point now);
+  void onRendered(const FrameContext& context, std::optional<RenderedFrame> rendered, const std::string& error,
+                  Clock::time_point now);
+  void onPace(Clock::time_point now);
+  void onTick(Clock::time_point now);  // timeouts and Stats
+  void onSent(bool isFrame, std::size_t payloadBytes);
+
+  // A fatal error: counted, logged, sent, then the close. Idempotent.
+  void fail(ProtocolError error, CloseCode code = CloseCode::PolicyError);
+  // The transport has gone: jobs not yet started are skipped.
+  void end();
+
+  // On a render worker: the latest request, or nullopt when the session has
+  // ended (the job is skipped).
+  std::optional<render::FrameRequest> takeRequest(FrameContext& context);
+
+  bool closed() const { return closed_; }
+  bool welcomed() const { return welcomed_; }
+  const std::string& id() const { return id_; }
+  const SessionConfig& config() const { return config_; }
+  std::uint64_t framesSent() const { return framesSent_; }
+  std::uint64_t framesDropped() const { return framesDropped_; }
+  std::uint64_t bytesSent() const { return bytesSent_; }
+
+ private:
+  void handle(const v1::ClientMessage& message, Clock::time_point now);
+  void onHello(const v1::Hello& hello, Clock::time_point now);
+  void onPose(const v1::PoseUpdate& update, Clock::time_point now);
+  void adopt(SessionConfig next, bool announceScene, Clock::time_point now);
+  void prepareRenderer();
+  void maybeRender(Clock::time_point now);
+  void badMessage(ProtocolError e);
+  void sendError(const ProtocolError& e);
+  void sendStats(Clock::time_point now);
+  void log(const std::string& line) { port_.log(id_ + ": " + line); }
+
+  const ServerOptions& options_;
+  const Catalog& catalog_;
+  Metrics& metrics_;
+  SessionPort& port_;
+  const std::string id_;
+
+  // Strand state.
+  bool hello_ = false, welcomed_ = false, wantFrame_ = false, inFlight_ = false, paceArmed_ = false;
+  bool closed_ = false;
+  int badMessages_ = 0;
+  std::string clientName_;  // sanitised for the log
+  std::shared_ptr<PreparedRenderer> renderer_;
+  Clock::time_point opened_, lastMessage_, lastStats_, nextFrameAt_{};
+  std::uint64_t frameSequence_ = 0, framesSent_ = 0, framesDropped_ = 0, bytesSent_ = 0;
+  std::uint64_t periodFrames_ = 0, periodRendered_ = 0;
+  double periodRenderSeconds_ = 0.0;
+  std::string lastRenderError_;
+
+  // Shared with the render worker (takeRequest): under mutex_. config_ is
+  // written on the strand under the lock and read there without it.
+  std::mutex mutex_;
+  SessionConfig config_;
+  PoseState pose_;
+  Clock::time_point poseReceived_;
+  std::optional<double> lastExposure_;  // auto exposure: the last frame's, eased from (tonemap.h)
+  Clock::time_point lastExposureAt_;
+  std::atomic<bool> ended_{false};
+};
+
+}  // namespace haarcast::net

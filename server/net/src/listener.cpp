@@ -1,0 +1,243 @@
+// The Server: listening, accepting (per-address connection slots, back-off
+// when file descriptors run out), start, stop and drain.
+#include <csignal>
+#include <cstdarg>
+#include <cstdio>
+
+#include <boost/beast/core.hpp>
+
+#include "http_session.h"
+#include "server_impl.h"
+#include "ws_session.h"
+
+namespace haarcast::net {
+namespace {
+
+namespace asio = boost::asio;
+namespace beast = boost::beast;
+using tcp = asio::ip::tcp;
+
+// How often the drain checks whether every session has closed.
+constexpr auto kDrainPoll = std::chrono::milliseconds(20);
+// Past drainSeconds, the margin for the cut sessions' handlers to run.
+constexpr double kDrainMarginSeconds = 0.5;
+
+Admission::Limits checkedAdmission(Admission::Limits l) {
+  const std::pair<const char*, int> all[] = {{"sessions", l.sessions},
+                                             {"sessions per address", l.sessionsPerAddress},
+                                             {"connections per address", l.connectionsPerAddress},
+                                             {"pending", l.pending},
+                                             {"pending per address", l.pendingPerAddress}};
+  for (const auto& [name, value] : all) {
+    if (value < 1) throw std::invalid_argument(std::string("server limit ") + name + " must be at least 1 (got " + std::to_string(value) + ")");
+  }
+  return l;
+}
+
+}  // namespace
+
+std::string peerAddress(const tcp::socket& socket) {
+  beast::error_code ec;
+  const auto remote = socket.remote_endpoint(ec);
+  return ec ? std::string("?") : remote.address().to_string();
+}
+
+std::optional<std::string> exposureWarning(const ServerOptions& options) {
+  if (!options.token.empty() || isLoopbackAddress(options.bindAddress)) return std::nullopt;
+  return "WARNING: listening on " + options.bindAddress +
+         " without a token: anyone who can reach this port can open sessions (set --token or $HAARCAST_TOKEN, "
+         "or --bind 127.0.0.1)";
+}
+
+Server::Impl::Impl(ServerOptions o, Catalog c, RendererBuilder builder)
+    : options(std::move(o)),
+      catalog(std::move(c)),
+      admission(checkedAdmission(options.admission)),
+      tokenGuard(options.tokenGuard),
+      ioc(std::max(1, options.ioThreads)),
+      acceptor(asio::make_strand(ioc)),
+      acceptPause(acceptor.get_executor()),
+      drainTimer(ioc),
+      renderService(std::make_unique<RenderService>(std::move(builder), options.render, metrics)) {
+  if (!options.webRoot.empty()) webRoot = WebRoot::load(options.webRoot);
+  metrics.sessionCapacity.store(options.admission.sessions);
+}
+
+void Server::Impl::log(const char* format, ...) {
+  if (!options.log) return;
+  std::lock_guard lock(logMutex);
+  std::va_list args;
+  va_start(args, format);
+  std::fputs("[serve] ", stderr);
+  std::vfprintf(stderr, format, args);
+  std::fputc('\n', stderr);
+  va_end(args);
+}
+
+void Server::Impl::listen() {
+  beast::error_code ec;
+  const auto address = asio::ip::make_address(options.bindAddress, ec);
+  if (ec) throw std::runtime_error("--bind " + options.bindAddress + " is not an IP address: " + ec.message());
+  const tcp::endpoint endpoint(address, options.port);
+  const std::string where = options.bindAddress + ":" + std::to_string(options.port);
+  acceptor.open(endpoint.protocol(), ec);
+  if (!ec) acceptor.set_option(asio::socket_base::reuse_address(true), ec);
+  if (!ec) acceptor.bind(endpoint, ec);
+  if (!ec) acceptor.listen(asio::socket_base::max_listen_connections, ec);
+  if (ec) throw std::runtime_error("cannot listen on " + where + ": " + ec.message());
+  boundPort = acceptor.local_endpoint(ec).port();
+}
+
+void Server::Impl::doAccept() {
+  acceptor.async_accept(asio::make_strand(ioc), [this](beast::error_code ec, tcp::socket socket) {
+    onAccept(ec, std::move(socket));
+  });
+}
+
+void Server::Impl::onAccept(beast::error_code ec, tcp::socket socket) {
+  if (!acceptor.is_open()) return;
+  if (ec) {
+    const auto step = acceptBackoff.onError(ec.category() == boost::system::system_category() ? ec.value() : 0);
+    if (step.pause.count() == 0) {
+      log("accept: %s", ec.message().c_str());
+      doAccept();
+      return;
+    }
+    // Out of descriptors: a retry at once fails again. Pause, and say so
+    // once per episode rather than once per retry.
+    if (step.episodeStarted) log("accept: %s; pausing accepts (50 ms, doubling to 1 s) until one succeeds", ec.message().c_str());
+    acceptPause.expires_after(step.pause);
+    acceptPause.async_wait([this](beast::error_code waitEc) {
+      if (!waitEc) doAccept();
+    });
+    return;
+  }
+  if (const int errors = acceptBackoff.errorsInEpisode(); acceptBackoff.onSuccess()) {
+    log("accept: recovered after %d failed accepts", errors);
+  }
+  const std::string address = peerAddress(socket);
+  Admission::Refusal refusal;
+  if (auto slot = admission.take(SlotKind::Connection, address, &refusal)) {
+    // Frames are small writes answered by small pose messages: without
+    // this, Nagle's algorithm holds a frame's last segment until the
+    // client's delayed ACK (40 ms on Linux), a stall on every frame.
+    beast::error_code ignored;
+    socket.set_option(tcp::no_delay(true), ignored);
+    std::make_shared<HttpSession>(*this, std::move(socket), std::move(*slot), address)->run();
+  } else {
+    // Closed unanswered: a flood from one address costs it a descriptor
+    // for an instant, not a session's worth of buffers.
+    metrics.addRefusal("connections_per_address");
+    beast::error_code ignored;
+    socket.close(ignored);
+  }
+  doAccept();
+}
+
+std::size_t Server::Impl::sessionCount() {
+  std::lock_guard lock(sessionsMutex);
+  return sessions.size();
+}
+
+bool Server::Impl::atCapacity() const {
+  return stopping.load() || admission.count(SlotKind::Session) >= admission.limits().sessions;
+}
+
+void Server::Impl::stop() {
+  if (stopping.exchange(true)) return;
+  metrics.draining.store(true);
+  log("stopping: draining %zu sessions", sessionCount());
+  std::vector<std::shared_ptr<WsSession>> open;
+  {
+    std::lock_guard lock(sessionsMutex);
+    for (auto& [ptr, weak] : sessions) {
+      if (auto s = weak.lock()) open.push_back(std::move(s));
+    }
+  }
+  // Outside the lock: a session's destructor takes it.
+  for (auto& s : open) asio::post(s->executor(), [s] { s->shutdown(); });
+  open.clear();
+  asio::post(ioc, [this] {
+    if (signals) signals->cancel();
+    drainDeadline = Clock::now() + toDuration(options.drainSeconds + kDrainMarginSeconds);
+    watchDrain();
+  });
+}
+
+// Stops the io_context once every session has closed (HTTP keep-alive
+// connections are not waited for), or at the drain deadline. The port stays
+// open meanwhile, so that /readyz answers 503 to the load balancer and
+// upgrades get a 503 rather than a refused connection.
+void Server::Impl::watchDrain() {
+  if (sessionCount() == 0 || Clock::now() >= drainDeadline) {
+    const std::size_t left = sessionCount();
+    for (std::size_t i = 0; i < left; ++i) metrics.addCut("drain_deadline");
+    log("stopped (%zu sessions cut)", left);
+    asio::post(acceptor.get_executor(), [this] {
+      beast::error_code ec;
+      acceptPause.cancel();
+      acceptor.close(ec);
+      ioc.stop();
+    });
+    return;
+  }
+  drainTimer.expires_after(kDrainPoll);
+  drainTimer.async_wait([this](beast::error_code ec) {
+    if (!ec) watchDrain();
+  });
+}
+
+Server::Server(ServerOptions options, Catalog catalog, RendererBuilder builder)
+    : impl_(std::make_shared<Impl>(std::move(options), std::move(catalog), std::move(builder))) {
+  if (impl_->catalog.scenes.empty()) throw std::invalid_argument("the server needs at least one scene");
+  if (impl_->catalog.backends.empty()) throw std::invalid_argument("the server needs at least one enabled backend");
+  if (const auto warning = exposureWarning(impl_->options)) impl_->log("%s", warning->c_str());
+  if (impl_->options.handleSignals) {
+    impl_->signals.emplace(impl_->ioc, SIGINT, SIGTERM);
+    impl_->signals->async_wait([impl = impl_.get()](beast::error_code ec, int signal) {
+      if (ec) return;
+      impl->log("signal %d", signal);
+      impl->stop();
+    });
+  }
+  impl_->listen();
+  impl_->doAccept();
+}
+
+Server::~Server() {
+  stop();
+  wait();
+  impl_->renderService->stop();
+}
+
+std::uint16_t Server::port() const { return impl_->boundPort; }
+
+void Server::start() {
+  for (int i = 0; i < std::max(1, impl_->options.ioThreads); ++i) {
+    impl_->threads.emplace_back([impl = impl_.get()] { impl->ioc.run(); });
+  }
+}
+
+void Server::run() {
+  for (int i = 1; i < std::max(1, impl_->options.ioThreads); ++i) {
+    impl_->threads.emplace_back([impl = impl_.get()] { impl->ioc.run(); });
+  }
+  impl_->ioc.run();
+  wait();
+  impl_->renderService->stop();
+}
+
+void Server::stop() { impl_->stop(); }
+
+void Server::wait() {
+  for (auto& t : impl_->threads) {
+    if (t.joinable()) t.join();
+  }
+  impl_->threads.clear();
+}
+
+bool Server::atCapacity() const { return impl_->atCapacity(); }
+
+const Metrics& Server::metrics() const { return impl_->metrics; }
+
+}  // namespace haarcast::net

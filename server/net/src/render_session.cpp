@@ -1,0 +1,364 @@
+#include "haarcast/net/render_session.h"
+
+#include <algorithm>
+#include <cstdarg>
+#include <cstdio>
+
+namespace haarcast::net {
+namespace {
+
+// Stats are the one message that may be skipped: none is queued behind this
+// many control messages.
+constexpr std::size_t kMaxBacklogForStats = 4;
+
+std::chrono::nanoseconds toDuration(double seconds) {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::duration<double>(std::max(0.0, seconds)));
+}
+
+double secondsBetween(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
+
+std::string format(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
+std::string format(const char* fmt, ...) {
+  char line[512];
+  std::va_list args;
+  va_start(args, fmt);
+  std::vsnprintf(line, sizeof line, fmt, args);
+  va_end(args);
+  return line;
+}
+
+}  // namespace
+
+RenderSession::RenderSession(const ServerOptions& options, const Catalog& catalog, Metrics& metrics, SessionPort& port,
+                             std::string id, Clock::time_point opened)
+    : options_(options),
+      catalog_(catalog),
+      metrics_(metrics),
+      port_(port),
+      id_(std::move(id)),
+      opened_(opened),
+      lastMessage_(opened),
+      lastStats_(opened) {}
+
+// ------------------------------------------------------------------ messages
+
+void RenderSession::onMessage(std::string_view bytes, bool binary, Clock::time_point now) {
+  if (closed_) return;
+  lastMessage_ = now;
+  const auto& limits = options_.limits;
+  if (bytes.size() > limits.maxMessageBytes) {
+    fail({v1::ERROR_CODE_MESSAGE_TOO_LARGE,
+          "message of " + std::to_string(bytes.size()) + " bytes is over the limit of " +
+              std::to_string(limits.maxMessageBytes),
+          true},
+         CloseCode::TooBig);
+    return;
+  }
+  auto parsed = parseClientMessage(bytes);
+  if (auto* e = std::get_if<ProtocolError>(&parsed)) {
+    if (!binary) e->message = "text message: " + e->message + " (send protobuf as binary messages)";
+    badMessage(std::move(*e));
+    return;
+  }
+  handle(std::get<v1::ClientMessage>(parsed), now);
+}
+
+void RenderSession::handle(const v1::ClientMessage& message, Clock::time_point now) {
+  if (!hello_ && message.body_case() != v1::ClientMessage::kHello) {
+    fail({v1::ERROR_CODE_PROTOCOL_ORDER, "the first message must be a Hello", true});
+    return;
+  }
+  switch (message.body_case()) {
+    case v1::ClientMessage::kHello: onHello(message.hello(), now); break;
+    case v1::ClientMessage::kPose: onPose(message.pose(), now); break;
+    case v1::ClientMessage::kSettings: {
+      SessionConfig next = config_;
+      if (auto e = applySettings(next, message.settings(), options_.limits, catalog_)) {
+        sendError(*e);
+        return;
+      }
+      adopt(std::move(next), false, now);
+      break;
+    }
+    case v1::ClientMessage::kScene: {
+      SessionConfig next = config_;
+      if (auto e = applySceneChoice(next, message.scene(), catalog_)) {
+        sendError(*e);
+        return;
+      }
+      adopt(std::move(next), true, now);
+      break;
+    }
+    case v1::ClientMessage::kPing: port_.send(pongMessage(message.ping().nonce())); break;
+    case v1::ClientMessage::BODY_NOT_SET: break;  // parseClientMessage rejects it
+  }
+}
+
+void RenderSession::badMessage(ProtocolError e) {
+  ++badMessages_;
+  if (badMessages_ > options_.limits.maxBadMessages) {
+    e.message += "; too many bad messages (" + std::to_string(badMessages_) + ")";
+    fail(std::move(e));
+  } else {
+    sendError(e);
+  }
+}
+
+void RenderSession::onHello(const v1::Hello& hello, Clock::time_point now) {
+  if (hello_) {
+    sendError({v1::ERROR_CODE_PROTOCOL_ORDER, "a second Hello: send RenderSettings or SceneChoice to change settings", false});
+    return;
+  }
+  const auto& token = options_.token;
+  if (!token.empty() && !hello.auth_token().empty() && !tokensEqual(hello.auth_token(), token)) {
+    port_.tokenRejected();
+    fail({v1::ERROR_CODE_UNAUTHORIZED, "wrong auth_token in Hello", true});
+    return;
+  }
+  auto config = configFromHello(hello, options_.limits, options_.defaults, catalog_);
+  if (auto* e = std::get_if<ProtocolError>(&config)) {
+    fail(std::move(*e));
+    return;
+  }
+  // Only a valid Hello takes a session slot (a client cannot hold slots by
+  // connecting and saying nothing).
+  if (auto refused = port_.admit()) {
+    fail(std::move(*refused), CloseCode::TryAgainLater);
+    return;
+  }
+  hello_ = true;
+  clientName_ = sanitizeForLog(hello.client_name());
+  const auto* scene = catalog_.findScene(std::get<SessionConfig>(config).scene);
+  {
+    std::lock_guard lock(mutex_);
+    config_ = std::get<SessionConfig>(std::move(config));
+    pose_ = initialPose(scene->camera, scene->poses);
+    poseReceived_ = now;
+  }
+  log(format("hello from \"%s\": %dx%d %s, %.1f fps, level %d, %s, %s, scene \"%s\"", clientName_.c_str(),
+             config_.width, config_.height, std::string(encodingName(config_.encoding)).c_str(), config_.fps,
+             config_.level, std::string(methodName(config_.method)).c_str(),
+             std::string(backendName(config_.backend)).c_str(), sanitizeForLog(config_.scene).c_str()));
+  prepareRenderer();
+}
+
+void RenderSession::onPose(const v1::PoseUpdate& update, Clock::time_point now) {
+  std::optional<ProtocolError> e;
+  bool applied = false;
+  {
+    std::lock_guard lock(mutex_);
+    const auto before = pose_.sequence;
+    e = applyPose(pose_, update);
+    applied = pose_.sequence != before;
+    if (applied) poseReceived_ = now;
+  }
+  if (e) {
+    badMessage(std::move(*e));
+    return;
+  }
+  if (applied) {
+    wantFrame_ = true;
+    maybeRender(now);
+  }
+}
+
+// A changed config: a new renderer when its key changed; the scene's own
+// view again when the scene did (the objects are others). An accepted
+// SceneChoice is answered with the scene's SceneInfo.
+void RenderSession::adopt(SessionConfig next, bool announceScene, Clock::time_point now) {
+  // Both read before `next` is moved from.
+  const bool newScene = next.scene != config_.scene;
+  const bool newRenderer = next.rendererKey() != config_.rendererKey();
+  {
+    std::lock_guard lock(mutex_);
+    // Auto exposure starts afresh for another scene or after a fixed spell.
+    if (newScene || !next.autoExposure) lastExposure_.reset();
+    config_ = std::move(next);
+    if (newScene) {
+      const auto* scene = catalog_.findScene(config_.scene);
+      const auto sequence = pose_.sequence;
+      pose_ = initialPose(scene->camera, scene->poses);
+      pose_.sequence = sequence;  // later poses stay newer
+    }
+  }
+  if (announceScene && welcomed_) port_.send(sceneInfoMessage(config_, catalog_));
+  wantFrame_ = true;
+  if (newRenderer) {
+    prepareRenderer();
+  } else {
+    maybeRender(now);
+  }
+}
+
+// ------------------------------------------------------------------ renderer
+
+void RenderSession::prepareRenderer() {
+  renderer_.reset();  // no frames until the renderer for the new config is ready
+  port_.prepare(config_);
+}
+
+void RenderSession::onPrepared(const std::string& key, std::shared_ptr<PreparedRenderer> renderer,
+                               const std::string& error, Clock::time_point now) {
+  if (closed_ || key != config_.rendererKey()) return;  // superseded
+  if (!renderer) {
+    const ProtocolError e{v1::ERROR_CODE_RENDER_FAILED, "cannot prepare the renderer: " + error, !welcomed_};
+    if (e.fatal) {
+      fail(e);
+    } else {
+      sendError(e);
+    }
+    return;
+  }
+  renderer_ = std::move(renderer);
+  if (!welcomed_) {
+    welcomed_ = true;
+    lastStats_ = now;
+    port_.send(welcomeMessage(config_, catalog_, options_.limits,
+                              {id_, renderer_->renderer->objectCount(), renderer_->renderer->deviceName()}));
+  }
+  wantFrame_ = true;
+  maybeRender(now);
+}
+
+// ------------------------------------------------------------------ frames, paced to the fps cap
+
+void RenderSession::onPace(Clock::time_point now) {
+  paceArmed_ = false;
+  maybeRender(now);
+}
+
+void RenderSession::maybeRender(Clock::time_point now) {
+  if (!renderer_ || inFlight_ || !wantFrame_ || closed_) return;
+  if (now < nextFrameAt_) {
+    if (!paceArmed_) {
+      paceArmed_ = true;
+      port_.armPace(nextFrameAt_);
+    }
+    return;
+  }
+  wantFrame_ = false;
+  inFlight_ = true;
+  nextFrameAt_ = now + toDuration(1.0 / std::max(config_.fps, 1e-3));
+  port_.render({renderer_, config_.encoding, config_.jpegQuality, std::make_shared<FrameContext>()});
+}
+
+std::optional<render::FrameRequest> RenderSession::takeRequest(FrameContext& context) {
+  std::lock_guard lock(mutex_);
+  if (ended_.load()) return std::nullopt;
+  context.poseSequence = pose_.sequence;
+  context.clientTimeMs = pose_.clientTimeMs;
+  context.poseReceived = poseReceived_;
+  context.config = config_;
+  render::FrameRequest request = frameRequest(pose_, config_);
+  if (request.exposure.automatic && lastExposure_) {
+    request.exposure.previousStops = lastExposure_;
+    request.exposure.adaptation = render::exposureAdaptation(secondsBetween(lastExposureAt_, Clock::now()));
+  }
+  return request;
+}
+
+void RenderSession::onRendered(const FrameContext& context, std::optional<RenderedFrame> rendered,
+                               const std::string& error, Clock::time_point now) {
+  inFlight_ = false;
+  if (closed_) return;
+  if (!rendered) {
+    // Once per distinct message: a broken config must not flood the client.
+    if (error != lastRenderError_) sendError({v1::ERROR_CODE_RENDER_FAILED, error, false});
+    lastRenderError_ = error;
+    return;
+  }
+  lastRenderError_.clear();
+  if (context.config.autoExposure) {
+    std::lock_guard lock(mutex_);
+    if (config_.autoExposure && config_.scene == context.config.scene) {
+      lastExposure_ = rendered->frame.exposureStops;
+      lastExposureAt_ = now;
+    }
+  }
+  FrameFacts facts;
+  facts.stages = rendered->frame.stages;
+  facts.stages.push_back({"encode", rendered->encodeSeconds});
+  metrics_.addStages(facts.stages);
+  periodRenderSeconds_ += rendered->frame.seconds;
+  ++periodRendered_;
+  facts.sequence = ++frameSequence_;
+  facts.poseSequence = context.poseSequence;
+  facts.clientTimeMs = context.clientTimeMs;
+  facts.serverMs = secondsBetween(context.poseReceived, now) * 1e3;
+  const std::size_t payload = rendered->encoded.size();
+  if (port_.sendFrame(frameMessage(context.config, rendered->frame, std::move(rendered->encoded), facts), payload)) {
+    // The client had not taken the last one yet: latest wins.
+    ++framesDropped_;
+    metrics_.framesDropped.fetch_add(1);
+  }
+  maybeRender(now);
+}
+
+void RenderSession::onSent(bool isFrame, std::size_t payloadBytes) {
+  if (!isFrame) return;
+  ++framesSent_;
+  ++periodFrames_;
+  bytesSent_ += payloadBytes;
+  metrics_.framesTotal.fetch_add(1);
+  metrics_.bytesTotal.fetch_add(payloadBytes);
+}
+
+// ------------------------------------------------------------------ errors, timeouts, Stats
+
+void RenderSession::sendError(const ProtocolError& e) {
+  if (e.fatal) {
+    fail(e);
+    return;
+  }
+  if (closed_) return;
+  metrics_.addError(errorLabel(e.code));
+  log("error " + errorLabel(e.code) + ": " + sanitizeForLog(e.message, 256));
+  port_.send(errorMessage(e));
+}
+
+void RenderSession::fail(ProtocolError e, CloseCode code) {
+  if (closed_) return;
+  closed_ = true;
+  e.fatal = true;
+  const std::string label = errorLabel(e.code);
+  metrics_.addError(label);
+  metrics_.addCut(label);
+  log("closing, " + label + ": " + sanitizeForLog(e.message, 256));
+  port_.close(errorMessage(e), code, closeReason(e.message));
+}
+
+void RenderSession::end() {
+  closed_ = true;
+  ended_.store(true);
+}
+
+void RenderSession::onTick(Clock::time_point now) {
+  if (closed_) return;
+  const auto& o = options_;
+  if (!hello_ && secondsBetween(opened_, now) > o.handshakeSeconds) {
+    metrics_.addTimeout("hello");
+    fail({v1::ERROR_CODE_TIMEOUT, format("no Hello within %g s", o.handshakeSeconds), true});
+  } else if (secondsBetween(lastMessage_, now) > o.idleSeconds) {
+    metrics_.addTimeout("idle");
+    fail({v1::ERROR_CODE_TIMEOUT, format("no message for %g s (idle)", o.idleSeconds), true});
+  } else if (welcomed_ && secondsBetween(lastStats_, now) >= o.statsSeconds) {
+    sendStats(now);
+  }
+}
+
+void RenderSession::sendStats(Clock::time_point now) {
+  const double period = secondsBetween(lastStats_, now);
+  lastStats_ = now;
+  StatsFigures s;
+  s.framesSent = framesSent_;
+  s.framesDropped = framesDropped_;
+  s.bytesSent = bytesSent_;
+  s.fps = period > 0 ? static_cast<double>(periodFrames_) / period : 0.0;
+  s.renderMsMean = periodRendered_ ? periodRenderSeconds_ * 1e3 / static_cast<double>(periodRendered_) : 0.0;
+  s.sessions = static_cast<std::uint32_t>(std::max<std::int64_t>(0, metrics_.sessions.load()));
+  periodFrames_ = periodRendered_ = 0;
+  periodRenderSeconds_ = 0.0;
+  if (port_.backlog() < kMaxBacklogForStats) port_.send(statsMessage(s));
+}
+
+}  // namespace haarcast::net

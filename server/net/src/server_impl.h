@@ -1,0 +1,72 @@
+// What the listener, the HTTP sessions and the WebSocket sessions share: the
+// server's options, catalogue, metrics, slots and token guard, the session
+// registry (for stop()), the log, the io_context and the render service.
+#pragma once
+
+#include <atomic>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <boost/asio.hpp>
+
+#include "haarcast/net/access.h"
+#include "haarcast/net/server.h"
+#include "haarcast/net/static_files.h"
+
+namespace haarcast::net {
+
+class WsSession;
+
+struct Server::Impl {
+  ServerOptions options;
+  Catalog catalog;
+  std::optional<WebRoot> webRoot;  // the served client, when options.webRoot is set
+  Metrics metrics;
+  Admission admission;
+  TokenGuard tokenGuard;
+  std::mutex logMutex;
+  std::mutex sessionsMutex;
+  std::map<const WsSession*, std::weak_ptr<WsSession>> sessions;  // every WebSocket, before and after Hello
+  std::atomic<bool> stopping{false};
+  std::atomic<std::uint64_t> nextSessionId{1};
+  std::vector<std::thread> threads;
+
+  // Declared after everything sessions touch in their destructors, so that
+  // the handlers the io_context destroys find them alive; the render service
+  // after the io_context, so its threads (which post into it) stop first.
+  boost::asio::io_context ioc;
+  boost::asio::ip::tcp::acceptor acceptor;
+  std::optional<boost::asio::signal_set> signals;
+  boost::asio::steady_timer acceptPause;
+  AcceptBackoff acceptBackoff;
+  boost::asio::steady_timer drainTimer;
+  Clock::time_point drainDeadline;
+  std::uint16_t boundPort = 0;
+  std::unique_ptr<RenderService> renderService;
+
+  Impl(ServerOptions o, Catalog c, RendererBuilder builder);
+
+  void log(const char* format, ...) __attribute__((format(printf, 2, 3)));
+  void listen();
+  void doAccept();
+  void onAccept(boost::system::error_code ec, boost::asio::ip::tcp::socket socket);
+  void stop();
+  void watchDrain();
+  std::size_t sessionCount();
+  bool atCapacity() const;
+};
+
+// Seconds → a Clock duration (negative: 0).
+inline std::chrono::nanoseconds toDuration(double seconds) {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::duration<double>(std::max(0.0, seconds)));
+}
+
+// "address" of a connected socket (no port): the key of per-address limits.
+std::string peerAddress(const boost::asio::ip::tcp::socket& socket);
+
+}  // namespace haarcast::net

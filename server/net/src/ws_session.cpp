@@ -1,0 +1,311 @@
+#include "ws_session.h"
+
+#include <algorithm>
+
+namespace haarcast::net {
+namespace {
+
+namespace asio = boost::asio;
+namespace beast = boost::beast;
+namespace http = beast::http;
+namespace websocket = beast::websocket;
+using tcp = asio::ip::tcp;
+
+// How often a session checks its timeouts and whether Stats are due.
+constexpr auto kTick = std::chrono::milliseconds(100);
+// Control messages (Welcome, Error, Stats, Pong, SceneInfo) queued behind
+// the write in flight. A client that makes more pile up (a Ping burst, or
+// not reading) is told so and closed.
+constexpr std::size_t kMaxControlQueue = 64;
+
+double secondsBetween(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
+
+}  // namespace
+
+WsSession::WsSession(Server::Impl& server, tcp::socket&& socket, Admission::Slot connection, Admission::Slot pending,
+                     std::string address)
+    : server_(server),
+      ws_(std::move(socket)),
+      executor_(ws_.get_executor()),
+      ticker_(executor_),
+      paceTimer_(executor_),
+      id_("s" + std::to_string(server.nextSessionId.fetch_add(1))),
+      address_(std::move(address)),
+      connectionSlot_(std::move(connection)),
+      pendingSlot_(std::move(pending)),
+      session_(server.options, server.catalog, server.metrics, *this, id_, Clock::now()) {
+  if (pendingSlot_) server_.metrics.pending.fetch_add(1);
+}
+
+WsSession::~WsSession() {
+  if (pendingSlot_) server_.metrics.pending.fetch_sub(1);
+  if (sessionSlot_) server_.metrics.sessions.fetch_sub(1);
+  if (registered_) {
+    std::lock_guard lock(server_.sessionsMutex);
+    server_.sessions.erase(this);
+  }
+}
+
+void WsSession::accept(http::request<http::string_body> request) {
+  const auto& limits = server_.options.limits;
+  // The WebSocket stream keeps its own timeouts; the TCP layer's must be off.
+  beast::get_lowest_layer(ws_).expires_never();
+  websocket::stream_base::timeout timeouts{};
+  timeouts.handshake_timeout = toDuration(server_.options.handshakeSeconds);
+  timeouts.idle_timeout = websocket::stream_base::none();  // ours: Error TIMEOUT, with a reason
+  timeouts.keep_alive_pings = false;
+  ws_.set_option(timeouts);
+  ws_.set_option(websocket::stream_base::decorator(
+      [](websocket::response_type& res) { res.set(http::field::server, kServerVersion); }));
+  // A backstop only: messages over maxMessageBytes get Error
+  // MESSAGE_TOO_LARGE from the session; far larger ones are cut by Beast
+  // here (close code 1009) before they are buffered.
+  ws_.read_message_max(limits.maxMessageBytes * 4 + 4096);
+  ws_.binary(true);
+  ws_.async_accept(request, [self = shared_from_this()](beast::error_code ec) { self->onAccept(ec); });
+}
+
+void WsSession::shutdown() {
+  session_.fail({v1::ERROR_CODE_SHUTTING_DOWN, "the server is shutting down", true}, CloseCode::GoingAway);
+}
+
+void WsSession::onAccept(beast::error_code ec) {
+  if (ec) {
+    if (ec == beast::error::timeout) server_.metrics.addTimeout("ws_handshake");
+    server_.log("%s: WebSocket handshake with %s failed: %s", id_.c_str(), address_.c_str(), ec.message().c_str());
+    return;
+  }
+  {
+    std::lock_guard lock(server_.sessionsMutex);
+    server_.sessions.emplace(this, weak_from_this());
+    registered_ = true;
+  }
+  server_.log("%s: opened from %s", id_.c_str(), address_.c_str());
+  doRead();
+  tick();
+  if (server_.stopping.load()) shutdown();
+}
+
+// ------------------------------------------------------------------ reading
+
+void WsSession::doRead() {
+  ws_.async_read(readBuffer_, [self = shared_from_this()](beast::error_code ec, std::size_t) { self->onRead(ec); });
+}
+
+void WsSession::onRead(beast::error_code ec) {
+  if (ec) {
+    if (ec == websocket::error::message_too_big) {
+      server_.metrics.addWebSocketViolation("message_too_big");
+      server_.metrics.addError(errorLabel(v1::ERROR_CODE_MESSAGE_TOO_LARGE));
+      server_.metrics.addCut("message_too_large");
+      server_.log("%s: message over %zu bytes: closed (1009)", id_.c_str(), ws_.read_message_max());
+    } else if (ec.category() == websocket::make_error_code(websocket::error::bad_opcode).category()) {
+      // Beast's WebSocket errors: a frame that breaks RFC 6455 (bad opcode,
+      // unmasked, bad UTF-8 text, a close code out of range …), or `closed`.
+      if (ec != websocket::error::closed) {
+        server_.metrics.addWebSocketViolation("protocol");
+        server_.log("%s: WebSocket protocol violation: %s", id_.c_str(), ec.message().c_str());
+      }
+    } else if (ec != asio::error::operation_aborted) {
+      server_.log("%s: read: %s", id_.c_str(), ec.message().c_str());
+    }
+    finish();
+    return;
+  }
+  const std::string bytes = beast::buffers_to_string(readBuffer_.data());
+  readBuffer_.consume(readBuffer_.size());
+  if (!closeRequested_) session_.onMessage(bytes, ws_.got_binary(), Clock::now());
+  doRead();  // also while closing: the close handshake needs the peer's close frame read
+}
+
+// ------------------------------------------------------------------ SessionPort
+
+void WsSession::send(std::string bytes) {
+  if (closeRequested_ || gone_) return;
+  if (control_.size() >= kMaxControlQueue) {
+    // Say why before closing: the queued answers are dropped so the Error
+    // goes out next.
+    control_.clear();
+    session_.fail({v1::ERROR_CODE_OVERLOADED,
+                   "over " + std::to_string(kMaxControlQueue) +
+                       " messages waiting to be sent: the client sends faster than it reads (a Ping burst?)",
+                   true});
+    return;
+  }
+  control_.push_back(Outgoing{std::make_shared<const std::string>(std::move(bytes)), false, 0});
+  doWrite();
+}
+
+bool WsSession::sendFrame(std::string bytes, std::size_t payloadBytes) {
+  if (closeRequested_ || gone_) return false;
+  const bool replaced = frameSlot_.has_value();
+  frameSlot_ = Outgoing{std::make_shared<const std::string>(std::move(bytes)), true, payloadBytes};
+  doWrite();
+  return replaced;
+}
+
+void WsSession::close(std::string error, CloseCode code, std::string reason) {
+  if (closeRequested_ || gone_) return;
+  control_.push_back(Outgoing{std::make_shared<const std::string>(std::move(error)), false, 0});
+  closeRequested_ = true;
+  closeAt_ = Clock::now();
+  closeReason_ = websocket::close_reason(static_cast<websocket::close_code>(code), reason);
+  frameSlot_.reset();
+  paceTimer_.cancel();
+  doWrite();
+}
+
+void WsSession::armPace(Clock::time_point at) {
+  paceTimer_.expires_at(at);
+  paceTimer_.async_wait([self = shared_from_this()](beast::error_code ec) {
+    if (!ec && !self->gone_) self->session_.onPace(Clock::now());
+  });
+}
+
+void WsSession::prepare(const SessionConfig& config) {
+  server_.renderService->prepare(config, [weak = weak_from_this(), key = config.rendererKey()](
+                                             std::shared_ptr<PreparedRenderer> r, std::string error) {
+    if (auto self = weak.lock()) {
+      asio::post(self->executor_, [self, key, r = std::move(r), error = std::move(error)]() mutable {
+        if (!self->gone_) self->session_.onPrepared(key, std::move(r), error, Clock::now());
+      });
+    }
+  });
+}
+
+void WsSession::render(FrameOrder order) {
+  RenderJob job;
+  job.renderer = std::move(order.renderer);
+  job.encoding = order.encoding;
+  job.jpegQuality = order.jpegQuality;
+  // The seam for cancellation: a job whose session has gone finds no
+  // request here (and a `cancelled` poll would ask the same weak pointer).
+  job.take = [weak = weak_from_this(), context = order.context]() -> std::optional<render::FrameRequest> {
+    const auto self = weak.lock();
+    if (!self) return std::nullopt;
+    return self->session_.takeRequest(*context);
+  };
+  job.done = [weak = weak_from_this(), context = order.context](std::optional<RenderedFrame> frame, std::string error) {
+    if (auto self = weak.lock()) {
+      asio::post(self->executor_, [self, context, frame = std::move(frame), error = std::move(error)]() mutable {
+        self->session_.onRendered(*context, std::move(frame), error, Clock::now());
+      });
+    }
+  };
+  server_.renderService->submit(std::move(job));
+}
+
+std::optional<ProtocolError> WsSession::admit() {
+  Admission::Refusal refusal;
+  auto slot = server_.admission.take(SlotKind::Session, address_, &refusal);
+  if (!slot) {
+    server_.metrics.addRefusal(refusal.perAddress ? "sessions_per_address" : "sessions");
+    return ProtocolError{v1::ERROR_CODE_TOO_MANY_SESSIONS, refusal.reason, true};
+  }
+  sessionSlot_ = std::move(*slot);
+  server_.metrics.sessions.fetch_add(1);
+  server_.metrics.sessionsTotal.fetch_add(1);
+  if (pendingSlot_) {
+    pendingSlot_.release();
+    server_.metrics.pending.fetch_sub(1);
+  }
+  return std::nullopt;
+}
+
+void WsSession::tokenRejected() { server_.tokenGuard.failed(address_, Clock::now()); }
+
+void WsSession::log(const std::string& line) { server_.log("%s", line.c_str()); }
+
+// ------------------------------------------------------------------ writing: one in flight
+
+void WsSession::doWrite() {
+  if (writing_ || closeStarted_ || gone_) return;
+  Outgoing next;
+  if (!control_.empty()) {
+    next = std::move(control_.front());
+    control_.pop_front();
+  } else if (frameSlot_) {
+    next = std::move(*frameSlot_);
+    frameSlot_.reset();
+  } else {
+    if (closeRequested_) startClose();
+    return;
+  }
+  writing_ = true;
+  writeStarted_ = Clock::now();
+  ws_.async_write(asio::buffer(*next.bytes), [self = shared_from_this(), next](beast::error_code ec, std::size_t) {
+    self->onWrite(ec, next);
+  });
+}
+
+void WsSession::onWrite(beast::error_code ec, const Outgoing& sent) {
+  writing_ = false;
+  if (ec) {
+    if (ec != asio::error::operation_aborted) server_.log("%s: write: %s", id_.c_str(), ec.message().c_str());
+    finish();
+    return;
+  }
+  session_.onSent(sent.isFrame, sent.payloadBytes);
+  doWrite();
+}
+
+void WsSession::startClose() {
+  closeStarted_ = true;
+  ws_.async_close(closeReason_, [self = shared_from_this()](beast::error_code) { self->finish(); });
+}
+
+// Cuts the connection: pending operations complete with operation_aborted.
+void WsSession::hardClose(const char* why) {
+  if (gone_) return;
+  server_.log("%s: cut: %s", id_.c_str(), why);
+  closeRequested_ = true;
+  beast::error_code ec;
+  beast::get_lowest_layer(ws_).socket().shutdown(tcp::socket::shutdown_both, ec);
+  beast::get_lowest_layer(ws_).socket().close(ec);
+  finish();
+}
+
+// The session is over: stop the timers; it is destroyed when the last
+// pending handler lets go of it.
+void WsSession::finish() {
+  if (gone_) return;
+  gone_ = true;
+  session_.end();
+  ticker_.cancel();
+  paceTimer_.cancel();
+  server_.log("%s: closed (%llu frames, %llu dropped, %llu bytes)", id_.c_str(),
+              static_cast<unsigned long long>(session_.framesSent()),
+              static_cast<unsigned long long>(session_.framesDropped()),
+              static_cast<unsigned long long>(session_.bytesSent()));
+}
+
+// ------------------------------------------------------------------ timers
+
+void WsSession::tick() {
+  ticker_.expires_after(kTick);
+  ticker_.async_wait([self = shared_from_this()](beast::error_code ec) {
+    if (!ec) self->onTick();
+  });
+}
+
+void WsSession::onTick() {
+  if (gone_) return;
+  const auto& o = server_.options;
+  const auto now = Clock::now();
+  if (writing_ && secondsBetween(writeStarted_, now) > o.writeStallSeconds) {
+    server_.metrics.addError(errorLabel(v1::ERROR_CODE_TIMEOUT));  // no Error can reach a client that does not read
+    server_.metrics.addTimeout("write");
+    server_.metrics.addCut("write_stall");
+    hardClose("a write has not completed for too long (the client stopped reading)");
+    return;
+  }
+  if (closeRequested_ && secondsBetween(closeAt_, now) > o.drainSeconds) {
+    server_.metrics.addTimeout("close");
+    hardClose("the close did not complete in time");
+    return;
+  }
+  if (!closeRequested_) session_.onTick(now);
+  tick();
+}
+
+}  // namespace haarcast::net

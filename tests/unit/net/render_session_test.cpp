@@ -1,0 +1,295 @@
+// The application session without a socket: a recording SessionPort stands
+// in for the WebSocket, a stub renderer for the render service, and the
+// tests pass the clock, so Hello, settings, scenes, pacing and timeouts are
+// checked message by message and instant by instant.
+#include "haarcast/net/render_session.h"
+
+#include <deque>
+
+#include <gtest/gtest.h>
+
+namespace haarcast::net {
+namespace {
+
+using namespace std::chrono_literals;
+
+class StubRenderer : public render::Renderer {
+ public:
+  std::string backend() const override { return "cpu"; }
+  std::string deviceName() const override { return "stub"; }
+  const render::RenderOptions& options() const override { return options_; }
+  std::size_t objectCount() const override { return 2; }
+  render::Frame render(const render::FrameRequest& request) override {
+    render::Frame f;
+    f.width = request.width;
+    f.height = request.height;
+    return f;
+  }
+
+ private:
+  render::RenderOptions options_;
+};
+
+// Records everything the session emits.
+class RecordingPort : public SessionPort {
+ public:
+  void send(std::string bytes) override { sent.push_back(parse(bytes)); }
+  bool sendFrame(std::string bytes, std::size_t) override {
+    frames.push_back(parse(bytes));
+    return false;
+  }
+  std::size_t backlog() const override { return 0; }
+  void close(std::string error, CloseCode code, std::string reason) override {
+    sent.push_back(parse(error));
+    closeCode = code;
+    closeReason = std::move(reason);
+  }
+  void armPace(Clock::time_point at) override { paceAt = at; }
+  void prepare(const SessionConfig& config) override { prepared.push_back(config); }
+  void render(FrameOrder order) override { orders.push_back(std::move(order)); }
+  std::optional<ProtocolError> admit() override {
+    if (full) return ProtocolError{v1::ERROR_CODE_TOO_MANY_SESSIONS, "too many sessions: the server allows 1", true};
+    ++admitted;
+    return std::nullopt;
+  }
+  void tokenRejected() override { ++wrongTokens; }
+  void log(const std::string& line) override { logs.push_back(line); }
+
+  static v1::ServerMessage parse(const std::string& bytes) {
+    v1::ServerMessage m;
+    EXPECT_TRUE(m.ParseFromString(bytes));
+    return m;
+  }
+
+  std::deque<v1::ServerMessage> sent, frames;
+  std::optional<CloseCode> closeCode;
+  std::string closeReason;
+  std::optional<Clock::time_point> paceAt;
+  std::vector<SessionConfig> prepared;
+  std::vector<FrameOrder> orders;
+  bool full = false;
+  int admitted = 0, wrongTokens = 0;
+  std::vector<std::string> logs;
+};
+
+Catalog catalog() {
+  Catalog c;
+  render::Camera camera;
+  camera.eye = {0, 0, 3};
+  for (const char* name : {"default", "other"}) {
+    c.scenes.push_back({name, {"lambert", "lambert"}, camera, {render::Pose{}, render::Pose{}}, {"a", "b"}});
+  }
+  c.materials = {"lambert", "phong:16"};
+  c.backends = {Backend::Cpu};
+  return c;
+}
+
+ServerOptions options() {
+  ServerOptions o;
+  o.token = "t";
+  o.limits.maxFps = 10;
+  o.defaults.width = 16;
+  o.defaults.height = 16;
+  o.defaults.level = 4;
+  o.handshakeSeconds = 2;
+  o.idleSeconds = 30;
+  o.statsSeconds = 1;
+  return o;
+}
+
+v1::ClientMessage hello(double fps = 10) {
+  v1::ClientMessage m;
+  auto* h = m.mutable_hello();
+  h->set_protocol_version(kProtocolVersion);
+  h->set_fps_cap(fps);
+  h->set_client_name("line one\nFORGED [serve] line");
+  return m;
+}
+
+v1::ClientMessage pose(std::uint64_t sequence) {
+  v1::ClientMessage m;
+  m.mutable_pose()->set_sequence(sequence);
+  m.mutable_pose()->mutable_light_rotate_degrees()->set_y(static_cast<double>(sequence));
+  return m;
+}
+
+struct Fixture {
+  ServerOptions o = options();
+  Catalog c = catalog();
+  Metrics metrics;
+  RecordingPort port;
+  Clock::time_point t0 = Clock::now();
+  RenderSession session{o, c, metrics, port, "s1", t0};
+
+  void receive(const v1::ClientMessage& m, Clock::time_point at) { session.onMessage(m.SerializeAsString(), true, at); }
+  // Hello, and the renderer it asked for, ready at once.
+  void welcome() {
+    receive(hello(), t0);
+    ASSERT_EQ(port.prepared.size(), 1u);
+    session.onPrepared(port.prepared.back().rendererKey(), prepared(), "", t0);
+  }
+  static std::shared_ptr<PreparedRenderer> prepared() {
+    auto p = std::make_shared<PreparedRenderer>();
+    p->renderer = std::make_unique<StubRenderer>();
+    return p;
+  }
+  // Runs the last order as a worker would and hands the frame back.
+  void finishRender(Clock::time_point at) {
+    ASSERT_FALSE(port.orders.empty());
+    FrameOrder order = port.orders.back();
+    auto request = session.takeRequest(*order.context);
+    ASSERT_TRUE(request);
+    RenderedFrame f;
+    f.frame = order.renderer->renderer->render(*request);
+    f.encoded = "jpeg";
+    session.onRendered(*order.context, std::move(f), "", at);
+  }
+};
+
+TEST(RenderSession, HelloIsWelcomedOnceTheRendererIsReady) {
+  Fixture f;
+  f.receive(hello(), f.t0);
+  EXPECT_TRUE(f.port.sent.empty()) << "no Welcome before the renderer";
+  EXPECT_EQ(f.port.admitted, 1);
+  // A renderer for an older key (superseded) is ignored.
+  f.session.onPrepared("another key", Fixture::prepared(), "", f.t0);
+  EXPECT_TRUE(f.port.sent.empty());
+  f.session.onPrepared(f.port.prepared.back().rendererKey(), Fixture::prepared(), "", f.t0);
+  ASSERT_EQ(f.port.sent.size(), 1u);
+  const auto& w = f.port.sent.front().welcome();
+  EXPECT_EQ(w.session_id(), "s1");
+  EXPECT_EQ(w.width(), 16u);
+  EXPECT_EQ(w.object_count(), 2u);
+  EXPECT_EQ(w.device(), "stub");
+  EXPECT_EQ(w.scenes_size(), 2);
+  // The client's name reaches the log escaped: no forged second line.
+  bool logged = false;
+  for (const auto& line : f.port.logs) {
+    EXPECT_EQ(line.find('\n'), std::string::npos) << line;
+    logged = logged || line.find("line one\\nFORGED") != std::string::npos;
+  }
+  EXPECT_TRUE(logged);
+}
+
+TEST(RenderSession, NoSlotWithoutAValidHello) {
+  Fixture f;
+  v1::ClientMessage bad = hello();
+  bad.mutable_hello()->set_width(5000);
+  bad.mutable_hello()->set_height(5000);
+  f.receive(bad, f.t0);
+  EXPECT_EQ(f.port.admitted, 0) << "an invalid Hello must not take a session slot";
+  EXPECT_EQ(f.port.closeCode, CloseCode::PolicyError);
+
+  Fixture full;
+  full.port.full = true;
+  full.receive(hello(), full.t0);
+  ASSERT_EQ(full.port.sent.size(), 1u);
+  EXPECT_EQ(full.port.sent.front().error().code(), v1::ERROR_CODE_TOO_MANY_SESSIONS);
+  EXPECT_EQ(full.port.closeCode, CloseCode::TryAgainLater);
+  EXPECT_TRUE(full.port.prepared.empty());
+
+  Fixture wrong;
+  v1::ClientMessage h = hello();
+  h.mutable_hello()->set_auth_token("guess");
+  wrong.receive(h, wrong.t0);
+  EXPECT_EQ(wrong.port.wrongTokens, 1);
+  EXPECT_EQ(wrong.port.sent.front().error().code(), v1::ERROR_CODE_UNAUTHORIZED);
+}
+
+TEST(RenderSession, BadSettingsNameTheChoicesAndAreNotFatal) {
+  Fixture f;
+  f.welcome();
+  v1::ClientMessage m;
+  m.mutable_settings()->set_backend(v1::BACKEND_VULKAN);  // not enabled here
+  f.receive(m, f.t0);
+  const auto& e = f.port.sent.back().error();
+  EXPECT_EQ(e.code(), v1::ERROR_CODE_BAD_SETTINGS);
+  EXPECT_FALSE(e.fatal());
+  EXPECT_NE(e.message().find("enables cpu"), std::string::npos) << e.message();
+  m.Clear();
+  m.mutable_settings()->set_level(99);
+  f.receive(m, f.t0);
+  EXPECT_NE(f.port.sent.back().error().message().find("outside"), std::string::npos);
+  EXPECT_FALSE(f.port.closeCode);
+  EXPECT_EQ(f.port.prepared.size(), 1u) << "a refused change builds nothing";
+}
+
+TEST(RenderSession, SceneSwitchAnnouncesSceneInfoAndBuildsItsRenderer) {
+  Fixture f;
+  f.welcome();
+  v1::ClientMessage m;
+  m.mutable_scene()->set_scene("other");
+  f.receive(m, f.t0);
+  ASSERT_TRUE(f.port.sent.back().has_scene_info());
+  EXPECT_EQ(f.port.sent.back().scene_info().name(), "other");
+  ASSERT_EQ(f.port.prepared.size(), 2u);
+  EXPECT_EQ(f.port.prepared.back().scene, "other");
+  EXPECT_EQ(f.session.config().scene, "other");
+  // A material change on the same scene is a SceneChoice too: SceneInfo again.
+  m.mutable_scene()->mutable_object_materials()->insert({1, "phong:16"});
+  f.receive(m, f.t0);
+  EXPECT_EQ(f.port.sent.back().scene_info().objects(1).material(), "phong:16");
+}
+
+TEST(RenderSession, PosesArePacedToTheFpsCapAndTheLatestWins) {
+  Fixture f;
+  f.welcome();
+  ASSERT_EQ(f.port.orders.size(), 1u);  // the first frame, at once
+  f.finishRender(f.t0 + 5ms);
+  ASSERT_EQ(f.port.frames.size(), 1u);
+  // Two poses inside the 100 ms frame interval: no render yet, one timer.
+  f.receive(pose(1), f.t0 + 10ms);
+  f.receive(pose(2), f.t0 + 20ms);
+  EXPECT_EQ(f.port.orders.size(), 1u);
+  ASSERT_TRUE(f.port.paceAt);
+  EXPECT_EQ(*f.port.paceAt, f.t0 + 100ms);
+  f.session.onPace(f.t0 + 100ms);
+  ASSERT_EQ(f.port.orders.size(), 2u);
+  f.receive(pose(3), f.t0 + 101ms);  // arrives before the worker starts: the frame shows it
+  f.finishRender(f.t0 + 110ms);
+  EXPECT_EQ(f.port.frames.back().frame().pose_sequence(), 3u);
+  EXPECT_EQ(f.port.frames.back().frame().sequence(), 2u);
+  // A stale pose changes nothing.
+  f.receive(pose(2), f.t0 + 300ms);
+  EXPECT_EQ(f.port.orders.size(), 2u);
+}
+
+TEST(RenderSession, HelloTimeoutIdleTimeoutAndStats) {
+  Fixture f;
+  f.session.onTick(f.t0 + 1s);
+  EXPECT_TRUE(f.port.sent.empty());
+  f.session.onTick(f.t0 + 2100ms);
+  ASSERT_EQ(f.port.sent.size(), 1u);
+  EXPECT_EQ(f.port.sent.front().error().code(), v1::ERROR_CODE_TIMEOUT);
+  EXPECT_NE(f.metrics.prometheusText().find("haarcast_timeouts_total{phase=\"hello\"} 1"), std::string::npos);
+
+  Fixture g;
+  g.welcome();
+  g.session.onTick(g.t0 + 1s);
+  EXPECT_TRUE(g.port.sent.back().has_stats());
+  g.session.onTick(g.t0 + 31s);
+  EXPECT_EQ(g.port.sent.back().error().code(), v1::ERROR_CODE_TIMEOUT);
+  EXPECT_NE(g.port.sent.back().error().message().find("idle"), std::string::npos);
+}
+
+TEST(RenderSession, FatalErrorsCloseOnceWithAReasonCutOnUtf8) {
+  Fixture f;
+  f.welcome();
+  v1::ClientMessage m;
+  m.mutable_scene()->set_scene(std::string(200, 'x'));
+  f.receive(m, f.t0);  // not fatal: an Error naming the scenes
+  EXPECT_FALSE(f.port.closeCode);
+  f.session.fail({v1::ERROR_CODE_BAD_MESSAGE, "é" + std::string(120, 'a') + "éé", true});
+  ASSERT_TRUE(f.port.closeCode);
+  EXPECT_LE(f.port.closeReason.size(), kMaxCloseReasonBytes);
+  // Byte 123 falls inside the second "é": the cut drops it whole.
+  EXPECT_EQ(f.port.closeReason, "é" + std::string(120, 'a'));
+  const auto sent = f.port.sent.size();
+  f.session.fail({v1::ERROR_CODE_TIMEOUT, "again", true});
+  f.receive(pose(9), f.t0);
+  EXPECT_EQ(f.port.sent.size(), sent) << "nothing after the close";
+  EXPECT_NE(f.metrics.prometheusText().find("haarcast_session_cuts_total{reason=\"bad_message\"} 1"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace haarcast::net
