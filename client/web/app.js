@@ -475,7 +475,8 @@ function startH264View(on) {
       ctx.drawImage(frame, 0, 0);
       done();
     },
-    // A pose with only its sequence and `keyframe`: the same view, as a keyframe.
+    // A pose with no view fields, only `keyframe` (and the time the frame
+    // echoes for the HUD latency): the same view, as a keyframe.
     requestKeyframe: () => {
       const sequence = ++poseSequence;
       if (!send({ pose: { sequence, clientTimeMs: performance.now(), keyframe: true } })) return 0;
