@@ -101,7 +101,8 @@ v1::Encoding parseEncoding(const std::string& name) {
   if (name == "png") return v1::ENCODING_PNG;
   if (name == "raw" || name == "rgba8") return v1::ENCODING_RAW_RGBA8;
   if (name == "exr") return v1::ENCODING_EXR;
-  throw std::invalid_argument("--encoding must be jpeg, png, raw or exr (got \"" + name + "\")");
+  if (name == "h264" || name == "h.264") return v1::ENCODING_H264;
+  throw std::invalid_argument("--encoding must be jpeg, png, raw, exr or h264 (got \"" + name + "\")");
 }
 
 std::string encodingName(v1::Encoding encoding) {
@@ -110,6 +111,7 @@ std::string encodingName(v1::Encoding encoding) {
     case v1::ENCODING_PNG: return "png";
     case v1::ENCODING_RAW_RGBA8: return "raw";
     case v1::ENCODING_EXR: return "exr";
+    case v1::ENCODING_H264: return "h264";
     default: return "unspecified";
   }
 }
@@ -122,7 +124,24 @@ std::string encodingFileExtension(v1::Encoding encoding) {
     // behind a 60-byte header that records the size, so any viewer opens them.
     case v1::ENCODING_RAW_RGBA8: return ".pam";
     case v1::ENCODING_EXR: return ".exr";
+    // Decoded by the session's FrameDecoder and written as PNG (encodePng).
+    case v1::ENCODING_H264: return ".png";
     default: return ".bin";
+  }
+}
+
+void checkH264Options(v1::Encoding encoding, const Size& size, const H264Options& options) {
+  if (encoding != v1::ENCODING_H264) {
+    const char* flag = options.bitrateKbps != 0 ? "--bitrate" : options.keyframeInterval != 0 ? "--keyframe-interval" : nullptr;
+    if (flag) {
+      throw std::invalid_argument(std::string(flag) + " applies to --encoding h264 only (got --encoding " +
+                                  encodingName(encoding) + ")");
+    }
+    return;
+  }
+  if (size.width % 2 != 0 || size.height % 2 != 0) {
+    throw std::invalid_argument("--encoding h264 needs an even width and height (4:2:0 chroma), got --size " +
+                                std::to_string(size.width) + "x" + std::to_string(size.height));
   }
 }
 

@@ -34,10 +34,22 @@ struct Size {
 };
 Size parseSize(const std::string& text);
 
-// "jpeg" | "png" | "raw" | "exr" (and "rgba8" for raw).
+// "jpeg" | "png" | "raw" | "exr" | "h264" (and "rgba8" for raw).
 v1::Encoding parseEncoding(const std::string& name);
 std::string encodingName(v1::Encoding encoding);
+// The extension of a frame written under --out. H.264 frames are written as
+// PNG: one access unit depends on the ones before it and is no file of its own.
 std::string encodingFileExtension(v1::Encoding encoding);
+
+// --bitrate and --keyframe-interval (0 = the server's default), checked
+// against what they apply to: H.264 only, and H.264 (4:2:0) wants an even
+// width and height (proto/haarcast.proto, ENCODING_H264). Throws
+// std::invalid_argument naming the flag and the valid choices.
+struct H264Options {
+  std::uint32_t bitrateKbps = 0;
+  std::uint32_t keyframeInterval = 0;
+};
+void checkH264Options(v1::Encoding encoding, const Size& size, const H264Options& options);
 
 // "auto" → automatic exposure; a number → that many stops, fixed.
 struct Exposure {

@@ -126,6 +126,7 @@ int run(int argc, char** argv) {
   std::string outDir;
   double fpsCap = 0.0;
   unsigned quality = 0;
+  H264Options h264;
   std::string method;
   unsigned level = 0;
   unsigned coefficients = 0;
@@ -149,12 +150,18 @@ int run(int argc, char** argv) {
   auto* framesOpt = app.add_option("--frames,-n", frames, "Poses to play, one frame each (default 100; a --path file's length)")
                         ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{10000000}));
   app.add_option("--size", size, "WIDTHxHEIGHT of the frames")->capture_default_str();
-  app.add_option("--encoding", encoding, "jpeg | png | raw | exr")->capture_default_str();
+  app.add_option("--encoding", encoding, "jpeg | png | raw | exr | h264")->capture_default_str();
   app.add_option("--token", token, "Bearer token, if the server was started with --token");
   app.add_option("--out", outDir, "Record every frame into this folder (client-K/ subfolders with --clients > 1)");
   app.add_option("--fps-cap", fpsCap, "Ask the server for at most this many frames per second (0 = its default)")
       ->check(CLI::Range(0.0, 1000.0));
   app.add_option("--quality", quality, "JPEG quality 1..100 (0 = the server's default)")->check(CLI::Range(0u, 100u));
+  app.add_option("--bitrate", h264.bitrateKbps,
+                 "H.264 bitrate cap in kbit/s (0 = the server's default; Welcome.limits has its maximum)")
+      ->check(CLI::Range(0u, 10000000u));
+  app.add_option("--keyframe-interval", h264.keyframeInterval,
+                 "H.264 frames from one keyframe to the next (0 = the server's default)")
+      ->check(CLI::Range(0u, 100000u));
   app.add_option("--method", method, "Per-pixel method: fused | haar | spatial | matrix | table (default: the server's)");
   app.add_option("--level", level,
                  "Map level n, 2^n x 2^n: " + std::to_string(minLevel()) + ".." + std::to_string(maxLevel()) +
@@ -211,6 +218,7 @@ int run(int argc, char** argv) {
     base.hello.set_width(wh.width);
     base.hello.set_height(wh.height);
     base.hello.set_encoding(parseEncoding(encoding));
+    checkH264Options(base.hello.encoding(), wh, h264);
     base.hello.set_fps_cap(fpsCap);
     base.hello.set_jpeg_quality(quality);
     auto* settings = base.hello.mutable_settings();
@@ -220,6 +228,8 @@ int run(int argc, char** argv) {
     const Exposure e = parseExposure(exposure);
     settings->set_exposure_mode(e.mode);
     settings->set_exposure_stops(e.stops);
+    settings->set_h264_bitrate_kbps(h264.bitrateKbps);
+    settings->set_h264_keyframe_interval(h264.keyframeInterval);
     if (!scene.empty() || !materials.empty()) {
       auto* choice = base.hello.mutable_scene();
       choice->set_scene(scene);
@@ -317,9 +327,12 @@ int run(int argc, char** argv) {
   }
 
   // Exit 1 when anything went wrong: a failed session, a server Error, a
-  // blank frame, or a frame that never came.
+  // blank frame, or a frame that never came. An H.264 frame that did not
+  // decode is recovered from (a keyframe is asked for), but when frames are
+  // checked it is one that was not: that fails the run too.
   bool ok = j["errors"].get<std::uint64_t>() == 0 && j["blank_frames"].get<std::uint64_t>() == 0 &&
             j["clipped_frames"].get<std::uint64_t>() == 0;
+  if ((checkNotBlank || maxClipped >= 0.0) && j["undecoded_frames"].get<std::uint64_t>() != 0) ok = false;
   for (const auto& s : summary.sessions) ok = ok && s.failure.empty();
   const std::uint64_t answered = j["frames"].get<std::uint64_t>() + j["dropped"].get<std::uint64_t>();
   if (ok && duration <= 0.0 && answered != frames * clients) ok = false;

@@ -42,7 +42,7 @@ nlohmann::json latencyFields(const std::vector<double>& latency) {
 
 nlohmann::json summaryJson(const RunSummary& run) {
   std::uint64_t frames = 0, dropped = 0, errors = 0, payload = 0, wire = 0, blank = 0, extra = 0, failed = 0;
-  std::uint64_t clippedFrames = 0;
+  std::uint64_t clippedFrames = 0, undecoded = 0, keyframeRequests = 0;
   double clippedMax = -1.0;
   std::vector<double> latency, server;
   std::map<std::string, std::vector<double>> stages;
@@ -56,6 +56,8 @@ nlohmann::json summaryJson(const RunSummary& run) {
     wire += s.wireBytes;
     blank += s.blankFrames;
     clippedFrames += s.clippedFrames;
+    undecoded += s.undecodedFrames;
+    keyframeRequests += s.keyframeRequests;
     clippedMax = std::max(clippedMax, s.clippedFractionMax);
     extra += s.extraFrames;
     failed += s.failure.empty() ? 0 : 1;
@@ -69,6 +71,8 @@ nlohmann::json summaryJson(const RunSummary& run) {
         {"bytes_per_frame", ratio(static_cast<double>(s.payloadBytes), static_cast<double>(s.frames))},
         {"dropped", s.dropped},
         {"errors", s.errors},
+        {"undecoded_frames", s.undecodedFrames},
+        {"keyframe_requests", s.keyframeRequests},
         {"server_fps", s.serverFps},
         {"exposure_stops", s.lastExposureStops},
         {"failure", s.failure},
@@ -90,6 +94,8 @@ nlohmann::json summaryJson(const RunSummary& run) {
       {"blank_frames", blank},
       {"clipped_frames", clippedFrames},
       {"clipped_fraction_max", clippedMax < 0.0 ? nlohmann::json(nullptr) : nlohmann::json(clippedMax)},
+      {"undecoded_frames", undecoded},
+      {"keyframe_requests", keyframeRequests},
       {"failed_clients", failed},
       {"encoding", run.encoding},
       {"width", run.width},

@@ -26,6 +26,11 @@ struct SessionStats {
   std::uint64_t wireBytes = 0;      // whole WebSocket messages of those frames
   std::uint64_t blankFrames = 0;    // only counted with --check-not-blank
   std::uint64_t clippedFrames = 0;  // over --max-clipped
+  // H.264 only: frames the session's decoder could not decode (a delta
+  // frame without its keyframe), counted or not, and the poses sent with
+  // PoseUpdate.keyframe to recover.
+  std::uint64_t undecodedFrames = 0;
+  std::uint64_t keyframeRequests = 0;
   double clippedFractionMax = -1.0; // the most blown-out frame's share of pixels at 255; < 0: not measured
   double lastExposureStops = 0.0;   // Frame.exposure_stops of the last frame
   double firstPoseSeconds = 0.0;    // steady-clock times, from the run's start
@@ -49,7 +54,8 @@ struct RunSummary {
 };
 
 // The `--json` object: frames, fps, latency_ms_p50/p90/p99/mean/max,
-// bytes_per_frame, wire_bytes_per_frame, dropped, errors, encoding, size,
+// bytes_per_frame, wire_bytes_per_frame, dropped, errors, undecoded_frames,
+// keyframe_requests, encoding, size,
 // clients, the server's stage timings (mean ms per stage name, under
 // "stage_ms_mean"), and per-client figures under "per_client". fps is total frames
 // over the wall time: with N clients it is the server's aggregate rate.

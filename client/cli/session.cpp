@@ -6,6 +6,7 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <optional>
 #include <span>
 
 #include <boost/asio/ip/tcp.hpp>
@@ -60,6 +61,11 @@ struct Session::Impl : std::enable_shared_from_this<Session::Impl> {
   std::uint64_t nextPose = 1;  // sequence of the next pose to send
   bool timeUp = false;         // --duration has passed: no new poses
   std::map<std::uint64_t, double> outstanding;  // pose sequence → sent at (ms since run start)
+  // Every frame of the session in order: an H.264 frame refers to the ones
+  // before it, so the decoder sees each one, counted or not.
+  FrameDecoder decoder;
+  bool keyframeWanted = false;     // the next pose asks for a keyframe (PoseUpdate.keyframe)
+  std::uint64_t keyframeAskedAt = 0;  // the pose that last asked; 0: none outstanding
   std::string phase = "connecting";
 
   double nowMs() const {
@@ -258,6 +264,14 @@ struct Session::Impl : std::enable_shared_from_this<Session::Impl> {
       const std::uint64_t pathIndex = measured(nextPose) ? nextPose - 1 - config.warmup : nextPose - 1;
       *pose = config.path->at(static_cast<std::size_t>(pathIndex % config.frames), static_cast<std::size_t>(config.frames));
       pose->set_sequence(nextPose);
+      if (keyframeWanted) {
+        // The request rides on the next pose of the path, so the path's
+        // numbering and the closed loop stay as they are.
+        pose->set_keyframe(true);
+        keyframeWanted = false;
+        keyframeAskedAt = nextPose;
+        ++stats.keyframeRequests;
+      }
       const double sentMs = nowMs();
       pose->set_client_time_ms(sentMs);
       outstanding[nextPose] = sentMs;
@@ -269,7 +283,40 @@ struct Session::Impl : std::enable_shared_from_this<Session::Impl> {
     armWatchdog("the frame answering pose " + std::to_string(outstanding.empty() ? 0 : outstanding.begin()->first));
   }
 
+  bool inspects() const { return config.checkNotBlank || config.maxClipped >= 0.0; }
+
+  // H.264 frames through the session's decoder, every one and in order.
+  // A frame that does not decode (a delta frame without its keyframe) is
+  // counted, and the next pose asks for a keyframe: unless a request is
+  // already on its way, i.e. the failing frame answers a pose sent before
+  // the one that asked (the keyframe answers that one or a later pose).
+  std::optional<Rgba8Image> decodeInOrder(const v1::Frame& frame) {
+    const std::span<const std::uint8_t> data(reinterpret_cast<const std::uint8_t*>(frame.data().data()),
+                                             frame.data().size());
+    try {
+      Rgba8Image image = decoder.decode(frame.encoding(), data, frame.width(), frame.height());
+      keyframeAskedAt = 0;
+      return image;
+    } catch (const std::runtime_error& e) {
+      ++stats.undecodedFrames;
+      const bool asked = keyframeWanted || (keyframeAskedAt != 0 && frame.pose_sequence() < keyframeAskedAt);
+      if (!asked) keyframeWanted = true;
+      onMessage(who() + "frame " + std::to_string(frame.sequence()) + " (pose " +
+                std::to_string(frame.pose_sequence()) + ") did not decode: " + e.what() +
+                (asked ? "; a keyframe is on its way" : "; the next pose asks for a keyframe"));
+      return std::nullopt;
+    }
+  }
+
   void onFrameMessage(const v1::Frame& frame, std::size_t wireBytes) {
+    // Decoded before anything else, so that warm-up and extra frames reach
+    // the decoder too; only when a frame is inspected or recorded at all.
+    std::optional<Rgba8Image> h264;
+    bool undecoded = false;
+    if (frame.encoding() == v1::ENCODING_H264 && (inspects() || !config.outDir.empty())) {
+      h264 = decodeInOrder(frame);
+      undecoded = !h264;
+    }
     const auto it = outstanding.find(frame.pose_sequence());
     if (!welcomed || it == outstanding.end()) {
       ++stats.extraFrames;  // e.g. a first frame for pose 0, or a repeat
@@ -294,7 +341,7 @@ struct Session::Impl : std::enable_shared_from_this<Session::Impl> {
     for (const auto& t : frame.timings()) stats.stageMs[t.name()].push_back(t.ms());
     stats.lastFrameSeconds = nowMs() / 1000.0;
 
-    if (!recordAndCheck(frame)) return;
+    if (!undecoded && !recordAndCheck(frame, std::move(h264))) return;
     onFrame({index, frame.pose_sequence(), latency, frame.data().size()});
 
     fillWindow();
@@ -302,18 +349,24 @@ struct Session::Impl : std::enable_shared_from_this<Session::Impl> {
   }
 
   // Writes the frame under --out and checks it is not blank; false when the
-  // session failed doing so.
-  bool recordAndCheck(const v1::Frame& frame) {
+  // session failed doing so. `decoded`: the H.264 picture, decoded in order.
+  bool recordAndCheck(const v1::Frame& frame, std::optional<Rgba8Image> decoded) {
     const auto encoding = frame.encoding();
     const std::span<const std::uint8_t> data(reinterpret_cast<const std::uint8_t*>(frame.data().data()),
                                              frame.data().size());
+    // Raw and H.264 frames are written decoded (PAM, PNG): their bytes alone are no viewable file.
     const bool raw = encoding == v1::ENCODING_RAW_RGBA8;
+    const bool h264 = encoding == v1::ENCODING_H264;
     stats.lastExposureStops = frame.exposure_stops();
-    const bool inspect = config.checkNotBlank || config.maxClipped >= 0.0;
+    const bool inspect = inspects();
     if (!inspect && config.outDir.empty()) return true;
     try {
       Rgba8Image image;
-      if (inspect || raw) image = decodeFrame(encoding, data, frame.width(), frame.height());
+      if (decoded) {
+        image = std::move(*decoded);
+      } else if (inspect || raw) {
+        image = decodeFrame(encoding, data, frame.width(), frame.height());
+      }
       if (inspect) {
         const PixelStats px = pixelStats(image);
         stats.clippedFractionMax = std::max(stats.clippedFractionMax, px.clippedFraction);
@@ -340,9 +393,9 @@ struct Session::Impl : std::enable_shared_from_this<Session::Impl> {
         std::snprintf(name, sizeof name, "frame-%06llu", static_cast<unsigned long long>(stats.frames));
         const auto path = std::filesystem::path(config.outDir) / (name + encodingFileExtension(encoding));
         std::ofstream out(path, std::ios::binary);
-        if (raw) {
-          const auto pam = encodePam(image);
-          out.write(reinterpret_cast<const char*>(pam.data()), static_cast<std::streamsize>(pam.size()));
+        if (raw || h264) {
+          const auto file = raw ? encodePam(image) : encodePng(image);
+          out.write(reinterpret_cast<const char*>(file.data()), static_cast<std::streamsize>(file.size()));
         } else {
           out.write(frame.data().data(), static_cast<std::streamsize>(frame.data().size()));
         }

@@ -11,10 +11,12 @@
 //   f / Esc       full window on / off
 //
 // Page parameters (page_params.js; a bad one is shown and nothing connects):
-//   ?size=256x256&encoding=jpeg|png|raw&quality=85&fps=30&token=T
+//   ?size=256x256&encoding=jpeg|png|raw|h264&quality=85&fps=30&token=T
 //   &method=fused&level=4&k=256&exposure=auto|STOPS&scene=NAME
 /* global protobuf */
 import { FrameWindow, backoffMs, formatNumber, formatStops } from './frame_stats.js';
+import { h264Support } from './h264_decoder.js';
+import { H264View, helloEncoding } from './h264_view.js';
 import { parsePageParameters } from './page_params.js';
 
 const $ = (id) => document.getElementById(id);
@@ -39,6 +41,9 @@ const state = {
   reconnectAttempt: 0,
   reconnectInS: null,  // seconds to the next attempt while waiting
   scene: { name: '', firstPose: 0 },  // frames answering poses older than firstPose show the previous scene
+  h264: null,          // h264Support()'s answer, once H.264 was chosen
+  helloEncoding: '',   // what the last Hello asked for (jpeg when H.264 falls back)
+  keyframeRequests: 0, // poses sent with PoseUpdate.keyframe
 };
 window.haarcast = state;
 // The eye the next camera pose would carry (for the test: a scene switch
@@ -166,7 +171,9 @@ function exposureSettings() {
 }
 
 function hello() {
-  const encoding = { jpeg: 'ENCODING_JPEG', png: 'ENCODING_PNG', raw: 'ENCODING_RAW_RGBA8' }[page.encoding];
+  state.helloEncoding = helloEncoding(page.encoding, state.h264).encoding;
+  const encoding = { jpeg: 'ENCODING_JPEG', png: 'ENCODING_PNG', raw: 'ENCODING_RAW_RGBA8', h264: 'ENCODING_H264' }[
+    state.helloEncoding];
   const h = {
     protocolVersion: 1, authToken: page.token, width: page.width, height: page.height,
     encoding: Encoding.values[encoding], fpsCap: page.fps, jpegQuality: page.quality, clientName: 'browser',
@@ -307,6 +314,7 @@ function onWelcome(w) {
   $('reconnect').hidden = true;
   $('banner').hidden = true;  // what it said was about the previous session
   setFrameSize(w.width, w.height);
+  startH264View(w.encoding === Encoding.values.ENCODING_H264);
   effective = w.settings || {};
   const limits = w.limits || {};
 
@@ -447,9 +455,48 @@ async function onFrame(f, gen) {
       shown();
     }
     bitmap.close();
+  } else if (f.encoding === Encoding.values.ENCODING_H264 && h264View) {
+    // Decoded in order by the session's decoder; drawn when its picture comes out.
+    h264View.frame(f, () => { if (gen === generation) shown(); });
   } else {
-    showBanner(`cannot show ${Encoding.valuesById[f.encoding]} frames in the browser; use ?encoding=jpeg, png or raw`);
+    showBanner(`cannot show ${Encoding.valuesById[f.encoding]} frames here; use ?encoding=jpeg, png, raw or h264`);
   }
+}
+
+// ---- H.264 (h264_view.js) -----------------------------------------------------------
+
+let h264View = null;  // one per session: the decoder keeps the stream's reference pictures
+
+function startH264View(on) {
+  if (h264View) h264View.close();
+  h264View = on ? new H264View({
+    draw: (frame, done) => {
+      setFrameSize(frame.displayWidth, frame.displayHeight);
+      ctx.drawImage(frame, 0, 0);
+      done();
+    },
+    // A pose with no view fields, only `keyframe` (and the time the frame
+    // echoes for the HUD latency): the same view, as a keyframe.
+    requestKeyframe: () => {
+      const sequence = ++poseSequence;
+      if (!send({ pose: { sequence, clientTimeMs: performance.now(), keyframe: true } })) return 0;
+      state.keyframeRequests++;
+      return sequence;
+    },
+  }) : null;
+  state.h264View = h264View;
+}
+
+// The encoding chosen on the page (or ?encoding=): H.264 is asked for only
+// where WebCodecs decodes it; otherwise the reason is shown and the Hello
+// asks for JPEG.
+async function chooseEncoding(name) {
+  page.encoding = name;
+  $('encoding').value = name;
+  if (name === 'h264' && !state.h264) state.h264 = await h264Support();
+  const { note } = helloEncoding(name, state.h264);
+  $('encoding-note').textContent = note;
+  $('encoding-note').hidden = !note;
 }
 
 function onError(e) {
@@ -580,6 +627,17 @@ $('reset-view').addEventListener('click', () => {
   poseDirty = true;
 });
 $('reconnect').addEventListener('click', () => connect());
+// The encoding is a Hello field: another one takes a new session. The address
+// keeps the choice, so a reload asks for it again.
+$('encoding').addEventListener('change', async () => {
+  await chooseEncoding($('encoding').value);
+  const params = new URLSearchParams(location.search);
+  params.set('encoding', page.encoding);
+  history.replaceState(null, '', `?${params}`);
+  const old = ws;
+  connect();
+  if (old) old.close();
+});
 $('banner-close').addEventListener('click', () => { $('banner').hidden = true; });
 
 // ---- status, errors, HUD ------------------------------------------------------------
@@ -788,6 +846,7 @@ async function main() {
     $('exposure-auto').checked = false;
     $('exposure').value = String(page.exposure.stops);
   }
+  await chooseEncoding(page.encoding);
   connect();
   setInterval(updateHud, 250);
   // The server closes sessions that send nothing for a while; a page left

@@ -1,13 +1,15 @@
 // The page's parameters (?size=…&encoding=…), checked before the page
 // connects: a bad one is reported at once, naming the parameter and its valid
 // values, instead of a Hello the server would refuse (or one never sent).
-// Pure, so that node tests it (tests/e2e/frame_stats_test.mjs).
+// Pure, so that node tests it (tests/e2e/web_client_test.mjs).
 //
 // Ranges only the server knows (level, size, exposure, scene names) are left
 // to it: its Error names them, and the page shows that.
 
 // What the browser can draw: EXR frames are linear floats, not an image type.
-export const ENCODINGS = ['jpeg', 'png', 'raw'];
+// H.264 is drawn through WebCodecs where the browser has it, else the page
+// asks for JPEG and says why (h264_view.js).
+export const ENCODINGS = ['jpeg', 'png', 'raw', 'h264'];
 
 export const PARAMETERS = {
   size: 'WIDTHxHEIGHT, e.g. 256x256',

@@ -34,6 +34,8 @@ expect() {
 
 expect "bad --size" 2 "--size" -- "$client_bin" ws://127.0.0.1:1 --size 0x10
 expect "bad --encoding" 2 "--encoding must be" -- "$client_bin" ws://127.0.0.1:1 --encoding webp
+expect "--bitrate without h264" 2 "--bitrate applies to --encoding h264 only" -- "$client_bin" ws://127.0.0.1:1 --bitrate 900
+expect "h264 at an odd size" 2 "even width and height" -- "$client_bin" ws://127.0.0.1:1 --encoding h264 --size 255x256
 expect "wss:// refused" 2 "wss://" -- "$client_bin" wss://127.0.0.1:1
 expect "bad --level" 2 "--level: Value 12 not in range 0 to 7" -- "$client_bin" ws://127.0.0.1:1 --level 12
 expect "bad --exposure" 2 "--exposure must be auto or a number of stops" -- "$client_bin" ws://127.0.0.1:1 --exposure bright

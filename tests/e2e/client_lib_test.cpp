@@ -63,15 +63,45 @@ TEST(Flags, SizeEncodingAndMethod) {
   EXPECT_EQ(parseEncoding("jpeg"), v1::ENCODING_JPEG);
   EXPECT_EQ(parseEncoding("raw"), v1::ENCODING_RAW_RGBA8);
   EXPECT_THROW(parseEncoding("webp"), std::invalid_argument);
-  for (auto e : {v1::ENCODING_JPEG, v1::ENCODING_PNG, v1::ENCODING_RAW_RGBA8, v1::ENCODING_EXR}) {
+  for (auto e : {v1::ENCODING_JPEG, v1::ENCODING_PNG, v1::ENCODING_RAW_RGBA8, v1::ENCODING_EXR, v1::ENCODING_H264}) {
     EXPECT_EQ(parseEncoding(encodingName(e)), e);  // names round-trip
   }
+  try {
+    parseEncoding("avc");
+    ADD_FAILURE() << "\"avc\" was taken as an encoding";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("h264"), std::string::npos) << e.what();  // the valid choices
+  }
+  // H.264 frames are written decoded, as PNG: an access unit alone is no file.
+  EXPECT_EQ(encodingFileExtension(v1::ENCODING_H264), ".png");
   EXPECT_EQ(parseMethod(""), v1::ROTATION_METHOD_UNSPECIFIED);
   for (auto m : {v1::ROTATION_METHOD_HAAR, v1::ROTATION_METHOD_SPATIAL, v1::ROTATION_METHOD_MATRIX,
                  v1::ROTATION_METHOD_TABLE}) {
     EXPECT_EQ(parseMethod(methodName(m)), m);
   }
   EXPECT_THROW(parseMethod("Haar"), std::invalid_argument);
+}
+
+// The H.264 flags: for h264 only, and h264 wants an even size.
+TEST(Flags, H264OptionsApplyToH264Only) {
+  EXPECT_NO_THROW(checkH264Options(v1::ENCODING_H264, {256, 256}, {2000, 60}));
+  EXPECT_NO_THROW(checkH264Options(v1::ENCODING_H264, {320, 200}, {}));
+  EXPECT_NO_THROW(checkH264Options(v1::ENCODING_JPEG, {255, 255}, {}));  // odd is fine for JPEG
+  const auto message = [](v1::Encoding e, Size size, H264Options o) {
+    try {
+      checkH264Options(e, size, o);
+    } catch (const std::invalid_argument& error) {
+      return std::string(error.what());
+    }
+    return std::string("(accepted)");
+  };
+  EXPECT_EQ(message(v1::ENCODING_JPEG, {256, 256}, {2000, 0}),
+            "--bitrate applies to --encoding h264 only (got --encoding jpeg)");
+  EXPECT_EQ(message(v1::ENCODING_PNG, {256, 256}, {0, 30}),
+            "--keyframe-interval applies to --encoding h264 only (got --encoding png)");
+  EXPECT_EQ(message(v1::ENCODING_H264, {255, 256}, {}),
+            "--encoding h264 needs an even width and height (4:2:0 chroma), got --size 255x256");
+  EXPECT_NE(message(v1::ENCODING_H264, {256, 99}, {}), "(accepted)");
 }
 
 double length(const v1::Vec3& v) { return std::sqrt(v.x() * v.x() + v.y() * v.y() + v.z() * v.z()); }
@@ -187,6 +217,8 @@ TEST(Summary, AggregatesClients) {
   b.payloadBytes = 90000;
   b.dropped = 2;
   b.errors = 1;
+  b.undecodedFrames = 3;
+  b.keyframeRequests = 1;
   run.sessions = {a, b};
   const auto j = summaryJson(run);
   EXPECT_EQ(j["frames"], 40u);
@@ -196,6 +228,9 @@ TEST(Summary, AggregatesClients) {
   EXPECT_DOUBLE_EQ(j["latency_ms_p99"].get<double>(), 20.0);
   EXPECT_EQ(j["dropped"], 2u);
   EXPECT_EQ(j["errors"], 1u);
+  EXPECT_EQ(j["undecoded_frames"], 3u);
+  EXPECT_EQ(j["keyframe_requests"], 1u);
+  EXPECT_EQ(j["per_client"][1]["keyframe_requests"], 1u);
   EXPECT_EQ(j["encoding"], "jpeg");
   EXPECT_DOUBLE_EQ(j["stage_ms_mean"]["encode"].get<double>(), 2.0);
   EXPECT_EQ(j["clients"], 2u);

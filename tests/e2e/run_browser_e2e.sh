@@ -44,4 +44,5 @@ fi
 
 args=(--haarcast "$haarcast" --chromium "$chromium")
 [[ -n "$out" ]] && args+=(--out "$out")
-exec node "$repo/tests/e2e/browser_e2e.mjs" "${args[@]}" -- "$@"
+# E2E_SCRIPT: another test of the page in this folder (browser_h264.mjs).
+exec node "$repo/tests/e2e/${E2E_SCRIPT:-browser_e2e.mjs}" "${args[@]}" -- "$@"

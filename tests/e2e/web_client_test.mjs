@@ -1,6 +1,7 @@
 // Unit tests of the browser client's pure parts, in node (no browser): the
 // HUD's frame window (client/web/frame_stats.js) with made-up arrival times,
-// and the page-parameter checks (client/web/page_params.js).
+// the page-parameter checks (client/web/page_params.js), and the page's H.264
+// view (client/web/h264_view.js) over a stand-in WebCodecs VideoDecoder.
 //
 // usage: node web_client_test.mjs
 import assert from 'node:assert/strict';
@@ -10,6 +11,7 @@ import { fileURLToPath, pathToFileURL } from 'node:url';
 const web = join(resolve(dirname(fileURLToPath(import.meta.url)), '..', '..'), 'client', 'web');
 const { FrameWindow, backoffMs, formatNumber, formatStops } = await import(pathToFileURL(join(web, 'frame_stats.js')));
 const { parsePageParameters } = await import(pathToFileURL(join(web, 'page_params.js')));
+const { H264View, helloEncoding } = await import(pathToFileURL(join(web, 'h264_view.js')));
 
 const tests = [];
 const test = (name, fn) => tests.push({ name, fn });
@@ -151,8 +153,9 @@ test('page parameters: each bad one is named with its valid values', () => {
   assert.match(e.message, /\?method=fast/);
   assert.match(e.message, /haar, spatial, matrix, table, fused/);
   e = one('?encoding=exr');
-  assert.match(e.message, /\?encoding=exr.*cannot show EXR.*jpeg, png, raw/);
-  assert.match(one('?encoding=gif').message, /jpeg, png, raw/);
+  assert.match(e.message, /\?encoding=exr.*cannot show EXR.*jpeg, png, raw, h264/);
+  assert.match(one('?encoding=gif').message, /jpeg, png, raw, h264/);
+  assert.match(one('?encoding=H264').message, /\?encoding=H264/);  // names are lower case, as the page lists them
   assert.match(one('?size=big').message, /\?size=big.*WIDTHxHEIGHT/);
   assert.match(one('?size=0x10').message, /\?size=0x10/);
   assert.match(one('?level=4.5').message, /\?level=4\.5/);
@@ -165,6 +168,97 @@ test('page parameters: each bad one is named with its valid values', () => {
   assert.match(one('?methd=haar').message, /\?methd is not a parameter.*method/);
   assert.match(one('?level=3&level=4').message, /more than once/);
   assert.equal(parsePageParameters('?method=fast&encoding=exr', { methods }).errors.length, 2);
+});
+
+test('page parameters: ?encoding=h264', () => {
+  const p = parsePageParameters('?encoding=h264&size=320x240', { methods });
+  assert.deepEqual(p.errors, []);
+  assert.equal(p.encoding, 'h264');
+});
+
+test('H.264 falls back to JPEG, with the reason, where WebCodecs cannot decode it', () => {
+  const reason = 'this browser has no WebCodecs VideoDecoder';
+  const off = helloEncoding('h264', { supported: false, reason, fallback: 'jpeg' });
+  assert.equal(off.encoding, 'jpeg');
+  assert.ok(off.note.includes(reason) && off.note.includes('JPEG'), off.note);
+  assert.deepEqual(helloEncoding('h264', { supported: true, codec: 'avc1.42E01E' }), { encoding: 'h264', note: '' });
+  assert.deepEqual(helloEncoding('png', { supported: false, reason, fallback: 'jpeg' }), { encoding: 'png', note: '' });
+});
+
+// A stand-in for WebCodecs: every chunk decodes at once into a "frame" that
+// carries its timestamp; `fail()` makes the decoder report an error as a real
+// one does for a damaged stream.
+class FakeVideoDecoder {
+  static all = [];
+  constructor({ output, error }) {
+    Object.assign(this, { output, error, state: 'unconfigured', chunks: [] });
+    FakeVideoDecoder.all.push(this);
+  }
+  configure(config) { this.config = config; this.state = 'configured'; }
+  decode(chunk) {
+    this.chunks.push(chunk);
+    this.output({ timestamp: chunk.timestamp, displayWidth: this.config.codedWidth, closed: false,
+                  close() { this.closed = true; } });
+  }
+  fail(message) { this.state = 'closed'; this.error(new Error(message)); }
+  close() { this.state = 'closed'; }
+}
+class FakeChunk { constructor(init) { Object.assign(this, init); } }
+
+// Annex-B access units: a keyframe (SPS High 4.0, PPS, IDR slice) and a delta frame (non-IDR slice).
+const KEY = new Uint8Array([0, 0, 0, 1, 0x67, 0x64, 0x00, 0x28, 0xac, 0, 0, 0, 1, 0x68, 0xee, 0x3c, 0x80,
+                            0, 0, 0, 1, 0x65, 0x88, 0x84]);
+const DELTA = new Uint8Array([0, 0, 0, 1, 0x41, 0x9a, 0x02]);
+
+test('H.264 view: a delta frame before any keyframe asks for one keyframe, then frames are drawn', () => {
+  globalThis.VideoDecoder = FakeVideoDecoder;
+  globalThis.EncodedVideoChunk = FakeChunk;
+  try {
+    let pose = 10;
+    const asked = [];
+    const drawn = [];
+    const view = new H264View({
+      draw: (frame, done) => { drawn.push(frame.timestamp); done(); },
+      requestKeyframe: () => { asked.push(++pose); return pose; },
+    });
+    const shown = [];
+    const frame = (sequence, poseSequence, data) =>
+      view.frame({ sequence, poseSequence, width: 64, height: 48, data }, () => shown.push(sequence));
+
+    // Joining mid-stream: delta frames answering poses 9 and 10 cannot be
+    // decoded; one request (pose 11), not one per frame.
+    assert.equal(frame(1, 9, DELTA), false);
+    assert.equal(frame(2, 10, DELTA), false);
+    assert.deepEqual(asked, [11]);
+    // The request was lost (a frame answering pose 11 is still a delta): ask again.
+    assert.equal(frame(3, 11, DELTA), false);
+    assert.deepEqual(asked, [11, 12]);
+    // The keyframe configures the decoder from its SPS; frames from it on are drawn.
+    assert.equal(frame(4, 12, KEY), true);
+    assert.equal(frame(5, 13, DELTA), true);  // answers pose 13, a drag after the keyframe
+    const decoder = FakeVideoDecoder.all.at(-1);
+    assert.equal(decoder.config.codec, 'avc1.640028');
+    assert.deepEqual(decoder.chunks.map((c) => c.type), ['key', 'delta']);
+    assert.deepEqual(drawn, [4, 5]);
+    assert.deepEqual(shown, [4, 5]);
+    assert.equal(view.undecoded, 3);
+    assert.equal(view.requests, 2);
+
+    // The page sent poses 13 and 14 (drags); the decoder fails on the frame
+    // answering 13 (a damaged frame): the view asks for a keyframe again (15).
+    pose = 14;
+    decoder.fail('decoding error');
+    assert.deepEqual(asked, [11, 12, 15]);
+    assert.match(view.errors[0], /decoding error/);
+    assert.equal(frame(6, 14, DELTA), false);  // answers a pose sent before the asking one: no new request
+    assert.deepEqual(asked, [11, 12, 15]);
+    assert.equal(frame(7, 15, KEY), true);
+    assert.deepEqual(shown, [4, 5, 7]);
+    view.close();
+  } finally {
+    delete globalThis.VideoDecoder;
+    delete globalThis.EncodedVideoChunk;
+  }
 });
 
 let failed = 0;
