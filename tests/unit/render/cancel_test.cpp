@@ -105,7 +105,7 @@ TEST(CpuBackend, ConcurrentFramesOnOneRendererEqualSerialOnes) {
   std::vector<std::vector<std::uint8_t>> serial;
   for (const FrameRequest& r : requests) serial.push_back(renderer->render(r).rgba8);
   ASSERT_NE(serial[0], serial[1]);
-  constexpr int kRounds = 6;
+  constexpr int kRounds = 12;
   std::atomic<int> mismatches{0};
   std::vector<std::thread> threads;
   for (std::size_t t = 0; t < 4; ++t) {
