@@ -96,7 +96,6 @@ struct RenderService::Impl {
     SessionConfig config;
     std::string key;
     std::vector<std::pair<std::string, PrepareDone>> waiters;  // owner, callback
-    bool running = false;
     std::atomic<bool> abandoned{false};
   };
   std::mutex cacheMutex;
@@ -106,7 +105,7 @@ struct RenderService::Impl {
   std::map<std::string, std::shared_ptr<Build>> ownerWaits;  // owner → the build it waits for
   std::condition_variable buildCv;
   bool buildsStopping = false;
-  std::shared_ptr<Build> runningBuild;
+  std::shared_ptr<Build> runningBuild;  // taken from the queue by the builder thread
   std::thread builderThread;
 
   // ---- Frames --------------------------------------------------------------
@@ -149,12 +148,26 @@ struct RenderService::Impl {
       break;
     }
     if (!w.empty()) return;
-    if (build->running) {
+    if (build == runningBuild) {
       build->abandoned = true;
     } else {
       buildQueue.erase(std::remove(buildQueue.begin(), buildQueue.end(), build), buildQueue.end());
     }
     if (const auto b = builds.find(build->key); b != builds.end() && b->second == build) builds.erase(b);
+  }
+
+  // When the owner already waits for a build of `key`, its new callback
+  // takes the old one's place (answered Superseded) and the build goes on.
+  // Under cacheMutex.
+  bool replaceWaiter(const std::string& owner, const std::string& key, PrepareDone& done, std::vector<Answer>& answers) {
+    const auto it = ownerWaits.find(owner);
+    if (it == ownerWaits.end() || it->second->key != key || it->second->abandoned) return false;
+    for (auto& [who, callback] : it->second->waiters) {
+      if (who != owner) continue;
+      answers.push_back({std::exchange(callback, std::move(done)), {PrepareStatus::Superseded, nullptr, {}}});
+      return true;
+    }
+    return false;
   }
 
   // The cached renderer of `key`, made the most recently used; null if none.
@@ -173,7 +186,10 @@ struct RenderService::Impl {
     std::vector<Answer> answers;
     const std::string key = config.rendererKey();
     std::lock_guard lock(cacheMutex);
-    if (!owner.empty()) detachOwner(owner, &answers);  // the latest wins
+    if (!owner.empty()) {  // the latest wins
+      if (replaceWaiter(owner, key, done, answers)) return answers;
+      detachOwner(owner, &answers);
+    }
     if (buildsStopping) {
       answers.push_back({std::move(done), {PrepareStatus::Refused, nullptr, "the render service is stopping"}});
       return answers;
@@ -213,7 +229,6 @@ struct RenderService::Impl {
         if (buildsStopping) return;
         build = std::move(buildQueue.front());
         buildQueue.pop_front();
-        build->running = true;
         runningBuild = build;
         cached = cachedLocked(build->key);  // an abandoned build of this key may have finished meanwhile
       }

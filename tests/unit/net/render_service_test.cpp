@@ -440,7 +440,8 @@ TEST(RenderService, TheBuildQueueIsBoundedAcrossTheServer) {
   JobLog log;
   auto record = [&](const std::string& who) {
     return [&log, who](PrepareOutcome o) {
-      log.add(who + (o.status == PrepareStatus::Ready ? " ready" : o.status == PrepareStatus::Refused ? " refused " + o.error : " other"));
+      const char* status[] = {" ready", " failed", " refused ", " superseded"};
+      log.add(who + status[static_cast<int>(o.status)] + o.error);
     };
   };
   service.prepare(config(0), "running", record("running"));
@@ -448,15 +449,17 @@ TEST(RenderService, TheBuildQueueIsBoundedAcrossTheServer) {
   service.prepare(config(1), "o1", record("o1"));
   service.prepare(config(2), "o2", record("o2"));
   service.prepare(config(1), "o4", record("o4"));  // joins o1's build: no new one
+  service.prepare(config(1), "o1", record("o1 again"));  // the same build: o1's first callback superseded
+  EXPECT_EQ(service.queuedBuilds(), 2u);
   service.prepare(config(3), "o3", record("o3"));
-  EXPECT_EQ(log.get(), std::vector<std::string>{"o3 refused the server has 2 renderer builds queued, its limit "
-                                                "(max-queued-builds); try again later"});
+  EXPECT_EQ(log.get(), (std::vector<std::string>{"o1 superseded", "o3 refused the server has 2 renderer builds queued, "
+                                                 "its limit (max-queued-builds); try again later"}));
   service.withdraw("o2");  // its session closed: its build is dropped, unanswered
   EXPECT_EQ(service.queuedBuilds(), 1u);
   service.prepare(config(3), "o3", record("o3"));
   release = true;
-  ASSERT_TRUE(waitUntil([&] { return log.get().size() == 5; }));
-  for (const char* ready : {"running ready", "o1 ready", "o4 ready", "o3 ready"}) EXPECT_TRUE(has(log.get(), ready)) << ready;
+  ASSERT_TRUE(waitUntil([&] { return log.get().size() == 6; }));
+  for (const char* ready : {"running ready", "o1 again ready", "o4 ready", "o3 ready"}) EXPECT_TRUE(has(log.get(), ready)) << ready;
   EXPECT_FALSE(has(log.get(), "o2 ready"));
 }
 
