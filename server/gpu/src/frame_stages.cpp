@@ -35,6 +35,8 @@ void VulkanRenderer::Impl::runStages(const std::vector<FrameStage>& stages, rend
   };
   if (!useTimestamps) {
     for (const auto& [name, record] : stages) {
+      frame.cancelled = cancelRequested();
+      if (frame.cancelled) return;
       const auto t = RendererClock::now();
       context.submit([&](VkCommandBuffer cb) {
         record(cb);
@@ -44,6 +46,8 @@ void VulkanRenderer::Impl::runStages(const std::vector<FrameStage>& stages, rend
     }
     return;
   }
+  frame.cancelled = cancelRequested();  // one submission: the frame is the batch
+  if (frame.cancelled) return;
   const auto count = static_cast<std::uint32_t>(stages.size());
   ensureQueries(count + 1);
   context.submit([&](VkCommandBuffer cb) {

@@ -49,6 +49,7 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
               }},
              {"tonemap", [&](VkCommandBuffer cb) { recordTonemap(cb, request); }}},
             frame);
+  if (frame.cancelled) return frame;  // stopped between stages: no images
 
   // ---- Results: RGBA8 always, the linear image only when asked for ----------
   frame.rgba8.resize(pixels * 4);

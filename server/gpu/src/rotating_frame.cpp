@@ -76,6 +76,7 @@ render::Frame VulkanRenderer::Impl::renderRotating(const render::FrameRequest& r
   }
   stages.emplace_back("tonemap", [&](VkCommandBuffer cb) { recordTonemap(cb, request); });
   runStages(stages, frame);
+  if (frame.cancelled) return frame;  // stopped between batches: no images
 
   std::uint32_t covered = 0;
   counter.read(&covered, sizeof covered);

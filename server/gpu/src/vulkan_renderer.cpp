@@ -55,6 +55,11 @@ VulkanRenderer::Impl::~Impl() {
 }
 
 render::Frame VulkanRenderer::Impl::render(const render::FrameRequest& request) {
+  struct Polled {  // request.cancelled, for runStages, for this frame only
+    Impl& impl;
+    ~Polled() { impl.cancelled = nullptr; }
+  } polled{*this};
+  cancelled = &request.cancelled;
   return fused ? renderFused(request) : renderRotating(request);
 }
 

@@ -131,6 +131,10 @@ struct VulkanRenderer::Impl {
   bool useTimestamps = false;
   VkQueryPool queries = VK_NULL_HANDLE;
   std::uint32_t queryCapacity = 0;  // timestamps the pool holds
+  // The request's `cancelled` while render() runs (null otherwise): polled
+  // by runStages before each submission, the batch boundary of a frame.
+  const std::function<bool()>* cancelled = nullptr;
+  bool cancelRequested() const { return cancelled && *cancelled && (*cancelled)(); }
 
   // vulkan_renderer.cpp
   Impl(const render::Scene& scene, const render::RenderOptions& o, const VulkanOptions& vulkan,
@@ -175,7 +179,8 @@ struct VulkanRenderer::Impl {
   // command buffer (a timestamp after each) and submitted once; otherwise
   // (a CPU device) one submission per stage, timed on the host. Stages of
   // one name (the batches of rotation and triple-product) add up to one
-  // entry of frame.stages, at the place of the first.
+  // entry of frame.stages, at the place of the first. Stops before a
+  // submission once cancelRequested(), with frame.cancelled set.
   void runStages(const std::vector<FrameStage>& stages, render::Frame& frame);
   void ensureQueries(std::uint32_t count);
 

@@ -1,15 +1,17 @@
 #include "haarcast/net/render_service.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <deque>
 #include <list>
 #include <map>
+#include <mutex>
 #include <set>
 #include <stdexcept>
-#include <mutex>
 #include <thread>
+#include <utility>
 
 #include "haarcast/net/encode.h"
 
@@ -20,7 +22,7 @@ using Clock = std::chrono::steady_clock;
 
 double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-// A FIFO of tasks served by a fixed set of threads.
+// A FIFO of tasks served by a fixed set of threads (the encoders).
 class TaskQueue {
  public:
   void start(int threads) {
@@ -34,15 +36,12 @@ class TaskQueue {
     }
     cv_.notify_one();
   }
-  std::size_t size() const {
-    std::lock_guard lock(mutex_);
-    return tasks_.size();
-  }
   void stop() {
+    std::deque<std::function<void()>> dropped;  // destroyed outside the lock
     {
       std::lock_guard lock(mutex_);
       stopping_ = true;
-      tasks_.clear();
+      dropped.swap(tasks_);
     }
     cv_.notify_all();
     for (auto& t : threads_) {
@@ -66,113 +65,322 @@ class TaskQueue {
     }
   }
 
-  mutable std::mutex mutex_;
+  std::mutex mutex_;
   std::condition_variable cv_;
   std::deque<std::function<void()>> tasks_;
   std::vector<std::thread> threads_;
   bool stopping_ = false;
 };
 
+void checkOptions(const RenderService::Options& o) {
+  auto bad = [](const std::string& what) { throw std::invalid_argument("RenderService options: " + what); };
+  if (o.workers < 1) bad("workers must be at least 1 (got " + std::to_string(o.workers) + ")");
+  if (o.encoders < 1) bad("encoders must be at least 1 (got " + std::to_string(o.encoders) + ")");
+  if (o.maxSessionPixels < 1) bad("maxSessionPixels must be at least 1");
+  if (o.maxQueuedBuilds < 1) bad("maxQueuedBuilds must be at least 1");
+}
+
+// A prepare's answer, made under the cache lock and given outside it.
+using Answer = std::pair<RenderService::PrepareDone, PrepareOutcome>;
+
 }  // namespace
 
 struct RenderService::Impl {
-  RendererBuilder builder;
+  AbandonableRendererBuilder builder;
   Options options;
   Metrics& metrics;
 
-  // The cache: ready renderers in LRU order (front = most recent), and the
-  // configs being built with the callbacks waiting for them.
+  // ---- Renderers: the cache, the builds, who waits for what --------------
+  // A build of one key, queued or running, with the prepares waiting for it.
+  struct Build {
+    SessionConfig config;
+    std::string key;
+    std::vector<std::pair<std::string, PrepareDone>> waiters;  // owner, callback
+    std::atomic<bool> abandoned{false};
+  };
   std::mutex cacheMutex;
-  std::list<std::shared_ptr<PreparedRenderer>> ready;
-  std::map<std::string, std::vector<PrepareCallback>> building;
+  std::list<std::shared_ptr<PreparedRenderer>> ready;  // LRU order, front = most recent
+  std::map<std::string, std::shared_ptr<Build>> builds;  // by key: the one new waiters join
+  std::deque<std::shared_ptr<Build>> buildQueue;         // not yet running, FIFO
+  std::map<std::string, std::shared_ptr<Build>> ownerWaits;  // owner → the build it waits for
+  std::condition_variable buildCv;
+  bool buildsStopping = false;
+  std::shared_ptr<Build> runningBuild;  // taken from the queue by the builder thread
+  std::thread builderThread;
 
-  // The frame queue. A worker takes the oldest job whose renderer is idle:
-  // renderers are not thread-safe, and a worker waiting on a busy one's lock
-  // instead would let whichever thread wins the lock jump the queue.
+  // ---- Frames --------------------------------------------------------------
+  // A worker takes the oldest job whose renderer is free (a renderer that
+  // cannot render concurrently is busy while one of its frames renders) and
+  // whose pixels fit the budget; no job passes one waiting for the budget,
+  // so a large frame is not starved by small ones.
   struct Queued {
     RenderJob job;
     Clock::time_point submitted;
   };
-  std::mutex queueMutex;
+  mutable std::mutex queueMutex;
   std::condition_variable queueCv;
   std::deque<Queued> queue;
   std::set<const PreparedRenderer*> busy;
-  bool stopping = false;
+  std::size_t pixelsInFlight = 0;
+  bool budgetWait = false;  // the oldest startable job waits for the budget
+  std::atomic<bool> stopping{false};
   std::vector<std::thread> workers;
 
-  TaskQueue builderQueue, encodeQueue;
+  TaskQueue encodeQueue;
 
-  Impl(RendererBuilder b, Options o, Metrics& m) : builder(std::move(b)), options(o), metrics(m) {}
+  Impl(AbandonableRendererBuilder b, Options o, Metrics& m) : builder(std::move(b)), options(o), metrics(m) {}
+
+  // -------------------------------------------------------------- builds
+
+  // Removes the owner's waiting prepare (answered Superseded when `answers`
+  // is given, else dropped); a build then waited for by nobody is dropped
+  // from the queue, or abandoned when running. Under cacheMutex.
+  void detachOwner(const std::string& owner, std::vector<Answer>* answers) {
+    const auto it = ownerWaits.find(owner);
+    if (it == ownerWaits.end()) return;
+    const std::shared_ptr<Build> build = it->second;
+    ownerWaits.erase(it);
+    auto& w = build->waiters;
+    for (auto k = w.begin(); k != w.end(); ++k) {
+      if (k->first != owner) continue;
+      if (answers) answers->push_back({std::move(k->second), {PrepareStatus::Superseded, nullptr, {}}});
+      w.erase(k);
+      break;
+    }
+    if (!w.empty()) return;
+    if (build == runningBuild) {
+      build->abandoned = true;
+    } else {
+      buildQueue.erase(std::remove(buildQueue.begin(), buildQueue.end(), build), buildQueue.end());
+    }
+    if (const auto b = builds.find(build->key); b != builds.end() && b->second == build) builds.erase(b);
+  }
+
+  // When the owner already waits for a build of `key`, its new callback
+  // takes the old one's place (answered Superseded) and the build goes on.
+  // Under cacheMutex.
+  bool replaceWaiter(const std::string& owner, const std::string& key, PrepareDone& done, std::vector<Answer>& answers) {
+    const auto it = ownerWaits.find(owner);
+    if (it == ownerWaits.end() || it->second->key != key || it->second->abandoned) return false;
+    for (auto& [who, callback] : it->second->waiters) {
+      if (who != owner) continue;
+      answers.push_back({std::exchange(callback, std::move(done)), {PrepareStatus::Superseded, nullptr, {}}});
+      return true;
+    }
+    return false;
+  }
+
+  // The cached renderer of `key`, made the most recently used; null if none.
+  // Under cacheMutex.
+  std::shared_ptr<PreparedRenderer> cachedLocked(const std::string& key) {
+    for (auto it = ready.begin(); it != ready.end(); ++it) {
+      if ((*it)->key == key) {
+        ready.splice(ready.begin(), ready, it);
+        return ready.front();
+      }
+    }
+    return nullptr;
+  }
+
+  std::vector<Answer> prepare(const SessionConfig& config, const std::string& owner, PrepareDone done) {
+    std::vector<Answer> answers;
+    const std::string key = config.rendererKey();
+    std::lock_guard lock(cacheMutex);
+    if (!owner.empty()) {  // the latest wins
+      if (replaceWaiter(owner, key, done, answers)) return answers;
+      detachOwner(owner, &answers);
+    }
+    if (buildsStopping) {
+      answers.push_back({std::move(done), {PrepareStatus::Refused, nullptr, "the render service is stopping"}});
+      return answers;
+    }
+    if (auto cached = cachedLocked(key)) {
+      answers.push_back({std::move(done), {PrepareStatus::Ready, std::move(cached), {}}});
+      return answers;
+    }
+    std::shared_ptr<Build>& build = builds[key];  // an abandoned build is not in `builds`
+    if (!build) {
+      if (buildQueue.size() >= options.maxQueuedBuilds) {
+        builds.erase(key);
+        answers.push_back({std::move(done),
+                           {PrepareStatus::Refused, nullptr,
+                            "the server has " + std::to_string(buildQueue.size()) +
+                                " renderer builds queued, its limit (max-queued-builds); try again later"}});
+        return answers;
+      }
+      build = std::make_shared<Build>();
+      build->config = config;
+      build->key = key;
+      buildQueue.push_back(build);
+      buildCv.notify_one();
+    }
+    build->waiters.emplace_back(owner, std::move(done));
+    if (!owner.empty()) ownerWaits[owner] = build;
+    return answers;
+  }
+
+  void builderLoop() {
+    for (;;) {
+      std::shared_ptr<Build> build;
+      std::shared_ptr<PreparedRenderer> cached;
+      {
+        std::unique_lock lock(cacheMutex);
+        buildCv.wait(lock, [&] { return buildsStopping || !buildQueue.empty(); });
+        if (buildsStopping) return;
+        build = std::move(buildQueue.front());
+        buildQueue.pop_front();
+        runningBuild = build;
+        cached = cachedLocked(build->key);  // an abandoned build of this key may have finished meanwhile
+      }
+      std::shared_ptr<PreparedRenderer> renderer = cached;
+      std::string error;
+      if (!renderer) {
+        try {
+          renderer = builder(build->config, [&build] { return build->abandoned.load(); });
+          if (!renderer || !renderer->renderer) error = "the renderer builder returned nothing";
+        } catch (const std::exception& e) {
+          error = e.what();
+        } catch (...) {
+          error = "the renderer builder failed";
+        }
+        if (!error.empty()) renderer.reset();
+      }
+      finishBuild(build, std::move(renderer), error, !cached);
+    }
+  }
+
+  void finishBuild(const std::shared_ptr<Build>& build, std::shared_ptr<PreparedRenderer> renderer,
+                   const std::string& error, bool built) {
+    std::vector<Answer> answers;
+    {
+      std::lock_guard lock(cacheMutex);
+      runningBuild.reset();
+      if (const auto b = builds.find(build->key); b != builds.end() && b->second == build) builds.erase(b);
+      if (renderer && built) {
+        // Cached even when abandoned: another session may want it next.
+        renderer->key = build->key;
+        metrics.renderersBuilt.fetch_add(1);
+        ready.push_front(renderer);
+        while (ready.size() > options.maxRenderers) ready.pop_back();  // sessions keep theirs alive
+      }
+      if (buildsStopping) return;  // the waiters are dropped unanswered
+      for (auto& [owner, done] : build->waiters) {
+        if (const auto o = ownerWaits.find(owner); o != ownerWaits.end() && o->second == build) ownerWaits.erase(o);
+        answers.push_back({std::move(done), renderer ? PrepareOutcome{PrepareStatus::Ready, renderer, {}}
+                                                     : PrepareOutcome{PrepareStatus::Failed, nullptr, error}});
+      }
+      build->waiters.clear();
+    }
+    for (auto& [done, outcome] : answers) done(std::move(outcome));
+  }
+
+  // -------------------------------------------------------------- frames
+
+  static bool isCancelled(const RenderJob& job) { return job.cancelled && job.cancelled(); }
+
+  // The next job a worker may start, or none (then `dropped` may hold jobs
+  // found cancelled). Under queueMutex.
+  std::optional<Queued> pickLocked(std::vector<RenderJob>& dropped) {
+    budgetWait = false;
+    for (auto it = queue.begin(); it != queue.end();) {
+      if (isCancelled(it->job)) {
+        dropped.push_back(std::move(it->job));
+        it = queue.erase(it);
+        continue;
+      }
+      const PreparedRenderer* renderer = it->job.renderer.get();
+      if (!renderer->renderer->concurrentRenders() && busy.count(renderer)) {
+        ++it;
+        continue;
+      }
+      const std::size_t p = chargeOf(it->job);
+      if (options.serverPixelBudget && pixelsInFlight > 0 && pixelsInFlight + p > options.serverPixelBudget) {
+        budgetWait = true;  // and nobody passes it
+        return std::nullopt;
+      }
+      Queued next = std::move(*it);
+      queue.erase(it);
+      return next;
+    }
+    return std::nullopt;
+  }
+
+  // What a job holds of the budget from its start: its declared pixels (a
+  // job over the session limit fails before rendering and holds nothing).
+  std::size_t chargeOf(const RenderJob& job) const {
+    return job.pixels > options.maxSessionPixels ? 0 : job.pixels;
+  }
 
   void workerLoop() {
     for (;;) {
-      Queued next;
+      std::optional<Queued> next;
+      std::vector<RenderJob> dropped;
+      std::size_t charge = 0;
       {
         std::unique_lock lock(queueMutex);
-        std::deque<Queued>::iterator it;
-        queueCv.wait(lock, [&] {
-          if (stopping) return true;
-          it = std::find_if(queue.begin(), queue.end(),
-                            [&](const Queued& q) { return !busy.count(q.job.renderer.get()); });
-          return it != queue.end();
-        });
-        if (stopping) return;
-        next = std::move(*it);
-        queue.erase(it);
-        busy.insert(next.job.renderer.get());
+        for (;;) {
+          if (stopping) return;
+          next = pickLocked(dropped);
+          if (next || !dropped.empty()) break;
+          queueCv.wait(lock);
+        }
+        if (next) {
+          if (!next->job.renderer->renderer->concurrentRenders()) busy.insert(next->job.renderer.get());
+          charge = chargeOf(next->job);
+          pixelsInFlight += charge;
+        }
       }
-      const PreparedRenderer* renderer = next.job.renderer.get();
-      render(next.job, next.submitted);
+      for (RenderJob& job : dropped) {
+        if (job.onCancelled) job.onCancelled();
+      }
+      if (!next) continue;
+      const PreparedRenderer* renderer = next->job.renderer.get();  // render() may move the job on
+      render(next->job, next->submitted, charge);
       {
         std::lock_guard lock(queueMutex);
         busy.erase(renderer);
+        pixelsInFlight -= charge;
       }
       queueCv.notify_all();
     }
   }
 
-  void build(const SessionConfig& config) {
-    std::shared_ptr<PreparedRenderer> renderer;
-    std::string error;
-    try {
-      renderer = builder(config);
-      if (!renderer || !renderer->renderer) error = "the renderer builder returned nothing";
-    } catch (const std::exception& e) {
-      error = e.what();
-    }
-    std::vector<PrepareCallback> waiting;
-    {
-      std::lock_guard lock(cacheMutex);
-      auto it = building.find(config.rendererKey());
-      if (it != building.end()) {
-        waiting = std::move(it->second);
-        building.erase(it);
-      }
-      if (error.empty()) {
-        renderer->key = config.rendererKey();
-        metrics.renderersBuilt.fetch_add(1);
-        ready.push_front(renderer);
-        while (ready.size() > options.maxRenderers) ready.pop_back();  // sessions keep theirs alive
-      }
-    }
-    for (auto& cb : waiting) cb(error.empty() ? renderer : nullptr, error);
-  }
-
-  void render(RenderJob& job, Clock::time_point submitted) {
+  // Holds `charge` pixels of the budget; resizes it to the request's.
+  void render(RenderJob& job, Clock::time_point submitted, std::size_t& charge) {
     const double queuedSeconds = secondsSince(submitted);
+    auto cancel = [&job] {
+      if (job.onCancelled) job.onCancelled();
+    };
     std::optional<render::FrameRequest> request = job.take();
-    if (!request) return;  // the session has gone
+    if (!request || isCancelled(job)) return cancel();
+    const std::size_t pixels = static_cast<std::size_t>(std::max(0, request->width)) *
+                               static_cast<std::size_t>(std::max(0, request->height));
+    if (pixels > options.maxSessionPixels) {
+      job.done(std::nullopt, "a frame of " + std::to_string(request->width) + "×" + std::to_string(request->height) +
+                                 " (" + std::to_string(pixels) + " pixels) is over the server's limit of " +
+                                 std::to_string(options.maxSessionPixels) + " pixels per session (max-session-pixels)");
+      return;
+    }
+    if (pixels != charge) {  // the session's size changed since submit
+      std::lock_guard lock(queueMutex);
+      pixelsInFlight = pixelsInFlight - charge + pixels;
+      charge = pixels;
+    }
     // Only EXR encodes the linear image; every other encoding needs RGBA8
     // alone, and a GPU backend then skips reading the linear image back.
     request->linearImage = job.encoding == FrameEncoding::Exr;
+    request->cancelled = [this, &job, own = std::move(request->cancelled)] {
+      return stopping.load() || isCancelled(job) || (own && own());
+    };
     RenderedFrame out;
     out.queuedSeconds = queuedSeconds;
     try {
-      out.frame = job.renderer->renderer->render(*request);  // this worker alone holds the renderer
+      out.frame = job.renderer->renderer->render(*request);
     } catch (const std::exception& e) {
       job.done(std::nullopt, std::string("render failed: ") + e.what());
       return;
     }
+    if (out.frame.cancelled || stopping) return cancel();
     // Encoding goes to its own threads: the next frame can render meanwhile.
     encodeQueue.push([job = std::move(job), out = std::move(out)]() mutable {
       try {
@@ -189,41 +397,51 @@ struct RenderService::Impl {
   }
 };
 
+namespace {
+AbandonableRendererBuilder abandonable(RendererBuilder builder) {
+  if (!builder) return {};
+  return [builder = std::move(builder)](const SessionConfig& config, const std::function<bool()>&) {
+    return builder(config);  // cannot stop early: an abandoned build finishes into the cache
+  };
+}
+}  // namespace
+
 RenderService::RenderService(RendererBuilder builder, Options options, Metrics& metrics)
-    : impl_(std::make_unique<Impl>(std::move(builder), options, metrics)) {
-  impl_->builderQueue.start(1);
-  for (int i = 0; i < std::max(1, options.workers); ++i) {
+    : RenderService(abandonable(std::move(builder)), options, metrics) {}
+
+RenderService::RenderService(AbandonableRendererBuilder builder, Options options, Metrics& metrics) {
+  checkOptions(options);
+  if (!builder) throw std::invalid_argument("RenderService: no renderer builder");
+  impl_ = std::make_unique<Impl>(std::move(builder), options, metrics);
+  impl_->builderThread = std::thread([impl = impl_.get()] { impl->builderLoop(); });
+  for (int i = 0; i < options.workers; ++i) {
     impl_->workers.emplace_back([impl = impl_.get()] { impl->workerLoop(); });
   }
-  impl_->encodeQueue.start(std::max(1, options.encoders));
+  impl_->encodeQueue.start(options.encoders);
 }
 
 RenderService::~RenderService() { stop(); }
 
+void RenderService::prepare(const SessionConfig& config, const std::string& owner, PrepareDone done) {
+  if (!done) throw std::invalid_argument("RenderService::prepare: no callback");
+  for (auto& [callback, outcome] : impl_->prepare(config, owner, std::move(done))) callback(std::move(outcome));
+}
+
 void RenderService::prepare(const SessionConfig& config, PrepareCallback done) {
-  const std::string key = config.rendererKey();
-  std::shared_ptr<PreparedRenderer> cached;
-  {
-    std::lock_guard lock(impl_->cacheMutex);
-    for (auto it = impl_->ready.begin(); it != impl_->ready.end(); ++it) {
-      if ((*it)->key == key) {
-        cached = *it;
-        impl_->ready.splice(impl_->ready.begin(), impl_->ready, it);  // most recently used
-        break;
-      }
-    }
-    if (!cached) {
-      auto [it, fresh] = impl_->building.try_emplace(key);
-      it->second.push_back(std::move(done));
-      if (fresh) impl_->builderQueue.push([impl = impl_.get(), config] { impl->build(config); });
-      return;
-    }
-  }
-  done(cached, {});
+  if (!done) throw std::invalid_argument("RenderService::prepare: no callback");
+  prepare(config, std::string(), [done = std::move(done)](PrepareOutcome o) {
+    done(std::move(o.renderer), std::move(o.error));
+  });
+}
+
+void RenderService::withdraw(const std::string& owner) {
+  if (owner.empty()) return;  // nobody's prepares are never withdrawn
+  std::lock_guard lock(impl_->cacheMutex);
+  impl_->detachOwner(owner, nullptr);
 }
 
 void RenderService::submit(RenderJob job) {
-  if (!job.renderer) throw std::invalid_argument("RenderService::submit: a job without a renderer");
+  if (!job.renderer || !job.renderer->renderer) throw std::invalid_argument("RenderService::submit: a job without a renderer");
   {
     std::lock_guard lock(impl_->queueMutex);
     if (impl_->stopping) return;
@@ -237,20 +455,50 @@ std::size_t RenderService::queued() const {
   return impl_->queue.size();
 }
 
+std::size_t RenderService::queuedBuilds() const {
+  std::lock_guard lock(impl_->cacheMutex);
+  return impl_->buildQueue.size();
+}
+
+std::size_t RenderService::pixelsInFlight() const {
+  std::lock_guard lock(impl_->queueMutex);
+  return impl_->pixelsInFlight;
+}
+
+bool RenderService::atPixelBudget() const {
+  std::lock_guard lock(impl_->queueMutex);
+  const std::size_t budget = impl_->options.serverPixelBudget;
+  return impl_->budgetWait || (budget && impl_->pixelsInFlight >= budget);
+}
+
 void RenderService::stop() {
   if (!impl_) return;
-  impl_->builderQueue.stop();
+  Impl& s = *impl_;
+  // Flags first, then joins: a running build and the running frames stop
+  // together, at their next stage, tile or batch.
+  std::deque<std::shared_ptr<Impl::Build>> droppedBuilds;  // callbacks destroyed outside the locks
+  std::deque<Impl::Queued> droppedJobs;
   {
-    std::lock_guard lock(impl_->queueMutex);
-    impl_->stopping = true;
-    impl_->queue.clear();
+    std::lock_guard lock(s.cacheMutex);
+    s.buildsStopping = true;
+    if (s.runningBuild) s.runningBuild->abandoned = true;
+    droppedBuilds.swap(s.buildQueue);
+    s.builds.clear();
+    s.ownerWaits.clear();
   }
-  impl_->queueCv.notify_all();
-  for (auto& t : impl_->workers) {
+  s.buildCv.notify_all();
+  {
+    std::lock_guard lock(s.queueMutex);
+    s.stopping = true;
+    droppedJobs.swap(s.queue);
+  }
+  s.queueCv.notify_all();
+  if (s.builderThread.joinable()) s.builderThread.join();
+  for (auto& t : s.workers) {
     if (t.joinable()) t.join();
   }
-  impl_->workers.clear();
-  impl_->encodeQueue.stop();
+  s.workers.clear();
+  s.encodeQueue.stop();
 }
 
 }  // namespace haarcast::net

@@ -1,5 +1,7 @@
 // The CPU reference backend behind the Renderer interface: Embree primary
-// rays, per-pixel shading on a thread pool, edge pixels antialiased.
+// rays, per-pixel shading on a thread pool, edge pixels antialiased. Frames
+// may render concurrently (each borrows its own posed ray scene) and stop at
+// the next row once the request's `cancelled` says so.
 #include "haarcast/render/renderer.h"
 
 #include <algorithm>
@@ -9,6 +11,7 @@
 #include <stdexcept>
 #include <string>
 #include <functional>
+#include <mutex>
 #include <thread>
 
 #include <glm/geometric.hpp>
@@ -24,6 +27,24 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+// Thrown at a tile boundary once the request's `cancelled` says so; it stops
+// parallelFor from handing out further rows (parallel.h) and render() turns
+// it into a cancelled Frame. Private to this file: it never leaves render().
+struct FrameCancelled {};
+
+// The tile-boundary check: a tile is one row of a pass (or a run of edge
+// pixels), so a cancelled frame stops after at most the rows in flight.
+class CancelPoint {
+ public:
+  explicit CancelPoint(const std::function<bool()>& cancelled) : cancelled_(cancelled) {}
+  void operator()() const {
+    if (cancelled_ && cancelled_()) throw FrameCancelled{};
+  }
+
+ private:
+  const std::function<bool()>& cancelled_;
+};
 
 class CpuRenderer final : public Renderer {
  public:
@@ -49,9 +70,7 @@ class CpuRenderer final : public Renderer {
       }
     }
     // The meshes' ray structures are built once; frames only move them.
-    std::vector<Instance> instances;
-    for (const PreparedObject& p : prepared_.objects) instances.push_back({p.mesh.get(), glm::mat4(p.pose.objectToWorld())});
-    rays_ = std::make_unique<RayScene>(std::move(instances));
+    idleRays_.push_back(makeRays());
   }
 
   std::string backend() const override { return "cpu"; }
@@ -62,11 +81,46 @@ class CpuRenderer final : public Renderer {
   }
   const RenderOptions& options() const override { return options_; }
   std::size_t objectCount() const override { return prepared_.objects.size(); }
+  bool concurrentRenders() const override { return true; }
 
   Frame render(const FrameRequest& request) override;
 
  private:
   static unsigned hardwareThreads(unsigned t) { return t ? t : std::max(1u, std::thread::hardware_concurrency()); }
+  std::unique_ptr<RayScene> makeRays() const {
+    std::vector<Instance> instances;
+    for (const PreparedObject& p : prepared_.objects) instances.push_back({p.mesh.get(), glm::mat4(p.pose.objectToWorld())});
+    return std::make_unique<RayScene>(std::move(instances));
+  }
+  // A frame poses its objects in a ray scene (setTransform), which no other
+  // frame may query meanwhile: each concurrent render borrows its own from
+  // the pool, built on first need (the concurrency the server runs, at most),
+  // and returns it when done. Everything else a frame reads is immutable.
+  class RaysLease {
+   public:
+    explicit RaysLease(const CpuRenderer& r) : owner_(r) {
+      {
+        const std::lock_guard lock(owner_.raysMutex_);
+        if (!owner_.idleRays_.empty()) {
+          rays_ = std::move(owner_.idleRays_.back());
+          owner_.idleRays_.pop_back();
+        }
+      }
+      if (!rays_) rays_ = owner_.makeRays();
+    }
+    ~RaysLease() {
+      const std::lock_guard lock(owner_.raysMutex_);
+      owner_.idleRays_.push_back(std::move(rays_));
+    }
+    RaysLease(const RaysLease&) = delete;
+    RaysLease& operator=(const RaysLease&) = delete;
+    RayScene& operator*() const { return *rays_; }
+
+   private:
+    const CpuRenderer& owner_;
+    std::unique_ptr<RayScene> rays_;
+  };
+  Frame renderFrame(const FrameRequest& request, const CancelPoint& cancelPoint) const;
   // Bytes one rotation of one channel reads: the slice, plus for `matrix`
   // the two elevation matrices it blends and for `table` the stored copy
   // (which replaces the slice).
@@ -95,8 +149,9 @@ class CpuRenderer final : public Renderer {
   };
   // gbuffer: traces the centres, finds the edge pixels, traces their
   // sub-samples. rotation-input: each sample's slice and Euler angles.
-  void traceGBuffer(const CameraRays& camera, int w, int h, GBuffer& g) const;
-  void fillInputs(const ResolvedFrame& resolved, GBuffer& g) const;
+  void traceGBuffer(const RayScene& rays, const CameraRays& camera, int w, int h, GBuffer& g,
+                    const CancelPoint& cancelPoint) const;
+  void fillInputs(const ResolvedFrame& resolved, GBuffer& g, const CancelPoint& cancelPoint) const;
   static glm::dvec3 subsampleDirection(const CameraRays& camera, int x, int y, unsigned k);
   // rgb = the sample's radiance; returns the coefficient bytes read.
   using Shade = std::function<std::size_t(const Sample&, std::array<float, 3>& rgb)>;
@@ -104,20 +159,23 @@ class CpuRenderer final : public Renderer {
   // mean of its sub-samples (the backdrop where one misses); rows in
   // parallel. Marks objectMask; returns the bytes read.
   std::size_t shadePixels(const GBuffer& g, const FrameRequest& request, const CameraRays& camera, Frame& frame,
-                          const Shade& shade) const;
+                          const Shade& shade, const CancelPoint& cancelPoint) const;
   // The per-pixel passes: rotation + triple product (the rotating methods),
   // or one fused pass. Each adds its stages and returns the bytes read.
   std::size_t shadeRotating(const ResolvedFrame& resolved, const GBuffer& g, const FrameRequest& request,
-                            const CameraRays& camera, Frame& frame);
+                            const CameraRays& camera, Frame& frame, const CancelPoint& cancelPoint) const;
   std::size_t shadeFused(const ResolvedFrame& resolved, const GBuffer& g, const FrameRequest& request,
-                         const CameraRays& camera, Frame& frame);
+                         const CameraRays& camera, Frame& frame, const CancelPoint& cancelPoint) const;
 
   RenderOptions options_;
   PreparedScene prepared_;
   std::vector<std::array<std::unique_ptr<SliceRotator>, 3>> rotators_;  // rotating methods
   std::vector<std::unique_ptr<RgbHaarRotator>> rgbHaar_;                 // haar refined, else null
   std::vector<PixelSlices> pixelSlices_;                                 // fused
-  std::unique_ptr<RayScene> rays_;  // posed per frame with setTransform (top level only)
+  // Ray scenes not in use by a frame (RaysLease); posed per frame with
+  // setTransform (top level only).
+  mutable std::mutex raysMutex_;
+  mutable std::vector<std::unique_ptr<RayScene>> idleRays_;
 };
 
 std::size_t CpuRenderer::rotationBytes(std::size_t object) const {
@@ -133,9 +191,9 @@ glm::dvec3 CpuRenderer::subsampleDirection(const CameraRays& camera, int x, int 
   return camera.directionAt(x + 0.5 + ((k & 1u) ? o : -o), y + 0.5 + ((k & 2u) ? o : -o));
 }
 
-void CpuRenderer::traceGBuffer(const CameraRays& camera, int w, int h, GBuffer& g) const {
+void CpuRenderer::traceGBuffer(const RayScene& rays, const CameraRays& camera, int w, int h, GBuffer& g,
+                               const CancelPoint& cancelPoint) const {
   const std::size_t pixels = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
-  const RayScene& rays = *rays_;
   auto trace = [&](const glm::dvec3& direction) -> std::optional<Sample> {
     Ray r;
     r.origin = glm::vec3(camera.origin());
@@ -151,6 +209,7 @@ void CpuRenderer::traceGBuffer(const CameraRays& camera, int w, int h, GBuffer& 
   g.width = static_cast<std::size_t>(w);
   g.height = static_cast<std::size_t>(h);
   parallelFor(static_cast<std::size_t>(h), [&](std::size_t y) {
+    cancelPoint();
     for (int x = 0; x < w; ++x) g.centre[y * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)] = trace(camera.direction(x, static_cast<int>(y)));
   }, {}, options_.threads);
 
@@ -163,6 +222,7 @@ void CpuRenderer::traceGBuffer(const CameraRays& camera, int w, int h, GBuffer& 
     return c ? c->hit.object + 1 : 0;
   };
   for (int y = 0; y < h; ++y) {
+    cancelPoint();
     for (int x = 0; x < w; ++x) {
       const std::size_t mine = id(x, y);
       bool edge = false;
@@ -174,7 +234,9 @@ void CpuRenderer::traceGBuffer(const CameraRays& camera, int w, int h, GBuffer& 
       g.sub.emplace_back();
     }
   }
+  cancelPoint();
   parallelFor(static_cast<std::size_t>(h), [&](std::size_t y) {
+    cancelPoint();
     for (int x = 0; x < w; ++x) {
       const std::uint32_t e = g.edge[y * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)];
       if (e == kInterior) continue;
@@ -183,7 +245,7 @@ void CpuRenderer::traceGBuffer(const CameraRays& camera, int w, int h, GBuffer& 
   }, {}, options_.threads);
 }
 
-void CpuRenderer::fillInputs(const ResolvedFrame& resolved, GBuffer& g) const {
+void CpuRenderer::fillInputs(const ResolvedFrame& resolved, GBuffer& g, const CancelPoint& cancelPoint) const {
   // The interpolated normal and the view direction in the object's frame.
   auto fill = [&](Sample& s) {
     const PreparedObject& p = prepared_.objects[s.hit.object];
@@ -204,10 +266,12 @@ void CpuRenderer::fillInputs(const ResolvedFrame& resolved, GBuffer& g) const {
   // In rows (and runs of 64 edge pixels): one task per pixel would cost
   // more in scheduling than the work.
   parallelFor(g.height, [&](std::size_t y) {
+    cancelPoint();
     for (std::size_t i = y * g.width; i < (y + 1) * g.width; ++i)
       if (g.centre[i]) fill(*g.centre[i]);
   }, {}, options_.threads);
   parallelFor((g.sub.size() + 63) / 64, [&](std::size_t run) {
+    cancelPoint();
     for (std::size_t e = run * 64; e < std::min(g.sub.size(), run * 64 + 64); ++e)
       for (auto& s : g.sub[e])
         if (s) fill(*s);
@@ -215,10 +279,11 @@ void CpuRenderer::fillInputs(const ResolvedFrame& resolved, GBuffer& g) const {
 }
 
 std::size_t CpuRenderer::shadePixels(const GBuffer& g, const FrameRequest& request, const CameraRays& camera,
-                                     Frame& frame, const Shade& shade) const {
+                                     Frame& frame, const Shade& shade, const CancelPoint& cancelPoint) const {
   const int w = frame.width, h = frame.height;
   std::atomic<std::size_t> total{0};
   parallelFor(static_cast<std::size_t>(h), [&](std::size_t y) {
+    cancelPoint();
     std::size_t rowBytes = 0;
     std::array<float, 3> rgb{};
     for (int x = 0; x < w; ++x) {
@@ -250,6 +315,19 @@ std::size_t CpuRenderer::shadePixels(const GBuffer& g, const FrameRequest& reque
 }
 
 Frame CpuRenderer::render(const FrameRequest& request) {
+  const CancelPoint cancelPoint(request.cancelled);
+  try {
+    return renderFrame(request, cancelPoint);
+  } catch (const FrameCancelled&) {
+    Frame frame;
+    frame.width = request.width;
+    frame.height = request.height;
+    frame.cancelled = true;
+    return frame;
+  }
+}
+
+Frame CpuRenderer::renderFrame(const FrameRequest& request, const CancelPoint& cancelPoint) const {
   const auto start = Clock::now();
   Frame frame;
 
@@ -260,7 +338,9 @@ Frame CpuRenderer::render(const FrameRequest& request) {
   frame.stages.push_back({"light", since(t0)});
 
   // ---- gbuffer, rotation-input: Embree primary rays, per-sample inputs ----
-  for (std::size_t i = 0; i < resolved.objects.size(); ++i) rays_->setTransform(i, glm::mat4(resolved.objects[i].objectToWorld));
+  cancelPoint();
+  const RaysLease rays(*this);
+  for (std::size_t i = 0; i < resolved.objects.size(); ++i) (*rays).setTransform(i, glm::mat4(resolved.objects[i].objectToWorld));
   const int w = request.width, h = request.height;
   frame.width = w;
   frame.height = h;
@@ -268,21 +348,22 @@ Frame CpuRenderer::render(const FrameRequest& request) {
   const std::size_t pixels = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
   GBuffer g;
   t0 = Clock::now();
-  traceGBuffer(camera, w, h, g);
+  traceGBuffer(*rays, camera, w, h, g, cancelPoint);
   frame.stages.push_back({"gbuffer", since(t0)});
   t0 = Clock::now();
-  fillInputs(resolved, g);
+  fillInputs(resolved, g, cancelPoint);
   frame.stages.push_back({"rotation-input", since(t0)});
 
   frame.image = io::makeImage(w, h);
   frame.objectMask.assign(pixels, 0);
-  bytes += options_.method == RotationMethod::Fused ? shadeFused(resolved, g, request, camera, frame)
-                                                    : shadeRotating(resolved, g, request, camera, frame);
+  bytes += options_.method == RotationMethod::Fused ? shadeFused(resolved, g, request, camera, frame, cancelPoint)
+                                                    : shadeRotating(resolved, g, request, camera, frame, cancelPoint);
 
   // ---- tonemap: backdrop, RGBA8 --------------------------------------------
   t0 = Clock::now();
   if (options_.environmentBackground) {
     parallelFor(static_cast<std::size_t>(h), [&](std::size_t y) {
+      cancelPoint();
       for (int x = 0; x < w; ++x) {
         const std::size_t i = y * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
         if (frame.objectMask[i] || g.edge[i] != kInterior) continue;  // drawn by the shading
@@ -301,7 +382,7 @@ Frame CpuRenderer::render(const FrameRequest& request) {
 }
 
 std::size_t CpuRenderer::shadeRotating(const ResolvedFrame& resolved, const GBuffer& g, const FrameRequest& request,
-                                       const CameraRays& camera, Frame& frame) {
+                                       const CameraRays& camera, Frame& frame, const CancelPoint& cancelPoint) const {
   // The light's lists are validated and put in the walk's order once per frame.
   std::vector<std::array<PreparedLight, 3>> light(resolved.objects.size());
   for (std::size_t i = 0; i < light.size(); ++i)
@@ -343,7 +424,7 @@ std::size_t CpuRenderer::shadeRotating(const ResolvedFrame& resolved, const GBuf
     std::size_t read = 3 * rotationBytes(object);
     for (const SparseHaar* v : vertices) read += v->size() * (sizeof(std::uint32_t) + sizeof(float));
     return read;
-  });
+  }, cancelPoint);
   const double shading = since(t0);
   const double busy = static_cast<double>(rotationNs.load() + productNs.load());
   const double rotationShare = busy > 0.0 ? static_cast<double>(rotationNs.load()) / busy : 0.5;
@@ -353,7 +434,7 @@ std::size_t CpuRenderer::shadeRotating(const ResolvedFrame& resolved, const GBuf
 }
 
 std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const GBuffer& g, const FrameRequest& request,
-                                    const CameraRays& camera, Frame& frame) {
+                                    const CameraRays& camera, Frame& frame, const CancelPoint& cancelPoint) const {
   const auto t0 = Clock::now();
   const std::size_t bytes = shadePixels(g, request, camera, frame, [&](const Sample& sample, std::array<float, 3>& rgb) {
     // Per worker thread, kept across pixels: no allocation per pixel.
@@ -372,7 +453,7 @@ std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const GBuffer
                                                           options_.interpolateSlices ? 1u : 0u);
     rgb = fusedShade(slices, blend, in.rotation.euler, resolved.objects[sample.hit.object].fusedLight, vis, scratch);
     return fusedPixelBytes(slices.level(), blend.weight != 0.0f, entries);
-  });
+  }, cancelPoint);
   frame.stages.push_back({"fused", since(t0)});
   return bytes;
 }

@@ -4,16 +4,25 @@
 //   prepare()  gets the renderer for a session's config from an LRU cache,
 //              or builds it on the builder thread (slice tables, visibility:
 //              seconds), never on an I/O thread. Sessions with the same
-//              config share one.
-//   submit()   queues one frame job. Jobs run on the worker thread(s) in
-//              FIFO order, and each session keeps at most one job queued or
-//              running, so the queue is a round robin over the sessions that
-//              want a frame: a fast client cannot starve a slow one.
+//              config share one. Per owner (session) the latest prepare
+//              wins: an earlier one still waiting is answered Superseded, and
+//              a build nobody waits for any more is dropped (queued) or
+//              abandoned (running). At most Options::maxQueuedBuilds builds
+//              wait across the server; beyond that prepare is Refused.
+//   submit()   queues one frame job. Jobs start in FIFO order on
+//              Options::workers threads, and each session keeps at most one
+//              job queued or running, so the queue is a round robin over the
+//              sessions that want a frame: a fast client cannot starve a slow
+//              one. Frames of different sessions render at once, up to the
+//              workers and the server's pixel budget; a renderer that cannot
+//              render concurrently (Vulkan) renders one frame at a time.
 //
 // A job asks its session for the request when the worker starts it (not when
-// it was queued), so the frame answers the latest pose. Renderers are not
-// thread-safe: each is locked while it renders. Encoding runs on a separate
-// small pool, so the device is not idle while a frame is compressed.
+// it was queued), so the frame answers the latest pose. A job is cancelled
+// when its `cancelled` says so or the service stops: before it starts, or
+// mid-frame at the renderer's next tile (CPU) or batch (Vulkan) boundary.
+// Encoding runs on a separate small pool, so the device is not idle while a
+// frame is compressed.
 #pragma once
 
 #include <cstddef>
@@ -38,6 +47,13 @@ struct PreparedRenderer {
 // Builds the renderer for a config; runs on the builder thread. Throws with
 // a message naming what was wrong.
 using RendererBuilder = std::function<std::shared_ptr<PreparedRenderer>(const SessionConfig& config)>;
+// A builder that may stop early: `abandoned()` turns true once nobody waits
+// for the build any more (every waiter superseded or withdrawn) or the
+// service stops. The builder polls it between its precompute stages (a
+// RenderProgress callback is a good place) and then throws anything: the
+// build ends quietly, unanswered.
+using AbandonableRendererBuilder = std::function<std::shared_ptr<PreparedRenderer>(
+    const SessionConfig& config, const std::function<bool()>& abandoned)>;
 
 struct RenderedFrame {
   render::Frame frame;
@@ -49,40 +65,97 @@ struct RenderedFrame {
 struct RenderJob {
   std::shared_ptr<PreparedRenderer> renderer;
   // Called on the worker when it starts: the latest request, or nullopt when
-  // the session has gone (the job is skipped).
+  // the session has gone (the job ends as cancelled).
   std::function<std::optional<render::FrameRequest>()> take;
+  // The frame's width × height, as the session's config says at submit: the
+  // share of the server's pixel budget the job waits for and holds while it
+  // renders. 0 = unknown: the job does not wait, and holds the size of the
+  // request take() returns.
+  std::size_t pixels = 0;
+  // Polled before the job starts and at every tile or batch boundary of its
+  // render (and possibly under the service's lock): cheap, thread-safe and
+  // never calling into the service. true = the session has gone or the pose
+  // is superseded. Empty = only stop() cancels.
+  std::function<bool()> cancelled;
   // The encoding of the finished frame.
   FrameEncoding encoding = FrameEncoding::Jpeg;
   int jpegQuality = 85;
-  // Called once, on a service thread, with the frame or an error message.
+  // Called once, on a service thread, with the frame or an error message
+  // (a frame over Options::maxSessionPixels is an error naming the limit).
   std::function<void(std::optional<RenderedFrame>, std::string error)> done;
+  // Called once instead of `done` when the job ends without a frame and
+  // without an error: cancelled before or during its render, or take()
+  // returned nullopt. On a service thread; may be empty.
+  std::function<void()> onCancelled;
+};
+
+// How a prepare() ended.
+enum class PrepareStatus {
+  Ready,       // `renderer` is set
+  Failed,      // the build threw: `error` says why
+  Refused,     // the server's build queue is full: `error` names the limit
+  Superseded,  // a newer prepare() from the same owner replaced this one
+};
+struct PrepareOutcome {
+  PrepareStatus status = PrepareStatus::Failed;
+  std::shared_ptr<PreparedRenderer> renderer;
+  std::string error;
 };
 
 class RenderService {
  public:
   struct Options {
     std::size_t maxRenderers = 4;  // LRU bound of the cache (in use ones stay alive while used)
-    int workers = 1;               // render threads: one per device
-    int encoders = 2;              // encode threads
+    // Render threads: the frames of this many sessions render at once (a
+    // renderer that cannot render concurrently, Vulkan, one at a time).
+    int workers = 4;
+    int encoders = 2;  // encode threads
+    // One frame's width × height per session; a larger frame is an error
+    // naming this limit. By default the protocol's largest frame.
+    std::size_t maxSessionPixels = static_cast<std::size_t>(Limits{}.maxWidth) * static_cast<std::size_t>(Limits{}.maxHeight);
+    // The pixels rendering at once across the server: a job waits while
+    // its pixels would not fit, and a job larger than the budget runs
+    // alone. 0 = no budget. By default two of the largest frames.
+    std::size_t serverPixelBudget = 2 * maxSessionPixels;
+    // Renderer builds waiting (not running) across the server; a prepare()
+    // that needs one more is Refused.
+    std::size_t maxQueuedBuilds = 8;
   };
 
+  // Throws std::invalid_argument naming an option out of range.
   RenderService(RendererBuilder builder, Options options, Metrics& metrics);
+  RenderService(AbandonableRendererBuilder builder, Options options, Metrics& metrics);
   ~RenderService();  // stop()
   RenderService(const RenderService&) = delete;
   RenderService& operator=(const RenderService&) = delete;
 
+  using PrepareDone = std::function<void(PrepareOutcome)>;
+  // done(outcome) once, on a service thread, or on the caller's thread when
+  // the answer is immediate (cached, superseded, refused). `owner` names
+  // the session: its newer prepare supersedes this one ("" = nobody's:
+  // never superseded).
+  void prepare(const SessionConfig& config, const std::string& owner, PrepareDone done);
+  // The owner's waiting prepare, if any, is dropped unanswered (its session
+  // has gone); a build then waited for by nobody is dropped or abandoned.
+  void withdraw(const std::string& owner);
   using PrepareCallback = std::function<void(std::shared_ptr<PreparedRenderer>, std::string error)>;
-  // done(renderer, "") or done(nullptr, error), on a service thread (or on
-  // the caller's thread when the renderer is already cached).
+  // Nobody's prepare: done(renderer, "") or done(nullptr, error).
   void prepare(const SessionConfig& config, PrepareCallback done);
 
   void submit(RenderJob job);
 
-  // Jobs waiting now (for tests and /metrics).
+  // For tests, /metrics and /readyz: jobs waiting now, builds waiting now,
+  // the pixels of the frames rendering now, and whether a job waits for the
+  // server's pixel budget (or the budget is spent).
   std::size_t queued() const;
+  std::size_t queuedBuilds() const;
+  std::size_t pixelsInFlight() const;
+  bool atPixelBudget() const;
 
-  // Finishes the jobs in progress, drops the rest (their callbacks are
-  // destroyed uncalled), joins the threads. Idempotent.
+  // Cancels the renders in progress (they end at their next tile or batch
+  // boundary, as cancelled) and abandons a running build, drops the queued
+  // jobs and prepares (their callbacks destroyed uncalled), joins the
+  // threads. Idempotent.
   void stop();
 
  private:

@@ -18,6 +18,7 @@
 #include <cstddef>
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -52,6 +53,11 @@ struct FrameRequest {
   // false: the caller needs only rgba8 (an encoder), so a backend may skip
   // reading the linear image back (Frame::image is then empty).
   bool linearImage = true;
+  // Polled at every tile (CPU: a row of a pass) or batch (Vulkan: a
+  // submission) boundary; once it returns true the render stops there and
+  // returns a Frame with `cancelled` set. Empty = never cancelled. Called on
+  // the render's own threads, so it must be cheap and thread-safe.
+  std::function<bool()> cancelled;
 };
 
 struct StageTime {
@@ -70,6 +76,10 @@ struct Frame {
   std::size_t coefficientBytes = 0;   // coefficient data read this frame (slices, light, visibility, method tables)
   double exposureStops = 0.0;         // the exposure rgba8 was made with
   double logAverageLuminance = 0.0;   // of the lit object pixels (frameLogAverage); 0: none lit
+  // The request's `cancelled` turned true mid-frame: the render stopped at
+  // the next tile or batch boundary and the images are empty (an outcome,
+  // not an error: nothing is wrong with the request).
+  bool cancelled = false;
 };
 
 class Renderer {
@@ -79,7 +89,12 @@ class Renderer {
   virtual std::string deviceName() const = 0;  // e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
   virtual const RenderOptions& options() const = 0;
   virtual std::size_t objectCount() const = 0;
-  // Not thread-safe: one frame at a time per renderer (the server serialises).
+  // Whether render() may run on several threads at once. The CPU backend's
+  // prepared data is immutable and each call keeps its own scratch, so it
+  // may; a Vulkan renderer owns one set of device buffers and may not (the
+  // server then serialises its frames).
+  virtual bool concurrentRenders() const { return false; }
+  // One frame. Unless concurrentRenders(), one at a time per renderer.
   // Throws std::invalid_argument naming what was wrong (resolution outside
   // 1..8192, pose count ≠ object count, …).
   virtual Frame render(const FrameRequest& request) = 0;
