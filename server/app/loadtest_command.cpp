@@ -8,11 +8,9 @@
 
 #include <algorithm>
 #include <chrono>
-#include <condition_variable>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <mutex>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -23,6 +21,7 @@
 #include "app_paths.h"
 #include "client_options.h"
 #include "haarcast/render/renderer.h"
+#include "loadtest_progress.h"
 #include "loadtest_report.h"
 #include "loadtest_server.h"
 #include "loadtest_storage.h"
@@ -114,87 +113,6 @@ std::string loadAverage() {
   std::string a, b, c;
   return in >> a >> b >> c ? a + " " + b + " " + c : "unknown";
 }
-
-// The progress of the whole test on stderr: on a terminal one line redrawn
-// twice a second ("run k of N … s left"), otherwise a line per run and one
-// every 10 s. Session messages go through message() so they are not drawn over.
-class LoadtestProgress {
- public:
-  explicit LoadtestProgress(std::size_t runs) : runs_(runs), terminal_(stderrIsTerminal()) {}
-  ~LoadtestProgress() { endRun(); }
-
-  void startRun(std::size_t k, std::string label, double seconds) {
-    std::lock_guard lock(mutex_);
-    k_ = k, label_ = std::move(label), seconds_ = seconds, runStart_ = Clock::now(), stop_ = false;
-    if (!terminal_) print("[loadtest] run " + std::to_string(k + 1) + " of " + std::to_string(runs_) + ": " + label_ + ", " + left() + "\n");
-    thread_ = std::thread([this] { loop(); });
-  }
-
-  void endRun() {
-    {
-      std::lock_guard lock(mutex_);
-      if (!thread_.joinable()) return;
-      stop_ = true;
-      done_.push_back(std::chrono::duration<double>(Clock::now() - runStart_).count());
-    }
-    wake_.notify_all();
-    thread_.join();
-    std::lock_guard lock(mutex_);
-    if (terminal_) print("\r\x1b[K");
-  }
-
-  void message(const std::string& text) {
-    std::lock_guard lock(mutex_);
-    print(std::string(terminal_ ? "\r\x1b[K" : "") + "[loadtest] " + text + "\n");
-  }
-
- private:
-  // "about 3 min 10 s left": this run's remaining time plus the mean of the
-  // finished runs (or the run length itself before any finished) per run to go.
-  std::string left() const {
-    const double elapsed = std::chrono::duration<double>(Clock::now() - runStart_).count();
-    double perRun = seconds_;
-    if (!done_.empty()) {
-      perRun = 0.0;
-      for (double d : done_) perRun += d / static_cast<double>(done_.size());
-    }
-    const double rest = std::max(0.0, perRun - elapsed) + perRun * static_cast<double>(runs_ - k_ - 1);
-    return "about " + formatDuration(rest) + " left";
-  }
-
-  void loop() {
-    std::unique_lock lock(mutex_);
-    auto lastLine = Clock::now();
-    while (!wake_.wait_for(lock, std::chrono::milliseconds(500), [this] { return stop_; })) {
-      const double elapsed = std::chrono::duration<double>(Clock::now() - runStart_).count();
-      const std::string line = "[loadtest] run " + std::to_string(k_ + 1) + " of " + std::to_string(runs_) + ": " +
-                               label_ + ", " + formatDuration(elapsed) + " in, " + left();
-      if (terminal_) {
-        print("\r" + line + "\x1b[K");
-      } else if (Clock::now() - lastLine >= std::chrono::seconds(10)) {
-        print(line + "\n");
-        lastLine = Clock::now();
-      }
-    }
-  }
-
-  static void print(const std::string& s) {
-    std::fputs(s.c_str(), stderr);
-    std::fflush(stderr);
-  }
-
-  std::size_t runs_;
-  bool terminal_;
-  std::mutex mutex_;
-  std::condition_variable wake_;
-  std::thread thread_;
-  bool stop_ = false;
-  std::size_t k_ = 0;
-  std::string label_;
-  double seconds_ = 0.0;
-  Clock::time_point runStart_;
-  std::vector<double> done_;
-};
 
 // The renderer options `haarcast serve` gives a session of this method and
 // level (serve_command.cpp: RenderOptions defaults, the cache folder, k =
