@@ -57,6 +57,13 @@ struct LoadtestArgs {
 // it): at 30 fps one turn takes 8 s; the path cycles in longer runs.
 constexpr std::uint64_t kPathPoses = 240;
 
+// --quick: what the test suite runs (docs/loadtest.md "--quick").
+constexpr const char* kQuickMethods = "fused,haar,table";
+constexpr const char* kQuickClients = "1,2";
+constexpr const char* kQuickSizes = "32";
+constexpr double kQuickSeconds = 2.0;
+constexpr int kQuickLevel = 4;
+
 std::vector<std::string> splitList(const std::string& text, const char* flag) {
   std::vector<std::string> out;
   std::stringstream in(text);
@@ -365,17 +372,20 @@ std::function<int()> addLoadtestCommand(CLI::App& app) {
   c->add_option("--backend", a->backend, "cpu|vulkan (default: the server's)");
   c->add_option("--cache-dir", a->cacheDir, "Slice-table and visibility cache, shared with the local server");
   c->add_option("--out", a->out, "Folder for report.json, report.md and the figures")->capture_default_str();
-  c->add_flag("--quick", a->quick,
-              "A short run for the test suite: fused, haar, table; 1 and 2 clients; 32×32; level 4; 2 s per run "
-              "(flags given explicitly win)");
+  char quick[200];
+  std::snprintf(quick, sizeof quick,
+                "A short run for the test suite: --methods %s --clients %s --sizes %s --level %d --seconds %g "
+                "(flags given explicitly win)",
+                kQuickMethods, kQuickClients, kQuickSizes, kQuickLevel, kQuickSeconds);
+  c->add_flag("--quick", a->quick, quick);
   return [c, a, methods, clients, sizes, seconds, level]() {
     if (!c->parsed()) return -1;
     if (a->quick) {
-      if (methods->count() == 0) a->methods = "fused,haar,table";
-      if (clients->count() == 0) a->clients = "1,2";
-      if (sizes->count() == 0) a->sizes = "32";
-      if (seconds->count() == 0) a->seconds = 2.0;
-      if (level->count() == 0) a->level = 4;
+      if (methods->count() == 0) a->methods = kQuickMethods;
+      if (clients->count() == 0) a->clients = kQuickClients;
+      if (sizes->count() == 0) a->sizes = kQuickSizes;
+      if (seconds->count() == 0) a->seconds = kQuickSeconds;
+      if (level->count() == 0) a->level = kQuickLevel;
     }
     return run(*a);
   };
