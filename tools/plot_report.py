@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
-"""Draws the figures of `haarcast eval` from its report.json, with matplotlib.
+"""Draws the figures of `haarcast eval` and `haarcast loadtest` from their
+report.json, with matplotlib.
 
     python3 tools/plot_report.py eval/report.json [--out DIR]
+    python3 tools/plot_report.py build/loadtest/report.json [--out DIR]
 
 `haarcast eval` runs this itself when python3 has matplotlib (Debian:
 `apt-get install python3-matplotlib`). It writes, beside report.json or into
@@ -16,6 +18,13 @@ DIR, the files that report.json names:
       The glossiness tiles (glossiness.tiles, one PNG per material and light
       coefficient count, written by eval) laid out in a labelled grid.
 
+A loadtest report ("kind": "loadtest") gets the three files it lists under
+"figures": loadtest_bandwidth.png (Mbit/s per client against clients, a line
+per method), loadtest_fps.png (fps per client against clients: the median,
+bars from the slowest to the fastest client) and loadtest_storage.png (stored
+bytes per method on a logarithmic axis, at the runs' level and at the
+storage level, with the PRT downloads).
+
 Headless: matplotlib's Agg backend, no display needed. Exit status 0 when
 drawn, 2 for a bad report (the message names what is wrong), 3 when
 matplotlib is missing.
@@ -29,6 +38,7 @@ import sys
 
 DPI = 100
 MSE_SIZE_IN = (12.0, 5.0)      # one (level, material) figure: 1200×500 px
+LOADTEST_SIZE_IN = (8.0, 5.0)  # each loadtest figure: 800×500 px
 TILE_IN = 2.0                  # a glossiness tile is drawn 200 px wide …
 TILE_GAP_IN = 0.1              # … 10 px apart
 SHEET_MARGINS_IN = {"left": 0.9, "right": 0.15, "top": 0.75, "bottom": 0.15}
@@ -197,9 +207,118 @@ def glossiness_figure(plt, report, base_dir):
     return fig
 
 
+def loadtest_series(report):
+    """{label: [(clients, run), …] sorted by clients}: a line per method, size and encoding."""
+    runs = need(report, "runs")
+    if not runs:
+        raise ReportError("report.json: runs is empty")
+    keys = {(r["width"], r["height"], r["encoding"]) for r in runs}
+    series = {}
+    for r in runs:
+        label = need(r, "method")
+        if len(keys) > 1:  # name the size and encoding only when they vary
+            label += " %d×%d %s" % (r["width"], r["height"], r["encoding"])
+        series.setdefault(label, []).append((need(r, "clients"), r))
+    return {label: sorted(points, key=lambda p: p[0]) for label, points in series.items()}
+
+
+def clients_axis(ax, report):
+    counts = sorted({r["clients"] for r in report["runs"]})
+    ax.set_xscale("log", base=2)
+    ax.set_xticks(counts)
+    ax.set_xticklabels([str(c) for c in counts])
+    ax.minorticks_off()
+    ax.set_xlabel("clients at once")
+    ax.grid(color="#dddddd", linewidth=0.6)
+    ax.set_axisbelow(True)
+
+
+def loadtest_subtitle(report):
+    return "level %s, %s s per run, load average %s at the start" % (
+        report.get("level", "?"), report.get("seconds_per_run", "?"),
+        report.get("machine", {}).get("load_average_at_start", "?"))
+
+
+def bandwidth_figure(plt, report):
+    fig, ax = plt.subplots(figsize=LOADTEST_SIZE_IN, dpi=DPI)
+    for i, (label, points) in enumerate(sorted(loadtest_series(report).items())):
+        xs = [c for c, _ in points]
+        ys = [need(r, "bits_per_second_per_client") / 1e6 for _, r in points]
+        ax.plot(xs, ys, marker="o", color=COLOURS[i % len(COLOURS)], label=label)
+    clients_axis(ax, report)
+    ax.set_ylim(bottom=0)
+    ax.set_ylabel("Mbit/s per client (Frame messages)")
+    ax.set_title("Bandwidth per client against clients\n" + loadtest_subtitle(report), fontsize=11)
+    ax.legend(title="method", frameon=False)
+    fig.tight_layout()
+    return fig
+
+
+def fps_figure(plt, report):
+    fig, ax = plt.subplots(figsize=LOADTEST_SIZE_IN, dpi=DPI)
+    top = 0.0
+    for i, (label, points) in enumerate(sorted(loadtest_series(report).items())):
+        xs = [c for c, _ in points]
+        fps = [need(r, "fps_per_client") for _, r in points]
+        top = max([top] + [need(f, "max") for f in fps])
+        median = [need(f, "median") for f in fps]
+        below = [m - need(f, "min") for m, f in zip(median, fps)]
+        above = [need(f, "max") - m for m, f in zip(median, fps)]
+        ax.errorbar(xs, median, yerr=[below, above], marker="o", capsize=3, color=COLOURS[i % len(COLOURS)],
+                    label=label)
+    clients_axis(ax, report)
+    ax.set_ylim(0, top * 1.15 if top > 0 else 1.0)  # room above the fastest client's bar
+    ax.set_ylabel("frames per second per client\n(median; bars: slowest to fastest client)")
+    ax.set_title("Frame rate per client against clients\n" + loadtest_subtitle(report), fontsize=11)
+    ax.legend(title="method", frameon=False)
+    fig.tight_layout()
+    return fig
+
+
+def storage_figure(plt, report):
+    """Bars per method at the runs' level and at the storage level; the PRT downloads as lines."""
+    storage = need(report, "storage")
+    at_run = need(report, "storage_at_run_level")
+    methods = sorted(set(need(storage, "stored_bytes")) | set(need(at_run, "stored_bytes")))
+    fig, ax = plt.subplots(figsize=LOADTEST_SIZE_IN, dpi=DPI)
+    width = 0.38
+    for k, (s, offset) in enumerate([(at_run, -width / 2), (storage, width / 2)]):
+        xs = [m + offset for m, name in enumerate(methods) if name in s["stored_bytes"]]
+        ys = [s["stored_bytes"][name] for name in methods if name in s["stored_bytes"]]
+        ax.bar(xs, ys, width=width * 0.92, color=COLOURS[k], edgecolor="black", linewidth=0.3,
+               label="stored bytes, level %d" % need(s, "level"))
+    for k, (name, b) in enumerate(sorted(report.get("prt_baseline", {}).items())):
+        ax.axhline(need(b, "bytes"), color=COLOURS[4 + k], linestyle="--", linewidth=1.2,
+                   label="PRT download with %s, level %d (%.0f s of the fastest stream)"
+                   % (name, b.get("level", 0), b.get("break_even_seconds", 0)))
+    ax.set_yscale("log")
+    ax.set_xticks(range(len(methods)))
+    ax.set_xticklabels(methods)
+    ax.set_xlabel("method")
+    ax.set_ylabel("bytes (log scale)")
+    ax.grid(axis="y", color="#dddddd", linewidth=0.6)
+    ax.set_axisbelow(True)
+    ax.set_title("BRDF coefficient data each method holds, and the PRT downloads", fontsize=11)
+    ax.legend(frameon=False, fontsize=8, loc="upper left")
+    fig.tight_layout()
+    return fig
+
+
+def loadtest_figures(plt, report):
+    """(file name, figure) for each figure a loadtest report lists."""
+    drawers = {"loadtest_bandwidth.png": bandwidth_figure, "loadtest_fps.png": fps_figure,
+               "loadtest_storage.png": storage_figure}
+    for name in need(report, "figures"):
+        if name not in drawers:
+            raise ReportError("report.json names the figure %s, which this script does not draw (it draws %s)"
+                              % (name, ", ".join(sorted(drawers))))
+        yield name, drawers[name](plt, report)
+
+
 def main(argv):
-    parser = argparse.ArgumentParser(description="Draw the figures of haarcast eval's report.json (matplotlib).")
-    parser.add_argument("report", help="report.json written by `haarcast eval`")
+    parser = argparse.ArgumentParser(
+        description="Draw the figures of haarcast eval's or loadtest's report.json (matplotlib).")
+    parser.add_argument("report", help="report.json written by `haarcast eval` or `haarcast loadtest`")
     parser.add_argument("--out", help="folder for the PNGs (default: report.json's)")
     args = parser.parse_args(argv)
 
@@ -216,7 +335,8 @@ def main(argv):
 
     written = []
     try:
-        for name, fig in mse_figures(plt, report):
+        figures = loadtest_figures(plt, report) if report.get("kind") == "loadtest" else mse_figures(plt, report)
+        for name, fig in figures:
             fig.savefig(os.path.join(out_dir, name), dpi=DPI)
             plt.close(fig)
             written.append(name)

@@ -10,6 +10,7 @@
 
 #include "bench_frame_command.h"
 #include "eval.h"
+#include "loadtest_command.h"
 #include "progress.h"
 #include "reference_command.h"
 #include "render_command.h"
@@ -93,6 +94,7 @@ int main(int argc, char** argv) {
   const auto runEval = haarcast::app::addEvalCommand(app);
   const auto runBenchFrame = haarcast::app::addBenchFrameCommand(app);
   const auto runServe = haarcast::app::addServeCommand(app);
+  const auto runLoadtest = haarcast::app::addLoadtestCommand(app);
 
   if (const auto unknown = unknownCommand(app, argc, argv)) {
     std::fprintf(stderr, "haarcast: error: %s\n", unknown->c_str());
@@ -105,6 +107,7 @@ int main(int argc, char** argv) {
     if (const int rc = runEval(); rc >= 0) return rc;
     if (const int rc = runBenchFrame(); rc >= 0) return rc;
     if (const int rc = runServe(); rc >= 0) return rc;
+    if (const int rc = runLoadtest(); rc >= 0) return rc;
     if (rr->parsed()) {
       const auto v = haarcast::parseHaarVariant(variant);
       if (!v) throw std::invalid_argument("--haar-variant must be faithful, local or refined (got \"" + variant + "\")");
