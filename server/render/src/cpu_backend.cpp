@@ -56,8 +56,15 @@ class CpuRenderer final : public Renderer {
         pixelSlices_.push_back(PixelSlices::synthesize(p.table));
         continue;
       }
+      // matrix and table precompute per channel for seconds at level 6
+      // (elevation matrices, pre-rotated copies): reported as a stage.
+      const std::string stage = "rotators " + p.name;
       std::array<std::unique_ptr<SliceRotator>, 3> r;
-      for (int c = 0; c < 3; ++c) r[static_cast<std::size_t>(c)] = makeRotator(options.method, p.table.channelSlices(c), options.rotator);
+      for (std::size_t c = 0; c < r.size(); ++c) {
+        if (progress) progress(stage, c, r.size());
+        r[c] = makeRotator(options.method, p.table.channelSlices(static_cast<int>(c)), options.rotator);
+      }
+      if (progress) progress(stage, r.size(), r.size());
       rotators_.push_back(std::move(r));
       // haar refined rotates the three channels together, sharing the
       // geometry and the cell walk (rotate_haar.h).
