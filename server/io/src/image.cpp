@@ -13,6 +13,7 @@
 #include <memory>
 #include <sstream>
 #include <stdexcept>
+#include <system_error>
 
 #include <ImfArray.h>
 #include <ImfChannelList.h>
@@ -21,6 +22,7 @@
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
 #include <ImfRgbaFile.h>
+#include <ImfTileDescription.h>
 #include <png.h>
 
 namespace haarcast::io {
@@ -54,6 +56,19 @@ void checkImage(const std::string& path, const RgbImage& image) {
     throw std::invalid_argument(path + ": cannot write a " + sizeText(image.width, image.height) +
                                 " image holding " + std::to_string(image.rgb.size()) + " floats");
   }
+}
+
+// Makes room for `more` floats at the end of `pixels`, whose final size is
+// `total`: capacity doubles (never past `total`), so a reader that grows the
+// image with the data it has decoded allocates at most twice what the file
+// has delivered, and exactly `total` once it is all there. A header alone
+// never sizes the pixels: old-style Radiance runs let 12 bytes stand for a
+// 32768-pixel scanline and a ZIP'd EXR chunk can hold thousands of pixels a
+// byte, so only the decoded data bounds the image by the file.
+void growPixels(std::vector<float>& pixels, std::size_t more, std::size_t total) {
+  const std::size_t needed = pixels.size() + more;
+  if (needed > pixels.capacity()) pixels.reserve(std::min(total, std::max(needed, 2 * pixels.capacity())));
+  pixels.resize(needed);
 }
 
 std::vector<std::uint8_t> readFileBytes(const std::string& path) {
@@ -182,6 +197,17 @@ void readRgbeScanline(const std::string& path, ByteCursor& c, int width, int lin
   }
 }
 
+// The fewest bytes a scanline of `width` pixels can take: a flat pixel (4),
+// then old-style run escapes of up to 255 << 0, 255 << 8, 255 << 16 copies
+// (4 bytes each). New-style runs never do better (a 4-byte marker, then 2
+// bytes per run of ≤ 127 per channel: 12 bytes at least for width ≥ 8).
+std::size_t minRgbeScanlineBytes(long long width) {
+  if (width <= 1) return 4;
+  if (width <= 1 + 255) return 8;
+  if (width <= 1 + 255 + (255 << 8)) return 12;
+  return 16;
+}
+
 // ---------------------------------------------------------------- PFM
 // The PFM format (Paul Debevec's HDRShop notes, also netpbm's pfm(5)): "PF"
 // or "Pf", width, height, scale as ASCII separated by whitespace, exactly one
@@ -201,6 +227,60 @@ bool parseInteger(const std::string& token, long long& value) {
   char* endp = nullptr;
   value = std::strtoll(token.c_str(), &endp, 10);
   return endp == token.c_str() + token.size();
+}
+
+// ---------------------------------------------------------------- OpenEXR
+
+// Rows read per band: a multiple of every compression's chunk height
+// (exrLinesPerChunk), so that no chunk is decoded twice.
+constexpr int kExrBandRows = 256;
+
+// Scanlines per chunk for each compression (OpenEXR "Technical Introduction",
+// the table of compression methods; ImfCompressor.cpp's numScanLines).
+int exrLinesPerChunk(Imf::Compression compression) {
+  switch (compression) {
+    case Imf::ZIP_COMPRESSION:
+    case Imf::PXR24_COMPRESSION:
+      return 16;
+    case Imf::PIZ_COMPRESSION:
+    case Imf::B44_COMPRESSION:
+    case Imf::B44A_COMPRESSION:
+    case Imf::DWAA_COMPRESSION:
+      return 32;
+    case Imf::DWAB_COMPRESSION:
+      return 256;
+    default:  // none, RLE, ZIPS
+      return 1;
+  }
+}
+
+// Every chunk of a file has an 8-byte entry in the offset table and, in the
+// chunk itself, at least its coordinates and data size (8 bytes for a
+// scanline chunk, 20 for a tile: OpenEXR "File Layout"). A data window
+// promising more chunks than the file has bytes for is refused before any
+// pixel is allocated.
+void checkExrChunksFit(const std::string& path, const Imf::Header& header, long long width, long long height) {
+  std::error_code ec;
+  const std::uintmax_t fileBytes = std::filesystem::file_size(path, ec);
+  if (ec) fail(path, "cannot read its size: " + ec.message());
+  unsigned long long chunks = 0;
+  std::size_t chunkBytes = 0;
+  if (header.hasTileDescription()) {
+    const Imf::TileDescription& tiles = header.tileDescription();
+    const unsigned long long tw = std::max(1u, tiles.xSize), th = std::max(1u, tiles.ySize);
+    chunks = ((static_cast<unsigned long long>(width) + tw - 1) / tw) *
+             ((static_cast<unsigned long long>(height) + th - 1) / th);
+    chunkBytes = 8 + 20;
+  } else {
+    const auto lines = static_cast<unsigned long long>(exrLinesPerChunk(header.compression()));
+    chunks = (static_cast<unsigned long long>(height) + lines - 1) / lines;
+    chunkBytes = 8 + 8;
+  }
+  if (chunks > fileBytes / chunkBytes) {
+    fail(path, "truncated file: a " + sizeText(width, height) + " data window needs " + std::to_string(chunks) +
+                   " chunks of at least " + std::to_string(chunkBytes) + " bytes each, and the file has " +
+                   std::to_string(fileBytes) + " bytes");
+  }
 }
 
 }  // namespace
@@ -242,6 +322,15 @@ RgbImage readExr(const std::string& path) {
       fail(path, "not an OpenEXR file (bad magic number)");
     }
   }
+  // OpenEXR sizes its offset table and line buffers from the header's data
+  // window while it opens the file; with these limits set it refuses an
+  // absurd window before allocating for it (Imf::Header::sanityCheck).
+  static const bool limitsSet = [] {
+    Imf::Header::setMaxImageSize(kMaxImageDimension, kMaxImageDimension);
+    Imf::Header::setMaxTileSize(kMaxImageDimension, kMaxImageDimension);
+    return true;
+  }();
+  (void)limitsSet;
   std::unique_ptr<Imf::InputFile> file;
   try {
     file = std::make_unique<Imf::InputFile>(path.c_str());
@@ -252,6 +341,7 @@ RgbImage readExr(const std::string& path) {
   const long long width = static_cast<long long>(dw.max.x) - dw.min.x + 1;
   const long long height = static_cast<long long>(dw.max.y) - dw.min.y + 1;
   checkFileDimensions(path, width, height);
+  checkExrChunksFit(path, file->header(), width, height);
 
   const Imf::ChannelList& channels = file->header().channels();
   const auto full = [&](const char* name) {
@@ -271,21 +361,35 @@ RgbImage readExr(const std::string& path) {
                    "; expected R, G, B, or Y alone, or Y, RY, BY)");
   }
 
-  RgbImage image = makeImage(static_cast<int>(width), static_cast<int>(height));
+  // Read a band of rows at a time, the image growing with each (growPixels):
+  // a file whose chunks are missing or corrupt fails having allocated no
+  // more than it delivered.
+  RgbImage image;
+  image.width = static_cast<int>(width);
+  image.height = static_cast<int>(height);
+  const std::size_t rowFloats = static_cast<std::size_t>(width) * 3;
+  const std::size_t totalFloats = rowFloats * static_cast<std::size_t>(height);
   try {
     if (lumaChroma) {
       // Subsampled luminance-chroma needs OpenEXR's own reconstruction, which
       // the RGBA interface does (in half precision, the precision such files have).
       file.reset();
       Imf::RgbaInputFile rgbaFile(path.c_str());
-      Imf::Array2D<Imf::Rgba> pixels(height, width);
-      rgbaFile.setFrameBuffer(Imf::ComputeBasePointer(&pixels[0][0], dw), 1, static_cast<std::size_t>(width));
-      rgbaFile.readPixels(dw.min.y, dw.max.y);
-      for (int y = 0; y < image.height; ++y) {
-        for (int x = 0; x < image.width; ++x) {
-          image.at(y, x, 0) = pixels[y][x].r;
-          image.at(y, x, 1) = pixels[y][x].g;
-          image.at(y, x, 2) = pixels[y][x].b;
+      Imf::Array2D<Imf::Rgba> band(kExrBandRows, width);
+      for (int y0 = dw.min.y; y0 <= dw.max.y; y0 += kExrBandRows) {
+        const int y1 = std::min(dw.max.y, y0 + kExrBandRows - 1);
+        const Imath::Box2i bandWindow(Imath::V2i(dw.min.x, y0), Imath::V2i(dw.max.x, y1));
+        rgbaFile.setFrameBuffer(Imf::ComputeBasePointer(&band[0][0], bandWindow), 1, static_cast<std::size_t>(width));
+        rgbaFile.readPixels(y0, y1);
+        growPixels(image.rgb, rowFloats * static_cast<std::size_t>(y1 - y0 + 1), totalFloats);
+        for (int y = y0; y <= y1; ++y) {
+          for (int x = 0; x < image.width; ++x) {
+            const Imf::Rgba& px = band[y - y0][x];
+            float* out = &image.rgb[image.index(y - dw.min.y, x)];
+            out[0] = px.r;
+            out[1] = px.g;
+            out[2] = px.b;
+          }
         }
       }
       return image;
@@ -293,16 +397,22 @@ RgbImage readExr(const std::string& path) {
     // OpenEXR converts half and uint channels to the FLOAT slices we ask for.
     const std::size_t xStride = 3 * sizeof(float);
     const std::size_t yStride = xStride * static_cast<std::size_t>(width);
-    Imf::FrameBuffer fb;
-    if (rgb) {
-      fb.insert("R", Imf::Slice::Make(Imf::FLOAT, image.rgb.data() + 0, dw, xStride, yStride));
-      fb.insert("G", Imf::Slice::Make(Imf::FLOAT, image.rgb.data() + 1, dw, xStride, yStride));
-      fb.insert("B", Imf::Slice::Make(Imf::FLOAT, image.rgb.data() + 2, dw, xStride, yStride));
-    } else {
-      fb.insert("Y", Imf::Slice::Make(Imf::FLOAT, image.rgb.data(), dw, xStride, yStride));
+    for (int y0 = dw.min.y; y0 <= dw.max.y; y0 += kExrBandRows) {
+      const int y1 = std::min(dw.max.y, y0 + kExrBandRows - 1);
+      growPixels(image.rgb, rowFloats * static_cast<std::size_t>(y1 - y0 + 1), totalFloats);
+      float* first = &image.rgb[image.index(y0 - dw.min.y, 0)];
+      const Imath::Box2i bandWindow(Imath::V2i(dw.min.x, y0), Imath::V2i(dw.max.x, y1));
+      Imf::FrameBuffer fb;
+      if (rgb) {
+        fb.insert("R", Imf::Slice::Make(Imf::FLOAT, first + 0, bandWindow, xStride, yStride));
+        fb.insert("G", Imf::Slice::Make(Imf::FLOAT, first + 1, bandWindow, xStride, yStride));
+        fb.insert("B", Imf::Slice::Make(Imf::FLOAT, first + 2, bandWindow, xStride, yStride));
+      } else {
+        fb.insert("Y", Imf::Slice::Make(Imf::FLOAT, first, bandWindow, xStride, yStride));
+      }
+      file->setFrameBuffer(fb);
+      file->readPixels(y0, y1);
     }
-    file->setFrameBuffer(fb);
-    file->readPixels(dw.min.y, dw.max.y);
   } catch (const std::exception& e) {
     fail(path, std::string("cannot read OpenEXR pixels (truncated or corrupt file?): ") + e.what());
   }
@@ -384,26 +494,39 @@ RgbImage readRadianceHdr(const std::string& path) {
     fail(path, "unsupported resolution line \"" + line + "\" (expected -Y h +X w, or its flips)");
   }
   checkFileDimensions(path, width, height);
-  // Every scanline takes at least 4 bytes (one pixel) and, for width > 1, at
-  // least 8 (a pixel and a run escape, or the new-style marker and runs): a
-  // header promising more rows than the file can hold is refused before allocating.
-  const std::size_t minScanline = width > 1 ? 8 : 4;
+  // A header promising more scanlines than the rest of the file can hold is
+  // refused before anything is allocated for them.
+  const std::size_t minScanline = minRgbeScanlineBytes(width);
   if (c.left() / minScanline < static_cast<std::size_t>(height)) {
-    fail(path, "truncated file: " + std::to_string(c.left()) + " bytes of pixel data cannot hold " +
-                   std::to_string(height) + " scanlines");
+    fail(path, "truncated file: " + std::to_string(height) + " scanlines of " + std::to_string(width) +
+                   " pixels need at least " + std::to_string(static_cast<std::size_t>(height) * minScanline) +
+                   " bytes, and " + std::to_string(c.left()) + " bytes of pixel data remain");
   }
 
-  RgbImage image = makeImage(static_cast<int>(width), static_cast<int>(height));
+  // The pixels grow with the decoded scanlines (growPixels), in file order;
+  // a "+Y" file's rows are put top-down at the end.
+  RgbImage image;
+  image.width = static_cast<int>(width);
+  image.height = static_cast<int>(height);
+  const std::size_t rowFloats = static_cast<std::size_t>(width) * 3;
+  const std::size_t totalFloats = rowFloats * static_cast<std::size_t>(height);
   const bool bottomUp = yAxis == "+Y";
   const bool rightToLeft = xAxis == "-X";
   std::vector<std::uint8_t> scan(static_cast<std::size_t>(width) * 4);
   const double scale = 1.0 / exposure;
   for (int line_i = 0; line_i < image.height; ++line_i) {
     readRgbeScanline(path, c, image.width, line_i, image.height, scan);
-    const int row = bottomUp ? image.height - 1 - line_i : line_i;
+    growPixels(image.rgb, rowFloats, totalFloats);
     for (int x = 0; x < image.width; ++x) {
       const int col = rightToLeft ? image.width - 1 - x : x;
-      rgbeToFloat(&scan[static_cast<std::size_t>(x) * 4], scale, &image.rgb[image.index(row, col)]);
+      rgbeToFloat(&scan[static_cast<std::size_t>(x) * 4], scale, &image.rgb[image.index(line_i, col)]);
+    }
+  }
+  if (bottomUp) {
+    for (int top = 0, bottom = image.height - 1; top < bottom; ++top, --bottom) {
+      std::swap_ranges(image.rgb.begin() + static_cast<std::ptrdiff_t>(image.index(top, 0)),
+                       image.rgb.begin() + static_cast<std::ptrdiff_t>(image.index(top, 0) + rowFloats),
+                       image.rgb.begin() + static_cast<std::ptrdiff_t>(image.index(bottom, 0)));
     }
   }
   return image;
@@ -436,8 +559,9 @@ RgbImage readPfm(const std::string& path) {
   const std::size_t count = static_cast<std::size_t>(width) * static_cast<std::size_t>(height) *
                             static_cast<std::size_t>(channels);
   if (c.left() / sizeof(float) < count) {
-    fail(path, "truncated pixel data: expected " + std::to_string(count * sizeof(float)) + " bytes, found " +
-                   std::to_string(c.left()));
+    fail(path, "truncated pixel data: " + sizeText(width, height) + " pixels of " + std::to_string(channels) +
+                   " floats need " + std::to_string(count * sizeof(float)) + " bytes, and " +
+                   std::to_string(c.left()) + " bytes remain");
   }
   const bool fileLittle = scale < 0.0;
   const bool swap = fileLittle != (std::endian::native == std::endian::little);
