@@ -231,9 +231,9 @@ bool parseInteger(const std::string& token, long long& value) {
 
 // ---------------------------------------------------------------- OpenEXR
 
-// Rows read per band: a multiple of every compression's chunk height
-// (exrLinesPerChunk), so that no chunk is decoded twice.
-constexpr int kExrBandRows = 256;
+// A band of rows holds about this many bytes of float RGB (at least one
+// chunk's rows), so that the image grows in steps the file has delivered.
+constexpr std::size_t kExrBandBytes = std::size_t{8} << 20;
 
 // Scanlines per chunk for each compression (OpenEXR "Technical Introduction",
 // the table of compression methods; ImfCompressor.cpp's numScanLines).
@@ -369,22 +369,30 @@ RgbImage readExr(const std::string& path) {
   image.height = static_cast<int>(height);
   const std::size_t rowFloats = static_cast<std::size_t>(width) * 3;
   const std::size_t totalFloats = rowFloats * static_cast<std::size_t>(height);
+  // Whole chunks per band, so that no chunk is decoded twice.
+  const int chunkRows = file->header().hasTileDescription()
+                            ? static_cast<int>(std::max(1u, file->header().tileDescription().ySize))
+                            : exrLinesPerChunk(file->header().compression());
+  const std::size_t chunkBytes = rowFloats * sizeof(float) * static_cast<std::size_t>(chunkRows);
+  const int bandRows = static_cast<int>(std::min<long long>(
+      height, chunkRows * static_cast<long long>(std::max<std::size_t>(1, kExrBandBytes / chunkBytes))));
   try {
     if (lumaChroma) {
       // Subsampled luminance-chroma needs OpenEXR's own reconstruction, which
       // the RGBA interface does (in half precision, the precision such files have).
       file.reset();
       Imf::RgbaInputFile rgbaFile(path.c_str());
-      Imf::Array2D<Imf::Rgba> band(kExrBandRows, width);
-      for (int y0 = dw.min.y; y0 <= dw.max.y; y0 += kExrBandRows) {
-        const int y1 = std::min(dw.max.y, y0 + kExrBandRows - 1);
-        const Imath::Box2i bandWindow(Imath::V2i(dw.min.x, y0), Imath::V2i(dw.max.x, y1));
+      Imf::Array2D<Imf::Rgba> band(bandRows, width);
+      for (long long y0 = dw.min.y; y0 <= dw.max.y; y0 += bandRows) {
+        const int top = static_cast<int>(y0);
+        const int y1 = static_cast<int>(std::min<long long>(dw.max.y, y0 + bandRows - 1));
+        const Imath::Box2i bandWindow(Imath::V2i(dw.min.x, top), Imath::V2i(dw.max.x, y1));
         rgbaFile.setFrameBuffer(Imf::ComputeBasePointer(&band[0][0], bandWindow), 1, static_cast<std::size_t>(width));
-        rgbaFile.readPixels(y0, y1);
-        growPixels(image.rgb, rowFloats * static_cast<std::size_t>(y1 - y0 + 1), totalFloats);
-        for (int y = y0; y <= y1; ++y) {
+        rgbaFile.readPixels(top, y1);
+        growPixels(image.rgb, rowFloats * static_cast<std::size_t>(y1 - top + 1), totalFloats);
+        for (int y = top; y <= y1; ++y) {
           for (int x = 0; x < image.width; ++x) {
-            const Imf::Rgba& px = band[y - y0][x];
+            const Imf::Rgba& px = band[y - top][x];
             float* out = &image.rgb[image.index(y - dw.min.y, x)];
             out[0] = px.r;
             out[1] = px.g;
@@ -397,11 +405,13 @@ RgbImage readExr(const std::string& path) {
     // OpenEXR converts half and uint channels to the FLOAT slices we ask for.
     const std::size_t xStride = 3 * sizeof(float);
     const std::size_t yStride = xStride * static_cast<std::size_t>(width);
-    for (int y0 = dw.min.y; y0 <= dw.max.y; y0 += kExrBandRows) {
-      const int y1 = std::min(dw.max.y, y0 + kExrBandRows - 1);
-      growPixels(image.rgb, rowFloats * static_cast<std::size_t>(y1 - y0 + 1), totalFloats);
-      float* first = &image.rgb[image.index(y0 - dw.min.y, 0)];
-      const Imath::Box2i bandWindow(Imath::V2i(dw.min.x, y0), Imath::V2i(dw.max.x, y1));
+    // y0 in long long: a data window may end at INT_MAX.
+    for (long long y0 = dw.min.y; y0 <= dw.max.y; y0 += bandRows) {
+      const int top = static_cast<int>(y0);
+      const int y1 = static_cast<int>(std::min<long long>(dw.max.y, y0 + bandRows - 1));
+      growPixels(image.rgb, rowFloats * static_cast<std::size_t>(y1 - top + 1), totalFloats);
+      float* first = &image.rgb[image.index(top - dw.min.y, 0)];
+      const Imath::Box2i bandWindow(Imath::V2i(dw.min.x, top), Imath::V2i(dw.max.x, y1));
       Imf::FrameBuffer fb;
       if (rgb) {
         fb.insert("R", Imf::Slice::Make(Imf::FLOAT, first + 0, bandWindow, xStride, yStride));
@@ -411,7 +421,7 @@ RgbImage readExr(const std::string& path) {
         fb.insert("Y", Imf::Slice::Make(Imf::FLOAT, first, bandWindow, xStride, yStride));
       }
       file->setFrameBuffer(fb);
-      file->readPixels(y0, y1);
+      file->readPixels(top, y1);
     }
   } catch (const std::exception& e) {
     fail(path, std::string("cannot read OpenEXR pixels (truncated or corrupt file?): ") + e.what());
