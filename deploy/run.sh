@@ -7,6 +7,10 @@
 #                                 the CLI client against the server for a few seconds
 #                                 (on a terminal the server keeps running until Ctrl-C)
 #   deploy/run.sh test  [args]   ctest --test-dir build --output-on-failure [args]
+#   deploy/run.sh test --sanitize  the fast unit tests (core, io, render, net) built with
+#                                 ASan + UBSan into build-sanitize/ (no GPU, no end-to-end)
+#   deploy/run.sh fuzz [--seconds N]  deploy/fuzz.sh: builds the libFuzzer targets (clang)
+#                                 into build-fuzz/ and runs each N seconds (default 20)
 #   deploy/run.sh bench [args]   the speed table (bench-frame, fused: 128², 256², 512² at
 #                                 levels 4-6, fps per backend), then build/bin/haarcast-bench [args]
 #                                 e.g. deploy/run.sh bench -- --benchmark_filter=Rotate
@@ -113,7 +117,7 @@ command="$1"
 shift
 [[ "${1:-}" == "--" ]] && shift
 case "$command" in
-  demo | test | bench | build) ;;
+  demo | test | bench | build | fuzz) ;;
   -h | --help | help) usage ;;
   *)
     echo "error: unknown command '$command'" >&2
@@ -139,7 +143,35 @@ vendor_web_client() {
   touch "$web/node_modules"
 }
 
+# The fast unit tests under AddressSanitizer and UBSan (undefined behaviour
+# fatal), in a build folder of their own; the GPU and end-to-end tests are
+# left to the ordinary build.
+SANITIZE_TESTS=(haarcast_core_tests haarcast_io_tests haarcast_render_tests haarcast_net_tests)
+sanitized_tests() {
+  local dir=build-sanitize jobs="${HAARCAST_JOBS:-$(nproc)}" launcher=() failed=0 t
+  command -v ccache >/dev/null 2>&1 && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+  log "configuring $dir/ (ASan + UBSan)"
+  cmake -S . -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DHAARCAST_SANITIZE=ON \
+    -DHAARCAST_BUILD_BENCHMARKS=OFF "${launcher[@]}" </dev/null
+  log "building ${SANITIZE_TESTS[*]} with $jobs jobs"
+  ninja -C "$dir" -j "$jobs" "${SANITIZE_TESTS[@]}" </dev/null
+  for t in "${SANITIZE_TESTS[@]}"; do
+    log "running $t"
+    ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
+      "$dir/bin/$t" "$@" </dev/null || failed=1
+  done
+  return "$failed"
+}
+
 install_packages
+if [[ "$command" == fuzz ]]; then
+  exec deploy/fuzz.sh "$@"
+fi
+if [[ "$command" == test && "${1:-}" == --sanitize ]]; then
+  shift
+  sanitized_tests "$@"
+  exit
+fi
 configure_and_build
 vendor_web_client
 
