@@ -7,6 +7,10 @@
 #                                 the CLI client against the server for a few seconds
 #                                 (on a terminal the server keeps running until Ctrl-C)
 #   deploy/run.sh test  [args]   ctest --test-dir build --output-on-failure [args]
+#   deploy/run.sh test --sanitize  the fast unit tests (core, io, render, net) built with
+#                                 ASan + UBSan (clang) into build-sanitize/ (no GPU, no end-to-end)
+#   deploy/run.sh fuzz [--seconds N]  deploy/fuzz.sh: builds the libFuzzer targets (clang)
+#                                 into build-sanitize/ and runs each N seconds (default 20)
 #   deploy/run.sh bench [args]   the speed table (bench-frame, fused: 128², 256², 512² at
 #                                 levels 4-6, fps per backend), then build/bin/haarcast-bench [args]
 #                                 e.g. deploy/run.sh bench -- --benchmark_filter=Rotate
@@ -95,6 +99,9 @@ TEST_PACKAGES=(
   python3-matplotlib
   python3-yaml
   kubernetes-client
+  # deploy/fuzz.sh: libFuzzer targets built with clang.
+  clang
+  libfuzzer-14-dev
 )
 
 # Build folder, relative to the repository root (HAARCAST_BUILD_DIR overrides).
@@ -174,7 +181,7 @@ command="$1"
 shift
 [[ "${1:-}" == "--" ]] && shift
 case "$command" in
-  demo | test | bench | build | install | packages) ;;
+  demo | test | bench | build | fuzz | install | packages) ;;
   -h | --help | help) usage ;;
   *)
     echo "error: unknown command '$command'" >&2
@@ -211,9 +218,33 @@ case "$command" in
     install_packages "$@"
     exit 0
     ;;
-  test) install_packages build runtime test ;;
+  test | fuzz) install_packages build runtime test ;;
   *) install_packages build runtime ;;
 esac
+
+# The fast unit tests under AddressSanitizer and UBSan (undefined behaviour
+# fatal), in a build folder of their own; the GPU and end-to-end tests are
+# left to the ordinary build.
+SANITIZE_TESTS=(haarcast_core_tests haarcast_io_tests haarcast_render_tests haarcast_net_tests)
+sanitized_tests() {
+  local dir="${HAARCAST_SANITIZE_DIR:-build-sanitize}" failed=0 t
+  deploy/sanitize_build.sh "${SANITIZE_TESTS[@]}"
+  for t in "${SANITIZE_TESTS[@]}"; do
+    log "running $t (ASan + UBSan)"
+    ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
+      "$dir/bin/$t" "$@" </dev/null || failed=1
+  done
+  return "$failed"
+}
+
+if [[ "$command" == fuzz ]]; then
+  exec deploy/fuzz.sh "$@"
+fi
+if [[ "$command" == test && "${1:-}" == --sanitize ]]; then
+  shift
+  sanitized_tests "$@"
+  exit
+fi
 configure_and_build
 vendor_web_client
 

@@ -13,6 +13,7 @@
 #include <memory>
 #include <sstream>
 #include <stdexcept>
+#include <system_error>
 
 #include <ImfArray.h>
 #include <ImfChannelList.h>
@@ -21,165 +22,27 @@
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
 #include <ImfRgbaFile.h>
+#include <ImfTileDescription.h>
 #include <png.h>
+
+#include "image_common.h"
 
 namespace haarcast::io {
 namespace {
 
-[[noreturn]] void fail(const std::string& path, const std::string& what) {
-  throw std::runtime_error(path + ": " + what);
-}
-
-std::string sizeText(long long width, long long height) {
-  return std::to_string(width) + "x" + std::to_string(height);
-}
-
-// The one size check of every reader, done before any pixel is allocated.
-void checkFileDimensions(const std::string& path, long long width, long long height) {
-  if (width <= 0 || height <= 0 || width > kMaxImageDimension || height > kMaxImageDimension) {
-    fail(path, "bad dimensions " + sizeText(width, height) + " (each must be in [1, " +
-                   std::to_string(kMaxImageDimension) + "])");
-  }
-  if (static_cast<unsigned long long>(width) * static_cast<unsigned long long>(height) > kMaxImagePixels) {
-    fail(path, "image of " + sizeText(width, height) + " pixels exceeds the limit of " +
-                   std::to_string(kMaxImagePixels) + " pixels");
-  }
-}
-
-// Writers refuse malformed images: a caller's bug, hence invalid_argument.
-void checkImage(const std::string& path, const RgbImage& image) {
-  if (image.width <= 0 || image.height <= 0 || image.width > kMaxImageDimension ||
-      image.height > kMaxImageDimension ||
-      image.rgb.size() != static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height) * 3) {
-    throw std::invalid_argument(path + ": cannot write a " + sizeText(image.width, image.height) +
-                                " image holding " + std::to_string(image.rgb.size()) + " floats");
-  }
-}
-
-std::vector<std::uint8_t> readFileBytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary | std::ios::ate);
-  if (!in) fail(path, "cannot open for reading");
-  const std::streamoff size = in.tellg();
-  if (size < 0) fail(path, "cannot determine the file size");
-  if (size == 0) fail(path, "empty file");
-  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(size));
-  in.seekg(0);
-  if (!in.read(reinterpret_cast<char*>(bytes.data()), size)) fail(path, "read error");
-  return bytes;
-}
+using detail::ByteCursor;
+using detail::checkFileDimensions;
+using detail::checkImage;
+using detail::fail;
+using detail::growPixels;
+using detail::readFileBytes;
+using detail::sizeText;
 
 std::string lowerExtension(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return ext;
-}
-
-// ---------------------------------------------------------------- Radiance
-// Greg Ward, "Real Pixels", Graphics Gems II (1991), and the Radiance file
-// format notes (radsite.lbl.gov, "The RADIANCE Picture File Format"): a text
-// header ended by a blank line, a resolution line, then one record per
-// scanline of 4-byte RGBE pixels, flat, old-style run-length or new-style
-// (per-channel) run-length encoded.
-
-// A cursor over the file's bytes that never reads past the end.
-struct ByteCursor {
-  const std::uint8_t* pos;
-  const std::uint8_t* end;
-  std::size_t left() const { return static_cast<std::size_t>(end - pos); }
-};
-
-// One header line without its '\n' (and a trailing '\r', for files that went
-// through Windows tools); false at the end of the data.
-bool nextLine(ByteCursor& c, std::string& line) {
-  if (c.pos == c.end) return false;
-  const std::uint8_t* nl = std::find(c.pos, c.end, std::uint8_t{'\n'});
-  if (nl == c.end) return false;
-  line.assign(reinterpret_cast<const char*>(c.pos), static_cast<std::size_t>(nl - c.pos));
-  if (!line.empty() && line.back() == '\r') line.pop_back();
-  c.pos = nl + 1;
-  return true;
-}
-
-// Ward's colr_color: the mantissa byte's centre, (m + ½)·2^(e−136); e = 0 is black.
-inline void rgbeToFloat(const std::uint8_t* p, double scale, float* out) {
-  if (p[3] == 0) {
-    out[0] = out[1] = out[2] = 0.0f;
-    return;
-  }
-  const double f = std::ldexp(1.0, static_cast<int>(p[3]) - (128 + 8)) * scale;
-  for (int ch = 0; ch < 3; ++ch) out[ch] = static_cast<float>((p[ch] + 0.5) * f);
-}
-
-// Decodes one scanline of `width` RGBE pixels into `scan` (4 bytes a pixel).
-// `line` is the scanline's index in file order, for messages.
-void readRgbeScanline(const std::string& path, ByteCursor& c, int width, int line, int lines,
-                      std::vector<std::uint8_t>& scan) {
-  const auto truncated = [&] {
-    fail(path, "truncated scanline " + std::to_string(line) + " of " + std::to_string(lines));
-  };
-  const auto corrupt = [&](const std::string& what) {
-    fail(path, "corrupt scanline " + std::to_string(line) + ": " + what);
-  };
-  if (c.left() < 4) truncated();
-  const std::uint8_t* head = c.pos;
-  // New-style RLE (Radiance ≥ 2.0): marker 2, 2, then the width as a 15-bit
-  // big-endian number; each of the four channels follows as runs (count > 128:
-  // count − 128 copies of one byte) and literals (count bytes). Only widths in
-  // [8, 0x7fff] may use it.
-  if (width >= 8 && width <= 0x7fff && head[0] == 2 && head[1] == 2 && (head[2] & 0x80) == 0) {
-    const int encodedWidth = (head[2] << 8) | head[3];
-    if (encodedWidth != width) {
-      corrupt("run-length header gives width " + std::to_string(encodedWidth) + ", expected " +
-              std::to_string(width));
-    }
-    c.pos += 4;
-    for (int ch = 0; ch < 4; ++ch) {
-      int x = 0;
-      while (x < width) {
-        if (c.left() < 1) truncated();
-        int count = *c.pos++;
-        if (count > 128) {
-          count -= 128;
-          if (x + count > width) corrupt("run overruns the scanline");
-          if (c.left() < 1) truncated();
-          const std::uint8_t value = *c.pos++;
-          for (int k = 0; k < count; ++k) scan[static_cast<std::size_t>(x + k) * 4 + static_cast<std::size_t>(ch)] = value;
-        } else {
-          if (count == 0) corrupt("zero-length literal");
-          if (x + count > width) corrupt("literal overruns the scanline");
-          if (c.left() < static_cast<std::size_t>(count)) truncated();
-          for (int k = 0; k < count; ++k) scan[static_cast<std::size_t>(x + k) * 4 + static_cast<std::size_t>(ch)] = *c.pos++;
-        }
-        x += count;
-      }
-    }
-    return;
-  }
-  // Flat pixels, with the original format's run-length escape: a pixel
-  // (1, 1, 1, n) repeats the previous pixel n << shift times, and consecutive
-  // escapes shift by 8 more bits each (Radiance's oldreadcolrs).
-  int x = 0;
-  int shift = 0;
-  while (x < width) {
-    if (c.left() < 4) truncated();
-    const std::uint8_t* p = c.pos;
-    c.pos += 4;
-    if (p[0] == 1 && p[1] == 1 && p[2] == 1) {
-      if (x == 0) corrupt("run-length escape before the first pixel");
-      if (shift > 16) corrupt("run-length escape too long");
-      const long long count = static_cast<long long>(p[3]) << shift;
-      if (x + count > width) corrupt("run overruns the scanline");
-      for (long long k = 0; k < count; ++k, ++x) {
-        std::memcpy(&scan[static_cast<std::size_t>(x) * 4], &scan[static_cast<std::size_t>(x - 1) * 4], 4);
-      }
-      shift += 8;
-    } else {
-      std::memcpy(&scan[static_cast<std::size_t>(x) * 4], p, 4);
-      ++x;
-      shift = 0;
-    }
-  }
 }
 
 // ---------------------------------------------------------------- PFM
@@ -201,6 +64,60 @@ bool parseInteger(const std::string& token, long long& value) {
   char* endp = nullptr;
   value = std::strtoll(token.c_str(), &endp, 10);
   return endp == token.c_str() + token.size();
+}
+
+// ---------------------------------------------------------------- OpenEXR
+
+// A band of rows holds about this many bytes of float RGB (at least one
+// chunk's rows), so that the image grows in steps the file has delivered.
+constexpr std::size_t kExrBandBytes = std::size_t{8} << 20;
+
+// Scanlines per chunk for each compression (OpenEXR "Technical Introduction",
+// the table of compression methods; ImfCompressor.cpp's numScanLines).
+int exrLinesPerChunk(Imf::Compression compression) {
+  switch (compression) {
+    case Imf::ZIP_COMPRESSION:
+    case Imf::PXR24_COMPRESSION:
+      return 16;
+    case Imf::PIZ_COMPRESSION:
+    case Imf::B44_COMPRESSION:
+    case Imf::B44A_COMPRESSION:
+    case Imf::DWAA_COMPRESSION:
+      return 32;
+    case Imf::DWAB_COMPRESSION:
+      return 256;
+    default:  // none, RLE, ZIPS
+      return 1;
+  }
+}
+
+// Every chunk of a file has an 8-byte entry in the offset table and, in the
+// chunk itself, at least its coordinates and data size (8 bytes for a
+// scanline chunk, 20 for a tile: OpenEXR "File Layout"). A data window
+// promising more chunks than the file has bytes for is refused before any
+// pixel is allocated.
+void checkExrChunksFit(const std::string& path, const Imf::Header& header, long long width, long long height) {
+  std::error_code ec;
+  const std::uintmax_t fileBytes = std::filesystem::file_size(path, ec);
+  if (ec) fail(path, "cannot read its size: " + ec.message());
+  unsigned long long chunks = 0;
+  std::size_t chunkBytes = 0;
+  if (header.hasTileDescription()) {
+    const Imf::TileDescription& tiles = header.tileDescription();
+    const unsigned long long tw = std::max(1u, tiles.xSize), th = std::max(1u, tiles.ySize);
+    chunks = ((static_cast<unsigned long long>(width) + tw - 1) / tw) *
+             ((static_cast<unsigned long long>(height) + th - 1) / th);
+    chunkBytes = 8 + 20;
+  } else {
+    const auto lines = static_cast<unsigned long long>(exrLinesPerChunk(header.compression()));
+    chunks = (static_cast<unsigned long long>(height) + lines - 1) / lines;
+    chunkBytes = 8 + 8;
+  }
+  if (chunks > fileBytes / chunkBytes) {
+    fail(path, "truncated file: a " + sizeText(width, height) + " data window needs " + std::to_string(chunks) +
+                   " chunks of at least " + std::to_string(chunkBytes) + " bytes each, and the file has " +
+                   std::to_string(fileBytes) + " bytes");
+  }
 }
 
 }  // namespace
@@ -242,6 +159,15 @@ RgbImage readExr(const std::string& path) {
       fail(path, "not an OpenEXR file (bad magic number)");
     }
   }
+  // OpenEXR sizes its offset table and line buffers from the header's data
+  // window while it opens the file; with these limits set it refuses an
+  // absurd window before allocating for it (Imf::Header::sanityCheck).
+  static const bool limitsSet = [] {
+    Imf::Header::setMaxImageSize(kMaxImageDimension, kMaxImageDimension);
+    Imf::Header::setMaxTileSize(kMaxImageDimension, kMaxImageDimension);
+    return true;
+  }();
+  (void)limitsSet;
   std::unique_ptr<Imf::InputFile> file;
   try {
     file = std::make_unique<Imf::InputFile>(path.c_str());
@@ -252,6 +178,7 @@ RgbImage readExr(const std::string& path) {
   const long long width = static_cast<long long>(dw.max.x) - dw.min.x + 1;
   const long long height = static_cast<long long>(dw.max.y) - dw.min.y + 1;
   checkFileDimensions(path, width, height);
+  checkExrChunksFit(path, file->header(), width, height);
 
   const Imf::ChannelList& channels = file->header().channels();
   const auto full = [&](const char* name) {
@@ -271,21 +198,43 @@ RgbImage readExr(const std::string& path) {
                    "; expected R, G, B, or Y alone, or Y, RY, BY)");
   }
 
-  RgbImage image = makeImage(static_cast<int>(width), static_cast<int>(height));
+  // Read a band of rows at a time, the image growing with each (growPixels):
+  // a file whose chunks are missing or corrupt fails having allocated no
+  // more than it delivered.
+  RgbImage image;
+  image.width = static_cast<int>(width);
+  image.height = static_cast<int>(height);
+  const std::size_t rowFloats = static_cast<std::size_t>(width) * 3;
+  const std::size_t totalFloats = rowFloats * static_cast<std::size_t>(height);
+  // Whole chunks per band, so that no chunk is decoded twice.
+  const int chunkRows = file->header().hasTileDescription()
+                            ? static_cast<int>(std::max(1u, file->header().tileDescription().ySize))
+                            : exrLinesPerChunk(file->header().compression());
+  const std::size_t chunkBytes = rowFloats * sizeof(float) * static_cast<std::size_t>(chunkRows);
+  const int bandRows = static_cast<int>(std::min<long long>(
+      height, chunkRows * static_cast<long long>(std::max<std::size_t>(1, kExrBandBytes / chunkBytes))));
   try {
     if (lumaChroma) {
       // Subsampled luminance-chroma needs OpenEXR's own reconstruction, which
       // the RGBA interface does (in half precision, the precision such files have).
       file.reset();
       Imf::RgbaInputFile rgbaFile(path.c_str());
-      Imf::Array2D<Imf::Rgba> pixels(height, width);
-      rgbaFile.setFrameBuffer(Imf::ComputeBasePointer(&pixels[0][0], dw), 1, static_cast<std::size_t>(width));
-      rgbaFile.readPixels(dw.min.y, dw.max.y);
-      for (int y = 0; y < image.height; ++y) {
-        for (int x = 0; x < image.width; ++x) {
-          image.at(y, x, 0) = pixels[y][x].r;
-          image.at(y, x, 1) = pixels[y][x].g;
-          image.at(y, x, 2) = pixels[y][x].b;
+      Imf::Array2D<Imf::Rgba> band(bandRows, width);
+      for (long long y0 = dw.min.y; y0 <= dw.max.y; y0 += bandRows) {
+        const int top = static_cast<int>(y0);
+        const int y1 = static_cast<int>(std::min<long long>(dw.max.y, y0 + bandRows - 1));
+        const Imath::Box2i bandWindow(Imath::V2i(dw.min.x, top), Imath::V2i(dw.max.x, y1));
+        rgbaFile.setFrameBuffer(Imf::ComputeBasePointer(&band[0][0], bandWindow), 1, static_cast<std::size_t>(width));
+        rgbaFile.readPixels(top, y1);
+        growPixels(image.rgb, rowFloats * static_cast<std::size_t>(y1 - top + 1), totalFloats);
+        for (int y = top; y <= y1; ++y) {
+          for (int x = 0; x < image.width; ++x) {
+            const Imf::Rgba& px = band[y - top][x];
+            float* out = &image.rgb[image.index(y - dw.min.y, x)];
+            out[0] = px.r;
+            out[1] = px.g;
+            out[2] = px.b;
+          }
         }
       }
       return image;
@@ -293,16 +242,24 @@ RgbImage readExr(const std::string& path) {
     // OpenEXR converts half and uint channels to the FLOAT slices we ask for.
     const std::size_t xStride = 3 * sizeof(float);
     const std::size_t yStride = xStride * static_cast<std::size_t>(width);
-    Imf::FrameBuffer fb;
-    if (rgb) {
-      fb.insert("R", Imf::Slice::Make(Imf::FLOAT, image.rgb.data() + 0, dw, xStride, yStride));
-      fb.insert("G", Imf::Slice::Make(Imf::FLOAT, image.rgb.data() + 1, dw, xStride, yStride));
-      fb.insert("B", Imf::Slice::Make(Imf::FLOAT, image.rgb.data() + 2, dw, xStride, yStride));
-    } else {
-      fb.insert("Y", Imf::Slice::Make(Imf::FLOAT, image.rgb.data(), dw, xStride, yStride));
+    // y0 in long long: a data window may end at INT_MAX.
+    for (long long y0 = dw.min.y; y0 <= dw.max.y; y0 += bandRows) {
+      const int top = static_cast<int>(y0);
+      const int y1 = static_cast<int>(std::min<long long>(dw.max.y, y0 + bandRows - 1));
+      growPixels(image.rgb, rowFloats * static_cast<std::size_t>(y1 - top + 1), totalFloats);
+      float* first = &image.rgb[image.index(top - dw.min.y, 0)];
+      const Imath::Box2i bandWindow(Imath::V2i(dw.min.x, top), Imath::V2i(dw.max.x, y1));
+      Imf::FrameBuffer fb;
+      if (rgb) {
+        fb.insert("R", Imf::Slice::Make(Imf::FLOAT, first + 0, bandWindow, xStride, yStride));
+        fb.insert("G", Imf::Slice::Make(Imf::FLOAT, first + 1, bandWindow, xStride, yStride));
+        fb.insert("B", Imf::Slice::Make(Imf::FLOAT, first + 2, bandWindow, xStride, yStride));
+      } else {
+        fb.insert("Y", Imf::Slice::Make(Imf::FLOAT, first, bandWindow, xStride, yStride));
+      }
+      file->setFrameBuffer(fb);
+      file->readPixels(top, y1);
     }
-    file->setFrameBuffer(fb);
-    file->readPixels(dw.min.y, dw.max.y);
   } catch (const std::exception& e) {
     fail(path, std::string("cannot read OpenEXR pixels (truncated or corrupt file?): ") + e.what());
   }
@@ -337,78 +294,6 @@ void writeExr(const std::string& path, const RgbImage& image) {
   }
 }
 
-// ---------------------------------------------------------------- Radiance
-
-RgbImage readRadianceHdr(const std::string& path) {
-  const std::vector<std::uint8_t> bytes = readFileBytes(path);
-  ByteCursor c{bytes.data(), bytes.data() + bytes.size()};
-
-  // Header: the magic line, "NAME=value" and comment lines, a blank line.
-  std::string line;
-  const bool haveFirst = nextLine(c, line);
-  if (!haveFirst || (line != "#?RADIANCE" && line != "#?RGBE")) {
-    fail(path, "not a Radiance file (the first line must be #?RADIANCE or #?RGBE)");
-  }
-  double exposure = 1.0;
-  bool ended = false;
-  while (nextLine(c, line)) {
-    if (line.empty()) {
-      ended = true;
-      break;
-    }
-    if (line.rfind("FORMAT=", 0) == 0) {
-      const std::string format = line.substr(7);
-      if (format != "32-bit_rle_rgbe") {
-        fail(path, "unsupported Radiance FORMAT=" + format + " (only 32-bit_rle_rgbe is read)");
-      }
-    } else if (line.rfind("EXPOSURE=", 0) == 0) {
-      char* endp = nullptr;
-      const double e = std::strtod(line.c_str() + 9, &endp);
-      if (endp == line.c_str() + 9 || !(e > 0.0) || !std::isfinite(e)) fail(path, "bad header line \"" + line + "\"");
-      exposure *= e;  // EXPOSURE lines are cumulative
-    }
-  }
-  if (!ended) fail(path, "truncated header (no blank line before the resolution line)");
-
-  // Resolution line: "-Y h +X w" is the standard top-to-bottom, left-to-right
-  // order; "+Y" stores rows bottom to top and "-X" right to left. The
-  // transposed orders ("+X w -Y h", …) are rare and not read.
-  if (!nextLine(c, line)) fail(path, "truncated file: no resolution line");
-  std::istringstream res(line);
-  std::string yAxis, xAxis, rest;
-  long long height = 0, width = 0;
-  if (!(res >> yAxis >> height >> xAxis >> width) || (res >> rest)) {
-    fail(path, "bad resolution line \"" + line + "\"");
-  }
-  if ((yAxis != "-Y" && yAxis != "+Y") || (xAxis != "+X" && xAxis != "-X")) {
-    fail(path, "unsupported resolution line \"" + line + "\" (expected -Y h +X w, or its flips)");
-  }
-  checkFileDimensions(path, width, height);
-  // Every scanline takes at least 4 bytes (one pixel) and, for width > 1, at
-  // least 8 (a pixel and a run escape, or the new-style marker and runs): a
-  // header promising more rows than the file can hold is refused before allocating.
-  const std::size_t minScanline = width > 1 ? 8 : 4;
-  if (c.left() / minScanline < static_cast<std::size_t>(height)) {
-    fail(path, "truncated file: " + std::to_string(c.left()) + " bytes of pixel data cannot hold " +
-                   std::to_string(height) + " scanlines");
-  }
-
-  RgbImage image = makeImage(static_cast<int>(width), static_cast<int>(height));
-  const bool bottomUp = yAxis == "+Y";
-  const bool rightToLeft = xAxis == "-X";
-  std::vector<std::uint8_t> scan(static_cast<std::size_t>(width) * 4);
-  const double scale = 1.0 / exposure;
-  for (int line_i = 0; line_i < image.height; ++line_i) {
-    readRgbeScanline(path, c, image.width, line_i, image.height, scan);
-    const int row = bottomUp ? image.height - 1 - line_i : line_i;
-    for (int x = 0; x < image.width; ++x) {
-      const int col = rightToLeft ? image.width - 1 - x : x;
-      rgbeToFloat(&scan[static_cast<std::size_t>(x) * 4], scale, &image.rgb[image.index(row, col)]);
-    }
-  }
-  return image;
-}
-
 // ---------------------------------------------------------------- PFM
 
 RgbImage readPfm(const std::string& path) {
@@ -436,8 +321,9 @@ RgbImage readPfm(const std::string& path) {
   const std::size_t count = static_cast<std::size_t>(width) * static_cast<std::size_t>(height) *
                             static_cast<std::size_t>(channels);
   if (c.left() / sizeof(float) < count) {
-    fail(path, "truncated pixel data: expected " + std::to_string(count * sizeof(float)) + " bytes, found " +
-                   std::to_string(c.left()));
+    fail(path, "truncated pixel data: " + sizeText(width, height) + " pixels of " + std::to_string(channels) +
+                   " floats need " + std::to_string(count * sizeof(float)) + " bytes, and " +
+                   std::to_string(c.left()) + " bytes remain");
   }
   const bool fileLittle = scale < 0.0;
   const bool swap = fileLittle != (std::endian::native == std::endian::little);

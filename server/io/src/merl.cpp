@@ -124,20 +124,24 @@ glm::dvec3 MerlBrdf::evaluate(const glm::dvec3& wi, const glm::dvec3& wo) const 
   return {std::max(rgb_[k], 0.0f), std::max(rgb_[k + 1], 0.0f), std::max(rgb_[k + 2], 0.0f)};
 }
 
-std::unique_ptr<MerlBrdf> loadMerlBrdf(const std::string& path, const MerlLoadOptions& options) {
-  std::error_code ec;
-  const std::uintmax_t size = std::filesystem::file_size(path, ec);
-  if (ec) fail(path, "cannot open MERL BRDF: " + ec.message());
+namespace {
+
+// The size is known before a byte is read, and a MERL file has exactly one.
+void checkMerlSize(const std::string& path, std::uintmax_t size) {
   if (size != kMerlFileBytes) {
     fail(path, "is " + std::to_string(size) + " bytes; a MERL .binary file is exactly " +
                    std::to_string(kMerlFileBytes) + " (12-byte header + 3 × 1,458,000 doubles)" +
                    (size < kMerlFileBytes ? ", so it is truncated or not a MERL file" : ""));
   }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) fail(path, "cannot open MERL BRDF");
+}
 
+// The header and the three channels from `read(out, n)` (false: the data
+// ended), already checked to be kMerlFileBytes long. `path` names errors.
+template <typename Read>
+std::unique_ptr<MerlBrdf> decodeMerl(const Read& read, const std::string& path, const std::string& name,
+                                     const MerlLoadOptions& options) {
   std::array<unsigned char, 12> header{};
-  if (!in.read(reinterpret_cast<char*>(header.data()), header.size())) fail(path, "cannot read the MERL header");
+  if (!read(header.data(), header.size())) fail(path, "cannot read the MERL header");
   const std::array<std::int32_t, 3> dims{fromLittleEndian<std::int32_t>(header.data()),
                                          fromLittleEndian<std::int32_t>(header.data() + 4),
                                          fromLittleEndian<std::int32_t>(header.data() + 8)};
@@ -157,7 +161,7 @@ std::unique_ptr<MerlBrdf> loadMerlBrdf(const std::string& path, const MerlLoadOp
   for (int c = 0; c < 3; ++c) {
     for (std::size_t first = 0; first < kMerlCells; first += kChunk) {
       const std::size_t n = std::min(kChunk, kMerlCells - first);
-      if (!in.read(reinterpret_cast<char*>(buffer.data()), static_cast<std::streamsize>(n * sizeof(double)))) {
+      if (!read(buffer.data(), n * sizeof(double))) {
         fail(path, std::string("read failed in the ") + kChannelName[c] + " channel (file changed while reading?)");
       }
       for (std::size_t k = 0; k < n; ++k) {
@@ -221,7 +225,35 @@ std::unique_ptr<MerlBrdf> loadMerlBrdf(const std::string& path, const MerlLoadOp
       }
     }
   }
-  return std::make_unique<MerlBrdf>(std::filesystem::path(path).stem().string(), std::move(rgb), nonFinite);
+  return std::make_unique<MerlBrdf>(name, std::move(rgb), nonFinite);
+}
+
+}  // namespace
+
+std::unique_ptr<MerlBrdf> loadMerlBrdf(const std::string& path, const MerlLoadOptions& options) {
+  std::error_code ec;
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  if (ec) fail(path, "cannot open MERL BRDF: " + ec.message());
+  checkMerlSize(path, size);
+  std::ifstream in(path, std::ios::binary);
+  if (!in) fail(path, "cannot open MERL BRDF");
+  const auto read = [&](unsigned char* out, std::size_t n) {
+    return static_cast<bool>(in.read(reinterpret_cast<char*>(out), static_cast<std::streamsize>(n)));
+  };
+  return decodeMerl(read, path, std::filesystem::path(path).stem().string(), options);
+}
+
+std::unique_ptr<MerlBrdf> parseMerlBrdf(std::string_view bytes, const std::string& name,
+                                        const MerlLoadOptions& options) {
+  checkMerlSize(name, bytes.size());
+  std::size_t pos = 0;
+  const auto read = [&](unsigned char* out, std::size_t n) {
+    if (bytes.size() - pos < n) return false;
+    std::memcpy(out, bytes.data() + pos, n);
+    pos += n;
+    return true;
+  };
+  return decodeMerl(read, name, name, options);
 }
 
 std::unique_ptr<Brdf> loadMerl(const std::string& path, const MerlLoadOptions& options) {

@@ -182,6 +182,8 @@ std::shared_ptr<Mesh> meshAt(const nlohmann::json& j, const std::string& file, c
   return std::make_shared<Mesh>(std::move(mesh));
 }
 
+Scene sceneFromJson(const nlohmann::json& j, const std::string& path);
+
 }  // namespace
 
 Scene loadScene(const std::string& path) {
@@ -194,6 +196,17 @@ Scene loadScene(const std::string& path) {
     throw std::runtime_error(path + ": not valid JSON: " + e.what());
   }
   if (!j.is_object()) fail(path, "top level", "expected an object");
+  try {
+    return sceneFromJson(j, path);
+  } catch (const nlohmann::json::exception& e) {
+    // A value of the wrong type where a field is read ("fov_y": "wide").
+    throw std::runtime_error(path + ": " + e.what());
+  }
+}
+
+namespace {
+
+Scene sceneFromJson(const nlohmann::json& j, const std::string& path) {
   const fs::path base = fs::path(path).parent_path();
   Scene s;
   s.environment = builtinEnvironment();
@@ -237,5 +250,7 @@ Scene loadScene(const std::string& path) {
   }
   return s;
 }
+
+}  // namespace
 
 }  // namespace haarcast::render

@@ -203,7 +203,7 @@ TEST_F(ImageIo, ExrFailures) {
   expectFailure([&] { readExr(path("layers.exr")); }, path("layers.exr"), "unsupported EXR channel layout");
   // A data window 40000 pixels wide is refused before anything is allocated.
   writeBytes(path("wide.exr"), handMadeExr({"Y"}, 39999, 0, {{{1.0f}}}));
-  expectFailure([&] { readExr(path("wide.exr")); }, path("wide.exr"), "bad dimensions 40000x1");
+  expectFailure([&] { readExr(path("wide.exr")); }, path("wide.exr"), "exceeds the maximum width of 32768");
   writeBytes(path("empty.exr"), {});
   expectFailure([&] { readExr(path("empty.exr")); }, path("empty.exr"), "empty file");
   Bytes notExr;

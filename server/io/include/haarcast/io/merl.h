@@ -32,6 +32,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -119,5 +120,9 @@ struct MerlLoadOptions {
 std::unique_ptr<Brdf> loadMerl(const std::string& path, const MerlLoadOptions& options = {});
 // The same, typed, for callers that want cell() or repairedCells().
 std::unique_ptr<MerlBrdf> loadMerlBrdf(const std::string& path, const MerlLoadOptions& options = {});
+// The same from a file's bytes in memory; `name` names the BRDF and the
+// errors. A pure function over bytes, so it can be fuzzed.
+std::unique_ptr<MerlBrdf> parseMerlBrdf(std::string_view bytes, const std::string& name,
+                                        const MerlLoadOptions& options = {});
 
 }  // namespace haarcast::io
