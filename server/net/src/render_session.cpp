@@ -182,6 +182,9 @@ void RenderSession::adopt(SessionConfig next, bool announceScene, Clock::time_po
     }
   }
   if (announceScene && welcomed_) port_.send(sceneInfoMessage(config_, catalog_));
+  // The frame in flight answers the old config: cancelled at its next tile,
+  // so the new one starts without waiting for a frame nobody wants.
+  if (inFlight_ && current_) current_->cancelled.store(true);
   wantFrame_ = true;
   if (newRenderer) {
     prepareRenderer();
@@ -198,10 +201,10 @@ void RenderSession::prepareRenderer() {
 }
 
 void RenderSession::onPrepared(const std::string& key, std::shared_ptr<PreparedRenderer> renderer,
-                               const std::string& error, Clock::time_point now) {
+                               const std::string& error, Clock::time_point now, v1::ErrorCode code) {
   if (closed_ || key != config_.rendererKey()) return;  // superseded
   if (!renderer) {
-    const ProtocolError e{v1::ERROR_CODE_RENDER_FAILED, "cannot prepare the renderer: " + error, !welcomed_};
+    const ProtocolError e{code, "cannot prepare the renderer: " + error, !welcomed_};
     if (e.fatal) {
       fail(e);
     } else {
@@ -239,7 +242,19 @@ void RenderSession::maybeRender(Clock::time_point now) {
   wantFrame_ = false;
   inFlight_ = true;
   nextFrameAt_ = now + toDuration(1.0 / std::max(config_.fps, 1e-3));
-  port_.render({renderer_, config_.encoding, config_.jpegQuality, std::make_shared<FrameContext>()});
+  current_ = std::make_shared<FrameContext>();
+  const std::size_t pixels = static_cast<std::size_t>(config_.width) * static_cast<std::size_t>(config_.height);
+  port_.render({renderer_, config_.encoding, config_.jpegQuality, pixels, current_});
+}
+
+void RenderSession::onCancelled(const FrameContext& context, Clock::time_point now) {
+  if (current_.get() != &context) return;  // not the frame in flight (cannot happen: one at a time)
+  inFlight_ = false;
+  current_.reset();
+  if (closed_) return;
+  // The frame was wanted for the old request; the new one still wants one.
+  wantFrame_ = true;
+  maybeRender(now);
 }
 
 std::optional<render::FrameRequest> RenderSession::takeRequest(FrameContext& context) {
@@ -260,6 +275,7 @@ std::optional<render::FrameRequest> RenderSession::takeRequest(FrameContext& con
 void RenderSession::onRendered(const FrameContext& context, std::optional<RenderedFrame> rendered,
                                const std::string& error, Clock::time_point now) {
   inFlight_ = false;
+  current_.reset();
   if (closed_) return;
   if (!rendered) {
     // Once per distinct message: a broken config must not flood the client.
@@ -330,6 +346,7 @@ void RenderSession::fail(ProtocolError e, CloseCode code) {
 void RenderSession::end() {
   closed_ = true;
   ended_.store(true);
+  if (current_) current_->cancelled.store(true);  // nobody will read the frame
 }
 
 void RenderSession::onTick(Clock::time_point now) {

@@ -34,6 +34,11 @@ namespace haarcast::net {
 // What a frame job read when its worker started it; the strand reads it back
 // when the frame is done.
 struct FrameContext {
+  // Set on the strand when the frame is no longer wanted: its session has
+  // ended, or a new size, settings or scene replaced the request (a newer
+  // pose alone does not: a client that sends poses continuously would never
+  // get a frame). The job's `cancelled` reads it from a render worker.
+  std::atomic<bool> cancelled{false};
   std::uint64_t poseSequence = 0;
   double clientTimeMs = 0.0;
   Clock::time_point poseReceived;
@@ -46,6 +51,7 @@ struct FrameOrder {
   std::shared_ptr<PreparedRenderer> renderer;
   FrameEncoding encoding = FrameEncoding::Jpeg;
   int jpegQuality = 85;
+  std::size_t pixels = 0;  // width × height: the job's share of the server's pixel budget
   std::shared_ptr<FrameContext> context;
 };
 
@@ -80,10 +86,15 @@ class RenderSession {
                 std::string id, Clock::time_point opened);
 
   void onMessage(std::string_view bytes, bool binary, Clock::time_point now);
+  // A renderer, or nullptr and why not: `code` is RENDER_FAILED for a build
+  // that failed, OVERLOADED for one the server's build queue refused.
   void onPrepared(const std::string& key, std::shared_ptr<PreparedRenderer> renderer, const std::string& error,
-                  Clock::time_point now);
+                  Clock::time_point now, v1::ErrorCode code = v1::ERROR_CODE_RENDER_FAILED);
   void onRendered(const FrameContext& context, std::optional<RenderedFrame> rendered, const std::string& error,
                   Clock::time_point now);
+  // The job of `context` ended without a frame (cancelled, or its session
+  // gone): the next frame may be rendered.
+  void onCancelled(const FrameContext& context, Clock::time_point now);
   void onPace(Clock::time_point now);
   void onTick(Clock::time_point now);  // timeouts and Stats
   void onSent(bool isFrame, std::size_t payloadBytes);
@@ -129,6 +140,7 @@ class RenderSession {
   int badMessages_ = 0;
   std::string clientName_;  // sanitised for the log
   std::shared_ptr<PreparedRenderer> renderer_;
+  std::shared_ptr<FrameContext> current_;  // the frame in flight (inFlight_), to cancel
   Clock::time_point opened_, lastMessage_, lastStats_, nextFrameAt_{};
   std::uint64_t frameSequence_ = 0, framesSent_ = 0, framesDropped_ = 0, bytesSent_ = 0;
   std::uint64_t periodFrames_ = 0, periodRendered_ = 0;
