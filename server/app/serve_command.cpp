@@ -118,7 +118,8 @@ int run(ServeArgs& a) {
   else if (a.encoding == "png") d.encoding = net::FrameEncoding::Png;
   else if (a.encoding == "raw") d.encoding = net::FrameEncoding::RawRgba8;
   else if (a.encoding == "exr") d.encoding = net::FrameEncoding::Exr;
-  else throw std::invalid_argument("--encoding must be jpeg, png, raw or exr (got \"" + a.encoding + "\")");
+  else if (a.encoding == "h264") d.encoding = net::FrameEncoding::H264;
+  else throw std::invalid_argument("--encoding must be jpeg, png, raw, exr or h264 (got \"" + a.encoding + "\")");
   a.server.port = static_cast<std::uint16_t>(a.port);
   auto& limits = a.server.limits;
   if (limits.maxLevel < render::kMinRenderLevel || limits.maxLevel > render::kMaxRenderLevel) {
@@ -261,7 +262,7 @@ std::function<int()> addServeCommand(CLI::App& app) {
       ->capture_default_str();
   c->add_option("--method", a->method, "Default per-pixel method: " + pixelMethodNames())->capture_default_str();
   c->add_option("--light-coeffs", a->lightCoefficients, "Default light coefficients kept (k)")->capture_default_str();
-  c->add_option("--encoding", a->encoding, "Default encoding: jpeg|png|raw|exr")->capture_default_str();
+  c->add_option("--encoding", a->encoding, "Default encoding: jpeg|png|raw|exr|h264")->capture_default_str();
   c->add_option("--scene", a->sceneFiles, "Scene files to offer besides the built-in \"default\" (named by file stem)");
   c->add_option("--materials-dir", a->materialsDir, "Offer the MERL .binary files of this folder (as merl:NAME)");
   c->add_option("--web-root", a->webRoot, "The browser client's files (default: the source tree's client/web)");

@@ -157,6 +157,10 @@ void RenderSession::onPose(const v1::PoseUpdate& update, Clock::time_point now) 
     return;
   }
   if (applied) {
+    if (update.keyframe() && h264_) {
+      std::lock_guard lock(h264_->mutex);
+      h264_->keyframeAtPose = update.sequence();
+    }
     wantFrame_ = true;
     maybeRender(now);
   }
@@ -232,6 +236,10 @@ void RenderSession::onPace(Clock::time_point now) {
 
 void RenderSession::maybeRender(Clock::time_point now) {
   if (!renderer_ || inFlight_ || !wantFrame_ || closed_) return;
+  // H.264: every access unit must reach the decoder (each frame depends on
+  // the one before), so no frame is rendered while one waits to be sent:
+  // the frame slot's latest-wins never drops one. onSent() comes back here.
+  if (config_.encoding == FrameEncoding::H264 && frameUnsent_) return;
   if (now < nextFrameAt_) {
     if (!paceArmed_) {
       paceArmed_ = true;
@@ -244,7 +252,34 @@ void RenderSession::maybeRender(Clock::time_point now) {
   nextFrameAt_ = now + toDuration(1.0 / std::max(config_.fps, 1e-3));
   current_ = std::make_shared<FrameContext>();
   const std::size_t pixels = static_cast<std::size_t>(config_.width) * static_cast<std::size_t>(config_.height);
-  port_.render({renderer_, config_.encoding, config_.jpegQuality, pixels, current_});
+  FrameOrder order{renderer_, config_.encoding, config_.jpegQuality, pixels, current_, {}};
+  if (config_.encoding == FrameEncoding::H264) {
+    if (!h264_) h264_ = std::make_shared<H264Stream>();
+    order.encode = [stream = h264_, context = current_](const render::Frame& frame) {
+      return stream->encode(frame, *context);
+    };
+  }
+  port_.render(std::move(order));
+}
+
+std::string H264Stream::encode(const render::Frame& frame, const FrameContext& context) {
+  std::lock_guard lock(mutex);
+  H264Settings settings = h264Settings(context.config);
+  settings.width = frame.width;
+  settings.height = frame.height;
+  if (!encoder) {
+    encoder = std::make_unique<H264Encoder>(settings);  // its first frame is a keyframe
+  } else {
+    encoder->reconfigure(settings);  // new settings: a keyframe; the same: nothing
+  }
+  if (keyframeNow || (keyframeAtPose != 0 && context.poseSequence >= keyframeAtPose)) {
+    encoder->requestKeyframe();
+    keyframeNow = false;
+    keyframeAtPose = 0;
+  }
+  H264AccessUnit unit = encoder->encode(frame.rgba8, frame.width, frame.height);
+  if (unit.keyframe) ++keyframes;
+  return std::move(unit.annexB);
 }
 
 void RenderSession::onCancelled(const FrameContext& context, Clock::time_point now) {
@@ -306,17 +341,26 @@ void RenderSession::onRendered(const FrameContext& context, std::optional<Render
     // The client had not taken the last one yet: latest wins.
     ++framesDropped_;
     metrics_.framesDropped.fetch_add(1);
+    if (h264_) {
+      // Not expected (maybeRender waits for the slot to empty), but a lost
+      // access unit breaks the decoder until the next keyframe: ask for one.
+      std::lock_guard lock(h264_->mutex);
+      h264_->keyframeNow = true;
+    }
   }
+  frameUnsent_ = true;
   maybeRender(now);
 }
 
-void RenderSession::onSent(bool isFrame, std::size_t payloadBytes) {
+void RenderSession::onSent(bool isFrame, std::size_t payloadBytes, Clock::time_point now) {
   if (!isFrame) return;
+  frameUnsent_ = false;
   ++framesSent_;
   ++periodFrames_;
   bytesSent_ += payloadBytes;
   metrics_.framesTotal.fetch_add(1);
   metrics_.bytesTotal.fetch_add(payloadBytes);
+  if (config_.encoding == FrameEncoding::H264 && !closed_) maybeRender(now);
 }
 
 // ------------------------------------------------------------------ errors, timeouts, Stats

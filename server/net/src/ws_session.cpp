@@ -187,6 +187,7 @@ void WsSession::render(FrameOrder order) {
   job.encoding = order.encoding;
   job.jpegQuality = order.jpegQuality;
   job.pixels = order.pixels;
+  job.encode = std::move(order.encode);
   // Polled by a render worker at every tile or batch boundary: atomics and
   // a weak pointer only, never the session's strand or the service's lock.
   // The server's `stopping` outlives the service's threads (server_impl.h:
