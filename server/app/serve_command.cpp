@@ -41,6 +41,7 @@ struct ServeArgs {
   std::string materialsDir, webRoot, protoFile, cacheDir, vulkanDevice;
   bool vulkanValidation = false, quiet = false;
   unsigned renderThreads = 0;
+  long long serverPixelBudget = -1;  // -1: 2 × --max-session-pixels
 };
 
 // The analytic materials every server offers (MERL files come from --materials-dir).
@@ -117,7 +118,8 @@ int run(ServeArgs& a) {
   else if (a.encoding == "png") d.encoding = net::FrameEncoding::Png;
   else if (a.encoding == "raw") d.encoding = net::FrameEncoding::RawRgba8;
   else if (a.encoding == "exr") d.encoding = net::FrameEncoding::Exr;
-  else throw std::invalid_argument("--encoding must be jpeg, png, raw or exr (got \"" + a.encoding + "\")");
+  else if (a.encoding == "h264") d.encoding = net::FrameEncoding::H264;
+  else throw std::invalid_argument("--encoding must be jpeg, png, raw, exr or h264 (got \"" + a.encoding + "\")");
   a.server.port = static_cast<std::uint16_t>(a.port);
   auto& limits = a.server.limits;
   if (limits.maxLevel < render::kMinRenderLevel || limits.maxLevel > render::kMaxRenderLevel) {
@@ -138,6 +140,19 @@ int run(ServeArgs& a) {
   }
   if (!(limits.maxFps > 0)) throw std::invalid_argument("--max-fps must be positive");
   limits.defaultFps = std::min(limits.defaultFps, limits.maxFps);
+
+  auto& render = a.server.render;
+  for (const auto& [flag, value] : {std::pair{"--render-workers", static_cast<std::size_t>(std::max(0, render.workers))},
+                                    {"--max-session-pixels", render.maxSessionPixels},
+                                    {"--max-queued-builds", render.maxQueuedBuilds}}) {
+    if (value < 1) throw std::invalid_argument(std::string(flag) + " must be at least 1 (got " + std::to_string(value) + ")");
+  }
+  // Unset (the sentinel): two of the largest frames a session may ask for.
+  if (a.serverPixelBudget < 0) {
+    render.serverPixelBudget = 2 * render.maxSessionPixels;
+  } else {
+    render.serverPixelBudget = static_cast<std::size_t>(a.serverPixelBudget);
+  }
 
   // The token: the flag, else the environment (keeps it out of `ps`).
   a.server.token = !a.token.empty() ? a.token : (std::getenv("HAARCAST_TOKEN") ? std::getenv("HAARCAST_TOKEN") : "");
@@ -170,8 +185,11 @@ int run(ServeArgs& a) {
   const bool quiet = a.quiet;
   const std::string antialias = a.antialias;
   antialiasFor(antialias, a.backend);  // a bad flag fails at start, not in a session
-  net::RendererBuilder builder = [sharedScenes, materialFiles, base, vulkanOptions, quiet,
-                                  antialias](const net::SessionConfig& c) {
+  // Abandonable: once nobody waits for the build (its sessions closed, or
+  // the server stops) the next progress step throws, so a SIGTERM during a
+  // build of seconds still exits at once.
+  net::AbandonableRendererBuilder builder = [sharedScenes, materialFiles, base, vulkanOptions, quiet, antialias](
+                                                const net::SessionConfig& c, const std::function<bool()>& abandoned) {
     const auto it = std::find_if(sharedScenes->begin(), sharedScenes->end(),
                                  [&](const SceneSource& s) { return s.name == c.scene; });
     if (it == sharedScenes->end()) throw std::invalid_argument("unknown scene \"" + c.scene + "\"");
@@ -192,8 +210,12 @@ int run(ServeArgs& a) {
     auto prepared = std::make_shared<net::PreparedRenderer>();
     // Slice tables and visibility: lines, not a redrawn one (sessions log in between).
     StderrProgress progress("[serve] ", false);
-    prepared->renderer =
-        gpu::makeRenderer(backend, scene, options, vulkanOptions, quiet ? StageProgress{} : progress.callback());
+    const StageProgress shown = quiet ? StageProgress{} : progress.callback();
+    const render::RenderProgress stages = [&](const std::string& stage, std::size_t done, std::size_t total) {
+      if (abandoned()) throw std::runtime_error("renderer build abandoned: nobody waits for it");
+      if (shown) shown(stage, done, total);
+    };
+    prepared->renderer = gpu::makeRenderer(backend, scene, options, vulkanOptions, stages);
     if (!quiet) {
       std::fprintf(stderr, "[serve] renderer ready: %s on %s\n", prepared->renderer->backend().c_str(),
                    prepared->renderer->deviceName().c_str());
@@ -240,7 +262,7 @@ std::function<int()> addServeCommand(CLI::App& app) {
       ->capture_default_str();
   c->add_option("--method", a->method, "Default per-pixel method: " + pixelMethodNames())->capture_default_str();
   c->add_option("--light-coeffs", a->lightCoefficients, "Default light coefficients kept (k)")->capture_default_str();
-  c->add_option("--encoding", a->encoding, "Default encoding: jpeg|png|raw|exr")->capture_default_str();
+  c->add_option("--encoding", a->encoding, "Default encoding: jpeg|png|raw|exr|h264")->capture_default_str();
   c->add_option("--scene", a->sceneFiles, "Scene files to offer besides the built-in \"default\" (named by file stem)");
   c->add_option("--materials-dir", a->materialsDir, "Offer the MERL .binary files of this folder (as merl:NAME)");
   c->add_option("--web-root", a->webRoot, "The browser client's files (default: the source tree's client/web)");
@@ -271,6 +293,18 @@ std::function<int()> addServeCommand(CLI::App& app) {
   c->add_option("--io-threads", o.ioThreads, "Network threads")->capture_default_str();
   c->add_option("--render-threads", a->renderThreads, "CPU backend threads (0 = all cores)")->capture_default_str();
   c->add_option("--max-renderers", o.render.maxRenderers, "Prepared renderers kept (LRU)")->capture_default_str();
+  c->add_option("--render-workers", o.render.workers,
+                "Frames of different sessions rendering at once (a Vulkan renderer: one at a time)")
+      ->capture_default_str();
+  c->add_option("--max-session-pixels", o.render.maxSessionPixels,
+                "Largest frame (width × height) one session may ask for; a larger one is an Error")
+      ->capture_default_str();
+  c->add_option("--server-pixel-budget", a->serverPixelBudget,
+                "Pixels rendering at once across the server; a frame waits for its share, /readyz is 503 while one "
+                "waits (default 2 × --max-session-pixels; 0 = none)");
+  c->add_option("--max-queued-builds", o.render.maxQueuedBuilds,
+                "Renderer builds waiting across the server; one more is refused with Error OVERLOADED")
+      ->capture_default_str();
   c->add_option("--vulkan-device", a->vulkanDevice, "Vulkan device name substring");
   c->add_flag("--vulkan-validation", a->vulkanValidation, "Enable the Vulkan validation layers");
   c->add_flag("--quiet", a->quiet, "No per-session log lines on stderr");

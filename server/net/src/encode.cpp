@@ -87,6 +87,7 @@ std::string_view encodingName(FrameEncoding encoding) {
     case FrameEncoding::Png: return "png";
     case FrameEncoding::RawRgba8: return "raw";
     case FrameEncoding::Exr: return "exr";
+    case FrameEncoding::H264: return "h264";
   }
   return "unknown";
 }
@@ -167,6 +168,8 @@ std::string encodeFrame(FrameEncoding encoding, const std::vector<std::uint8_t>&
     case FrameEncoding::Png: return encodePng(rgba8, width, height);
     case FrameEncoding::RawRgba8: return encodeRaw(rgba8, width, height);
     case FrameEncoding::Exr: return encodeExr(linear);
+    case FrameEncoding::H264:
+      throw std::logic_error("encodeFrame: H.264 frames depend on the ones before; the session's H264Encoder encodes them");
   }
   throw std::runtime_error("encodeFrame: unknown encoding");
 }

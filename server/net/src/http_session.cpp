@@ -172,7 +172,7 @@ void HttpSession::serve(const Request& request) {
     return;
   }
   if (path == "/metrics") {
-    respond(request, http::status::ok, server_.metrics.prometheusText(), "text/plain; version=0.0.4; charset=utf-8",
+    respond(request, http::status::ok, server_.metricsText(), "text/plain; version=0.0.4; charset=utf-8",
             keepAlive);
     return;
   }

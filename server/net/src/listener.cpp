@@ -49,7 +49,7 @@ std::optional<std::string> exposureWarning(const ServerOptions& options) {
          "or --bind 127.0.0.1)";
 }
 
-Server::Impl::Impl(ServerOptions o, Catalog c, RendererBuilder builder)
+Server::Impl::Impl(ServerOptions o, Catalog c, AbandonableRendererBuilder builder)
     : options(std::move(o)),
       catalog(std::move(c)),
       admission(checkedAdmission(options.admission)),
@@ -140,7 +140,16 @@ std::size_t Server::Impl::sessionCount() {
 }
 
 bool Server::Impl::atCapacity() const {
-  return stopping.load() || admission.count(SlotKind::Session) >= admission.limits().sessions;
+  return stopping.load() || admission.count(SlotKind::Session) >= admission.limits().sessions ||
+         renderService->atPixelBudget();
+}
+
+std::string Server::Impl::metricsText() {
+  metrics.pixelsInFlight.store(renderService->pixelsInFlight());
+  metrics.pixelBudget.store(options.render.serverPixelBudget);
+  metrics.queuedBuilds.store(renderService->queuedBuilds());
+  metrics.maxQueuedBuilds.store(options.render.maxQueuedBuilds);
+  return metrics.prometheusText();
 }
 
 void Server::Impl::stop() {
@@ -187,7 +196,19 @@ void Server::Impl::watchDrain() {
   });
 }
 
+namespace {
+AbandonableRendererBuilder abandonable(RendererBuilder builder) {
+  if (!builder) return {};
+  return [builder = std::move(builder)](const SessionConfig& config, const std::function<bool()>&) {
+    return builder(config);
+  };
+}
+}  // namespace
+
 Server::Server(ServerOptions options, Catalog catalog, RendererBuilder builder)
+    : Server(std::move(options), std::move(catalog), abandonable(std::move(builder))) {}
+
+Server::Server(ServerOptions options, Catalog catalog, AbandonableRendererBuilder builder)
     : impl_(std::make_shared<Impl>(std::move(options), std::move(catalog), std::move(builder))) {
   if (impl_->catalog.scenes.empty()) throw std::invalid_argument("the server needs at least one scene");
   if (impl_->catalog.backends.empty()) throw std::invalid_argument("the server needs at least one enabled backend");

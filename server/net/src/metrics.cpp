@@ -65,8 +65,18 @@ std::string Metrics::prometheusText() const {
   // budget joins as budget="pixels".
   metric("haarcast_capacity", "gauge", "What each budget allows (sessions: --max-sessions).");
   out << "haarcast_capacity{budget=\"sessions\"} " << sessionCapacity.load() << '\n';
+  out << "haarcast_capacity{budget=\"pixels\"} " << pixelBudget.load() << '\n';
+  out << "haarcast_capacity{budget=\"builds\"} " << maxQueuedBuilds.load() << '\n';
   metric("haarcast_budget_in_use", "gauge", "How much of each budget is taken now.");
   out << "haarcast_budget_in_use{budget=\"sessions\"} " << sessions.load() << '\n';
+  out << "haarcast_budget_in_use{budget=\"pixels\"} " << pixelsInFlight.load() << '\n';
+  out << "haarcast_budget_in_use{budget=\"builds\"} " << queuedBuilds.load() << '\n';
+  metric("haarcast_pixels_in_flight", "gauge", "Width × height of the frames rendering now.");
+  out << "haarcast_pixels_in_flight " << pixelsInFlight.load() << '\n';
+  metric("haarcast_pixel_budget", "gauge", "Pixels that may render at once across the server (0 = no budget).");
+  out << "haarcast_pixel_budget " << pixelBudget.load() << '\n';
+  metric("haarcast_queued_builds", "gauge", "Renderer builds waiting for the builder thread.");
+  out << "haarcast_queued_builds " << queuedBuilds.load() << '\n';
   metric("haarcast_draining", "gauge", "1 while the server drains for shutdown.");
   out << "haarcast_draining " << (draining.load() ? 1 : 0) << '\n';
   metric("haarcast_sessions_total", "counter", "WebSocket sessions accepted since start.");
@@ -82,6 +92,9 @@ std::string Metrics::prometheusText() const {
   out << "haarcast_http_requests_total " << httpRequests.load() << '\n';
   metric("haarcast_renderers_built_total", "counter", "Renderers prepared (scene, materials, level, method, backend).");
   out << "haarcast_renderers_built_total " << renderersBuilt.load() << '\n';
+  metric("haarcast_frames_cancelled_total", "counter",
+         "Frame jobs ended without a frame: the session had gone, its request was replaced, or the server stopped.");
+  out << "haarcast_frames_cancelled_total " << framesCancelled.load() << '\n';
 
   std::lock_guard lock(mutex_);
   metric("haarcast_stage_seconds", "summary", "Time per frame stage, summed over frames.");

@@ -39,6 +39,7 @@ std::optional<FrameEncoding> fromWire(v1::Encoding e) {
     case v1::ENCODING_PNG: return FrameEncoding::Png;
     case v1::ENCODING_RAW_RGBA8: return FrameEncoding::RawRgba8;
     case v1::ENCODING_EXR: return FrameEncoding::Exr;
+    case v1::ENCODING_H264: return FrameEncoding::H264;
     default: return std::nullopt;
   }
 }
@@ -103,6 +104,27 @@ std::optional<ProtocolError> mergeSettings(SessionConfig& config, const v1::Rend
                    fatal);
     }
     next.backend = *backend;
+  }
+  // H.264 fields: 0 = unchanged. Accepted for any encoding (they take
+  // effect with ENCODING_H264), checked against h264_encoder.h's ranges.
+  if (s.h264_bitrate_kbps() != 0) {
+    if (s.h264_bitrate_kbps() < static_cast<std::uint32_t>(kMinH264BitrateKbps) ||
+        s.h264_bitrate_kbps() > static_cast<std::uint32_t>(kMaxH264BitrateKbps)) {
+      return error(v1::ERROR_CODE_BAD_SETTINGS,
+                   "h264_bitrate_kbps " + std::to_string(s.h264_bitrate_kbps()) + " is outside " +
+                       std::to_string(kMinH264BitrateKbps) + ".." + std::to_string(kMaxH264BitrateKbps),
+                   fatal);
+    }
+    next.h264BitrateKbps = static_cast<int>(s.h264_bitrate_kbps());
+  }
+  if (s.h264_keyframe_interval() != 0) {
+    if (s.h264_keyframe_interval() > static_cast<std::uint32_t>(kMaxH264KeyframeInterval)) {
+      return error(v1::ERROR_CODE_BAD_SETTINGS,
+                   "h264_keyframe_interval " + std::to_string(s.h264_keyframe_interval()) + " is outside 1.." +
+                       std::to_string(kMaxH264KeyframeInterval),
+                   fatal);
+    }
+    next.h264KeyframeInterval = static_cast<int>(s.h264_keyframe_interval());
   }
   switch (s.exposure_mode()) {
     case v1::EXPOSURE_MODE_UNSPECIFIED: break;  // unchanged (a Hello starts with auto)
@@ -259,7 +281,8 @@ std::variant<SessionConfig, ProtocolError> configFromHello(const v1::Hello& hell
   } else if (const auto e = fromWire(hello.encoding())) {
     c.encoding = *e;
   } else {
-    return error(v1::ERROR_CODE_BAD_SETTINGS, "unknown encoding " + std::to_string(hello.encoding()), true);
+    return error(v1::ERROR_CODE_BAD_SETTINGS, "unknown encoding " + std::to_string(hello.encoding()) +
+                     " (valid: JPEG = 1, PNG = 2, RAW_RGBA8 = 3, EXR = 4, H264 = 5)", true);
   }
   if (!std::isfinite(hello.fps_cap()) || hello.fps_cap() < 0.0) {
     return error(v1::ERROR_CODE_BAD_SETTINGS, "fps_cap must be a finite number ≥ 0 (0 = server default)", true);
@@ -276,6 +299,21 @@ std::variant<SessionConfig, ProtocolError> configFromHello(const v1::Hello& hell
   c.backend = defaults.backend;
   if (auto e = mergeScene(c, hello.scene(), catalog, true)) return *e;
   if (auto e = mergeSettings(c, hello.settings(), limits, catalog, true)) return *e;
+  if (c.encoding == FrameEncoding::H264) {
+    // 4:2:0 halves both dimensions: a resolution the encoder cannot take is
+    // refused here, before any renderer is built.
+    if (c.width % 2 != 0 || c.height % 2 != 0) {
+      return error(v1::ERROR_CODE_BAD_RESOLUTION,
+                   "resolution " + std::to_string(c.width) + "x" + std::to_string(c.height) +
+                       " is odd: ENCODING_H264 needs an even width and height",
+                   true);
+    }
+    try {
+      validateH264Settings(h264Settings(c));
+    } catch (const std::invalid_argument& e) {
+      return error(v1::ERROR_CODE_BAD_SETTINGS, e.what(), true);
+    }
+  }
   return c;
 }
 
@@ -365,6 +403,7 @@ v1::Encoding toWire(FrameEncoding encoding) {
     case FrameEncoding::Png: return v1::ENCODING_PNG;
     case FrameEncoding::RawRgba8: return v1::ENCODING_RAW_RGBA8;
     case FrameEncoding::Exr: return v1::ENCODING_EXR;
+    case FrameEncoding::H264: return v1::ENCODING_H264;
   }
   return v1::ENCODING_UNSPECIFIED;
 }
@@ -396,6 +435,20 @@ v1::RenderSettings settingsToWire(const SessionConfig& config) {
   s.set_backend(toWire(config.backend));
   s.set_exposure_mode(config.autoExposure ? v1::EXPOSURE_MODE_AUTO : v1::EXPOSURE_MODE_FIXED);
   s.set_exposure_stops(config.exposureStops);
+  if (config.encoding == FrameEncoding::H264) {
+    s.set_h264_bitrate_kbps(static_cast<std::uint32_t>(config.h264BitrateKbps));
+    s.set_h264_keyframe_interval(static_cast<std::uint32_t>(config.h264KeyframeInterval));
+  }
+  return s;
+}
+
+H264Settings h264Settings(const SessionConfig& config) {
+  H264Settings s;
+  s.width = config.width;
+  s.height = config.height;
+  s.bitrateKbps = config.h264BitrateKbps;
+  s.keyframeInterval = config.h264KeyframeInterval;
+  s.fps = config.fps;
   return s;
 }
 
@@ -408,6 +461,7 @@ v1::ServerLimits limitsToWire(const Limits& limits) {
   l.set_max_fps(limits.maxFps);
   l.set_max_light_coefficients(static_cast<std::uint32_t>(limits.maxLightCoefficients));
   l.set_max_exposure_stops(render::kMaxExposureStops);
+  l.set_max_h264_bitrate_kbps(static_cast<std::uint32_t>(kMaxH264BitrateKbps));
   return l;
 }
 

@@ -385,8 +385,9 @@ struct RenderService::Impl {
     encodeQueue.push([job = std::move(job), out = std::move(out)]() mutable {
       try {
         const auto t0 = Clock::now();
-        out.encoded = encodeFrame(job.encoding, out.frame.rgba8, out.frame.width, out.frame.height, out.frame.image,
-                                  job.jpegQuality);
+        out.encoded = job.encode ? job.encode(out.frame)
+                                 : encodeFrame(job.encoding, out.frame.rgba8, out.frame.width, out.frame.height,
+                                               out.frame.image, job.jpegQuality);
         out.encodeSeconds = secondsSince(t0);
       } catch (const std::exception& e) {
         job.done(std::nullopt, std::string("encode failed: ") + e.what());

@@ -157,6 +157,10 @@ void RenderSession::onPose(const v1::PoseUpdate& update, Clock::time_point now) 
     return;
   }
   if (applied) {
+    if (update.keyframe() && h264_) {
+      std::lock_guard lock(h264_->mutex);
+      h264_->keyframeAtPose = update.sequence();
+    }
     wantFrame_ = true;
     maybeRender(now);
   }
@@ -182,6 +186,9 @@ void RenderSession::adopt(SessionConfig next, bool announceScene, Clock::time_po
     }
   }
   if (announceScene && welcomed_) port_.send(sceneInfoMessage(config_, catalog_));
+  // The frame in flight answers the old config: cancelled at its next tile,
+  // so the new one starts without waiting for a frame nobody wants.
+  if (inFlight_ && current_) current_->cancelled.store(true);
   wantFrame_ = true;
   if (newRenderer) {
     prepareRenderer();
@@ -198,10 +205,10 @@ void RenderSession::prepareRenderer() {
 }
 
 void RenderSession::onPrepared(const std::string& key, std::shared_ptr<PreparedRenderer> renderer,
-                               const std::string& error, Clock::time_point now) {
+                               const std::string& error, Clock::time_point now, v1::ErrorCode code) {
   if (closed_ || key != config_.rendererKey()) return;  // superseded
   if (!renderer) {
-    const ProtocolError e{v1::ERROR_CODE_RENDER_FAILED, "cannot prepare the renderer: " + error, !welcomed_};
+    const ProtocolError e{code, "cannot prepare the renderer: " + error, !welcomed_};
     if (e.fatal) {
       fail(e);
     } else {
@@ -229,6 +236,10 @@ void RenderSession::onPace(Clock::time_point now) {
 
 void RenderSession::maybeRender(Clock::time_point now) {
   if (!renderer_ || inFlight_ || !wantFrame_ || closed_) return;
+  // H.264: every access unit must reach the decoder (each frame depends on
+  // the one before), so no frame is rendered while one waits to be sent:
+  // the frame slot's latest-wins never drops one. onSent() comes back here.
+  if (config_.encoding == FrameEncoding::H264 && frameUnsent_) return;
   if (now < nextFrameAt_) {
     if (!paceArmed_) {
       paceArmed_ = true;
@@ -239,7 +250,46 @@ void RenderSession::maybeRender(Clock::time_point now) {
   wantFrame_ = false;
   inFlight_ = true;
   nextFrameAt_ = now + toDuration(1.0 / std::max(config_.fps, 1e-3));
-  port_.render({renderer_, config_.encoding, config_.jpegQuality, std::make_shared<FrameContext>()});
+  current_ = std::make_shared<FrameContext>();
+  const std::size_t pixels = static_cast<std::size_t>(config_.width) * static_cast<std::size_t>(config_.height);
+  FrameOrder order{renderer_, config_.encoding, config_.jpegQuality, pixels, current_, {}};
+  if (config_.encoding == FrameEncoding::H264) {
+    if (!h264_) h264_ = std::make_shared<H264Stream>();
+    order.encode = [stream = h264_, context = current_](const render::Frame& frame) {
+      return stream->encode(frame, *context);
+    };
+  }
+  port_.render(std::move(order));
+}
+
+std::string H264Stream::encode(const render::Frame& frame, const FrameContext& context) {
+  std::lock_guard lock(mutex);
+  H264Settings settings = h264Settings(context.config);
+  settings.width = frame.width;
+  settings.height = frame.height;
+  if (!encoder) {
+    encoder = std::make_unique<H264Encoder>(settings);  // its first frame is a keyframe
+  } else {
+    encoder->reconfigure(settings);  // new settings: a keyframe; the same: nothing
+  }
+  if (keyframeNow || (keyframeAtPose != 0 && context.poseSequence >= keyframeAtPose)) {
+    encoder->requestKeyframe();
+    keyframeNow = false;
+    keyframeAtPose = 0;
+  }
+  H264AccessUnit unit = encoder->encode(frame.rgba8, frame.width, frame.height);
+  if (unit.keyframe) ++keyframes;
+  return std::move(unit.annexB);
+}
+
+void RenderSession::onCancelled(const FrameContext& context, Clock::time_point now) {
+  if (current_.get() != &context) return;  // not the frame in flight (cannot happen: one at a time)
+  inFlight_ = false;
+  current_.reset();
+  if (closed_) return;
+  // The frame was wanted for the old request; the new one still wants one.
+  wantFrame_ = true;
+  maybeRender(now);
 }
 
 std::optional<render::FrameRequest> RenderSession::takeRequest(FrameContext& context) {
@@ -260,6 +310,7 @@ std::optional<render::FrameRequest> RenderSession::takeRequest(FrameContext& con
 void RenderSession::onRendered(const FrameContext& context, std::optional<RenderedFrame> rendered,
                                const std::string& error, Clock::time_point now) {
   inFlight_ = false;
+  current_.reset();
   if (closed_) return;
   if (!rendered) {
     // Once per distinct message: a broken config must not flood the client.
@@ -290,17 +341,26 @@ void RenderSession::onRendered(const FrameContext& context, std::optional<Render
     // The client had not taken the last one yet: latest wins.
     ++framesDropped_;
     metrics_.framesDropped.fetch_add(1);
+    if (h264_) {
+      // Not expected (maybeRender waits for the slot to empty), but a lost
+      // access unit breaks the decoder until the next keyframe: ask for one.
+      std::lock_guard lock(h264_->mutex);
+      h264_->keyframeNow = true;
+    }
   }
+  frameUnsent_ = true;
   maybeRender(now);
 }
 
-void RenderSession::onSent(bool isFrame, std::size_t payloadBytes) {
+void RenderSession::onSent(bool isFrame, std::size_t payloadBytes, Clock::time_point now) {
   if (!isFrame) return;
+  frameUnsent_ = false;
   ++framesSent_;
   ++periodFrames_;
   bytesSent_ += payloadBytes;
   metrics_.framesTotal.fetch_add(1);
   metrics_.bytesTotal.fetch_add(payloadBytes);
+  if (config_.encoding == FrameEncoding::H264 && !closed_) maybeRender(now);
 }
 
 // ------------------------------------------------------------------ errors, timeouts, Stats
@@ -330,6 +390,7 @@ void RenderSession::fail(ProtocolError e, CloseCode code) {
 void RenderSession::end() {
   closed_ = true;
   ended_.store(true);
+  if (current_) current_->cancelled.store(true);  // nobody will read the frame
 }
 
 void RenderSession::onTick(Clock::time_point now) {

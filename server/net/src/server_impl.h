@@ -49,7 +49,7 @@ struct Server::Impl {
   std::uint16_t boundPort = 0;
   std::unique_ptr<RenderService> renderService;
 
-  Impl(ServerOptions o, Catalog c, RendererBuilder builder);
+  Impl(ServerOptions o, Catalog c, AbandonableRendererBuilder builder);
 
   void log(const char* format, ...) __attribute__((format(printf, 2, 3)));
   void listen();
@@ -59,6 +59,8 @@ struct Server::Impl {
   void watchDrain();
   std::size_t sessionCount();
   bool atCapacity() const;
+  // /metrics: the render service's gauges copied into `metrics`, then the text.
+  std::string metricsText();
 };
 
 // Seconds → a Clock duration (negative: 0).

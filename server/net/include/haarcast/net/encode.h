@@ -6,6 +6,9 @@
 //   RAW       the RGBA8 bytes as they are: width·height·4, row 0 at the top
 //   EXR       OpenEXR in memory, linear half RGB (ZIP): the renderer's numbers,
 //             rounded to half, for exact checks
+//   H264      one Annex-B access unit per frame: stateful (each frame depends
+//             on the ones before), so a session's own H264Encoder
+//             (h264_encoder.h) encodes it, never encodeFrame
 //
 // All of them throw std::runtime_error naming the codec and what was wrong;
 // a decoder given bytes that are not its format never crashes.
@@ -20,9 +23,9 @@
 
 namespace haarcast::net {
 
-enum class FrameEncoding { Jpeg, Png, RawRgba8, Exr };
+enum class FrameEncoding { Jpeg, Png, RawRgba8, Exr, H264 };
 
-std::string_view encodingName(FrameEncoding encoding);  // "jpeg", "png", "raw", "exr"
+std::string_view encodingName(FrameEncoding encoding);  // "jpeg", "png", "raw", "exr", "h264"
 
 // rgba8: width·height·4 bytes. jpegQuality is clamped to 1..100.
 std::string encodeJpeg(const std::vector<std::uint8_t>& rgba8, int width, int height, int jpegQuality);

@@ -28,6 +28,13 @@ class Metrics {
   std::atomic<std::uint64_t> bytesTotal{0};        // frame payload bytes sent
   std::atomic<std::uint64_t> httpRequests{0};
   std::atomic<std::uint64_t> renderersBuilt{0};
+  std::atomic<std::uint64_t> framesCancelled{0};   // frame jobs ended without a frame (session gone, request replaced, stop)
+  // Gauges of the render service, copied in just before each exposition
+  // (Server: the service owns the numbers).
+  std::atomic<std::uint64_t> pixelsInFlight{0};    // width × height of the frames rendering now
+  std::atomic<std::uint64_t> pixelBudget{0};       // --server-pixel-budget (0 = none)
+  std::atomic<std::uint64_t> queuedBuilds{0};      // renderer builds waiting
+  std::atomic<std::uint64_t> maxQueuedBuilds{0};   // --max-queued-builds
 
   // One frame's stage times (seconds), "encode" included.
   void addStages(const std::vector<render::StageTime>& stages);

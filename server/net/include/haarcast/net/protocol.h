@@ -17,6 +17,7 @@
 
 #include "haarcast/core/rotation.h"
 #include "haarcast/net/encode.h"
+#include "haarcast/net/h264_encoder.h"
 #include "haarcast/proto/haarcast.pb.h"
 #include "haarcast/render/renderer.h"
 
@@ -101,6 +102,9 @@ struct SessionConfig {
   Backend backend = Backend::Cpu;
   bool autoExposure = true;   // else exposureStops
   double exposureStops = 0.0;
+  // ENCODING_H264 only (h264_encoder.h has the ranges).
+  int h264BitrateKbps = kDefaultH264BitrateKbps;
+  int h264KeyframeInterval = kDefaultH264KeyframeInterval;
 
   // Identifies the prepared renderer this config needs; equal keys share one.
   std::string rendererKey() const;
@@ -151,6 +155,9 @@ v1::RotationMethod toWire(RotationMethod method);
 v1::Backend toWire(Backend backend);
 v1::RenderSettings settingsToWire(const SessionConfig& config);
 v1::ServerLimits limitsToWire(const Limits& limits);
+// The H.264 encoder settings of a config (size, bitrate, keyframe interval,
+// fps); meaningful for ENCODING_H264.
+H264Settings h264Settings(const SessionConfig& config);
 // The config's scene, its objects (named by the catalog) and their materials.
 v1::SceneInfo sceneInfo(const SessionConfig& config, const Catalog& catalog);
 

@@ -80,6 +80,11 @@ struct RenderJob {
   // The encoding of the finished frame.
   FrameEncoding encoding = FrameEncoding::Jpeg;
   int jpegQuality = 85;
+  // When set, encodes the finished frame instead of `encoding`'s stateless
+  // encoder: a session's own stateful encoder (H.264). Called on an encode
+  // thread; a session has one job at a time, so its frames are encoded in
+  // order, one at a time. Throws like the encoders.
+  std::function<std::string(const render::Frame& frame)> encode;
   // Called once, on a service thread, with the frame or an error message
   // (a frame over Options::maxSessionPixels is an error naming the limit).
   std::function<void(std::optional<RenderedFrame>, std::string error)> done;

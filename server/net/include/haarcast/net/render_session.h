@@ -17,12 +17,14 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
 #include <string_view>
 
+#include "haarcast/net/h264_encoder.h"
 #include "haarcast/net/messages.h"
 #include "haarcast/net/metrics.h"
 #include "haarcast/net/protocol.h"
@@ -34,6 +36,11 @@ namespace haarcast::net {
 // What a frame job read when its worker started it; the strand reads it back
 // when the frame is done.
 struct FrameContext {
+  // Set on the strand when the frame is no longer wanted: its session has
+  // ended, or a new size, settings or scene replaced the request (a newer
+  // pose alone does not: a client that sends poses continuously would never
+  // get a frame). The job's `cancelled` reads it from a render worker.
+  std::atomic<bool> cancelled{false};
   std::uint64_t poseSequence = 0;
   double clientTimeMs = 0.0;
   Clock::time_point poseReceived;
@@ -46,7 +53,27 @@ struct FrameOrder {
   std::shared_ptr<PreparedRenderer> renderer;
   FrameEncoding encoding = FrameEncoding::Jpeg;
   int jpegQuality = 85;
+  std::size_t pixels = 0;  // width × height: the job's share of the server's pixel budget
   std::shared_ptr<FrameContext> context;
+  // ENCODING_H264: the session's encoder (RenderJob::encode); empty otherwise.
+  std::function<std::string(const render::Frame& frame)> encode;
+};
+
+// The H.264 stream of one session: its encoder, used by one encode thread at
+// a time (a session has one frame in flight) and asked for keyframes from
+// the strand, hence the lock.
+struct H264Stream {
+  std::mutex mutex;
+  std::unique_ptr<H264Encoder> encoder;  // made by the first frame
+  // A keyframe for the frame answering this pose sequence or a later one
+  // (PoseUpdate.keyframe); 0 = none asked for.
+  std::uint64_t keyframeAtPose = 0;
+  bool keyframeNow = false;  // the next frame, whatever its pose (a frame was lost)
+  std::uint64_t keyframes = 0;  // IDRs sent out: for tests and the log
+
+  // One access unit for `frame`, under `config`'s H.264 settings (a change
+  // restarts the stream with a keyframe).
+  std::string encode(const render::Frame& frame, const FrameContext& context);
 };
 
 class SessionPort {
@@ -80,13 +107,20 @@ class RenderSession {
                 std::string id, Clock::time_point opened);
 
   void onMessage(std::string_view bytes, bool binary, Clock::time_point now);
+  // A renderer, or nullptr and why not: `code` is RENDER_FAILED for a build
+  // that failed, OVERLOADED for one the server's build queue refused.
   void onPrepared(const std::string& key, std::shared_ptr<PreparedRenderer> renderer, const std::string& error,
-                  Clock::time_point now);
+                  Clock::time_point now, v1::ErrorCode code = v1::ERROR_CODE_RENDER_FAILED);
   void onRendered(const FrameContext& context, std::optional<RenderedFrame> rendered, const std::string& error,
                   Clock::time_point now);
+  // The job of `context` ended without a frame (cancelled, or its session
+  // gone): the next frame may be rendered.
+  void onCancelled(const FrameContext& context, Clock::time_point now);
   void onPace(Clock::time_point now);
   void onTick(Clock::time_point now);  // timeouts and Stats
-  void onSent(bool isFrame, std::size_t payloadBytes);
+  // A message left the socket. A sent frame lets the next H.264 frame be
+  // rendered (its stream never drops an access unit).
+  void onSent(bool isFrame, std::size_t payloadBytes, Clock::time_point now = Clock::now());
 
   // A fatal error: counted, logged, sent, then the close. Idempotent.
   void fail(ProtocolError error, CloseCode code = CloseCode::PolicyError);
@@ -129,6 +163,9 @@ class RenderSession {
   int badMessages_ = 0;
   std::string clientName_;  // sanitised for the log
   std::shared_ptr<PreparedRenderer> renderer_;
+  std::shared_ptr<FrameContext> current_;  // the frame in flight (inFlight_), to cancel
+  std::shared_ptr<H264Stream> h264_;       // ENCODING_H264 sessions
+  bool frameUnsent_ = false;               // a frame waits in the transport's frame slot
   Clock::time_point opened_, lastMessage_, lastStats_, nextFrameAt_{};
   std::uint64_t frameSequence_ = 0, framesSent_ = 0, framesDropped_ = 0, bytesSent_ = 0;
   std::uint64_t periodFrames_ = 0, periodRendered_ = 0;

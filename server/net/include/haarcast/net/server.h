@@ -79,6 +79,10 @@ class Server {
   // when it cannot. The renderers come from `builder` (the app layer's
   // backend factory in `haarcast serve`).
   Server(ServerOptions options, Catalog catalog, RendererBuilder builder);
+  // A builder that stops early once nobody waits for its build (the
+  // session closed, or the server stops): what lets SIGTERM end a running
+  // build at its next precompute step.
+  Server(ServerOptions options, Catalog catalog, AbandonableRendererBuilder builder);
   ~Server();  // stop() and wait()
   Server(const Server&) = delete;
   Server& operator=(const Server&) = delete;
@@ -98,8 +102,9 @@ class Server {
   void wait();
 
   // True when a load balancer should send no new clients here (/readyz 503):
-  // the session budget is full or the server is draining. (The one place a
-  // further budget, such as rendered pixels, joins.)
+  // the session budget is full, the render service is at its pixel budget
+  // (RenderService::atPixelBudget: a job waits for pixels), or the server is
+  // draining.
   bool atCapacity() const;
 
   const Metrics& metrics() const;
