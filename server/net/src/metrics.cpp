@@ -1,6 +1,10 @@
 #include "haarcast/net/metrics.h"
 
+#include <sys/resource.h>
+#include <unistd.h>
+
 #include <cstdio>
+#include <fstream>
 #include <sstream>
 
 namespace haarcast::net {
@@ -22,6 +26,23 @@ constexpr Family kViolations{"haarcast_websocket_violations_total", "kind",
 constexpr Family kRefusals{"haarcast_refusals_total", "reason",
                            "Connections and upgrades turned away (origin, token, per-address and server budgets)."};
 constexpr Family kFamilies[] = {kHttpResponses, kTimeouts, kCuts, kViolations, kRefusals};
+
+// The process figures every Prometheus client library exports under these
+// names (so dashboards and `haarcast loadtest --url` read them unchanged):
+// CPU seconds from getrusage, resident bytes from /proc/self/statm.
+double processCpuSeconds() {
+  rusage u{};
+  if (getrusage(RUSAGE_SELF, &u) != 0) return -1.0;
+  auto seconds = [](const timeval& t) { return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec); };
+  return seconds(u.ru_utime) + seconds(u.ru_stime);
+}
+
+long long processResidentBytes() {
+  std::ifstream statm("/proc/self/statm");
+  long long sizePages = 0, residentPages = 0;
+  if (!(statm >> sizePages >> residentPages)) return -1;
+  return residentPages * static_cast<long long>(sysconf(_SC_PAGESIZE));
+}
 
 }  // namespace
 
@@ -57,6 +78,14 @@ std::string Metrics::prometheusText() const {
   auto metric = [&](const char* name, const char* type, const char* help) {
     out << "# HELP " << name << ' ' << help << "\n# TYPE " << name << ' ' << type << '\n';
   };
+  if (const double cpu = processCpuSeconds(); cpu >= 0.0) {
+    metric("process_cpu_seconds_total", "counter", "User and system CPU time of the server process, in seconds.");
+    out << "process_cpu_seconds_total " << cpu << '\n';
+  }
+  if (const long long rss = processResidentBytes(); rss >= 0) {
+    metric("process_resident_memory_bytes", "gauge", "Resident memory of the server process, in bytes.");
+    out << "process_resident_memory_bytes " << rss << '\n';
+  }
   metric("haarcast_sessions", "gauge", "WebSocket sessions open now (counted from a valid Hello).");
   out << "haarcast_sessions " << sessions.load() << '\n';
   metric("haarcast_pending_connections", "gauge", "WebSocket connections waiting for their Hello.");
