@@ -34,7 +34,10 @@ void VulkanRenderer::Impl::runStages(const std::vector<FrameStage>& stages, rend
     frame.stages.push_back({name, seconds});
   };
   if (!useTimestamps) {
-    for (const auto& [name, record] : stages) {
+    for (const FrameStage& stage : stages) {
+      // (not a structured binding: clang 14, the fuzzing build's compiler,
+      // cannot capture one in the lambda below)
+      const auto& record = stage.second;
       frame.cancelled = cancelRequested();
       if (frame.cancelled) return;
       const auto t = RendererClock::now();
@@ -42,7 +45,7 @@ void VulkanRenderer::Impl::runStages(const std::vector<FrameStage>& stages, rend
         record(cb);
         computeBarrier(cb);
       });
-      add(name, secondsSince(t));
+      add(stage.first, secondsSince(t));
     }
     return;
   }
