@@ -28,7 +28,7 @@ Catalog fuzzCatalog() {
   c.scenes.push_back({"default", {"phong:64", "lambert"}, render::Camera{}, {render::Pose{}, turned}, {"ball", "ring"}});
   c.scenes.push_back({"other", {"ggx:0.3"}, render::Camera{}, {render::Pose{}}, {}});
   c.materials = {"lambert", "phong:64", "ggx:0.3", "steel.binary"};
-  c.backends = {"cpu", "vulkan"};
+  c.backends = {Backend::Cpu, Backend::Vulkan};
   return c;
 }
 
