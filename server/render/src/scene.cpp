@@ -192,7 +192,8 @@ Scene loadScene(const std::string& path) {
   nlohmann::json j;
   try {
     j = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::parse_error& e) {
+  } catch (const nlohmann::json::exception& e) {
+    // parse_error, and out_of_range for a number no double holds (1e99999).
     throw std::runtime_error(path + ": not valid JSON: " + e.what());
   }
   if (!j.is_object()) fail(path, "top level", "expected an object");
