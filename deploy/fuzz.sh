@@ -50,6 +50,8 @@ failed=0
 printf '%-15s %12s %8s  %s\n' target executions crashes "crash inputs"
 for t in "${targets[@]}"; do
   work="$dir/corpus/$t" artifacts="$dir/artifacts/$t"
+  # Crash inputs of this run only: an earlier run's would be counted again.
+  rm -rf "$artifacts"
   mkdir -p "$work" "$artifacts"
   log="$dir/artifacts/$t.log"
   "$dir/fuzz/$t" -max_total_time="$seconds" -rss_limit_mb=2560 -malloc_limit_mb=2048 -timeout=10 \
