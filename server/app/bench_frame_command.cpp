@@ -20,6 +20,7 @@
 #include <nlohmann/json.hpp>
 
 #include "haarcast/gpu/backend.h"
+#include "list_flags.h"
 #include "haarcast/render/renderer.h"
 #include "haarcast/render/scene.h"
 
@@ -40,61 +41,6 @@ struct BenchArgs {
   int warmup = 1;
   bool json = false;
 };
-
-std::vector<int> parseInts(const std::string& text, const char* flag, int lo, int hi) {
-  std::vector<int> out;
-  std::stringstream in(text);
-  std::string item;
-  while (std::getline(in, item, ',')) {
-    std::size_t used = 0;
-    int v = 0;
-    try {
-      v = std::stoi(item, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used != item.size() || item.empty() || v < lo || v > hi) {
-      throw std::invalid_argument(std::string(flag) + ": \"" + item + "\" is not an integer in " + std::to_string(lo) +
-                                  ".." + std::to_string(hi));
-    }
-    out.push_back(v);
-  }
-  if (out.empty()) throw std::invalid_argument(std::string(flag) + " is empty");
-  return out;
-}
-
-// "256" (square) or "1920x1080", comma-separated.
-std::vector<std::pair<int, int>> parseSizes(const std::string& text) {
-  std::vector<std::pair<int, int>> out;
-  std::stringstream in(text);
-  std::string item;
-  while (std::getline(in, item, ',')) {
-    const std::size_t x = item.find('x');
-    const std::string w = item.substr(0, x), h = x == std::string::npos ? w : item.substr(x + 1);
-    const std::vector<int> wv = parseInts(w, "--sizes", 1, render::kMaxFrameSide);
-    const std::vector<int> hv = parseInts(h, "--sizes", 1, render::kMaxFrameSide);
-    out.emplace_back(wv[0], hv[0]);
-  }
-  if (out.empty()) throw std::invalid_argument("--sizes is empty");
-  return out;
-}
-
-std::vector<RotationMethod> parseMethods(const std::string& text) {
-  std::vector<RotationMethod> out;
-  std::stringstream in(text);
-  std::string item;
-  while (std::getline(in, item, ',')) {
-    if (item == "all") {
-      out.insert(out.end(), std::begin(kAllPixelMethods), std::end(kAllPixelMethods));
-      continue;
-    }
-    const auto m = parseRotationMethod(item);
-    if (!m) throw std::invalid_argument("--method: \"" + item + "\" is not one of " + pixelMethodNames() + " or all");
-    out.push_back(*m);
-  }
-  if (out.empty()) throw std::invalid_argument("--method is empty");
-  return out;
-}
 
 // Mean of each stage and of the frame over the timed frames.
 struct Measured {
@@ -150,12 +96,12 @@ int run(const BenchArgs& a) {
   }
   if (a.frames < 1 || a.frames > 1000) throw std::invalid_argument("--frames must be in 1..1000");
   if (a.warmup < 0 || a.warmup > 100) throw std::invalid_argument("--warmup must be in 0..100");
-  const std::vector<std::pair<int, int>> sizes = parseSizes(a.sizes);
+  const std::vector<std::pair<int, int>> sizes = parseSizeList(a.sizes, "--sizes");
   if (a.slices != "blend" && a.slices != "nearest") {
     throw std::invalid_argument("--slices must be blend or nearest (got \"" + a.slices + "\")");
   }
-  const std::vector<int> levels = parseInts(a.levels, "--levels", 2, 8);
-  const std::vector<RotationMethod> methods = parseMethods(a.methods);
+  const std::vector<int> levels = parseIntList(a.levels, "--levels", render::kMinRenderLevel, render::kMaxRenderLevel);
+  const std::vector<RotationMethod> methods = parseMethodList(a.methods, "--method", true);
   const bool cpu = a.backend != "vulkan", vulkan = a.backend != "cpu";
   if (a.antialias != "on" && a.antialias != "off") {
     throw std::invalid_argument("--antialias must be on or off (got \"" + a.antialias + "\")");

@@ -21,6 +21,7 @@
 #include "app_paths.h"
 #include "client_options.h"
 #include "haarcast/render/renderer.h"
+#include "list_flags.h"
 #include "loadtest_progress.h"
 #include "loadtest_report.h"
 #include "loadtest_server.h"
@@ -64,57 +65,6 @@ constexpr const char* kQuickSizes = "32";
 constexpr double kQuickSeconds = 2.0;
 constexpr int kQuickLevel = 4;
 
-std::vector<std::string> splitList(const std::string& text, const char* flag) {
-  std::vector<std::string> out;
-  std::stringstream in(text);
-  std::string item;
-  while (std::getline(in, item, ',')) {
-    if (item.empty()) throw std::invalid_argument(std::string(flag) + " \"" + text + "\" has an empty item");
-    out.push_back(item);
-  }
-  if (out.empty()) throw std::invalid_argument(std::string(flag) + " is empty");
-  return out;
-}
-
-int parseBounded(const std::string& item, const char* flag, int lo, int hi) {
-  std::size_t used = 0;
-  int v = 0;
-  try {
-    v = std::stoi(item, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used != item.size() || v < lo || v > hi) {
-    throw std::invalid_argument(std::string(flag) + ": \"" + item + "\" is not an integer in " + std::to_string(lo) +
-                                ".." + std::to_string(hi));
-  }
-  return v;
-}
-
-// The encodings the protocol names (haarcast.proto's Encoding, less
-// UNSPECIFIED), as lower-case words: "ENCODING_RAW_RGBA8" → "raw_rgba8".
-std::vector<std::pair<std::string, v1::Encoding>> protocolEncodings() {
-  std::vector<std::pair<std::string, v1::Encoding>> out;
-  const auto* d = v1::Encoding_descriptor();
-  for (int i = 0; i < d->value_count(); ++i) {
-    const auto* value = d->value(i);
-    if (value->number() == v1::ENCODING_UNSPECIFIED) continue;
-    std::string word = value->name().substr(std::string_view("ENCODING_").size());
-    std::transform(word.begin(), word.end(), word.begin(), [](unsigned char c) { return std::tolower(c); });
-    out.emplace_back(word, static_cast<v1::Encoding>(value->number()));
-  }
-  return out;
-}
-
-v1::Encoding parseProtocolEncoding(const std::string& word) {
-  std::string valid;
-  for (const auto& [name, e] : protocolEncodings()) {
-    if (name == word) return e;
-    valid += (valid.empty() ? "" : ", ") + name;
-  }
-  throw std::invalid_argument("--encodings: \"" + word + "\" is not an encoding of the protocol (valid: " + valid + ")");
-}
-
 std::string loadAverage() {
   std::ifstream in("/proc/loadavg");
   std::string a, b, c;
@@ -142,18 +92,15 @@ struct Plan {
 
 Plan plan(const LoadtestArgs& a) {
   Plan p;
-  for (const auto& m : splitList(a.methods, "--methods")) {
-    const auto method = parseRotationMethod(m);
-    if (!method) throw std::invalid_argument("--methods: \"" + m + "\" is not one of " + pixelMethodNames());
-    p.methods.push_back(*method);
+  p.methods = parseMethodList(a.methods, "--methods", false);
+  p.clients = parseIntList(a.clients, "--clients", 1, 256);
+  p.sizes = parseSizeList(a.sizes, "--sizes");
+  // The client's encoding names (jpeg, png, raw, exr, h264): one spelling
+  // for haarcast-client --encoding and this report.
+  for (const auto& e : splitList(a.encodings, "--encodings")) {
+    const v1::Encoding encoding = client::parseEncoding(e);
+    p.encodings.emplace_back(client::encodingName(encoding), encoding);
   }
-  for (const auto& c : splitList(a.clients, "--clients")) p.clients.push_back(parseBounded(c, "--clients", 1, 256));
-  for (const auto& s : splitList(a.sizes, "--sizes")) {
-    const std::size_t x = s.find('x');
-    const int w = parseBounded(s.substr(0, x), "--sizes", 1, render::kMaxFrameSide);
-    p.sizes.emplace_back(w, x == std::string::npos ? w : parseBounded(s.substr(x + 1), "--sizes", 1, render::kMaxFrameSide));
-  }
-  for (const auto& e : splitList(a.encodings, "--encodings")) p.encodings.emplace_back(e, parseProtocolEncoding(e));
   if (a.level < render::kMinRenderLevel || a.level > render::kMaxRenderLevel ||
       a.storageLevel < render::kMinRenderLevel || a.storageLevel > render::kMaxRenderLevel) {
     throw std::invalid_argument("--level and --storage-level must be in " + std::to_string(render::kMinRenderLevel) +
@@ -358,9 +305,7 @@ std::function<int()> addLoadtestCommand(CLI::App& app) {
                       ->capture_default_str();
   auto* clients = c->add_option("--clients", a->clients, "Client counts, comma-separated")->capture_default_str();
   auto* sizes = c->add_option("--sizes", a->sizes, "Frame sizes, comma-separated: N for N×N, or WxH")->capture_default_str();
-  std::string encodingNames;
-  for (const auto& [name, e] : protocolEncodings()) encodingNames += (encodingNames.empty() ? "" : ", ") + name;
-  c->add_option("--encodings", a->encodings, "Encodings, comma-separated: " + encodingNames)->capture_default_str();
+  c->add_option("--encodings", a->encodings, "Encodings, comma-separated: jpeg, png, raw, exr, h264")->capture_default_str();
   auto* seconds = c->add_option("--seconds", a->seconds, "Measured seconds per run (after the warm-up)")->capture_default_str();
   c->add_option("--warmup", a->warmup, "Poses per client played first and left out (the renderer is built before Welcome)")
       ->capture_default_str();

@@ -5,32 +5,19 @@
 #include <string>
 
 #include "haarcast/core/fused.h"
-#include "haarcast/io/slice_cache.h"
 
 namespace haarcast::app {
 namespace {
 
-// The slice tables of every object at options.level, exactly as prepareScene
-// makes them (same table options, same cache), without the visibility that
+// The slice tables of every object at options.level, by the function
+// prepareScene uses (same table options, same cache), without the visibility that
 // prepareScene also computes: sizing level 6 then costs seconds, not the
 // minutes level-6 visibility takes.
 std::vector<BrdfSliceTable> sliceTables(const render::Scene& scene, const render::RenderOptions& options,
                                         const StageProgress& progress) {
   render::checkRenderOptions(options);
   std::vector<BrdfSliceTable> tables;
-  for (const render::SceneObject& object : scene.objects) {
-    SliceTableOptions table;
-    table.level = options.level;
-    table.thetaSamples = options.thetaSamples;
-    table.supersampling = options.sliceSupersampling;
-    auto tableProgress = [&](int done, int total) {
-      if (progress) progress("slices " + object.name, static_cast<std::size_t>(done), static_cast<std::size_t>(total));
-    };
-    tables.push_back(options.cacheDir.empty()
-                         ? BrdfSliceTable::build(*object.material.brdf, table, tableProgress)
-                         : io::loadOrBuildSliceTable(*object.material.brdf, table, options.cacheDir,
-                                                     object.material.cacheKey, tableProgress));
-  }
+  for (const render::SceneObject& object : scene.objects) tables.push_back(render::objectSliceTable(object, options, progress));
   return tables;
 }
 

@@ -41,21 +41,8 @@ expect "bad --level" 2 "--level: Value 12 not in range 0 to 7" -- "$client_bin" 
 expect "bad --exposure" 2 "--exposure must be auto or a number of stops" -- "$client_bin" ws://127.0.0.1:1 --exposure bright
 expect "connection refused" 1 "Connection refused" -- "$client_bin" ws://127.0.0.1:1 --frames 1 --quiet
 
-"$server_bin" serve --port 0 --token sekret --backend "${HAARCAST_SMOKE_BACKEND:-cpu}" \
-  >"$work/server.out" 2>"$work/server.err" </dev/null &
-server_pid=$!
-port=""
-for ((i = 0; i < 600; i++)); do
-  port="$(sed -n 's#.*listening on http://[^:]*:\([0-9]*\)/.*#\1#p' "$work/server.out" | head -1)"
-  [[ -n "$port" ]] && break
-  kill -0 "$server_pid" 2>/dev/null || break
-  sleep 0.1
-done
-if [[ -z "$port" ]]; then
-  echo "FAIL the server did not start:"
-  cat "$work/server.err"
-  exit 1
-fi
+source "$(dirname "${BASH_SOURCE[0]}")/start_server.sh"
+start_server "$server_bin" serve --port 0 --token sekret --backend "${HAARCAST_SMOKE_BACKEND:-cpu}"
 url="ws://127.0.0.1:$port"
 common=(--frames 2 --size 64x64 --quiet --timeout 60)
 expect "no token" 1 "HTTP 401" -- "$client_bin" "$url" "${common[@]}"

@@ -23,21 +23,8 @@ cleanup() {
 }
 trap cleanup EXIT
 
-"$server_bin" serve --port 0 --backend "${HAARCAST_SMOKE_BACKEND:-cpu}" \
-  >"$work/server.out" 2>"$work/server.err" </dev/null &
-server_pid=$!
-port=""
-for ((i = 0; i < 600; i++)); do
-  port="$(sed -n 's#.*listening on http://[^:]*:\([0-9]*\)/.*#\1#p' "$work/server.out" | head -1)"
-  [[ -n "$port" ]] && break
-  kill -0 "$server_pid" 2>/dev/null || break
-  sleep 0.1
-done
-if [[ -z "$port" ]]; then
-  echo "FAIL: the server did not start:"
-  cat "$work/server.out" "$work/server.err"
-  exit 1
-fi
+source "$(dirname "${BASH_SOURCE[0]}")/start_server.sh"
+start_server "$server_bin" serve --port 0 --backend "${HAARCAST_SMOKE_BACKEND:-cpu}"
 url="ws://127.0.0.1:$port"
 run=(--frames 60 --size 256x256 --orbit 360 --check-not-blank --quiet --json --timeout 120)
 

@@ -17,30 +17,7 @@ if (($# > 0)) && [[ "$1" != "--" ]]; then
 fi
 [[ "${1:-}" == "--" ]] && shift
 
-repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
-web="$repo/client/web"
-chromium="${CHROMIUM:-/usr/bin/chromium}"
-
-for tool in node npm; do
-  if ! command -v "$tool" >/dev/null 2>&1; then
-    echo "SKIP: $tool is not installed (deploy/run.sh installs it)"
-    exit 77
-  fi
-done
-if [[ ! -x "$chromium" ]]; then
-  echo "SKIP: no Chromium at $chromium (apt-get install chromium, or set CHROMIUM)"
-  exit 77
-fi
-
-# The lock file pins every package; `npm ci` installs exactly those, from the
-# configured registry, and its postinstall copies protobufjs into vendor/.
-# Never a browser download: playwright-core drives the Chromium above.
-export PLAYWRIGHT_SKIP_BROWSER_DOWNLOAD=1
-if [[ ! -d "$web/node_modules/playwright-core" || ! -f "$web/vendor/protobuf.min.js" ||
-      "$web/package-lock.json" -nt "$web/node_modules/.package-lock.json" ]]; then
-  echo "npm ci in $web"
-  (cd "$web" && npm ci --no-audit --no-fund)
-fi
+source "$(dirname "${BASH_SOURCE[0]}")/browser_env.sh"
 
 args=(--haarcast "$haarcast" --chromium "$chromium")
 [[ -n "$out" ]] && args+=(--out "$out")

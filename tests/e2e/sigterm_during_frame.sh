@@ -19,16 +19,8 @@ cleanup() {
 }
 trap cleanup EXIT
 
-"$server_bin" serve --port 0 --backend cpu --level 4 >"$work/server.out" 2>"$work/server.err" </dev/null &
-server_pid=$!
-port=""
-for ((i = 0; i < 600; i++)); do
-  port="$(sed -n 's#.*listening on http://[^:]*:\([0-9]*\)/.*#\1#p' "$work/server.out" | head -1)"
-  [[ -n "$port" ]] && break
-  kill -0 "$server_pid" 2>/dev/null || break
-  sleep 0.1
-done
-[[ -n "$port" ]] || { echo "FAIL: the server did not start:"; cat "$work/server.err"; exit 1; }
+source "$(dirname "${BASH_SOURCE[0]}")/start_server.sh"
+start_server "$server_bin" serve --port 0 --backend cpu --level 4
 
 "$client_bin" "ws://127.0.0.1:$port" --size 2048x2048 --frames 1000 --orbit 360 --quiet --timeout 300 \
   >"$work/client.out" 2>"$work/client.err" &

@@ -30,6 +30,19 @@ void checkRenderOptions(const RenderOptions& o) {
   if (o.thetaSamples < 1 || o.thetaSamples > 256) bad("theta samples must be in 1..256");
 }
 
+BrdfSliceTable objectSliceTable(const SceneObject& object, const RenderOptions& options, const RenderProgress& progress) {
+  SliceTableOptions table;
+  table.level = options.level;
+  table.thetaSamples = options.thetaSamples;
+  table.supersampling = options.sliceSupersampling;
+  auto tableProgress = [&](int done, int total) {
+    if (progress) progress("slices " + object.name, static_cast<std::size_t>(done), static_cast<std::size_t>(total));
+  };
+  return options.cacheDir.empty() ? BrdfSliceTable::build(*object.material.brdf, table, tableProgress)
+                                  : io::loadOrBuildSliceTable(*object.material.brdf, table, options.cacheDir,
+                                                              object.material.cacheKey, tableProgress);
+}
+
 PreparedScene prepareScene(const Scene& scene, const RenderOptions& options, const RenderProgress& progress) {
   checkRenderOptions(options);
   if (scene.objects.empty()) throw std::invalid_argument("render: the scene has no objects");
@@ -43,17 +56,7 @@ PreparedScene prepareScene(const Scene& scene, const RenderOptions& options, con
     p.pose = object.pose;
     object.mesh->validate();
     p.mesh = withNormals(object.mesh);  // a mesh built in code may come without them
-    SliceTableOptions table;
-    table.level = options.level;
-    table.thetaSamples = options.thetaSamples;
-    table.supersampling = options.sliceSupersampling;
-    auto tableProgress = [&](int done, int total) {
-      if (progress) progress("slices " + object.name, static_cast<std::size_t>(done), static_cast<std::size_t>(total));
-    };
-    p.table = options.cacheDir.empty()
-                  ? BrdfSliceTable::build(*object.material.brdf, table, tableProgress)
-                  : io::loadOrBuildSliceTable(*object.material.brdf, table, options.cacheDir,
-                                              object.material.cacheKey, tableProgress);
+    p.table = objectSliceTable(object, options, progress);
     VisibilityOptions vis = options.visibility;
     vis.level = options.level;
     p.visibility = loadOrComputeVertexVisibility(*p.mesh, vis, options.cacheDir, [&](std::size_t done, std::size_t total) {

@@ -10,7 +10,7 @@
 #include <glm/vec3.hpp>
 #include <gtest/gtest.h>
 
-#include "allocation_counter.h"
+#include "../allocation_tracking.h"
 #include "test_maps.h"
 
 #include "haarcast/core/brdf.h"

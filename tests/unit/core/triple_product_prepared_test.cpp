@@ -9,7 +9,7 @@
 
 #include <gtest/gtest.h>
 
-#include "allocation_counter.h"
+#include "../allocation_tracking.h"
 
 #include "haarcast/core/haar.h"
 #include "haarcast/core/sphere_map.h"

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "allocation_peak.h"
+#include "../allocation_tracking.h"
 #include "haarcast/io/image.h"
 #include "haarcast/io/mesh_io.h"
 

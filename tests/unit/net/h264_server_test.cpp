@@ -57,7 +57,9 @@ TEST(ServerH264, FramesDecodeInOrderAndAKeyframePoseGetsAKeyframe) {
       EXPECT_EQ(image.height, 48u);
       EXPECT_FALSE(client::isBlank(client::pixelStats(image))) << "frame " << frame.sequence() << " decoded blank";
       keyframes.push_back(isKeyframe(data));
-      if (frame.pose_sequence() == keyframePose && keyframePose != 0) EXPECT_TRUE(keyframes.back()) << "keyframe pose";
+      if (frame.pose_sequence() == keyframePose && keyframePose != 0) {
+        EXPECT_TRUE(keyframes.back()) << "keyframe pose";
+      }
       if (frame.pose_sequence() >= sequence) break;
     }
   }

@@ -121,6 +121,12 @@ struct PreparedScene {
 // Level of the backdrop maps: fine enough to look like the probe (512²).
 inline constexpr int kBackgroundLevel = 9;
 
+// One object's slice table at options.level, from options.cacheDir when
+// cached there; progress as stage "slices NAME". prepareScene uses it, and so
+// does whatever sizes the tables without preparing the rest (loadtest).
+BrdfSliceTable objectSliceTable(const SceneObject& object, const RenderOptions& options,
+                                const RenderProgress& progress = {});
+
 // Slice tables (cached in options.cacheDir), visibility (cached), light and
 // backdrop maps. Validates the scene's meshes; progress per long stage.
 PreparedScene prepareScene(const Scene& scene, const RenderOptions& options, const RenderProgress& progress = {});
