@@ -231,7 +231,8 @@ std::function<int()> addBenchFrameCommand(CLI::App& app) {
   c->add_option("--backend", args->backend, "cpu|vulkan|both (both: ratios from one run)")->capture_default_str();
   c->add_option("--sizes", args->sizes, "Frame sizes, comma-separated: N for N×N, or WxH (e.g. 128,256,1920x1080)")
       ->capture_default_str();
-  c->add_option("--levels", args->levels, "Map levels, comma-separated (2..8; fused 2..7; the other methods on Vulkan 2..6)")
+  c->add_option("--levels", args->levels, "Map levels, comma-separated (" + std::to_string(render::kMinRenderLevel) + ".." +
+                    std::to_string(render::kMaxRenderLevel) + "; the split methods on Vulkan up to 6)")
       ->capture_default_str();
   c->add_option("--method", args->methods, "Per-pixel methods, comma-separated (" + pixelMethodNames() + "), or all")
       ->capture_default_str();
