@@ -6,6 +6,7 @@
 #include <condition_variable>
 #include <deque>
 #include <list>
+#include <limits>
 #include <map>
 #include <mutex>
 #include <set>
@@ -101,7 +102,14 @@ struct RenderService::Impl {
   std::mutex cacheMutex;
   std::list<std::shared_ptr<PreparedRenderer>> ready;  // LRU order, front = most recent
   std::map<std::string, std::shared_ptr<Build>> builds;  // by key: the one new waiters join
-  std::deque<std::shared_ptr<Build>> buildQueue;         // not yet running, FIFO
+  std::deque<std::shared_ptr<Build>> buildQueue;         // not yet running, in arrival order
+  // Owner → the number of the last build started for it (builds count from
+  // 1). The next build is the queued one whose most starved waiter was served
+  // longest ago, so a session flooding settings cannot keep a newcomer's
+  // first build behind its own latest one: a new owner waits at most for the
+  // build running when it arrives.
+  std::map<std::string, std::uint64_t> ownerServed;
+  std::uint64_t buildsStarted = 0;
   std::map<std::string, std::shared_ptr<Build>> ownerWaits;  // owner → the build it waits for
   std::condition_variable buildCv;
   bool buildsStopping = false;
@@ -219,6 +227,28 @@ struct RenderService::Impl {
     return answers;
   }
 
+  // The queued build to start next (see ownerServed); the queue is not empty.
+  // Under cacheMutex.
+  std::deque<std::shared_ptr<Build>>::iterator fairestBuild() {
+    auto served = [&](const Build& b) {
+      std::uint64_t least = std::numeric_limits<std::uint64_t>::max();
+      for (const auto& waiter : b.waiters) {
+        const auto it = ownerServed.find(waiter.first);
+        least = std::min(least, it == ownerServed.end() ? std::uint64_t{0} : it->second);
+      }
+      return least;
+    };
+    auto best = buildQueue.begin();
+    std::uint64_t bestServed = served(**best);
+    for (auto it = std::next(best); it != buildQueue.end() && bestServed > 0; ++it) {
+      if (const std::uint64_t s = served(**it); s < bestServed) {
+        best = it;
+        bestServed = s;
+      }
+    }
+    return best;
+  }
+
   void builderLoop() {
     for (;;) {
       std::shared_ptr<Build> build;
@@ -227,8 +257,13 @@ struct RenderService::Impl {
         std::unique_lock lock(cacheMutex);
         buildCv.wait(lock, [&] { return buildsStopping || !buildQueue.empty(); });
         if (buildsStopping) return;
-        build = std::move(buildQueue.front());
-        buildQueue.pop_front();
+        const auto next = fairestBuild();
+        build = std::move(*next);
+        buildQueue.erase(next);
+        ++buildsStarted;
+        for (const auto& waiter : build->waiters) {
+          if (!waiter.first.empty()) ownerServed[waiter.first] = buildsStarted;
+        }
         runningBuild = build;
         cached = cachedLocked(build->key);  // an abandoned build of this key may have finished meanwhile
       }
@@ -439,6 +474,7 @@ void RenderService::withdraw(const std::string& owner) {
   if (owner.empty()) return;  // nobody's prepares are never withdrawn
   std::lock_guard lock(impl_->cacheMutex);
   impl_->detachOwner(owner, nullptr);
+  impl_->ownerServed.erase(owner);  // a closed session's turn is not kept
 }
 
 void RenderService::submit(RenderJob job) {

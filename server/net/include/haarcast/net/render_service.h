@@ -7,8 +7,11 @@
 //              config share one. Per owner (session) the latest prepare
 //              wins: an earlier one still waiting is answered Superseded, and
 //              a build nobody waits for any more is dropped (queued) or
-//              abandoned (running). At most Options::maxQueuedBuilds builds
-//              wait across the server; beyond that prepare is Refused.
+//              abandoned (running). The next build is the one whose owner
+//              was served longest ago (never served first), so a new session
+//              waits at most for the build running when it arrives. At most
+//              Options::maxQueuedBuilds builds wait across the server;
+//              beyond that prepare is Refused.
 //   submit()   queues one frame job. Jobs start in FIFO order on
 //              Options::workers threads, and each session keeps at most one
 //              job queued or running, so the queue is a round robin over the
