@@ -62,10 +62,19 @@ void WsSession::accept(http::request<http::string_body> request) {
   // here (close code 1009) before they are buffered.
   ws_.read_message_max(limits.maxMessageBytes * 4 + 4096);
   ws_.binary(true);
+  // Registered before the handshake completes, so that a stop() meanwhile
+  // waits for this session's close instead of ending the drain without it
+  // (onAccept then shuts it down).
+  {
+    std::lock_guard lock(server_.sessionsMutex);
+    server_.sessions.emplace(this, weak_from_this());
+    registered_ = true;
+  }
   ws_.async_accept(request, [self = shared_from_this()](beast::error_code ec) { self->onAccept(ec); });
 }
 
 void WsSession::shutdown() {
+  if (!accepted_) return;  // onAccept sees the server stopping and comes back here
   session_.fail({v1::ERROR_CODE_SHUTTING_DOWN, "the server is shutting down", true}, CloseCode::GoingAway);
 }
 
@@ -75,11 +84,7 @@ void WsSession::onAccept(beast::error_code ec) {
     server_.log("%s: WebSocket handshake with %s failed: %s", id_.c_str(), address_.c_str(), ec.message().c_str());
     return;
   }
-  {
-    std::lock_guard lock(server_.sessionsMutex);
-    server_.sessions.emplace(this, weak_from_this());
-    registered_ = true;
-  }
+  accepted_ = true;
   server_.log("%s: opened from %s", id_.c_str(), address_.c_str());
   doRead();
   tick();

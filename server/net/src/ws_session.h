@@ -70,7 +70,8 @@ class WsSession : public std::enable_shared_from_this<WsSession>, private Sessio
   boost::beast::flat_buffer readBuffer_;
   std::string id_, address_;
   Admission::Slot connectionSlot_, pendingSlot_, sessionSlot_;
-  bool registered_ = false;
+  bool registered_ = false;  // in server_.sessions (from accept())
+  bool accepted_ = false;    // the WebSocket handshake completed (on the strand)
   RenderSession session_;
 
   bool writing_ = false, closeRequested_ = false, closeStarted_ = false, gone_ = false;

@@ -306,6 +306,9 @@ inline std::string httpGet(std::uint16_t port, const std::string& target, http::
   // (Connect, GET, read: a short request on its own connection.)
   asio::io_context ioc;
   beast::tcp_stream stream(ioc);
+  // A bound on the whole exchange: a server that stopped answering fails
+  // the test (the read throws) instead of hanging it.
+  stream.expires_after(std::chrono::seconds(10));
   stream.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), port));
   http::request<http::empty_body> req{http::verb::get, target, 11};
   req.set(http::field::host, "127.0.0.1");
