@@ -60,7 +60,9 @@ constexpr std::uint64_t kPathPoses = 240;
 
 // --quick: what the test suite runs (docs/loadtest.md "--quick").
 constexpr const char* kQuickMethods = "fused,haar,table";
-constexpr const char* kQuickClients = "1,2";
+// More clients than the default per-address caps (8 waiting for a Hello):
+// the local server must be started with caps that fit.
+constexpr const char* kQuickClients = "1,10";
 constexpr const char* kQuickSizes = "32";
 constexpr double kQuickSeconds = 2.0;
 constexpr int kQuickLevel = 4;
@@ -208,8 +210,22 @@ int run(const LoadtestArgs& a) {
     std::unique_ptr<LocalServer> server;
     client::SessionConfig base;
     if (a.url.empty()) {
-      std::vector<std::string> extra = {"--max-level", std::to_string(std::max(a.level, 6)), "--max-sessions",
-                                        std::to_string(std::max(64, *std::max_element(p.clients.begin(), p.clients.end())))};
+      // Every client comes from 127.0.0.1: the per-address caps must fit
+      // the largest run, or its clients past the pre-Hello cap are refused.
+      const std::string most = std::to_string(*std::max_element(p.clients.begin(), p.clients.end()));
+      const std::string sessions = std::to_string(std::max(64, std::stoi(most)));
+      std::vector<std::string> extra = {"--max-level",
+                                        std::to_string(std::max(a.level, 6)),
+                                        "--max-sessions",
+                                        sessions,
+                                        "--max-sessions-per-address",
+                                        most,
+                                        "--max-connections-per-address",
+                                        most,
+                                        "--max-pending-per-address",
+                                        most,
+                                        "--max-pending",
+                                        sessions};
       if (!a.cacheDir.empty()) extra.insert(extra.end(), {"--cache-dir", a.cacheDir});
       if (!a.backend.empty()) extra.insert(extra.end(), {"--backend", a.backend});
       server = std::make_unique<LocalServer>(extra, 60.0);

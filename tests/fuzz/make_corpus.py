@@ -132,3 +132,38 @@ pose = field(1, 2) + field(2, field(1, vec3(0, 0, 4)) + field(4, 45.0)) + \
 put("fuzz_protocol", "hello_pose", frames(field(1, hello), field(2, pose), field(5, field(1, 7))))
 put("fuzz_protocol", "settings_scene", frames(field(1, field(1, 1)), field(3, settings),
                                               field(4, field(1, b"other")), field(2, field(1, 3))))
+put("fuzz_protocol", "text_and_bad", struct.pack("<H", 0x8000 | 5) + b"hello" + frames(field(1, hello), b"\xff\xff",
+                                                                                      field(2, pose)))
+
+
+# WebSocket: byte 0 is the read size - 1; then an HTTP upgrade and masked
+# client frames (RFC 6455 §5.2, §5.3).
+def upgrade(target="/ws?token=t", extra=""):
+    return (f"GET {target} HTTP/1.1\r\nHost: localhost:8080\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+            f"Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n{extra}\r\n").encode()
+
+
+def ws_frame(opcode, payload, fin=True, mask=b"\x11\x22\x33\x44"):
+    head = bytes([(0x80 if fin else 0) | opcode])
+    n = len(payload)
+    if n < 126:
+        head += bytes([0x80 | n])
+    elif n < 65536:
+        head += bytes([0x80 | 126]) + struct.pack(">H", n)
+    else:
+        head += bytes([0x80 | 127]) + struct.pack(">Q", n)
+    return head + mask + bytes(b ^ mask[i % 4] for i, b in enumerate(payload))
+
+
+BINARY, TEXT, CONTINUATION, CLOSE, PING = 2, 1, 0, 8, 9
+session = [ws_frame(BINARY, field(1, hello)), ws_frame(BINARY, field(2, pose)),
+           ws_frame(PING, b"p"), ws_frame(BINARY, field(5, field(1, 7)))]
+put("fuzz_websocket", "session", bytes([255]) + upgrade("/ws?token=t", "Origin: http://localhost:8080\r\n") +
+    b"".join(session) + ws_frame(CLOSE, struct.pack(">H", 1000) + b"bye"))
+message = field(1, hello)
+put("fuzz_websocket", "fragmented_bearer", bytes([6]) + upgrade("/ws", "Authorization: bearer t\r\n") +
+    ws_frame(BINARY, message[:5], fin=False) + ws_frame(PING, b"") + ws_frame(CONTINUATION, message[5:]) +
+    ws_frame(TEXT, "settings ☃".encode()) + ws_frame(BINARY, field(3, settings)))
+put("fuzz_websocket", "foreign_origin", bytes([255]) + upgrade("/ws?token=t", "Origin: https://evil.example\r\n"))
+put("fuzz_websocket", "wrong_token", bytes([255]) + upgrade("/ws?token=x"))
+put("fuzz_websocket", "too_large", bytes([255]) + upgrade() + ws_frame(BINARY, bytes(20000)))

@@ -6,6 +6,7 @@
 #include <boost/beast/websocket.hpp>
 
 #include "haarcast/net/messages.h"
+#include "haarcast/net/upgrade.h"
 #include "ws_session.h"
 
 namespace haarcast::net {
@@ -16,9 +17,6 @@ namespace beast = boost::beast;
 namespace http = beast::http;
 namespace websocket = beast::websocket;
 
-// HTTP requests are small: a GET and its headers.
-constexpr std::uint32_t kMaxHttpHeaderBytes = 16 * 1024;
-constexpr std::uint64_t kMaxHttpBodyBytes = 16 * 1024;
 constexpr std::uintmax_t kMaxStaticFileBytes = 32u << 20;
 // Retry-After of a 429 and a 503 (seconds): a hint, not a promise.
 constexpr const char* kRetryAfterSeconds = "5";
@@ -49,8 +47,7 @@ void HttpSession::run() {
 
 void HttpSession::doRead() {
   parser_.emplace();
-  parser_->header_limit(kMaxHttpHeaderBytes);
-  parser_->body_limit(kMaxHttpBodyBytes);
+  limitRequestParser(*parser_);
   stream_.expires_after(toDuration(server_.options.handshakeSeconds));
   http::async_read(stream_, buffer_, *parser_,
                    [self = shared_from_this()](beast::error_code ec, std::size_t) { self->onRead(ec); });
@@ -81,45 +78,20 @@ void HttpSession::onRead(beast::error_code ec) {
 }
 
 void HttpSession::upgrade(Request request) {
-  const std::string_view target = view(request.target());
-  if (targetPath(target) != "/ws") {
-    respond(request, http::status::not_found, "no WebSocket at " + std::string(targetPath(target)) + " (use /ws)\n",
-            "text/plain", false);
-    return;
-  }
-  const auto& o = server_.options;
-  // A page on another site must not drive the server with the user's
-  // network position (cross-site WebSocket hijacking).
-  if (const auto origin = view(request[http::field::origin]);
-      !originAllowed(origin, view(request[http::field::host]), o.allowOrigins)) {
-    server_.log("upgrade from %s refused: Origin \"%s\" is neither this host nor --allow-origin", address_.c_str(),
-                sanitizeForLog(origin).c_str());
-    refuse(request, Response{http::status::forbidden, request.version()},
-           "forbidden: Origin " + sanitizeForLog(origin) + " may not open a session (see --allow-origin)\n", "origin");
-    return;
-  }
-  if (!o.token.empty()) {
-    const auto now = Clock::now();
-    if (server_.tokenGuard.locked(address_, now)) {
-      Response res{http::status::too_many_requests, request.version()};
-      res.set(http::field::retry_after, std::to_string(static_cast<int>(o.tokenGuard.lockoutSeconds)));
-      refuse(request, std::move(res), "too many wrong tokens from " + address_ + ": try again later\n", "token_rate");
-      return;
-    }
-    std::string given = queryParameter(target, "token");
-    if (given.empty()) given = bearerToken(view(request[http::field::authorization]));
-    if (!tokensEqual(given, o.token)) {
+  if (auto refusal = checkUpgrade(request, server_.options, server_.tokenGuard, address_, Clock::now())) {
+    if (!refusal->logLine.empty()) server_.log("%s", refusal->logLine.c_str());
+    if (refusal->status == http::status::unauthorized) {
       server_.metrics.addError(errorLabel(v1::ERROR_CODE_UNAUTHORIZED));
-      if (!given.empty()) server_.tokenGuard.failed(address_, now);  // a guess; no token is not one
-      server_.log("upgrade from %s refused: %s token", address_.c_str(), given.empty() ? "no" : "wrong");
-      Response res{http::status::unauthorized, request.version()};
-      res.set(http::field::www_authenticate, "Bearer");
-      refuse(request, std::move(res),
-             given.empty() ? "unauthorized: no token (use ?token=T or Authorization: Bearer T)\n"
-                           : "unauthorized: wrong token\n",
-             "token");
-      return;
     }
+    Response res{refusal->status, request.version()};
+    if (!refusal->retryAfter.empty()) res.set(http::field::retry_after, refusal->retryAfter);
+    if (refusal->bearerChallenge) res.set(http::field::www_authenticate, "Bearer");
+    if (refusal->metric.empty()) {
+      respond(request, std::move(res), std::move(refusal->body), "text/plain", false);
+    } else {
+      refuse(request, std::move(res), std::move(refusal->body), refusal->metric.c_str());
+    }
+    return;
   }
   if (server_.stopping.load()) {
     refuse(request, Response{http::status::service_unavailable, request.version()}, "the server is shutting down\n",

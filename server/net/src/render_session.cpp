@@ -11,10 +11,6 @@ namespace {
 // many control messages.
 constexpr std::size_t kMaxBacklogForStats = 4;
 
-std::chrono::nanoseconds toDuration(double seconds) {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::duration<double>(std::max(0.0, seconds)));
-}
-
 double secondsBetween(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
 
 std::string format(const char* fmt, ...) __attribute__((format(printf, 1, 2)));

@@ -63,11 +63,6 @@ struct Server::Impl {
   std::string metricsText();
 };
 
-// Seconds → a Clock duration (negative: 0).
-inline std::chrono::nanoseconds toDuration(double seconds) {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::duration<double>(std::max(0.0, seconds)));
-}
-
 // "address" of a connected socket (no port): the key of per-address limits.
 std::string peerAddress(const boost::asio::ip::tcp::socket& socket);
 

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "haarcast/net/upgrade.h"
+
 namespace haarcast::net {
 namespace {
 
@@ -47,21 +49,9 @@ WsSession::~WsSession() {
 }
 
 void WsSession::accept(http::request<http::string_body> request) {
-  const auto& limits = server_.options.limits;
   // The WebSocket stream keeps its own timeouts; the TCP layer's must be off.
   beast::get_lowest_layer(ws_).expires_never();
-  websocket::stream_base::timeout timeouts{};
-  timeouts.handshake_timeout = toDuration(server_.options.handshakeSeconds);
-  timeouts.idle_timeout = websocket::stream_base::none();  // ours: Error TIMEOUT, with a reason
-  timeouts.keep_alive_pings = false;
-  ws_.set_option(timeouts);
-  ws_.set_option(websocket::stream_base::decorator(
-      [](websocket::response_type& res) { res.set(http::field::server, kServerVersion); }));
-  // A backstop only: messages over maxMessageBytes get Error
-  // MESSAGE_TOO_LARGE from the session; far larger ones are cut by Beast
-  // here (close code 1009) before they are buffered.
-  ws_.read_message_max(limits.maxMessageBytes * 4 + 4096);
-  ws_.binary(true);
+  configureSessionStream(ws_, server_.options);
   // Registered before the handshake completes, so that a stop() meanwhile
   // waits for this session's close instead of ending the drain without it
   // (onAccept then shuts it down).

@@ -5,6 +5,7 @@
 // run out. Plain classes over strings and clocks, tested without sockets.
 #pragma once
 
+#include <algorithm>
 #include <chrono>
 #include <cstddef>
 #include <array>
@@ -18,6 +19,11 @@
 namespace haarcast::net {
 
 using Clock = std::chrono::steady_clock;
+
+// Seconds → a Clock duration (negative: 0).
+inline std::chrono::nanoseconds toDuration(double seconds) {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::duration<double>(std::max(0.0, seconds)));
+}
 
 // The Origin rule (RFC 6454; as gorilla/websocket's checkSameOrigin and
 // Selkies do): no Origin header is a non-browser client and is allowed; an
