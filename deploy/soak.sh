@@ -52,7 +52,8 @@ rss_kib() { [[ -n "$pid" && -r "/proc/$pid/status" ]] && awk '/^VmRSS:/ { print 
 if [[ -z "$url" ]]; then
   [[ -x "$server_bin" ]] || { echo "soak: no $server_bin (deploy/run.sh build)" >&2; exit 1; }
   args=(serve --port 0 --backend cpu --max-sessions "$clients" --max-sessions-per-address "$clients"
-        --max-connections-per-address "$((clients * 2))" "${serve_args[@]}")
+        --max-connections-per-address "$((clients * 2))" --max-pending-per-address "$clients"
+        "${serve_args[@]}")
   [[ -n "$token" ]] && args+=(--token "$token")
   echo "soak: starting $server_bin ${args[*]}"
   "$server_bin" "${args[@]}" >"$work/server.out" 2>"$work/server.err" </dev/null &

@@ -139,7 +139,8 @@ nlohmann::json toJson(const LoadtestReport& r) {
   j["stored_bytes_definition"] =
       "the BRDF coefficient data each method holds for the scene, summed over objects and colour channels: "
       "makeRotator(method, slices)->storedBytes() (the unrotated slices plus the method's precomputation; "
-      "table's pre-rotated copies replace the slices) and, for fused, the slices in pixel form "
+      "table's pre-rotated copies replace the slices; what rotators share, matrix's elevation matrices, "
+      "counted once: SliceRotator::sharedBytes) and, for fused, the slices in pixel form "
       "(PixelSlices::storedBytes). Visibility, light and meshes are the same for every method: see shared_bytes.";
   j["storage"] = storageJson(r.storage);
   j["storage_at_run_level"] = storageJson(r.runStorage);
@@ -203,7 +204,8 @@ std::string toMarkdown(const LoadtestReport& r, const std::string& figuresNote) 
 
   md += "## Storage and the PRT download baseline\n\n";
   md += "stored bytes = the BRDF coefficient data a method holds for this scene (all objects, all channels): "
-        "`makeRotator(method, slices)->storedBytes()`, or for fused the slices in pixel form.\n\n";
+        "`makeRotator(method, slices)->storedBytes()`, with what rotators share (matrix's elevation matrices) "
+        "counted once, or for fused the slices in pixel form.\n\n";
   md += "| method | stored bytes, level " + std::to_string(r.runStorage.level) + " | stored bytes, level " +
         std::to_string(r.storage.level) + " |\n|---|---|---|\n";
   for (const auto& [m, bytes] : r.storage.storedBytes) {

@@ -25,7 +25,7 @@ std::vector<BrdfSliceTable> sliceTables(const render::Scene& scene, const render
 
 std::size_t methodStoredBytes(RotationMethod method, const std::vector<BrdfSliceTable>& tables,
                               const RotatorOptions& rotator) {
-  std::size_t bytes = 0;
+  std::size_t bytes = 0, shared = 0;  // every table has the same level: one shared part
   for (const BrdfSliceTable& table : tables) {
     if (method == RotationMethod::Fused) {
       // fused reads the unrotated slices in pixel form (cpu_backend.cpp keeps
@@ -33,10 +33,15 @@ std::size_t methodStoredBytes(RotationMethod method, const std::vector<BrdfSlice
       bytes += PixelSlices::synthesize(table).storedBytes();
       continue;
     }
-    // The CPU backend builds one rotator per channel (cpu_backend.cpp), so do we.
-    for (int c = 0; c < BrdfSliceTable::kChannels; ++c) bytes += makeRotator(method, table.channelSlices(c), rotator)->storedBytes();
+    // The CPU backend builds one rotator per channel (cpu_backend.cpp), so do
+    // we; what they share (matrix: the elevation matrices) is stored once.
+    for (int c = 0; c < BrdfSliceTable::kChannels; ++c) {
+      const auto r = makeRotator(method, table.channelSlices(c), rotator);
+      bytes += r->storedBytes() - r->sharedBytes();
+      shared = std::max(shared, r->sharedBytes());
+    }
   }
-  return bytes;
+  return bytes + shared;
 }
 
 MethodStorage methodStorage(const render::Scene& scene, const render::RenderOptions& options,

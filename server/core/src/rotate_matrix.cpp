@@ -16,10 +16,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <map>
 #include <memory>
+#include <mutex>
 #include <stdexcept>
 #include <span>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "haarcast/core/rotation.h"
@@ -255,11 +258,33 @@ std::vector<CsrMatrix> elevationMatrices(int level, int count, double threshold)
   return matrices;
 }
 
+// The matrices depend on the level and the options only, not on the slices:
+// every rotator alive with the same ones shares them (the three channels of
+// an object, and every object of a scene), built once.
+std::shared_ptr<const std::vector<CsrMatrix>> sharedElevationMatrices(int level, int count, double threshold) {
+  using Key = std::tuple<int, int, double>;
+  static std::mutex mutex;
+  static std::map<Key, std::weak_ptr<const std::vector<CsrMatrix>>> cache;
+  const Key key{level, count, threshold};
+  {
+    std::lock_guard lock(mutex);
+    if (auto alive = cache[key].lock()) return alive;
+  }
+  // Built outside the lock (seconds at level 6); two callers racing for the
+  // same key may both build, and the first one stored is shared from then on.
+  auto built = std::make_shared<const std::vector<CsrMatrix>>(elevationMatrices(level, count, threshold));
+  std::lock_guard lock(mutex);
+  if (auto alive = cache[key].lock()) return alive;
+  cache[key] = built;
+  return built;
+}
+
 class MatrixRotator final : public SliceRotator {
  public:
   MatrixRotator(std::vector<HaarMap> slices, const RotatorOptions& options)
       : slices_(std::move(slices)),
-        matrices_(elevationMatrices(slices_.front().level(), options.matrixElevations, options.matrixThreshold)) {}
+        shared_(sharedElevationMatrices(slices_.front().level(), options.matrixElevations, options.matrixThreshold)),
+        matrices_(*shared_) {}
 
   RotationMethod method() const override { return RotationMethod::Matrix; }
   std::size_t sliceCount() const override { return slices_.size(); }
@@ -316,15 +341,18 @@ class MatrixRotator final : public SliceRotator {
     return out;
   }
 
-  std::size_t storedBytes() const override {
-    std::size_t bytes = coefficientBytes(slices_);
+  std::size_t storedBytes() const override { return coefficientBytes(slices_) + sharedBytes(); }
+
+  std::size_t sharedBytes() const override {
+    std::size_t bytes = 0;
     for (const CsrMatrix& a : matrices_) bytes += a.bytes();
     return bytes;
   }
 
  private:
   std::vector<HaarMap> slices_;
-  std::vector<CsrMatrix> matrices_;  // matrices_[k]: elevate_{β_k}, β_k = kπ/(K−1)
+  std::shared_ptr<const std::vector<CsrMatrix>> shared_;
+  const std::vector<CsrMatrix>& matrices_;  // matrices_[k]: elevate_{β_k}, β_k = kπ/(K−1)
 };
 
 }  // namespace

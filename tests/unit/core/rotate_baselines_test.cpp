@@ -372,6 +372,26 @@ TEST(MatrixRotator, KeepsEntriesAboveThresholdTimesLargest) {
   }
 }
 
+// The elevation matrices depend on the level and options only: rotators of
+// other slices (an object's three channels, other objects) share one copy,
+// which sharedBytes() names so a scene counts it once.
+TEST(Baselines, MatrixRotatorsShareTheirMatrices) {
+  RotatorOptions options;
+  options.matrixElevations = 3;
+  const auto a = makeRotator(RotationMethod::Matrix, {randomMap(3, 1)}, options);
+  const auto b = makeRotator(RotationMethod::Matrix, {randomMap(3, 2), randomMap(3, 3)}, options);
+  const std::size_t mapBytes = HaarMap(3).coefficientCount() * sizeof(float);
+  EXPECT_EQ(a->sharedBytes(), a->storedBytes() - mapBytes);
+  EXPECT_EQ(b->sharedBytes(), a->sharedBytes());
+  EXPECT_EQ(elevationMatrixViews(*a)[1].value.data(), elevationMatrixViews(*b)[1].value.data())
+      << "the same level and options must share one set of matrices";
+  options.matrixThreshold = 1e-2;
+  const auto c = makeRotator(RotationMethod::Matrix, {randomMap(3, 1)}, options);
+  EXPECT_NE(elevationMatrixViews(*c)[1].value.data(), elevationMatrixViews(*a)[1].value.data());
+  EXPECT_LT(c->sharedBytes(), a->sharedBytes()) << "a higher threshold keeps fewer entries";
+  EXPECT_EQ(makeRotator(RotationMethod::Haar, {randomMap(3, 1)})->sharedBytes(), 0u);
+}
+
 // ---- (f) bad input ----------------------------------------------------------
 
 TEST(Baselines, RejectEmptySlicesAndBadOptions) {

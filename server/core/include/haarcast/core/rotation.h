@@ -96,6 +96,10 @@ class SliceRotator {
   // Bytes of coefficient data the method keeps: the unrotated maps plus
   // whatever it precomputed (matrices, pre-rotated copies).
   virtual std::size_t storedBytes() const = 0;
+  // Of storedBytes(), what does not depend on the maps and is shared by
+  // every rotator of the same method, level and options (matrix: the
+  // elevation matrices). A scene stores it once, not once per rotator.
+  virtual std::size_t sharedBytes() const { return 0; }
 };
 
 // Throws std::invalid_argument if slices is empty or mixes levels, or for
