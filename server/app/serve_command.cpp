@@ -147,6 +147,8 @@ int run(ServeArgs& a) {
                                     {"--max-queued-builds", render.maxQueuedBuilds}}) {
     if (value < 1) throw std::invalid_argument(std::string(flag) + " must be at least 1 (got " + std::to_string(value) + ")");
   }
+  // The protocol refuses a Hello over the per-session budget up front.
+  limits.maxPixels = render.maxSessionPixels;
   // Unset (the sentinel): two of the largest frames a session may ask for.
   if (a.serverPixelBudget < 0) {
     render.serverPixelBudget = 2 * render.maxSessionPixels;

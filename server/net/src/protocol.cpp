@@ -274,6 +274,13 @@ std::variant<SessionConfig, ProtocolError> configFromHello(const v1::Hello& hell
                      " is outside 1x1.." + std::to_string(limits.maxWidth) + "x" + std::to_string(limits.maxHeight),
                  true);
   }
+  if (static_cast<std::size_t>(w) * h > limits.maxPixels) {
+    return error(v1::ERROR_CODE_BAD_RESOLUTION,
+                 "resolution " + std::to_string(w) + "x" + std::to_string(h) + " is " +
+                     std::to_string(static_cast<std::size_t>(w) * h) + " pixels, over the server's " +
+                     std::to_string(limits.maxPixels) + " per session (max-session-pixels)",
+                 true);
+  }
   c.width = static_cast<int>(w);
   c.height = static_cast<int>(h);
   if (hello.encoding() == v1::ENCODING_UNSPECIFIED) {
@@ -458,6 +465,7 @@ v1::ServerLimits limitsToWire(const Limits& limits) {
   l.set_max_level(static_cast<std::uint32_t>(limits.maxLevel));
   l.set_max_width(static_cast<std::uint32_t>(limits.maxWidth));
   l.set_max_height(static_cast<std::uint32_t>(limits.maxHeight));
+  l.set_max_pixels(limits.maxPixels);
   l.set_max_fps(limits.maxFps);
   l.set_max_light_coefficients(static_cast<std::uint32_t>(limits.maxLightCoefficients));
   l.set_max_exposure_stops(render::kMaxExposureStops);

@@ -108,6 +108,20 @@ TEST(Protocol, BadHellosNameWhatIsWrong) {
   h.set_width(0);
   EXPECT_EQ(helloError(h).code, v1::ERROR_CODE_BAD_RESOLUTION);
 
+  // Within the width and height limits but over the per-session pixel
+  // budget (--max-session-pixels): refused at the Hello, not frame by frame.
+  Limits budget;
+  budget.maxPixels = 512 * 512;
+  h = goodHello();
+  h.set_width(1024);
+  h.set_height(512);
+  e = helloError(h, budget);
+  EXPECT_EQ(e.code, v1::ERROR_CODE_BAD_RESOLUTION);
+  EXPECT_NE(e.message.find("524288 pixels, over the server's 262144 per session"), std::string::npos) << e.message;
+  h.set_width(512);
+  EXPECT_TRUE(std::holds_alternative<SessionConfig>(configFromHello(h, budget, Defaults{}, testCatalog())));
+  EXPECT_EQ(limitsToWire(budget).max_pixels(), 262144u);
+
   h = goodHello();
   h.set_fps_cap(-1);
   EXPECT_EQ(helloError(h).code, v1::ERROR_CODE_BAD_SETTINGS);

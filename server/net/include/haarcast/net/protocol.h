@@ -37,6 +37,10 @@ std::optional<Backend> parseBackend(std::string_view name);    // nullopt: not a
 struct Limits {
   int maxWidth = 2048;
   int maxHeight = 2048;
+  // width × height of one session's frames (serve: --max-session-pixels, the
+  // render service's per-session budget): a Hello over it is refused at once
+  // instead of failing every frame.
+  std::size_t maxPixels = 2048u * 2048u;
   double maxFps = 60.0;
   double defaultFps = 30.0;
   int minLevel = render::kMinRenderLevel;
