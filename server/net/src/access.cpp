@@ -73,6 +73,22 @@ bool isLoopbackAddress(std::string_view address) {
   return a.is_loopback();
 }
 
+std::string clientGroup(std::string_view address) {
+  namespace ip = boost::asio::ip;
+  boost::system::error_code ec;
+  const auto a = ip::make_address(std::string(address), ec);
+  if (ec) return std::string(address);
+  if (a.is_v4()) return a.to_string();
+  const ip::address_v6 v6 = a.to_v6();
+  if (v6.is_v4_mapped()) return ip::make_address_v4(ip::v4_mapped, v6).to_string();
+  if (v6.is_loopback()) return v6.to_string();
+  // One host is routinely given a whole /64 (SLAAC, privacy addresses): its
+  // interface half is the host's to choose, so limits count the prefix.
+  ip::address_v6::bytes_type bytes = v6.to_bytes();
+  std::fill(bytes.begin() + 8, bytes.end(), static_cast<unsigned char>(0));
+  return ip::address_v6(bytes).to_string() + "/64";
+}
+
 // ------------------------------------------------------------------ TokenGuard
 
 TokenGuard::TokenGuard(Options options) : options_(options) {

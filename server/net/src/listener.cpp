@@ -39,7 +39,7 @@ Admission::Limits checkedAdmission(Admission::Limits l) {
 std::string peerAddress(const tcp::socket& socket) {
   beast::error_code ec;
   const auto remote = socket.remote_endpoint(ec);
-  return ec ? std::string("?") : remote.address().to_string();
+  return ec ? std::string("?") : clientGroup(remote.address().to_string());
 }
 
 std::optional<std::string> exposureWarning(const ServerOptions& options) {

@@ -63,7 +63,9 @@ struct Server::Impl {
   std::string metricsText();
 };
 
-// "address" of a connected socket (no port): the key of per-address limits.
+// The client group of a connected socket's address (clientGroup: an IPv4
+// address or an IPv6 /64): the key of per-address limits and the address
+// the log names.
 std::string peerAddress(const boost::asio::ip::tcp::socket& socket);
 
 }  // namespace haarcast::net

@@ -55,6 +55,25 @@ TEST(Access, LoopbackAddresses) {
   EXPECT_FALSE(isLoopbackAddress("not an address"));
 }
 
+TEST(Access, IPv6PeersAreLimitedPerSlash64) {
+  EXPECT_EQ(clientGroup("2001:db8:1:2:aaaa:bbbb:cccc:1"), "2001:db8:1:2::/64");
+  EXPECT_EQ(clientGroup("2001:db8:1:2::ffff"), clientGroup("2001:db8:1:2:1234::9"));
+  EXPECT_NE(clientGroup("2001:db8:1:3::1"), clientGroup("2001:db8:1:2::1"));
+  EXPECT_EQ(clientGroup("::ffff:192.0.2.7"), "192.0.2.7") << "an IPv4-mapped peer is its IPv4 address";
+  EXPECT_EQ(clientGroup("192.0.2.7"), "192.0.2.7");
+  EXPECT_EQ(clientGroup("::1"), "::1");
+  EXPECT_EQ(clientGroup("?"), "?");
+  // The point: a host walking its /64 meets one cap.
+  Admission::Limits limits;
+  limits.connectionsPerAddress = 2;
+  Admission admission(limits);
+  auto a = admission.take(SlotKind::Connection, clientGroup("2001:db8::1"));
+  auto b = admission.take(SlotKind::Connection, clientGroup("2001:db8::2"));
+  EXPECT_TRUE(a && b);
+  EXPECT_FALSE(admission.take(SlotKind::Connection, clientGroup("2001:db8::3")));
+  EXPECT_TRUE(admission.take(SlotKind::Connection, clientGroup("2001:db8:0:1::3")));
+}
+
 TEST(Access, TokenGuessesLockAnAddressForAWhile) {
   TokenGuard guard({3, 60.0, 30.0});
   const auto t0 = Clock::now();

@@ -45,6 +45,12 @@ bool tokensEqual(std::string_view given, std::string_view expected);
 // else, "0.0.0.0" and "::" included (they listen on every interface).
 bool isLoopbackAddress(std::string_view address);
 
+// The key of per-address limits for a peer address: an IPv4 address (an
+// IPv4-mapped IPv6 one as IPv4), IPv6 loopback as itself, and any other
+// IPv6 address as its /64 ("2001:db8:1:2::/64"), since one host may pick
+// any address in its /64. Anything unparsable is its own key.
+std::string clientGroup(std::string_view address);
+
 // Token guesses per address: after `maxFailures` wrong tokens within
 // `windowSeconds`, the address is refused (HTTP 429) for `lockoutSeconds`.
 class TokenGuard {
