@@ -1,7 +1,8 @@
 // Unit tests of the browser client's pure parts, in node (no browser): the
 // HUD's frame window (client/web/frame_stats.js) with made-up arrival times,
-// the page-parameter checks (client/web/page_params.js), and the page's H.264
-// view (client/web/h264_view.js) over a stand-in WebCodecs VideoDecoder.
+// the page-parameter checks (client/web/page_params.js), the view's orbit
+// maths (client/web/orbit.js), and the page's H.264 view
+// (client/web/h264_view.js) over a stand-in WebCodecs VideoDecoder.
 //
 // usage: node web_client_test.mjs
 import assert from 'node:assert/strict';
@@ -12,6 +13,8 @@ const web = join(resolve(dirname(fileURLToPath(import.meta.url)), '..', '..'), '
 const { FrameWindow, backoffMs, formatNumber, formatStops } = await import(pathToFileURL(join(web, 'frame_stats.js')));
 const { parsePageParameters } = await import(pathToFileURL(join(web, 'page_params.js')));
 const { H264View, helloEncoding } = await import(pathToFileURL(join(web, 'h264_view.js')));
+const { DRAG_DEGREES_PER_PIXEL, dragOrbit, orbitEye, orbitFromCamera, v3, zoomOrbit } =
+  await import(pathToFileURL(join(web, 'orbit.js')));
 
 const tests = [];
 const test = (name, fn) => tests.push({ name, fn });
@@ -183,6 +186,102 @@ test('H.264 falls back to JPEG, with the reason, where WebCodecs cannot decode i
   assert.ok(off.note.includes(reason) && off.note.includes('JPEG'), off.note);
   assert.deepEqual(helloEncoding('h264', { supported: true, codec: 'avc1.42E01E' }), { encoding: 'h264', note: '' });
   assert.deepEqual(helloEncoding('png', { supported: false, reason, fallback: 'jpeg' }), { encoding: 'png', note: '' });
+});
+
+// ---- the view's orbit (orbit.js) ----------------------------------------------------
+
+const near = (a, b, what, eps = 1e-9) =>
+  assert.ok(v3.norm(v3.sub(a, b)) < eps, `${what}: ${JSON.stringify(a)} is not ${JSON.stringify(b)}`);
+
+// Scene cameras as SceneInfo carries them: protobuf leaves zero fields out.
+const cameras = {
+  'none (the default camera)': undefined,
+  'along +Z': { eye: { z: 4 }, target: {}, up: { y: 1 }, fovYDegrees: 40 },
+  'off axis, above': { eye: { x: 1, y: 2, z: 3 }, target: { x: 0.5, y: -1 }, up: { y: 1 } },
+  'below the target': { eye: { x: -2, y: -3, z: 0.5 }, target: { x: 0.1, y: 0.2, z: 0.3 }, up: { y: 2 } },
+  'Z up': { eye: { x: 3, y: -4, z: 2 }, target: {}, up: { z: 1 } },
+  'tilted up': { eye: { x: 0, y: 1, z: 6 }, target: { y: 1 }, up: { x: 1, y: 1 } },
+  'no up vector': { eye: { x: 2, y: 2, z: 2 }, target: {}, up: {} },
+};
+
+test('orbit: a scene camera made an orbit gives back its own eye', () => {
+  for (const [name, camera] of Object.entries(cameras)) {
+    const o = orbitFromCamera(camera);
+    const eye = v3.of(camera && camera.eye, { x: 0, y: 0, z: 5 });
+    near(orbitEye(o), eye, name);
+    near(o.target, v3.of(camera && camera.target, { x: 0, y: 0, z: 0 }), `${name}: target`);
+    assert.ok(Math.abs(o.distance - v3.norm(v3.sub(eye, o.target))) < 1e-9, `${name}: distance ${o.distance}`);
+    assert.equal(o.startDistance, o.distance, name);
+    // The frame the angles are measured in is orthonormal, with the camera's up as its pole.
+    for (const [a, b] of [['up', 'forward'], ['up', 'right'], ['forward', 'right']]) {
+      assert.ok(Math.abs(v3.dot(o[a], o[b])) < 1e-12, `${name}: ${a}·${b}`);
+    }
+    for (const k of ['up', 'forward', 'right']) assert.ok(Math.abs(v3.norm(o[k]) - 1) < 1e-12, `${name}: |${k}|`);
+  }
+  assert.equal(orbitFromCamera(cameras['along +Z']).fov, 40);
+  assert.equal(orbitFromCamera(cameras['off axis, above']).fov, 45);  // fovYDegrees 0: the default
+});
+
+test('orbit: a drag of 0 and a wheel turn of 0 leave the view as it was', () => {
+  for (const [name, camera] of Object.entries(cameras)) {
+    const start = orbitFromCamera(camera);
+    // The scene's own view, and one already dragged and zoomed away from it.
+    for (const o of [start, { ...start, ...dragOrbit(start, 40, -30), distance: zoomOrbit(start, 300) }]) {
+      const eye = orbitEye(o);
+      const after = { ...o, ...dragOrbit(o, 0, 0), distance: zoomOrbit(o, 0) };
+      assert.equal(after.azimuth, o.azimuth, name);
+      assert.equal(after.elevation, o.elevation, name);
+      assert.equal(after.distance, o.distance, name);
+      near(orbitEye(after), eye, name);
+    }
+  }
+});
+
+test('orbit: a sideways drag circles the target; a full turn comes back', () => {
+  for (const [name, camera] of Object.entries(cameras)) {
+    const o = orbitFromCamera(camera);
+    const height = v3.dot(v3.sub(orbitEye(o), o.target), o.up);
+    for (const dx of [1, -37, 250]) {
+      const eye = orbitEye({ ...o, ...dragOrbit(o, dx, 0) });
+      const d = v3.sub(eye, o.target);
+      assert.ok(Math.abs(v3.norm(d) - o.distance) < 1e-9, `${name}, dx ${dx}: off the sphere`);
+      assert.ok(Math.abs(v3.dot(d, o.up) - height) < 1e-9, `${name}, dx ${dx}: the height changed`);
+    }
+    const turn = 360 / DRAG_DEGREES_PER_PIXEL;
+    near(orbitEye({ ...o, ...dragOrbit(o, turn, 0) }), orbitEye(o), `${name}: a full turn`, 1e-9);
+  }
+  // Half a degree per pixel, and the camera moves against the drag: from +Z,
+  // a drag of a quarter turn to the right puts the eye at −X.
+  const o = orbitFromCamera(undefined);
+  near(orbitEye({ ...o, ...dragOrbit(o, 90 / DRAG_DEGREES_PER_PIXEL, 0) }), { x: -5, y: 0, z: 0 }, 'quarter turn');
+  assert.ok(orbitEye({ ...o, ...dragOrbit(o, 0, 20) }).y > 0, 'a downward drag raises the eye');
+});
+
+test('orbit: an upward or downward drag stops short of the pole', () => {
+  for (const [name, camera] of Object.entries(cameras)) {
+    const o = orbitFromCamera(camera);
+    for (const dy of [1e4, -1e4]) {
+      const pose = dragOrbit(o, 0, dy);
+      assert.ok(Math.abs(Math.abs(pose.elevation) - 89 * Math.PI / 180) < 1e-12, `${name}, dy ${dy}: ${pose.elevation}`);
+      assert.equal(Math.sign(pose.elevation), Math.sign(dy), name);
+      // The view direction is never along up, or the camera's frame would be undefined.
+      const d = v3.unit(v3.sub(orbitEye({ ...o, ...pose }), o.target));
+      assert.ok(v3.norm(v3.cross(d, o.up)) > 0.01, `${name}, dy ${dy}: along the pole`);
+    }
+  }
+});
+
+test('orbit: the wheel keeps the distance within a fifth and ten times the scene\'s own', () => {
+  const o = orbitFromCamera(cameras['off axis, above']);
+  const d = o.startDistance;
+  assert.ok(zoomOrbit(o, 100) > d && zoomOrbit(o, -100) < d, 'wheel down moves away, up comes closer');
+  assert.ok(Math.abs(zoomOrbit({ ...o, distance: zoomOrbit(o, 250) }, -250) - d) < 1e-12, 'there and back');
+  assert.equal(zoomOrbit(o, 1e5), 10 * d);
+  assert.equal(zoomOrbit(o, -1e5), 0.2 * d);
+  // The limits are the scene's distance, not the current one.
+  assert.equal(zoomOrbit({ ...o, distance: 10 * d }, 1e5), 10 * d);
+  const far = { ...o, distance: zoomOrbit(o, 500) };
+  assert.ok(Math.abs(v3.norm(v3.sub(orbitEye(far), o.target)) - far.distance) < 1e-9, 'the eye is that far');
 });
 
 // A stand-in for WebCodecs: every chunk decodes at once into a "frame" that

@@ -1,0 +1,44 @@
+// The state the page's modules share, each piece here and nowhere else: what
+// the page knows of its session (state), what the address asked for (page)
+// and what the user chose on the page (choices).
+import { ExposureMode } from './schema.js';
+
+// Exposed for the end-to-end test and for curious users (devtools).
+export const state = {
+  welcome: null,
+  sceneInfo: null,
+  framesReceived: 0,
+  framesShown: 0,
+  lastShownSequence: 0,
+  lastFrame: null,     // {sequence, poseSequence, width, height, encoding, method, bytes, exposureStops, exposureMode}
+  posesSent: 0,
+  errors: [],          // {code, message, fatal}; page-parameter errors have code "PAGE_PARAMETER"
+  closed: null,        // {code, reason} of the last socket close
+  hudUpdates: 0,
+  connection: 'loading',  // loading | connecting | waiting-welcome | ready | reconnect-wait | stopped
+  connections: 0,      // sockets opened (attempts)
+  welcomes: 0,
+  reconnectAttempt: 0,
+  reconnectInS: null,  // seconds to the next attempt while waiting
+  scene: { name: '', firstPose: 0 },  // frames answering poses older than firstPose show the previous scene
+  h264: null,          // h264Support()'s answer, once H.264 was chosen
+  helloEncoding: '',   // what the last Hello asked for (jpeg when H.264 falls back)
+  keyframeRequests: 0, // poses sent with PoseUpdate.keyframe
+};
+window.haarcast = state;
+
+// parsePageParameters(location.search), set once at the start.
+export let page = null;
+export function setPage(p) {
+  page = p;
+}
+
+// What the user asked for: the next Hello, after a reconnect, says it again.
+export const choices = { scene: '', method: '', level: 0, k: 0, exposure: { auto: true, stops: 0 } };
+
+// The exposure the user chose, as RenderSettings fields.
+export function exposureSettings() {
+  return choices.exposure.auto
+    ? { exposureMode: ExposureMode.values.EXPOSURE_MODE_AUTO }
+    : { exposureMode: ExposureMode.values.EXPOSURE_MODE_FIXED, exposureStops: choices.exposure.stops };
+}

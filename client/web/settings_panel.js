@@ -1,0 +1,163 @@
+// The rendering and exposure controls. They offer what the server allows
+// (Welcome.limits, the schema's methods), not a copy kept in the page, and
+// they show the settings in effect: a change the server refuses puts them
+// back as they were, and in auto exposure the slider follows the frames.
+import { h264Support } from './h264_decoder.js';
+import { helloEncoding } from './h264_view.js';
+import { formatStops } from './frame_stats.js';
+import { choices, exposureSettings, page, state } from './page_state.js';
+import { ExposureMode, methodName, methodNames, methodValue } from './schema.js';
+import { restartSession, send } from './session.js';
+import { view } from './view.js';
+
+const $ = (id) => document.getElementById(id);
+
+export function fillSelect(select, items, value) {
+  select.replaceChildren(...items.map(([v, text]) => new Option(text, String(v))));
+  if (value !== undefined && value !== null) selectValue(select, value);
+}
+
+export function selectValue(select, value) {
+  const v = String(value);
+  if (![...select.options].some((o) => o.value === v)) select.add(new Option(v, v));
+  select.value = v;
+}
+
+let effective = null;  // the RenderSettings in effect: Welcome's, then each frame's
+export function setEffective(settings) {
+  effective = settings;
+}
+
+// The controls' settings before the last change and after it: a change the
+// server refuses (BAD_SETTINGS) puts the controls back as they were.
+let settingsBeforeChange = null;
+let settingsAfterChange = null;
+let exposureDirty = false;
+
+// A new session: its limits and the settings it starts with.
+export function showWelcomeSettings(w) {
+  effective = w.settings || {};
+  const limits = w.limits || {};
+
+  fillSelect($('method'), methodNames.map((m) => [m, m]), methodName(effective.method) || undefined);
+  // Levels: the server's range, not a copy in the page.
+  const levels = [];
+  if (limits.maxLevel) {
+    for (let n = limits.minLevel || 1; n <= limits.maxLevel; n++) levels.push([n, `${n} (${2 ** n}×${2 ** n})`]);
+  }
+  fillSelect($('level'), levels, effective.level || undefined);
+  const ks = [16, 64, 256, 1024, 4096].filter((k) => !limits.maxLightCoefficients || k <= limits.maxLightCoefficients);
+  fillSelect($('coefficients'), ks.map((k) => [k, String(k)]), effective.lightCoefficients || undefined);
+
+  // Exposure: the slider spans ±8 stops, or less when the server allows less.
+  const range = Math.min(8, limits.maxExposureStops || 8);
+  const slider = $('exposure');
+  slider.min = String(-range);
+  slider.max = String(range);
+  const fixed = effective.exposureMode === ExposureMode.values.EXPOSURE_MODE_FIXED;
+  $('exposure-auto').checked = !fixed;
+  if (fixed) slider.value = String(effective.exposureStops || 0);
+  choices.exposure = { auto: !fixed, stops: Number(slider.value) };
+
+  settingsBeforeChange = null;
+  settingsAfterChange = currentSettings();
+}
+
+function showSettings(s) {
+  if (!s) return;
+  if (s.method) selectValue($('method'), methodName(s.method));
+  if (s.level) selectValue($('level'), s.level);
+  if (s.lightCoefficients) selectValue($('coefficients'), s.lightCoefficients);
+  if (s.exposureMode) {
+    const fixed = s.exposureMode === ExposureMode.values.EXPOSURE_MODE_FIXED;
+    $('exposure-auto').checked = !fixed;
+    if (fixed) $('exposure').value = String(s.exposureStops || 0);
+    choices.exposure = { auto: !fixed, stops: Number($('exposure').value) };
+  }
+  choices.method = $('method').value;
+  choices.level = Number($('level').value);
+  choices.k = Number($('coefficients').value);
+}
+
+// The server refused the last change (BAD_SETTINGS): the session goes on as
+// before, and the controls show what is in effect again.
+export function undoSettingsChange() {
+  showSettings(settingsBeforeChange || effective);
+  settingsAfterChange = settingsBeforeChange;
+}
+
+function currentSettings() {
+  return { method: methodValue($('method').value), level: Number($('level').value),
+           lightCoefficients: Number($('coefficients').value), ...exposureSettings() };
+}
+
+function sendSettings(fields) {
+  if (send({ settings: fields })) {
+    settingsBeforeChange = settingsAfterChange;
+    settingsAfterChange = currentSettings();
+  }
+}
+
+function onSettingsControl() {
+  choices.method = $('method').value;
+  choices.level = Number($('level').value);
+  choices.k = Number($('coefficients').value);
+  const { method, level, lightCoefficients } = currentSettings();
+  sendSettings({ method, level, lightCoefficients });
+  view.poseDirty = true;
+}
+
+// The exposure change due, if one is: called once per display frame, as the
+// slider moves faster than that and the server keeps only the latest.
+export function flushExposure() {
+  if (exposureDirty) {
+    exposureDirty = false;
+    sendSettings(exposureSettings());
+  }
+}
+
+export function showFrameExposure(stops, mode) {
+  $('exposure-value').textContent = `${formatStops(stops)} stops (${mode})`;
+  // In auto mode the slider follows the frames, so that leaving auto starts
+  // from the exposure on the screen.
+  if ($('exposure-auto').checked && !exposureDragging && Number.isFinite(stops)) $('exposure').value = String(stops);
+}
+
+let exposureDragging = false;
+$('exposure').addEventListener('pointerdown', () => { exposureDragging = true; });
+// The release may land outside the slider: any pointerup ends the drag.
+window.addEventListener('pointerup', () => { exposureDragging = false; });
+$('exposure').addEventListener('change', () => { exposureDragging = false; });
+$('exposure').addEventListener('input', () => {
+  $('exposure-auto').checked = false;
+  choices.exposure = { auto: false, stops: Number($('exposure').value) };
+  $('exposure-value').textContent = `${formatStops(choices.exposure.stops)} stops (fixed)`;
+  exposureDirty = true;  // sent by flushExposure(): at most one per display frame
+});
+$('exposure-auto').addEventListener('change', () => {
+  choices.exposure = { auto: $('exposure-auto').checked, stops: Number($('exposure').value) };
+  exposureDirty = true;
+});
+for (const id of ['method', 'level', 'coefficients']) $(id).addEventListener('change', onSettingsControl);
+
+// The encoding chosen on the page (or ?encoding=): H.264 is asked for only
+// where WebCodecs decodes it; otherwise the reason is shown and the Hello
+// asks for JPEG.
+export async function chooseEncoding(name) {
+  page.encoding = name;
+  $('encoding').value = name;
+  if (name === 'h264' && !state.h264) state.h264 = await h264Support();
+  const { note } = helloEncoding(name, state.h264);
+  $('encoding-note').textContent = note;
+  $('encoding-note').hidden = !note;
+}
+
+// The encoding is a Hello field: another one takes a new session. The address
+// keeps the choice, so a reload asks for it again.
+$('encoding').addEventListener('change', async () => {
+  await chooseEncoding($('encoding').value);
+  const params = new URLSearchParams(location.search);
+  params.set('encoding', page.encoding);
+  history.replaceState(null, '', `?${params}`);
+  restartSession();
+});
