@@ -13,7 +13,8 @@
 // the fallback is tested whatever this Chromium and this server can do; a
 // failure there fails the test even when the H.264 part is skipped.
 //
-// usage: node browser_h264.mjs --haarcast BUILD/bin/haarcast [--chromium /usr/bin/chromium]
+// usage: node browser_h264.mjs --haarcast BUILD/bin/haarcast [--chromium /usr/bin/chromium] [--out DIR]
+//        [-- extra `serve` args]   (--out is accepted for run_browser_e2e.sh; nothing is written)
 import { spawn } from 'node:child_process';
 import { createRequire } from 'node:module';
 import { dirname, join, resolve } from 'node:path';
@@ -24,8 +25,9 @@ const require = createRequire(join(repo, 'client', 'web', 'package.json'));
 const { chromium } = require('playwright-core');
 
 const args = process.argv.slice(2);
-const opts = { haarcast: '', chromium: '/usr/bin/chromium' };
-for (let i = 0; i < args.length && args[i] !== '--'; i += 2) {  // run_browser_e2e.sh ends with "--"
+const opts = { haarcast: '', chromium: '/usr/bin/chromium', out: '', serveArgs: [] };
+for (let i = 0; i < args.length; i += 2) {
+  if (args[i] === '--') { opts.serveArgs = args.slice(i + 1); break; }  // run_browser_e2e.sh passes serve args after it
   const key = args[i].replace(/^--/, '');
   if (!(key in opts) || i + 1 >= args.length) throw new Error(`unknown or incomplete argument "${args[i]}"`);
   opts[key] = args[i + 1];
@@ -38,7 +40,8 @@ function check(condition, what) {
   if (!condition) failures.push(what);
 }
 
-const server = spawn(opts.haarcast, ['serve', '--port', '0', '--backend', process.env.HAARCAST_SMOKE_BACKEND || 'cpu'],
+const server = spawn(opts.haarcast, ['serve', '--port', '0', '--backend', process.env.HAARCAST_SMOKE_BACKEND || 'cpu',
+                                     ...opts.serveArgs],
                      { stdio: ['ignore', 'pipe', 'pipe'] });
 let log = '';
 const base = await new Promise((resolveUrl, reject) => {
