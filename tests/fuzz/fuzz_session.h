@@ -26,27 +26,9 @@
 #include <string_view>
 
 #include "haarcast/net/render_session.h"
+#include "../unit/net/stub_renderer.h"
 
 namespace haarcast::net::fuzz {
-
-// A renderer that draws nothing: a frame of the asked size.
-class StubRenderer : public render::Renderer {
- public:
-  std::string backend() const override { return "cpu"; }
-  std::string deviceName() const override { return "fuzz"; }
-  const render::RenderOptions& options() const override { return options_; }
-  std::size_t objectCount() const override { return 2; }
-  render::Frame render(const render::FrameRequest& request) override {
-    render::Frame f;
-    f.width = request.width;
-    f.height = request.height;
-    f.exposureStops = -1.0;
-    return f;
-  }
-
- private:
-  render::RenderOptions options_;
-};
 
 inline void check(bool ok) {
   if (!ok) __builtin_trap();

@@ -8,27 +8,12 @@
 
 #include <gtest/gtest.h>
 
+#include "stub_renderer.h"
+
 namespace haarcast::net {
 namespace {
 
 using namespace std::chrono_literals;
-
-class StubRenderer : public render::Renderer {
- public:
-  std::string backend() const override { return "cpu"; }
-  std::string deviceName() const override { return "stub"; }
-  const render::RenderOptions& options() const override { return options_; }
-  std::size_t objectCount() const override { return 2; }
-  render::Frame render(const render::FrameRequest& request) override {
-    render::Frame f;
-    f.width = request.width;
-    f.height = request.height;
-    return f;
-  }
-
- private:
-  render::RenderOptions options_;
-};
 
 // Records everything the session emits.
 class RecordingPort : public SessionPort {
