@@ -127,6 +127,134 @@ FusedLight FusedLight::synthesize(const std::array<SparseHaar, 3>& light) {
   return out;
 }
 
+FusedLight FusedLight::fromWeightedMaps(const std::array<SphereMap, 3>& weighted) {
+  FusedLight out;
+  out.level = weighted[0].level();
+  checkFusedLevel(out.level);
+  const std::size_t n = static_cast<std::size_t>(mapSize(out.level)) * static_cast<std::size_t>(mapSize(out.level));
+  out.planes.resize(3 * n);
+  for (std::size_t c = 0; c < 3; ++c) {
+    checkSameLevel(weighted[c].level(), out.level, "a light channel");
+    std::copy(weighted[c].values().begin(), weighted[c].values().end(), out.planes.begin() + static_cast<std::ptrdiff_t>(c * n));
+  }
+  return out;
+}
+
+namespace {
+
+// ρ as the pass reads it: one slice, or the blend of two (linear, so
+// blending the texels once equals blending the two sums). Rows past
+// lastNonZeroRow are zero in every slice, so only the rows above are
+// blended; the buffer's rows below are kept zero (they may hold another
+// object's rows from an earlier pixel).
+const float* blendedSlice(const PixelSlices& slices, const shared::SliceBlend& blend, FusedScratch& scratch) {
+  const int level = slices.level();
+  const std::size_t n = static_cast<std::size_t>(mapSize(level)) * static_cast<std::size_t>(mapSize(level));
+  const float* slice = slices.slice(static_cast<int>(blend.first));
+  if (blend.weight == 0.0f || blend.second == blend.first) return slice;
+  const float* other = slices.slice(static_cast<int>(blend.second));
+  const std::size_t rowFloats = static_cast<std::size_t>(mapSize(level)) * shared::kTexelFloats;
+  const std::size_t rows = static_cast<std::size_t>(slices.lastNonZeroRow() + 1);
+  if (scratch.blended.size() != n * shared::kTexelFloats) {
+    scratch.blended.assign(n * shared::kTexelFloats, 0.0f);
+    scratch.blendedRows = 0;
+  }
+  if (scratch.blendedRows > rows) {
+    std::fill(scratch.blended.begin() + static_cast<std::ptrdiff_t>(rows * rowFloats),
+              scratch.blended.begin() + static_cast<std::ptrdiff_t>(scratch.blendedRows * rowFloats), 0.0f);
+  }
+  scratch.blendedRows = rows;
+  const float w = blend.weight;
+  for (std::size_t k = 0; k < rows * rowFloats; ++k) scratch.blended[k] = slice[k] + w * (other[k] - slice[k]);
+  return scratch.blended.data();
+}
+
+// The rotation's part of a pass: Rᵀ's angles, and γ as a column offset.
+void setRotation(detail::FusedPass& pass, const EulerYXY& r) {
+  pass.cosAlpha = static_cast<float>(std::cos(r.alpha));
+  pass.sinAlpha = static_cast<float>(std::sin(r.alpha));
+  pass.cosBeta = static_cast<float>(std::cos(r.beta));
+  pass.sinBeta = static_cast<float>(std::sin(r.beta));
+  // Source column = φ'·M/2π − (γ·M/2π + ½); the offset's whole part is
+  // applied to the integer column, its fraction to the float coordinate.
+  const int m = mapSize(pass.level);
+  double offset = r.gamma / kTwoPi * m + 0.5;
+  offset -= std::floor(offset / m) * m;  // [0, M): whole turns change nothing
+  const double whole = std::floor(offset);
+  pass.columnShift = static_cast<int>(whole);
+  pass.columnFraction = static_cast<float>(offset - whole);
+}
+
+// ρ_c at one object-frame direction: the kernel's per-direction lookup in
+// scalar float (fused_kernel.cpp: Rᵀω, θ', φ', bilinear taps).
+std::array<float, 3> sliceAt(const detail::FusedPass& p, const glm::vec3& w) {
+  const int m = 1 << p.level;
+  const float x1 = p.cosAlpha * w.x - p.sinAlpha * w.z;  // R_y(−α)
+  const float z1 = p.sinAlpha * w.x + p.cosAlpha * w.z;
+  const float y2 = p.cosBeta * w.y + p.sinBeta * z1;     // R_x(−β)
+  const float z2 = p.cosBeta * z1 - p.sinBeta * w.y;
+  if (y2 < p.skipBelowY) return {0.0f, 0.0f, 0.0f};
+  const float theta = std::atan2(std::sqrt(x1 * x1 + z2 * z2), y2);
+  const float phi = std::atan2(x1, z2);
+  const float rowPos = std::min(std::max(theta * (static_cast<float>(m) / shared::kPiF) - 0.5f, 0.0f), static_cast<float>(m - 1));
+  const float colPos = phi * (static_cast<float>(m) / (2.0f * shared::kPiF)) - p.columnFraction;
+  const float rowFloor = std::floor(rowPos), colFloor = std::floor(colPos);
+  const float tRow = rowPos - rowFloor, tCol = colPos - colFloor;
+  const int r0 = static_cast<int>(rowFloor);
+  const int r1 = std::min(r0 + 1, m - 1);
+  const int c0 = (static_cast<int>(colFloor) - p.columnShift) & (m - 1);
+  const int c1 = (c0 + 1) & (m - 1);
+  std::array<float, 3> out{};
+  for (std::size_t c = 0; c < 3; ++c) {
+    auto texel = [&](int row, int col) { return p.slice[static_cast<std::size_t>((row << p.level) | col) * shared::kTexelFloats + c]; };
+    const float a = texel(r0, c0), b = texel(r0, c1), cc = texel(r1, c0), e = texel(r1, c1);
+    const float top = tCol * (b - a) + a;
+    const float bottom = tCol * (e - cc) + cc;
+    out[c] = tRow * (bottom - top) + top;
+  }
+  return out;
+}
+
+detail::FusedPass makePass(const PixelSlices& slices, const float* slice, const EulerYXY& r) {
+  detail::FusedPass pass;
+  pass.level = slices.level();
+  pass.slice = slice;
+  pass.directions = detail::pixelDirections(pass.level);
+  setRotation(pass, r);
+  // A direction whose source row is beyond lastNonZeroRow + 1 reads only zero
+  // texels (both bilinear rows are zero); one more row of margin absorbs the
+  // float rounding of θ'.
+  const int m = mapSize(pass.level);
+  const int cutRow = slices.lastNonZeroRow() + 2;
+  pass.skipBelowY = cutRow < m ? static_cast<float>(std::cos(cutRow * kPi / m)) : -2.0f;
+  return pass;
+}
+
+}  // namespace
+
+std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBlend& blend, const EulerYXY& r,
+                                const FusedLight& light, std::span<const WeightedBits> visibility,
+                                std::span<const FusedPointLight> lights, std::uint32_t visibleLights,
+                                FusedScratch& scratch) {
+  const int level = slices.level();
+  checkSameLevel(light.level, level, "the light");
+  const std::size_t n = static_cast<std::size_t>(mapSize(level)) * static_cast<std::size_t>(mapSize(level));
+  scratch.visibility.resize(n);
+  blendVisibility(visibility, level, scratch.visibility);
+
+  detail::FusedPass pass = makePass(slices, blendedSlice(slices, blend, scratch), r);
+  pass.light = light.planes.data();
+  pass.visibility = scratch.visibility.data();
+  std::array<float, 3> out{};
+  detail::fusedSample(pass, out.data());
+  for (std::size_t k = 0; k < lights.size(); ++k) {
+    if (((visibleLights >> k) & 1u) == 0) continue;
+    const std::array<float, 3> rho = sliceAt(pass, lights[k].direction);
+    for (std::size_t c = 0; c < 3; ++c) out[c] += lights[k].power[c] * rho[c];
+  }
+  return out;
+}
+
 std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBlend& blend, const EulerYXY& r,
                                 const FusedLight& light, std::span<const WeightedVisibility> visibility,
                                 FusedScratch& scratch) {
@@ -143,53 +271,9 @@ std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBl
   }
   synthesizeInPlace(scratch.visibility, level, scratch.synthesis);
 
-  // ρ: one slice, or the blend of two (linear, so blending the texels once
-  // equals blending the two sums). Rows past lastNonZeroRow are zero in every
-  // slice, so only the rows above are blended; the buffer's rows below are
-  // kept zero (they may hold another object's rows from an earlier pixel).
-  const float* slice = slices.slice(static_cast<int>(blend.first));
-  if (blend.weight != 0.0f && blend.second != blend.first) {
-    const float* other = slices.slice(static_cast<int>(blend.second));
-    const std::size_t rowFloats = static_cast<std::size_t>(mapSize(level)) * shared::kTexelFloats;
-    const std::size_t rows = static_cast<std::size_t>(slices.lastNonZeroRow() + 1);
-    if (scratch.blended.size() != n * shared::kTexelFloats) {
-      scratch.blended.assign(n * shared::kTexelFloats, 0.0f);
-      scratch.blendedRows = 0;
-    }
-    if (scratch.blendedRows > rows) {
-      std::fill(scratch.blended.begin() + static_cast<std::ptrdiff_t>(rows * rowFloats),
-                scratch.blended.begin() + static_cast<std::ptrdiff_t>(scratch.blendedRows * rowFloats), 0.0f);
-    }
-    scratch.blendedRows = rows;
-    const float w = blend.weight;
-    for (std::size_t k = 0; k < rows * rowFloats; ++k) scratch.blended[k] = slice[k] + w * (other[k] - slice[k]);
-    slice = scratch.blended.data();
-  }
-
-  detail::FusedPass pass;
-  pass.level = level;
-  pass.slice = slice;
+  detail::FusedPass pass = makePass(slices, blendedSlice(slices, blend, scratch), r);
   pass.light = light.planes.data();
   pass.visibility = scratch.visibility.data();
-  pass.directions = detail::pixelDirections(level);
-  pass.cosAlpha = static_cast<float>(std::cos(r.alpha));
-  pass.sinAlpha = static_cast<float>(std::sin(r.alpha));
-  pass.cosBeta = static_cast<float>(std::cos(r.beta));
-  pass.sinBeta = static_cast<float>(std::sin(r.beta));
-  // Source column = φ'·M/2π − (γ·M/2π + ½); the offset's whole part is
-  // applied to the integer column, its fraction to the float coordinate.
-  const int m = mapSize(level);
-  double offset = r.gamma / kTwoPi * m + 0.5;
-  offset -= std::floor(offset / m) * m;  // [0, M): whole turns change nothing
-  const double whole = std::floor(offset);
-  pass.columnShift = static_cast<int>(whole);
-  pass.columnFraction = static_cast<float>(offset - whole);
-  // A direction whose source row is beyond lastNonZeroRow + 1 reads only zero
-  // texels (both bilinear rows are zero); one more row of margin absorbs the
-  // float rounding of θ'.
-  const int cutRow = slices.lastNonZeroRow() + 2;
-  pass.skipBelowY = cutRow < m ? static_cast<float>(std::cos(cutRow * kPi / m)) : -2.0f;
-
   std::array<float, 3> out{};
   detail::fusedSample(pass, out.data());
   return out;
@@ -197,10 +281,10 @@ std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBl
 
 std::string fusedTargetName() { return detail::fusedTarget(); }
 
-std::size_t fusedPixelBytes(int level, bool blended, std::size_t visibilityEntries) {
+std::size_t fusedPixelBytes(int level, bool blended, std::size_t visibilityBytes) {
   const std::size_t n = static_cast<std::size_t>(mapSize(level)) * static_cast<std::size_t>(mapSize(level));
   const std::size_t slice = n * shared::kTexelFloats * sizeof(float);
-  return slice * (blended ? 2 : 1) + 3 * n * sizeof(float) + visibilityEntries * (sizeof(std::uint32_t) + sizeof(float));
+  return slice * (blended ? 2 : 1) + 3 * n * sizeof(float) + visibilityBytes;
 }
 
 }  // namespace haarcast

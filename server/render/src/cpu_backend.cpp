@@ -20,6 +20,7 @@
 #include "haarcast/core/rotate_haar.h"
 #include "haarcast/core/triple_product.h"
 #include "haarcast/render/embree_scene.h"
+#include "haarcast/render/point_lights.h"
 #include "haarcast/render/shading.h"
 
 namespace haarcast::render {
@@ -171,8 +172,9 @@ class CpuRenderer final : public Renderer {
   // or one fused pass. Each adds its stages and returns the bytes read.
   std::size_t shadeRotating(const ResolvedFrame& resolved, const GBuffer& g, const FrameRequest& request,
                             const CameraRays& camera, Frame& frame, const CancelPoint& cancelPoint) const;
-  std::size_t shadeFused(const ResolvedFrame& resolved, const GBuffer& g, const FrameRequest& request,
-                         const CameraRays& camera, Frame& frame, const CancelPoint& cancelPoint) const;
+  std::size_t shadeFused(const ResolvedFrame& resolved, const RayScene& rays, const GBuffer& g,
+                         const FrameRequest& request, const CameraRays& camera, Frame& frame,
+                         const CancelPoint& cancelPoint) const;
 
   RenderOptions options_;
   PreparedScene prepared_;
@@ -363,7 +365,7 @@ Frame CpuRenderer::renderFrame(const FrameRequest& request, const CancelPoint& c
 
   frame.image = io::makeImage(w, h);
   frame.objectMask.assign(pixels, 0);
-  bytes += options_.method == RotationMethod::Fused ? shadeFused(resolved, g, request, camera, frame, cancelPoint)
+  bytes += options_.method == RotationMethod::Fused ? shadeFused(resolved, *rays, g, request, camera, frame, cancelPoint)
                                                     : shadeRotating(resolved, g, request, camera, frame, cancelPoint);
 
   // ---- tonemap: backdrop, RGBA8 --------------------------------------------
@@ -440,26 +442,45 @@ std::size_t CpuRenderer::shadeRotating(const ResolvedFrame& resolved, const GBuf
   return bytes;
 }
 
-std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const GBuffer& g, const FrameRequest& request,
-                                    const CameraRays& camera, Frame& frame, const CancelPoint& cancelPoint) const {
+std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const RayScene& rays, const GBuffer& g,
+                                    const FrameRequest& request, const CameraRays& camera, Frame& frame,
+                                    const CancelPoint& cancelPoint) const {
   const auto t0 = Clock::now();
+  std::vector<glm::mat4> toWorld;
+  std::vector<glm::mat3> rotations;
+  for (const ResolvedObject& o : resolved.objects) {
+    toWorld.emplace_back(o.objectToWorld);
+    rotations.emplace_back(o.rotation);
+  }
   const std::size_t bytes = shadePixels(g, request, camera, frame, [&](const Sample& sample, std::array<float, 3>& rgb) {
     // Per worker thread, kept across pixels: no allocation per pixel.
     thread_local FusedScratch scratch;
-    const PreparedObject& p = prepared_.objects[sample.hit.object];
+    const std::size_t object = sample.hit.object;
+    const PreparedObject& p = prepared_.objects[object];
+    const ResolvedObject& o = resolved.objects[object];
     const PixelInput& in = sample.input;
-    std::array<WeightedVisibility, 3> vis;
-    std::size_t entries = 0;
-    for (std::size_t v = 0; v < 3; ++v) {
-      vis[v] = {&p.visibility[in.vertex[v]], static_cast<float>(in.b[v])};
-      entries += vis[v].list->size();
+    const glm::uvec3 triangle(in.vertex[0], in.vertex[1], in.vertex[2]);
+    const float b[3] = {static_cast<float>(in.b[0]), static_cast<float>(in.b[1]), static_cast<float>(in.b[2])};
+    // The point lights this sample sees: one shadow ray each (point_lights.h).
+    const std::uint32_t seen =
+        pointLightMask(rays, shadingPoint(*p.mesh, triangle, b, toWorld[object], rotations[object],
+                                          p.shadowShift * static_cast<float>(o.scale)),
+                       resolved.pointLightDirections);
+    if (p.ground) {
+      rgb = o.groundFlat;
+      for (std::size_t k = 0; k < o.pointLights.size(); ++k)
+        if ((seen >> k) & 1u)
+          for (std::size_t c = 0; c < 3; ++c) rgb[c] += o.pointLights[k].power[c];
+      return std::size_t{0};
     }
-    const PixelSlices& slices = pixelSlices_[sample.hit.object];
+    std::array<WeightedBits, 3> vis;
+    for (std::size_t v = 0; v < 3; ++v) vis[v] = {p.visibilityBits.point(in.vertex[v]).data(), b[v]};
+    const PixelSlices& slices = pixelSlices_[object];
     const shared::SliceBlend blend = shared::sliceBlendAt(static_cast<float>(in.rotation.thetaOut),
                                                           static_cast<shared::uint>(slices.thetaSamples()),
                                                           options_.interpolateSlices ? 1u : 0u);
-    rgb = fusedShade(slices, blend, in.rotation.euler, resolved.objects[sample.hit.object].fusedLight, vis, scratch);
-    return fusedPixelBytes(slices.level(), blend.weight != 0.0f, entries);
+    rgb = fusedShade(slices, blend, in.rotation.euler, o.fusedLight, vis, o.pointLights, seen, scratch);
+    return fusedPixelBytes(slices.level(), blend.weight != 0.0f, 3 * p.visibilityBits.wordsPerPoint() * sizeof(std::uint32_t));
   }, cancelPoint);
   frame.stages.push_back({"fused", since(t0)});
   return bytes;

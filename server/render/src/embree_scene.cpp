@@ -285,6 +285,43 @@ void RayScene::occludedBatch(std::span<const Ray> rays, std::span<std::uint8_t> 
   }
 }
 
+void RayScene::occludedFrom(const glm::vec3& origin, float tnear, std::span<const glm::vec3> directions,
+                            std::span<std::uint8_t> out) const {
+  if (directions.size() != out.size()) {
+    throw std::invalid_argument("RayScene::occludedFrom: " + std::to_string(directions.size()) + " directions but " +
+                                std::to_string(out.size()) + " results");
+  }
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  alignas(32) RTCRay8 packet;
+  alignas(32) int valid[8];
+  for (std::size_t first = 0; first < directions.size(); first += 8) {
+    const std::size_t n = std::min<std::size_t>(8, directions.size() - first);
+    for (std::size_t k = 0; k < 8; ++k) {
+      const bool live = k < n;
+      const glm::vec3 d = live ? directions[first + k] : glm::vec3(0.0f, 1.0f, 0.0f);
+      valid[k] = live ? -1 : 0;
+      packet.org_x[k] = origin.x;
+      packet.org_y[k] = origin.y;
+      packet.org_z[k] = origin.z;
+      packet.dir_x[k] = d.x;
+      packet.dir_y[k] = d.y;
+      packet.dir_z[k] = d.z;
+      packet.tnear[k] = tnear;
+      packet.tfar[k] = std::numeric_limits<float>::infinity();
+      packet.time[k] = 0.0f;
+      packet.mask[k] = ~0u;
+      packet.id[k] = static_cast<unsigned>(k);
+      packet.flags[k] = 0;
+    }
+    rtcOccluded8(valid, impl_->top.get(), &context, &packet);
+    for (std::size_t k = 0; k < n; ++k) {
+      out[first + k] = packet.tfar[k] == -std::numeric_limits<float>::infinity() ? 1 : 0;
+    }
+  }
+}
+
 void RayScene::setTransform(std::size_t object, const glm::mat4& objectToWorld) {
   Impl& s = *impl_;
   if (object >= s.normalMatrices.size()) {

@@ -28,6 +28,9 @@ void checkRenderOptions(const RenderOptions& o) {
   }
   if (o.lightCoefficients == 0) bad("light coefficients must be at least 1");
   if (o.thetaSamples < 1 || o.thetaSamples > 256) bad("theta samples must be in 1..256");
+  if (o.pointLights.maxLights > shared::kMaxPointLights) {
+    bad("point lights " + std::to_string(o.pointLights.maxLights) + " is over " + std::to_string(shared::kMaxPointLights));
+  }
 }
 
 BrdfSliceTable objectSliceTable(const SceneObject& object, const RenderOptions& options, const RenderProgress& progress) {
@@ -57,14 +60,31 @@ PreparedScene prepareScene(const Scene& scene, const RenderOptions& options, con
     object.mesh->validate();
     p.mesh = withNormals(object.mesh);  // a mesh built in code may come without them
     p.table = objectSliceTable(object, options, progress);
+    p.ground = object.ground;
+    p.groundAlbedo = object.groundAlbedo;
+    if (p.ground) {
+      if (prepared.ground) throw std::invalid_argument("render: the scene has two grounds");
+      prepared.ground = k;
+    }
     VisibilityOptions vis = options.visibility;
     vis.level = options.level;
-    p.visibility = loadOrComputeVertexVisibility(*p.mesh, vis, options.cacheDir, [&](std::size_t done, std::size_t total) {
+    p.shadowShift = static_cast<float>(vis.offset * p.mesh->bounds().radius());
+    auto visibilityProgress = [&](std::size_t done, std::size_t total) {
       if (progress) progress("visibility " + object.name, done, total);
-    });
+    };
+    if (options.method == RotationMethod::Fused) {
+      p.visibilityBits = loadOrComputeVisibilityBits(*p.mesh, vis, options.cacheDir, visibilityProgress);
+    } else {
+      p.visibility = loadOrComputeVertexVisibility(*p.mesh, vis, options.cacheDir, visibilityProgress);
+    }
   }
   prepared.light = scene.environment.maps(options.level);
   prepared.background = scene.environment.maps(kBackgroundLevel);
+  if (options.method == RotationMethod::Fused) {
+    LightSplit split = splitLight(prepared.light, options.pointLights);
+    prepared.pointLights = std::move(split.lights);
+    prepared.restLight = std::move(split.rest);
+  }
   return prepared;
 }
 
@@ -151,20 +171,87 @@ void checkFrameRequest(const FrameRequest& r, std::size_t objectCount) {
   if (!(e.adaptation >= 0.0 && e.adaptation <= 1.0)) bad("exposure adaptation must be in 0..1");
 }
 
+namespace {
+
+// fused's light for one object (ResolvedObject): the rest map in the
+// object's frame, weighted by ΔΩ, zero where the ground hides it; the point
+// lights in the object's frame; and for the ground itself its closed form.
+void resolveFusedLight(const PreparedScene& prepared, const PreparedObject& object, const glm::dmat3& lightRotation,
+                       const std::optional<glm::dvec3>& groundNormal, const std::vector<glm::vec3>& worldDirections,
+                       ResolvedObject& o) {
+  // L_obj(ω) = L(Mω), M = lightRotationᵀ·objectRotation (lightInObjectFrame).
+  const EulerYXY toObject = eulerFromMatrix(glm::transpose(glm::transpose(lightRotation) * o.rotation));
+  std::array<SphereMap, 3> weighted;
+  for (std::size_t c = 0; c < 3; ++c)
+    weighted[c] = rotateSpatialMap(prepared.restLight[c], toObject).weightedBySolidAngle();
+  const int level = weighted[0].level();
+  const int m = mapSize(level);
+  if (groundNormal && !object.ground) {
+    // What the ground hides: every direction below its plane, as seen from
+    // above it (the plane is wide: DESIGN.md's direct light has no bounce).
+    const glm::dvec3 down = glm::transpose(o.rotation) * *groundNormal;  // the ground's normal in the object's frame
+    for (int r = 0; r < m; ++r)
+      for (int col = 0; col < m; ++col)
+        if (glm::dot(sphericalToDirection(rowTheta(level, r), colPhi(level, col)), down) < 0.0)
+          for (std::size_t c = 0; c < 3; ++c) weighted[c].at(r, col) = 0.0f;
+  }
+  o.fusedLight = FusedLight::fromWeightedMaps(weighted);
+  o.pointLights.resize(worldDirections.size());
+  for (std::size_t k = 0; k < worldDirections.size(); ++k) {
+    const glm::dvec3 d = glm::transpose(o.rotation) * glm::dvec3(worldDirections[k]);
+    o.pointLights[k].direction = glm::vec3(d);
+    for (std::size_t c = 0; c < 3; ++c) o.pointLights[k].power[c] = static_cast<float>(prepared.pointLights[k].power[c]);
+  }
+  if (!object.ground) return;
+  // The ground is a Lambert plane with +Y up in its own frame and nothing of
+  // its own above it: ρ·cos θ = albedo/π·max(y, 0) at every point, so the map
+  // part is one sum per frame and each point light adds a constant where seen.
+  const glm::dvec3 rho = object.groundAlbedo / kPi;
+  glm::dvec3 flat(0.0);
+  for (int r = 0; r < m; ++r) {
+    const double y = std::cos(rowTheta(level, r));
+    if (y <= 0.0) continue;
+    for (int col = 0; col < m; ++col)
+      for (int c = 0; c < 3; ++c) flat[c] += weighted[static_cast<std::size_t>(c)].at(r, col) * y;
+  }
+  for (int c = 0; c < 3; ++c) o.groundFlat[static_cast<std::size_t>(c)] = static_cast<float>(rho[c] * flat[c]);
+  for (FusedPointLight& l : o.pointLights) {
+    const double cosine = std::max(0.0, static_cast<double>(l.direction.y));
+    for (std::size_t c = 0; c < 3; ++c) l.power[c] = static_cast<float>(rho[static_cast<int>(c)] * cosine * l.power[c]);
+  }
+}
+
+}  // namespace
+
 ResolvedFrame resolveFrame(const PreparedScene& prepared, const RenderOptions& options, const FrameRequest& request) {
   checkFrameRequest(request, prepared.objects.size());
   ResolvedFrame out;
   out.lightCoefficients = request.lightCoefficients ? request.lightCoefficients : options.lightCoefficients;
   out.objects.resize(prepared.objects.size());
+  const bool fused = options.method == RotationMethod::Fused;
+  // A light at d in the environment's frame is seen at lightRotation·d (L'(ω) = L(Rᵀω)).
+  if (fused) {
+    for (const DirectionalLight& l : prepared.pointLights)
+      out.pointLightDirections.push_back(glm::vec3(glm::normalize(request.lightRotation * l.direction)));
+  }
   for (std::size_t i = 0; i < out.objects.size(); ++i) {
     const Pose& pose = request.poses.empty() ? prepared.objects[i].pose : request.poses[i];
     ResolvedObject& o = out.objects[i];
     o.rotation = pose.rotation();
     o.objectToWorld = pose.objectToWorld();
     o.scale = pose.scale;
+  }
+  std::optional<glm::dvec3> groundNormal;
+  if (prepared.ground) groundNormal = out.objects[*prepared.ground].rotation * glm::dvec3(0.0, 1.0, 0.0);
+  for (std::size_t i = 0; i < out.objects.size(); ++i) {
+    ResolvedObject& o = out.objects[i];
+    if (fused) {
+      resolveFusedLight(prepared, prepared.objects[i], request.lightRotation, groundNormal, out.pointLightDirections, o);
+      out.lightBytes += o.fusedLight.planes.size() * sizeof(float);
+      continue;
+    }
     o.light = lightInObjectFrame(prepared.light, o.rotation, request.lightRotation, out.lightCoefficients);
     for (const SparseHaar& l : o.light) out.lightBytes += l.size() * (sizeof(std::uint32_t) + sizeof(float));
-    if (options.method == RotationMethod::Fused) o.fusedLight = FusedLight::synthesize(o.light);
   }
   return out;
 }

@@ -1,7 +1,9 @@
 #include "haarcast/render/scene.h"
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <stdexcept>
 
 #include <glm/geometric.hpp>
@@ -131,6 +133,41 @@ void fitToUnitSphere(Mesh& mesh) {
   for (glm::vec3& p : mesh.positions) p = glm::vec3((glm::dvec3(p) - c) / r);
 }
 
+void addGround(Scene& scene, const GroundOptions& options) {
+  if (!(options.albedo >= 0.0 && options.albedo <= 1.0)) {
+    throw std::invalid_argument("ground: albedo " + std::to_string(options.albedo) + " is outside [0, 1]");
+  }
+  if (!(options.extent > 0.0 && std::isfinite(options.extent))) {
+    throw std::invalid_argument("ground: extent must be positive and finite");
+  }
+  if (scene.objects.empty()) throw std::invalid_argument("ground: the scene has no objects to stand under it");
+  // The objects' world bounds at the scene's poses, from every vertex.
+  glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
+  for (const SceneObject& o : scene.objects) {
+    if (o.ground) throw std::invalid_argument("ground: the scene has one already (\"" + o.name + "\")");
+    const glm::dmat4 m = o.pose.objectToWorld();
+    for (const glm::vec3& p : o.mesh->positions) {
+      const glm::dvec3 w(m * glm::dvec4(glm::dvec3(p), 1.0));
+      lo = glm::min(lo, w);
+      hi = glm::max(hi, w);
+    }
+  }
+  const double radius = 0.5 * glm::length(hi - lo);
+  SceneObject g;
+  g.name = "ground";
+  g.ground = true;
+  g.groundAlbedo = glm::dvec3(options.albedo);
+  // A finely divided plane: the G-buffer rasterises it like any mesh, and
+  // vertex visibility (not used by fused's closed form) stays cheap.
+  g.mesh = std::make_shared<Mesh>(assets::makePlane(1.0, 8));
+  g.material.name = "lambert:" + std::to_string(options.albedo);
+  g.material.cacheKey = "lambert-albedo-" + std::to_string(options.albedo);
+  g.material.brdf = makeLambert(g.groundAlbedo);
+  g.pose.scale = options.extent * std::max(radius, 1e-6);
+  g.pose.translate = {0.5 * (lo.x + hi.x), lo.y, 0.5 * (lo.z + hi.z)};
+  scene.objects.push_back(std::move(g));
+}
+
 Scene defaultScene() {
   Scene s;
   s.environment = builtinEnvironment();
@@ -147,6 +184,7 @@ Scene defaultScene() {
   // crops them (a portrait frame keeps this field across its width).
   s.camera.eye = {0.0, 0.85, 4.8};
   s.camera.fovYDegrees = 45.0;
+  addGround(s);
   return s;
 }
 
@@ -248,6 +286,31 @@ Scene sceneFromJson(const nlohmann::json& j, const std::string& path) {
     obj.pose.scale = o.value("scale", 1.0);
     if (!(obj.pose.scale > 0.0)) fail(path, where + ".scale", "must be positive");
     s.objects.push_back(std::move(obj));
+  }
+  // "ground": true, false (the default), or {"albedo": a, "extent": e}.
+  if (j.contains("ground")) {
+    const auto& g = j["ground"];
+    GroundOptions ground;
+    bool on = true;
+    if (g.is_boolean()) {
+      on = g.get<bool>();
+    } else if (g.is_object()) {
+      for (const auto& [key, value] : g.items()) {
+        if (key != "albedo" && key != "extent") fail(path, "ground", "unknown key \"" + key + "\" (albedo, extent)");
+        if (!value.is_number()) fail(path, "ground." + key, "expected a number");
+      }
+      ground.albedo = g.value("albedo", ground.albedo);
+      ground.extent = g.value("extent", ground.extent);
+    } else {
+      fail(path, "ground", "expected true, false or {\"albedo\": …, \"extent\": …}");
+    }
+    if (on) {
+      try {
+        addGround(s, ground);
+      } catch (const std::invalid_argument& e) {
+        fail(path, "ground", e.what());
+      }
+    }
   }
   return s;
 }

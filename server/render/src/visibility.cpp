@@ -109,6 +109,65 @@ std::vector<SparseHaar> computeVertexVisibility(
   return out;
 }
 
+VisibilityBits computeVisibilityBits(const Mesh& mesh, const VisibilityOptions& options,
+                                     const std::function<void(std::size_t done, std::size_t total)>& progress) {
+  checkVisibilityOptions(options);
+  mesh.validate();
+  if (mesh.normals.empty()) {
+    Mesh withNormals = mesh;
+    withNormals.computeNormals();
+    const RayScene scene({Instance{&withNormals}});
+    return computeVisibilityBits(scene, withNormals, options, progress);
+  }
+  const RayScene scene({Instance{&mesh}});
+  return computeVisibilityBits(scene, mesh, options, progress);
+}
+
+VisibilityBits computeVisibilityBits(const RayScene& occluders, const Mesh& mesh, const VisibilityOptions& options,
+                                     const std::function<void(std::size_t done, std::size_t total)>& progress) {
+  checkVisibilityOptions(options);
+  checkMeshForVisibility(mesh);
+  const int level = options.level;
+  const int m = mapSize(level);
+  const std::size_t n = static_cast<std::size_t>(m) * static_cast<std::size_t>(m);
+  std::vector<glm::vec3> directions(n);
+  for (int i = 0; i < m; ++i)
+    for (int j = 0; j < m; ++j)
+      directions[static_cast<std::size_t>(i * m + j)] = glm::vec3(sphericalToDirection(rowTheta(level, i), colPhi(level, j)));
+  const float skipBelow = static_cast<float>(-std::sin(kBitsSkipBelowDegrees * kPi / 180.0));
+  const float shift = shiftOf(mesh, options);
+  const std::size_t total = mesh.positions.size();
+  VisibilityBits out(level, total);
+  parallelFor(
+      total,
+      [&](std::size_t v) {
+        // Per worker thread, kept across vertices.
+        thread_local std::vector<glm::vec3> traced;
+        thread_local std::vector<std::uint32_t> which;
+        thread_local std::vector<std::uint8_t> blocked;
+        const RayStart start = rayStart(mesh, v, shift);
+        const glm::vec3 normal = mesh.normals[v];
+        const float len = glm::length(normal);
+        const glm::vec3 unit = len > 0.0f && std::isfinite(len) ? normal / len : glm::vec3(0.0f);
+        traced.clear();
+        which.clear();
+        for (std::size_t i = 0; i < n; ++i) {
+          if (len > 0.0f && glm::dot(directions[i], unit) < skipBelow) continue;
+          traced.push_back(directions[i]);
+          which.push_back(static_cast<std::uint32_t>(i));
+        }
+        blocked.resize(traced.size());
+        occluders.occludedFrom(start.origin, start.tnear, traced, blocked);
+        const std::span<std::uint32_t> words = out.point(v);
+        for (std::size_t k = 0; k < traced.size(); ++k)
+          if (!blocked[k]) words[which[k] / 32] |= 1u << (which[k] % 32);
+      },
+      [&](std::size_t done) {
+        if (progress) progress(done, total);
+      });
+  return out;
+}
+
 SphereMap vertexVisibilityMap(const RayScene& occluders, const Mesh& mesh, std::size_t vertex,
                               const VisibilityOptions& options) {
   checkVisibilityOptions(options);

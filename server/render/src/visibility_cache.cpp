@@ -186,4 +186,72 @@ std::vector<SparseHaar> loadOrComputeVertexVisibility(
   return visibility;
 }
 
+namespace {
+
+std::string bitsOptionsText(const VisibilityOptions& options) {
+  char offset[32];
+  const std::to_chars_result r = std::to_chars(offset, offset + sizeof offset, options.offset);
+  const std::string offsetText = r.ec == std::errc() ? std::string(offset, r.ptr) : std::string("?");
+  char skip[32];
+  const std::to_chars_result s = std::to_chars(skip, skip + sizeof skip, kBitsSkipBelowDegrees);
+  const std::string skipText = s.ec == std::errc() ? std::string(skip, s.ptr) : std::string("?");
+  return "level=" + std::to_string(options.level) + " offset=" + offsetText + " skip=" + skipText;
+}
+
+VisibilityBits decodeBits(std::string_view payload, std::size_t vertexCount, int level) {
+  io::PayloadReader in(payload);
+  const auto count = in.take<std::uint64_t>();
+  if (count != vertexCount) {
+    throw std::runtime_error("invalid contents: " + std::to_string(count) + " vertices, the mesh has " +
+                             std::to_string(vertexCount));
+  }
+  VisibilityBits bits(level, vertexCount);
+  const std::size_t words = vertexCount * bits.wordsPerPoint();
+  if (in.remaining() != 4 * words) {
+    throw std::runtime_error("invalid contents: " + std::to_string(in.remaining()) + " bytes of words, expected " +
+                             std::to_string(4 * words));
+  }
+  std::vector<std::uint32_t> w(words);
+  for (std::uint32_t& x : w) x = in.take<std::uint32_t>();
+  try {
+    bits.assign(w);
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(std::string("invalid contents: ") + e.what());
+  }
+  return bits;
+}
+
+}  // namespace
+
+VisibilityBits loadOrComputeVisibilityBits(const Mesh& mesh, const VisibilityOptions& options, const std::string& cacheDir,
+                                           const std::function<void(std::size_t done, std::size_t total)>& progress,
+                                           VisibilityCacheStatus* statusOut) {
+  VisibilityCacheStatus local;
+  VisibilityCacheStatus& status = statusOut ? *statusOut : local;
+  status = VisibilityCacheStatus{};
+  const bool warnOnStderr = statusOut == nullptr;
+  checkVisibilityOptions(options);
+  mesh.validate();
+  if (cacheDir.empty()) {
+    status.reason = "no cache directory";
+    return computeVisibilityBits(mesh, options, progress);
+  }
+  const io::CacheHeader entry{"visibility-bits", kVisibilityBitsCacheVersion, meshContentKey(mesh), bitsOptionsText(options)};
+  if (const std::optional<std::string> payload = io::lookUpCacheEntry(cacheDir, entry, status)) {
+    try {
+      return decodeBits(*payload, mesh.positions.size(), options.level);
+    } catch (const std::exception& e) {
+      status.hit = false;
+      status.reason = e.what();
+    }
+  }
+  VisibilityBits bits = computeVisibilityBits(mesh, options, progress);
+  std::string payload;
+  payload.reserve(8 + bits.storedBytes());
+  io::appendLittleEndian<std::uint64_t>(payload, bits.pointCount());
+  for (const std::uint32_t w : bits.words()) io::appendLittleEndian<std::uint32_t>(payload, w);
+  io::storeCacheEntry(cacheDir, entry, payload, status, warnOnStderr);
+  return bits;
+}
+
 }  // namespace haarcast

@@ -33,6 +33,7 @@
 #include "haarcast/core/haar.h"
 #include "haarcast/core/rotation.h"
 #include "haarcast/core/shared_layout.h"
+#include "haarcast/core/visibility_bits.h"
 
 namespace haarcast {
 
@@ -71,6 +72,18 @@ struct FusedLight {
   int level = 0;
   std::vector<float> planes;
   static FusedLight synthesize(const std::array<SparseHaar, 3>& light);
+  // The light whole, from its pixel maps with ΔΩ already folded in
+  // (SphereMap::weightedBySolidAngle): no Haar coding, no cut.
+  static FusedLight fromWeightedMaps(const std::array<SphereMap, 3>& weighted);
+};
+
+// A bright light taken out of the map (render/light_split.h) and shaded as a
+// direction: I_c += power_c · ρ_c(Rᵀd) when the pixel sees it. `direction`
+// is a unit vector in the object's frame; power_c = Σ L_c·ΔΩ over the map
+// texels it replaces.
+struct FusedPointLight {
+  glm::vec3 direction{0.0f, 1.0f, 0.0f};
+  std::array<float, 3> power{};
 };
 
 // One of the hit triangle's vertices: its visibility list and barycentric weight.
@@ -88,7 +101,16 @@ struct FusedScratch {
   std::size_t blendedRows = 0;    // rows of `blended` that may be non-zero
 };
 
-// One pixel of `fused`: Σ_ω W_c(ω)·ρ_c(Rᵀω) for c = R, G, B, with
+// One pixel of `fused` with exact visibility: V(ω) = Σ_v b_v·bit_v(ω) blended
+// from the hit triangle's vertices (visibility_bits.h), then the pass below;
+// plus Σ_k power_k·ρ(Rᵀd_k) over the point lights whose bit k is set in
+// `visibleLights` (each pixel's own shadow rays).
+std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBlend& blend, const EulerYXY& r,
+                                const FusedLight& light, std::span<const WeightedBits> visibility,
+                                std::span<const FusedPointLight> lights, std::uint32_t visibleLights,
+                                FusedScratch& scratch);
+
+// One pixel of `fused` from Haar visibility lists: Σ_ω W_c(ω)·ρ_c(Rᵀω) for c = R, G, B, with
 // ρ = (1 − w)·slice[first] + w·slice[second] (shared::sliceBlendAt) looked up
 // bilinearly exactly as rotateSpatialMap does (θ clamped at the poles, φ
 // wrapped). Equal, to float rounding, to Σ_v weight_v·tripleProduct(light_c,
@@ -102,7 +124,7 @@ std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBl
 std::string fusedTargetName();
 
 // The bytes one pixel reads in the pass: one slice (two when blending), the
-// light planes and the merged visibility list.
-std::size_t fusedPixelBytes(int level, bool blended, std::size_t visibilityEntries);
+// light planes and its visibility (bits or lists, in the caller's format).
+std::size_t fusedPixelBytes(int level, bool blended, std::size_t visibilityBytes);
 
 }  // namespace haarcast

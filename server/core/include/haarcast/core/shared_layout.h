@@ -249,9 +249,33 @@ struct ObjectInfo {
   uint vertexBase;     // its vertex 0 in the global vertex numbering
   uint triangleBase;   // its triangle 0 in the global triangle numbering
   float skipBelowY;    // `fused`: directions with cos θ' below this read only zero texels
-  uint pad0;
-  uint pad1;
+  uint pointLights;    // `fused`: its PointLight records this frame (≤ kMaxPointLights)
+  uint flags;          // kObjectGround, …
+  vec4 flat;           // a ground object: the radiance of its unshadowed map light (rgb)
 };
+
+// ObjectInfo::flags: the object is the scene's ground, a Lambert plane that
+// `fused` shades in closed form (its map light is the same at every point,
+// so only the point lights' shadow bits vary): radiance = flat + Σ_k bit_k·power_k.
+HC_CONST uint kObjectGround = 1u;
+
+// `fused`'s point lights (core/light_split.h): the light's brightest
+// regions, shaded per pixel with a shadow ray each. Records per object and
+// light at [object·kMaxPointLights + k]: `direction` (xyz) toward the light in
+// the object's frame; `power` (rgb) = Σ L·ΔΩ of the texels the light took
+// (for a ground object instead the radiance it adds where seen:
+// albedo/π·cos θ·power). Each covered sample s has a word of shadow bits,
+// bit k = 1 when the sample sees light k (render/point_lights.h computes
+// them on the host for both backends).
+HC_CONST uint kMaxPointLights = 8u;
+struct PointLight {
+  vec4 direction;
+  vec4 power;
+};
+
+// `fused`'s visibility (core/visibility_bits.h): vertex v's bits at words
+// [v·W, (v + 1)·W), W = visibilityWords(level), direction i at bit i % 32 of word i / 32.
+HC_FUNCTION uint visibilityWords(uint level) { return max((1u << (2u * level)) / 32u, 1u); }
 
 // Per covered pixel, what the rotation needs (the rotation contract's binding 0).
 struct RotationSample {
@@ -327,8 +351,9 @@ struct GBufferPush {
 #ifdef __cplusplus
 static_assert(sizeof(FrameParams) == 128 && offsetof(FrameParams, tanHalf) == 96 &&
               offsetof(FrameParams, fusedGroups) == 124);
-static_assert(sizeof(ObjectInfo) == 80 && offsetof(ObjectInfo, sliceBase) == 48 &&
-              offsetof(ObjectInfo, skipBelowY) == 68);
+static_assert(sizeof(ObjectInfo) == 96 && offsetof(ObjectInfo, sliceBase) == 48 &&
+              offsetof(ObjectInfo, skipBelowY) == 68 && offsetof(ObjectInfo, flat) == 80);
+static_assert(sizeof(PointLight) == 32);
 static_assert(sizeof(RotationSample) == 32 && offsetof(RotationSample, alpha) == 8 &&
               offsetof(RotationSample, thetaOut) == 24);
 static_assert(sizeof(ShadeSample) == 32 && offsetof(ShadeSample, b) == 16 && offsetof(ShadeSample, pixel) == 28);

@@ -23,6 +23,7 @@
 #include <functional>
 #include <string>
 
+#include "haarcast/core/light_split.h"
 #include "haarcast/core/rotation.h"
 #include "haarcast/io/image.h"
 #include "haarcast/render/scene.h"
@@ -48,6 +49,10 @@ struct RenderOptions {
   int thetaSamples = 16;                  // BRDF slices per channel
   int sliceSupersampling = 4;
   VisibilityOptions visibility;           // its level is overridden by `level`
+  // fused: the light's brightest regions taken out as point lights with a
+  // shadow ray per pixel each (core/light_split.h); maxLights 0 = none,
+  // at most shared::kMaxPointLights.
+  LightSplitOptions pointLights;
   bool environmentBackground = true;      // false: black where no object is
   std::string cacheDir;                   // slice-table and visibility cache; empty = none
   unsigned threads = 0;                   // 0 = hardware concurrency

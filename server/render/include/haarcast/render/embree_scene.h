@@ -84,6 +84,12 @@ class RayScene {
   // packets. Thread-safe. Throws std::invalid_argument if the spans differ in size.
   void occludedBatch(std::span<const Ray> rays, std::span<std::uint8_t> out, bool coherent = false) const;
 
+  // occluded() for rays that share an origin (one point's directions), as
+  // Embree packets of 8 with the coherent hint: out[i] = 1 if the ray
+  // origin + t·directions[i], t ∈ [tnear, ∞), is blocked. Thread-safe.
+  // Throws std::invalid_argument if the spans differ in size.
+  void occludedFrom(const glm::vec3& origin, float tnear, std::span<const glm::vec3> directions,
+                    std::span<std::uint8_t> out) const;
   // Moves object `object` and rebuilds the top level only (the meshes'
   // structures are kept): the per-frame path for posed objects. Not safe
   // while another thread queries this scene.

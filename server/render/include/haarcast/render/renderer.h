@@ -20,6 +20,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -28,6 +29,8 @@
 #include "haarcast/core/brdf_slices.h"
 #include "haarcast/core/fused.h"
 #include "haarcast/core/haar.h"
+#include "haarcast/core/light_split.h"
+#include "haarcast/core/visibility_bits.h"
 #include "haarcast/core/rotation.h"
 #include "haarcast/core/shared_layout.h"
 #include "haarcast/core/sphere_map.h"
@@ -107,8 +110,14 @@ struct PreparedObject {
   std::string name;
   std::shared_ptr<const Mesh> mesh;    // with normals, object frame
   BrdfSliceTable table;                // unrotated slices: the only BRDF data kept
-  std::vector<SparseHaar> visibility;  // per vertex, object frame, top-k
+  // Per vertex, object frame: the Haar methods' top-k lists (empty for
+  // fused), and fused's bits at map resolution (empty for the others).
+  std::vector<SparseHaar> visibility;
+  VisibilityBits visibilityBits;
   Pose pose;                           // the scene's pose
+  bool ground = false;                 // the scene's ground (SceneObject::ground)
+  glm::dvec3 groundAlbedo{0.0};        // its Lambert albedo
+  float shadowShift = 0.0f;            // point-light rays' origin shift, object units (× pose scale)
 };
 
 struct PreparedScene {
@@ -116,6 +125,11 @@ struct PreparedScene {
   std::vector<PreparedObject> objects;
   std::array<SphereMap, 3> light;       // world frame, level n, radiance (no solid angle)
   std::array<SphereMap, 3> background;  // world frame, level kBackgroundLevel, for the backdrop
+  // `fused` only: the light split (core/light_split.h) in the environment's
+  // frame: its point lights, and the map without them.
+  std::vector<DirectionalLight> pointLights;
+  std::array<SphereMap, 3> restLight;
+  std::optional<std::size_t> ground;    // index of the ground object, if any
 };
 
 // Level of the backdrop maps: fine enough to look like the probe (512²).
@@ -173,17 +187,27 @@ inline constexpr double kMaxEyeDistance = 1e4;
 // One frame resolved once, for every backend: the request checked, and per
 // object its pose in effect, the light in its frame (cut to k) and, for
 // `fused`, that light in pixel form (synthesised once per object per frame).
+//
+// `fused` gets the light whole instead: the map without its point lights
+// (in pixel form, ΔΩ folded in; where the scene has a ground, zero below
+// its plane for every other object, which the ground hides), and per object
+// the point lights in its frame. A ground object's point-light powers are
+// the radiance each adds where seen, and groundFlat the radiance of the map
+// part (both in closed form for its Lambert plane).
 struct ResolvedObject {
   glm::dmat3 rotation{1.0};        // object → world
   glm::dmat4 objectToWorld{1.0};
   double scale = 1.0;
-  std::array<SparseHaar, 3> light;
+  std::array<SparseHaar, 3> light; // the Haar methods' (empty for fused)
   FusedLight fusedLight;           // empty unless the method is fused
+  std::vector<FusedPointLight> pointLights;
+  std::array<float, 3> groundFlat{};
 };
 struct ResolvedFrame {
-  std::size_t lightCoefficients = 0;  // k in effect
+  std::size_t lightCoefficients = 0;  // k in effect (the Haar methods)
   std::vector<ResolvedObject> objects;
   std::size_t lightBytes = 0;         // the light lists, index + value per entry
+  std::vector<glm::vec3> pointLightDirections;  // fused: world frame, unit, toward each light
 };
 ResolvedFrame resolveFrame(const PreparedScene& prepared, const RenderOptions& options, const FrameRequest& request);
 

@@ -72,7 +72,13 @@ struct SceneObject {
   std::shared_ptr<const Mesh> mesh;  // object frame
   Material material;
   Pose pose;
+  // The scene's ground (addGround): a Lambert plane under the objects that
+  // takes their shadows and hides the light below its horizon from them.
+  bool ground = false;
+  glm::dvec3 groundAlbedo{0.0};
 };
+
+
 
 struct Camera {
   glm::dvec3 eye{0.0, 0.4, 3.2};
@@ -87,7 +93,18 @@ struct Scene {
   Camera camera;
 };
 
-// The built-in default: the procedural sky, a glossy sphere and a torus.
+// A ground under the objects: a square Lambert plane (+Y up) of half-size
+// `extent` × the objects' bounding radius, centred under them, its top at
+// the lowest point of their bounds at the scene's poses. Appended as the
+// last object, named "ground". Throws std::invalid_argument for an albedo
+// outside [0, 1], a non-positive extent, no objects, or a second ground.
+struct GroundOptions {
+  double albedo = 0.5;
+  double extent = 12.0;
+};
+void addGround(Scene& scene, const GroundOptions& options = {});
+
+// The built-in default: the procedural sky, a glossy sphere and a torus over a ground.
 Scene defaultScene();
 // Throws std::runtime_error with the file name and the JSON path of the
 // offending key.

@@ -37,6 +37,7 @@
 #include "haarcast/core/haar.h"
 #include "haarcast/core/mesh.h"
 #include "haarcast/core/sphere_map.h"
+#include "haarcast/core/visibility_bits.h"
 #include "haarcast/render/embree_scene.h"
 
 namespace haarcast {
@@ -71,6 +72,21 @@ std::vector<SparseHaar> computeVertexVisibility(
 std::vector<SparseHaar> computeVertexVisibility(
     const RayScene& occluders, const Mesh& mesh, const VisibilityOptions& options,
     const std::function<void(std::size_t done, std::size_t total)>& progress = {});
+
+// `fused`'s visibility: every vertex's bits at options.level (one ray toward
+// each pixel centre; supersampling and keep are not used), from the same ray
+// start as the lists. Directions more than kBitsSkipBelowDegrees below the
+// vertex's tangent plane are taken as occluded without a ray: the surface
+// itself lies there unless it is thinner than the offset, and only a pixel
+// whose interpolated normal leans that far from the vertex's could see them.
+// Rays go 8 at a time as Embree packets sharing the vertex's origin;
+// vertices are shared out over the threads as computeVertexVisibility does.
+inline constexpr double kBitsSkipBelowDegrees = 15.0;
+VisibilityBits computeVisibilityBits(const RayScene& occluders, const Mesh& mesh, const VisibilityOptions& options,
+                                     const std::function<void(std::size_t done, std::size_t total)>& progress = {});
+// The same against the mesh alone (normals made on a copy when it has none).
+VisibilityBits computeVisibilityBits(const Mesh& mesh, const VisibilityOptions& options,
+                                     const std::function<void(std::size_t done, std::size_t total)>& progress = {});
 
 // The dense visibility map of one vertex (the map computeVertexVisibility
 // truncates). `mesh` must have normals.

@@ -54,6 +54,17 @@ std::vector<SparseHaar> loadOrComputeVertexVisibility(
     const std::function<void(std::size_t done, std::size_t total)>& progress = {},
     VisibilityCacheStatus* status = nullptr);
 
+// `fused`'s visibility bits (computeVisibilityBits) through the same cache,
+// files of kind "visibility-bits", version kVisibilityBitsCacheVersion:
+// options text "level=<n> offset=<float> skip=<degrees>", payload u64 V then
+// V·W u32 words (W = visibilityWordsPerPoint(level)), little-endian. A
+// payload of the wrong size, or with a bit set past the map's directions,
+// is a miss.
+inline constexpr std::uint32_t kVisibilityBitsCacheVersion = 1;
+VisibilityBits loadOrComputeVisibilityBits(const Mesh& mesh, const VisibilityOptions& options, const std::string& cacheDir,
+                                           const std::function<void(std::size_t done, std::size_t total)>& progress = {},
+                                           VisibilityCacheStatus* status = nullptr);
+
 // "mesh-fnv1a64:<16 hex digits> vertices=<V> triangles=<T>": FNV-1a 64 over
 // the counts and the little-endian bytes of positions, normals and triangles
 // (names are left out: they do not change what the rays see). A moved vertex,
