@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 
 #include "bench_frame_command.h"
+#include "compare_command.h"
 #include "eval.h"
 #include "loadtest_command.h"
 #include "progress.h"
@@ -95,6 +96,7 @@ int main(int argc, char** argv) {
   const auto runBenchFrame = haarcast::app::addBenchFrameCommand(app);
   const auto runServe = haarcast::app::addServeCommand(app);
   const auto runLoadtest = haarcast::app::addLoadtestCommand(app);
+  const auto runCompare = haarcast::app::addCompareCommand(app);
 
   if (const auto unknown = unknownCommand(app, argc, argv)) {
     std::fprintf(stderr, "haarcast: error: %s\n", unknown->c_str());
@@ -108,6 +110,7 @@ int main(int argc, char** argv) {
     if (const int rc = runBenchFrame(); rc >= 0) return rc;
     if (const int rc = runServe(); rc >= 0) return rc;
     if (const int rc = runLoadtest(); rc >= 0) return rc;
+    if (const int rc = runCompare(); rc >= 0) return rc;
     if (rr->parsed()) {
       const auto v = haarcast::parseHaarVariant(variant);
       if (!v) throw std::invalid_argument("--haar-variant must be faithful, local or refined (got \"" + variant + "\")");

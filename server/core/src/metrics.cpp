@@ -17,11 +17,17 @@ ErrorStats compare(std::span<const T> reference, std::span<const T> test) {
                                 " values but test has " + std::to_string(test.size()));
   }
   ErrorStats stats;
-  double squared = 0.0;
+  double squared = 0.0, referenceSquared = 0.0, referenceSum = 0.0, testSum = 0.0;
   for (std::size_t k = 0; k < reference.size(); ++k) {
-    const double diff = static_cast<double>(test[k]) - static_cast<double>(reference[k]);
-    squared += diff * diff;
+    const double r = static_cast<double>(reference[k]), t = static_cast<double>(test[k]);
+    squared += (t - r) * (t - r);
+    referenceSquared += r * r;
+    referenceSum += r;
+    testSum += t;
   }
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  stats.relativeL2 = referenceSquared > 0.0 ? std::sqrt(squared / referenceSquared) : nan;
+  stats.brightnessRatio = referenceSum != 0.0 ? testSum / referenceSum : nan;
   stats.mse = squared / static_cast<double>(reference.size());
   stats.peak = static_cast<double>(*std::max_element(reference.begin(), reference.end()));
   // DESIGN.md "Measurements": PSNR = 10·log10(peak² / MSE).

@@ -58,12 +58,14 @@ TEST(CpuRenderer, EveryRotationMethodAgreesWithSpatialWhereTheyShould) {
 TEST(CpuRenderer, FusedEqualsSpatialRotationAndTheTripleProduct) {
   // Parseval: the pixel-basis sum of fused is the Haar-basis triple product
   // of the spatially rotated slice. With the nearest θₒ slice (as spatial
-  // takes it) the frames agree to float rounding, at each level fused takes.
+  // takes it), the light and the visibility whole (fused cuts neither; its
+  // bits are one ray per pixel, as supersampling 1 makes the lists) the
+  // frames agree to float rounding, at each level fused takes.
   const Scene scene = sphereScene("phong:32", 1.0);
   for (int level : {3, 4, 5}) {
     RenderOptions o = smallOptions();
     o.level = level;
-    o.lightCoefficients = 64;  // a truncated light, as in a frame
+    o.visibility.keep = std::size_t{1} << (2 * level);
     o.method = RotationMethod::Spatial;
     const RenderResult spatial = renderCpu(scene, o);
     o.method = RotationMethod::Fused;

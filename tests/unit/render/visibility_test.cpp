@@ -356,6 +356,52 @@ TEST(Visibility, SphereAboveFloorOccludesTheAnalyticCone) {
   EXPECT_NEAR(occludedAbove(again), occluded, 1e-4);
 }
 
+// fused's bits are the single-ray map (s = 1) of each vertex, bit for bit,
+// wherever a ray was cast; the directions skipped far below the tangent
+// plane are 0.
+TEST(Visibility, BitsAreTheOneRayMapOfEachVertex) {
+  const Mesh floor = floorMesh(6.0f);
+  const Mesh ball = icosphere(3, 0.5f);
+  const RayScene two({Instance{&floor}, Instance{&ball, glm::translate(glm::mat4(1.0f), {0.0f, 2.0f, 0.0f})}});
+  VisibilityOptions options;
+  options.level = 5;
+  options.supersampling = 1;
+  const VisibilityBits bits = computeVisibilityBits(two, floor, options);
+  ASSERT_EQ(bits.pointCount(), floor.positions.size());
+  std::size_t differing = 0, shadowed = 0;
+  for (std::size_t v = 0; v < floor.positions.size(); ++v) {
+    const SphereMap map = vertexVisibilityMap(two, floor, v, options);
+    const int m = map.size();
+    for (std::size_t i = 0; i < map.pixelCount(); ++i) {
+      const glm::dvec3 d = sphericalToDirection(rowTheta(5, static_cast<int>(i) / m), colPhi(5, static_cast<int>(i) % m));
+      if (d.y < -std::sin(kBitsSkipBelowDegrees * kPi / 180.0)) {
+        // Not traced (past the floor's edge a ray would escape): occluded.
+        differing += bits.visible(v, i) ? 1 : 0;
+        continue;
+      }
+      differing += (map.values()[i] != 0.0f) != bits.visible(v, i) ? 1 : 0;
+      shadowed += map.values()[i] == 0.0f && i < map.pixelCount() / 2 ? 1 : 0;
+    }
+  }
+  EXPECT_EQ(differing, 0u);
+  EXPECT_GT(shadowed, 0u) << "the sphere shadows the floor's upper hemisphere somewhere";
+  // And the mesh-alone overload: a convex sphere sees its upper hemisphere.
+  const Mesh sphere = icosphere(3, 1.0f);
+  const VisibilityBits own = computeVisibilityBits(sphere, options);
+  const std::size_t top = 0;  // icosphere vertex 0 lies well above the equator
+  const SphereMap map = own.map(top);
+  double seen = 0.0;
+  for (int row = 0; row < map.size(); ++row)
+    for (int col = 0; col < map.size(); ++col) seen += map.at(row, col) * pixelSolidAngle(5, row);
+  const glm::vec3 n = glm::normalize(sphere.positions[top]);
+  double hemisphere = 0.0;
+  for (int row = 0; row < map.size(); ++row)
+    for (int col = 0; col < map.size(); ++col)
+      hemisphere += glm::dot(glm::vec3(sphericalToDirection(rowTheta(5, row), colPhi(5, col))), n) > 0.0f
+                        ? pixelSolidAngle(5, row) : 0.0;
+  EXPECT_NEAR(seen / hemisphere, 1.0, 0.08);
+}
+
 TEST(Visibility, KeepingEveryCoefficientIsTheDenseMap) {
   const Mesh sphere = icosphere(2, 0.5f, {0.0f, 1.0f, 0.0f});
   const Mesh scene = merged(floorMesh(3.0f), sphere);

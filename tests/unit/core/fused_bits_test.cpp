@@ -1,0 +1,180 @@
+// `fused` with exact visibility bits and point lights (visibility_bits.h,
+// light_split.h, fused.h): the blend against a brute-force sum, the bits path
+// against the Haar-list path it replaces, a point light against the same
+// power left in the map, and the light split's bookkeeping.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "haarcast/core/fused.h"
+#include "haarcast/core/light_split.h"
+#include "haarcast/core/visibility_bits.h"
+
+namespace haarcast {
+namespace {
+
+std::vector<double> thetaOutLayout(int t) {
+  std::vector<double> out;
+  for (int k = 0; k < t; ++k) out.push_back((k + 0.5) * (kPi / 2.0) / t);
+  return out;
+}
+
+BrdfSliceTable randomTable(int level, int thetaSamples, std::mt19937& rng) {
+  std::uniform_real_distribution<double> dist(0.05, 1.0);
+  std::vector<HaarMap> slices;
+  for (int c = 0; c < 3; ++c) {
+    for (int t = 0; t < thetaSamples; ++t) {
+      SphereMap map(level);
+      for (int i = 0; i < map.size(); ++i)
+        for (int j = 0; j < map.size(); ++j) map.at(i, j) = i >= map.size() / 2 ? 0.0f : static_cast<float>(dist(rng));
+      slices.push_back(forwardHaar(map));
+    }
+  }
+  return BrdfSliceTable::fromSlices(thetaOutLayout(thetaSamples), std::move(slices));
+}
+
+VisibilityBits randomBits(int level, std::size_t points, std::mt19937& rng) {
+  VisibilityBits bits(level, points);
+  std::bernoulli_distribution coin(0.6);
+  for (std::size_t p = 0; p < points; ++p)
+    for (std::size_t i = 0; i < bits.directions(); ++i)
+      if (coin(rng)) bits.point(p)[i / 32] |= 1u << (i % 32);
+  return bits;
+}
+
+TEST(VisibilityBits, BlendIsTheWeightedSumOfTheBits) {
+  std::mt19937 rng(3);
+  for (int level : {2, 4, 5}) {
+    const VisibilityBits bits = randomBits(level, 3, rng);
+    const std::array<WeightedBits, 3> w = {WeightedBits{bits.point(0).data(), 0.2f},
+                                           WeightedBits{bits.point(1).data(), 0.5f},
+                                           WeightedBits{bits.point(2).data(), 0.3f}};
+    std::vector<float> v(bits.directions());
+    blendVisibility(w, level, v);
+    for (std::size_t i = 0; i < bits.directions(); ++i) {
+      const float want = 0.2f * bits.visible(0, i) + 0.5f * bits.visible(1, i) + 0.3f * bits.visible(2, i);
+      ASSERT_FLOAT_EQ(v[i], want) << "level " << level << " direction " << i;
+    }
+  }
+}
+
+TEST(VisibilityBits, AssignRefusesStrayBitsAndWrongSizes) {
+  VisibilityBits bits(2, 2);  // 16 directions in one word each
+  EXPECT_THROW(bits.assign(std::vector<std::uint32_t>{1u}), std::invalid_argument);
+  EXPECT_THROW(bits.assign(std::vector<std::uint32_t>{1u, 1u << 16}), std::invalid_argument);
+  bits.assign(std::vector<std::uint32_t>{0xFFFFu, 1u});
+  EXPECT_TRUE(bits.visible(0, 15));
+  EXPECT_TRUE(bits.visible(1, 0));
+  EXPECT_FALSE(bits.visible(1, 1));
+  EXPECT_EQ(bits.map(1).at(0, 0), 1.0f);
+  EXPECT_EQ(bits.map(1).at(0, 1), 0.0f);
+}
+
+// The bits path is the list path with nothing truncated: each vertex's bits
+// Haar-coded whole give the same V, so the same sum.
+TEST(FusedBits, EqualsTheListPathWithEveryCoefficientKept) {
+  std::mt19937 rng(7);
+  const int level = 4;
+  const BrdfSliceTable table = randomTable(level, 3, rng);
+  const PixelSlices slices = PixelSlices::synthesize(table);
+  std::array<SphereMap, 3> weighted;
+  std::uniform_real_distribution<double> l(0.0, 0.2);
+  for (auto& m : weighted) {
+    m = SphereMap(level);
+    for (float& x : m.values()) x = static_cast<float>(l(rng));
+  }
+  const FusedLight light = FusedLight::fromWeightedMaps(weighted);
+  const VisibilityBits bits = randomBits(level, 3, rng);
+  std::array<SparseHaar, 3> lists;
+  for (std::size_t v = 0; v < 3; ++v) lists[v] = keepLargest(forwardHaar(bits.map(v)), bits.directions());
+  const std::array<float, 3> b = {0.25f, 0.35f, 0.4f};
+  FusedScratch scratch;
+  for (const EulerYXY r : {EulerYXY{0.3, 1.1, -0.7}, EulerYXY{2.0, 0.2, 4.0}}) {
+    const shared::SliceBlend blend{0u, 1u, 0.3f};
+    const std::array<WeightedBits, 3> wb = {WeightedBits{bits.point(0).data(), b[0]}, WeightedBits{bits.point(1).data(), b[1]},
+                                            WeightedBits{bits.point(2).data(), b[2]}};
+    const std::array<WeightedVisibility, 3> wl = {WeightedVisibility{&lists[0], b[0]}, WeightedVisibility{&lists[1], b[1]},
+                                                  WeightedVisibility{&lists[2], b[2]}};
+    const auto fromBits = fusedShade(slices, blend, r, light, wb, {}, 0u, scratch);
+    const auto fromLists = fusedShade(slices, blend, r, light, wl, scratch);
+    for (std::size_t c = 0; c < 3; ++c) EXPECT_NEAR(fromBits[c], fromLists[c], 1e-5 * std::abs(fromLists[c]) + 1e-6);
+  }
+}
+
+// A point light at a texel centre shades exactly as the same power left in
+// that texel of the map (the pass looks ρ up at the same direction), and not
+// at all when its bit is clear.
+TEST(FusedBits, APointLightEqualsItsPowerInTheMap) {
+  std::mt19937 rng(11);
+  const int level = 4, m = mapSize(level);
+  const PixelSlices slices = PixelSlices::synthesize(randomTable(level, 2, rng));
+  VisibilityBits open(level, 1);
+  for (std::size_t i = 0; i < open.directions(); ++i) open.point(0)[i / 32] |= 1u << (i % 32);
+  const std::array<WeightedBits, 1> v = {WeightedBits{open.point(0).data(), 1.0f}};
+  const EulerYXY r{0.4, 0.5, 0.3};  // tilts the slice's lobe toward the texel below
+  FusedScratch scratch;
+  int tested = 0;
+  for (const auto [row, col] : {std::pair{2, 3}, std::pair{5, 9}, std::pair{6, 14}}) {
+    std::array<SphereMap, 3> inMap{SphereMap(level), SphereMap(level), SphereMap(level)};
+    const std::array<float, 3> power = {0.7f, 0.4f, 0.2f};
+    for (std::size_t c = 0; c < 3; ++c) inMap[c].at(row, col) = power[c];
+    const std::array<SphereMap, 3> empty{SphereMap(level), SphereMap(level), SphereMap(level)};
+    FusedPointLight point;
+    point.direction = glm::vec3(sphericalToDirection(rowTheta(level, row), colPhi(level, col)));
+    point.power = power;
+    const shared::SliceBlend blend{0u, 1u, 0.5f};
+    const auto mapped = fusedShade(slices, blend, r, FusedLight::fromWeightedMaps(inMap), v, {}, 0u, scratch);
+    const auto pointed = fusedShade(slices, blend, r, FusedLight::fromWeightedMaps(empty), v,
+                                    std::span(&point, 1), 1u, scratch);
+    const auto hidden = fusedShade(slices, blend, r, FusedLight::fromWeightedMaps(empty), v,
+                                   std::span(&point, 1), 0u, scratch);
+    for (std::size_t c = 0; c < 3; ++c) {
+      EXPECT_NEAR(pointed[c], mapped[c], 1e-4f * std::abs(mapped[c]) + 1e-7f) << row << "," << col;
+      EXPECT_EQ(hidden[c], 0.0f);
+    }
+    tested += mapped[0] > 0.0f ? 1 : 0;
+    (void)m;
+  }
+  EXPECT_GT(tested, 0) << "no case reached a non-zero texel of the slices";
+}
+
+// The split keeps every bit of energy: lights + rest = the map, channel by
+// channel, and a small sun is found where it is.
+TEST(LightSplit, FindsASmallSunAndLosesNothing) {
+  const int level = 6;
+  const glm::dvec3 sun = glm::normalize(glm::dvec3(0.3, 0.8, -0.5));
+  std::array<SphereMap, 3> light;
+  for (std::size_t c = 0; c < 3; ++c) {
+    light[c] = SphereMap::fromFunction(level, [&](const glm::dvec3& d) {
+      const double sky = 0.2 + 0.1 * d.y;
+      return glm::dot(d, sun) > std::cos(2.0 * kPi / 180.0) ? 5000.0 * (1.0 + 0.1 * static_cast<double>(c)) : sky;
+    });
+  }
+  const LightSplit split = splitLight(light);
+  ASSERT_EQ(split.lights.size(), 1u);
+  // Within a third of a level-6 texel (2.8°): the power-weighted centre of
+  // the texels the sun covers.
+  EXPECT_GT(glm::dot(split.lights[0].direction, sun), std::cos(1.0 * kPi / 180.0));
+  for (std::size_t c = 0; c < 3; ++c) {
+    double total = 0.0, rest = 0.0;
+    for (int r = 0; r < mapSize(level); ++r) {
+      for (int col = 0; col < mapSize(level); ++col) {
+        total += light[c].at(r, col) * pixelSolidAngle(level, r);
+        rest += split.rest[c].at(r, col) * pixelSolidAngle(level, r);
+      }
+    }
+    EXPECT_NEAR(rest + split.lights[0].power[c], total, 1e-6 * total);
+    EXPECT_GT(split.lights[0].power[c], 0.5 * total) << "the sun carries most of this sky's power";
+  }
+  LightSplitOptions none;
+  none.maxLights = 0;
+  EXPECT_TRUE(splitLight(light, none).lights.empty());
+  LightSplitOptions tooMany;
+  tooMany.maxLights = 33;
+  EXPECT_THROW(splitLight(light, tooMany), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace haarcast
