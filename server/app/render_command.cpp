@@ -41,6 +41,7 @@ int run(RenderArgs& a) {
   a.options.environmentBackground = environmentBackground(a.scene);
   a.options.antialias = antialiasFor(a.antialias, a.backend);
   a.options.cacheDir = cacheDirFromFlag(a.cacheDir);
+  a.options.sceneLimits = a.scene.limits;
   render::checkRenderOptions(a.options);
   checkOutputPath(a.scene);
 

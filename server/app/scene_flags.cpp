@@ -30,12 +30,23 @@ void addSceneFlags(CLI::App& c, SceneFlags& f) {
       ->capture_default_str();
   c.add_option("--out", f.out, "Output .exr (a .png is written beside it) or .png")->capture_default_str();
   c.add_option("--exposure", f.exposure, "PNG exposure in stops (default: auto, the lit object pixels' log-average luminance → 0.18)");
+  addSceneLimitFlags(c, f.limits);
+}
+
+void addSceneLimitFlags(CLI::App& c, render::SceneLimits& limits) {
+  c.add_option("--max-scene-objects", limits.maxObjects, "Most objects a scene may hold")->capture_default_str();
+  c.add_option("--max-scene-triangles", limits.maxTriangles, "Most triangles of all a scene's objects together")
+      ->capture_default_str();
+  c.add_option_function<std::size_t>(
+       "--max-visibility-mb", [&limits](std::size_t mb) { limits.maxVisibilityBytes = mb << 20; },
+       "Most per-vertex visibility a scene may hold, MB (default " + std::to_string(limits.maxVisibilityBytes >> 20) + ")")
+      ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 24));
 }
 
 render::Scene sceneFromFlags(const SceneFlags& f) {
   if (!f.scene.empty()) {
     if (!f.mesh.empty() || !f.env.empty()) throw std::invalid_argument("give either --scene or --env/--mesh, not both");
-    return render::loadScene(f.scene);
+    return render::loadScene(f.scene, f.limits);
   }
   if (f.mesh.empty()) {
     // The built-in scene's objects have their own materials and poses.

@@ -24,10 +24,14 @@ struct SceneFlags {
   std::string background = "env";
   std::string out;
   std::optional<double> exposure;
+  render::SceneLimits limits;
 };
 
+// --max-scene-objects --max-scene-triangles --max-visibility-mb into `limits`.
+void addSceneLimitFlags(CLI::App& command, render::SceneLimits& limits);
+
 // --scene --env --env-layout --mesh --material --rotate --width --height
-// --background --out --exposure
+// --background --out --exposure, and the scene limits
 void addSceneFlags(CLI::App& command, SceneFlags& flags);
 
 // --scene FILE, or one object from --mesh (with --env, --material, --rotate),

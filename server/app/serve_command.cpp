@@ -39,6 +39,7 @@ struct ServeArgs {
   std::size_t lightCoefficients = 256;
   std::vector<std::string> sceneFiles;
   std::string materialsDir, webRoot, protoFile, cacheDir, vulkanDevice;
+  render::SceneLimits sceneLimits;
   bool vulkanValidation = false, quiet = false;
   unsigned renderThreads = 0;
   long long serverPixelBudget = -1;  // -1: 2 × --max-session-pixels
@@ -61,7 +62,7 @@ int run(ServeArgs& a) {
     for (const auto& s : scenes) {
       if (s.name == name) throw std::invalid_argument("--scene " + file + ": a scene named \"" + name + "\" is already served");
     }
-    scenes.push_back({name, render::loadScene(file)});
+    scenes.push_back({name, render::loadScene(file, a.sceneLimits)});
   }
   auto materialFiles = std::make_shared<std::map<std::string, std::string>>();  // offered name → MERL path
   net::Catalog catalog;
@@ -181,6 +182,7 @@ int run(ServeArgs& a) {
   // backend factory. Runs on the render service's builder thread.
   render::RenderOptions base;
   base.cacheDir = cacheDirFromFlag(a.cacheDir);
+  base.sceneLimits = a.sceneLimits;
   base.threads = a.renderThreads;
   const gpu::VulkanOptions vulkanOptions{a.vulkanDevice, a.vulkanValidation};
   auto sharedScenes = std::make_shared<std::vector<SceneSource>>(std::move(scenes));
@@ -269,6 +271,7 @@ std::function<int()> addServeCommand(CLI::App& app) {
   c->add_option("--materials-dir", a->materialsDir, "Offer the MERL .binary files of this folder (as merl:NAME)");
   c->add_option("--web-root", a->webRoot, "The browser client's files (default: the source tree's client/web)");
   c->add_option("--proto-file", a->protoFile, "Served at /haarcast.proto (default: the source tree's)");
+  addSceneLimitFlags(*c, a->sceneLimits);
   c->add_option("--cache-dir", a->cacheDir, "Slice-table and visibility cache (default $XDG_CACHE_HOME/haarcast; 'none')");
   c->add_option("--max-sessions", o.admission.sessions, "Concurrent sessions (counted from a valid Hello)")
       ->capture_default_str();

@@ -49,6 +49,27 @@ BrdfSliceTable objectSliceTable(const SceneObject& object, const RenderOptions& 
 PreparedScene prepareScene(const Scene& scene, const RenderOptions& options, const RenderProgress& progress) {
   checkRenderOptions(options);
   if (scene.objects.empty()) throw std::invalid_argument("render: the scene has no objects");
+  // The scene's size against the operator's limits, before anything is
+  // computed: triangles, and what the visibility will hold (fused: bits per
+  // vertex; the Haar methods: `keep` entries of 8 bytes per vertex).
+  checkObjectCount(scene.objects.size(), options.sceneLimits);
+  std::size_t triangles = 0, visibilityBytes = 0;
+  const std::size_t perVertex = options.method == RotationMethod::Fused
+                                    ? 4 * visibilityWordsPerPoint(options.level)
+                                    : 8 * std::min<std::size_t>(options.visibility.keep, std::size_t{1} << (2 * options.level));
+  for (const SceneObject& object : scene.objects) {
+    triangles += object.mesh->triangles.size();
+    visibilityBytes += object.mesh->positions.size() * perVertex;
+  }
+  if (triangles > options.sceneLimits.maxTriangles) {
+    throw std::invalid_argument("render: the scene has " + std::to_string(triangles) + " triangles, over the limit of " +
+                                std::to_string(options.sceneLimits.maxTriangles) + " (--max-scene-triangles)");
+  }
+  if (visibilityBytes > options.sceneLimits.maxVisibilityBytes) {
+    throw std::invalid_argument("render: the scene's visibility would take " + std::to_string(visibilityBytes >> 20) +
+                                " MB at level " + std::to_string(options.level) + ", over the limit of " +
+                                std::to_string(options.sceneLimits.maxVisibilityBytes >> 20) + " MB (--max-visibility-mb)");
+  }
   PreparedScene prepared;
   prepared.scene = scene;
   prepared.objects.resize(scene.objects.size());

@@ -220,11 +220,18 @@ std::shared_ptr<Mesh> meshAt(const nlohmann::json& j, const std::string& file, c
   return std::make_shared<Mesh>(std::move(mesh));
 }
 
-Scene sceneFromJson(const nlohmann::json& j, const std::string& path);
+Scene sceneFromJson(const nlohmann::json& j, const std::string& path, const SceneLimits& limits);
 
 }  // namespace
 
-Scene loadScene(const std::string& path) {
+void checkObjectCount(std::size_t objects, const SceneLimits& limits) {
+  if (objects > limits.maxObjects) {
+    throw std::invalid_argument("the scene has " + std::to_string(objects) + " objects, over the limit of " +
+                                std::to_string(limits.maxObjects) + " (--max-scene-objects)");
+  }
+}
+
+Scene loadScene(const std::string& path, const SceneLimits& limits) {
   std::ifstream in(path);
   if (!in) throw std::runtime_error(path + ": cannot open scene file");
   nlohmann::json j;
@@ -236,7 +243,7 @@ Scene loadScene(const std::string& path) {
   }
   if (!j.is_object()) fail(path, "top level", "expected an object");
   try {
-    return sceneFromJson(j, path);
+    return sceneFromJson(j, path, limits);
   } catch (const nlohmann::json::exception& e) {
     // A value of the wrong type where a field is read ("fov_y": "wide").
     throw std::runtime_error(path + ": " + e.what());
@@ -245,7 +252,7 @@ Scene loadScene(const std::string& path) {
 
 namespace {
 
-Scene sceneFromJson(const nlohmann::json& j, const std::string& path) {
+Scene sceneFromJson(const nlohmann::json& j, const std::string& path, const SceneLimits& limits) {
   const fs::path base = fs::path(path).parent_path();
   Scene s;
   s.environment = builtinEnvironment();
@@ -267,6 +274,12 @@ Scene sceneFromJson(const nlohmann::json& j, const std::string& path) {
   }
   if (!j.contains("objects") || !j["objects"].is_array() || j["objects"].empty()) {
     fail(path, "objects", "expected a non-empty array");
+  }
+  // Before any mesh is read: the count alone can be the problem.
+  try {
+    checkObjectCount(j["objects"].size() + (j.contains("ground") ? 1 : 0), limits);
+  } catch (const std::invalid_argument& e) {
+    fail(path, "objects", e.what());
   }
   for (std::size_t k = 0; k < j["objects"].size(); ++k) {
     const auto& o = j["objects"][k];

@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "haarcast/render/renderer.h"
 #include "haarcast/render/scene.h"
 
 namespace haarcast::render {
@@ -41,6 +42,57 @@ TEST(SceneFile, AValueOfTheWrongTypeNamesTheFile) {
 TEST(SceneFile, BrokenJsonIsInvalidJson) {
   const std::string why = refusal("haarcast_scene_broken.json", R"({"camera": )");
   EXPECT_NE(why.find("not valid JSON"), std::string::npos) << why;
+}
+
+}  // namespace
+}  // namespace haarcast::render
+
+namespace haarcast::render {
+namespace {
+
+// A scene over the operator's limits is refused naming the limit and the
+// count, before its meshes are read (objects) or anything is computed.
+TEST(SceneLimits, RefusalsNameTheLimitAndTheCount) {
+  std::string objects = "[";
+  for (int k = 0; k < 70; ++k) objects += std::string(k ? "," : "") + R"({"mesh": "nowhere.ply", "material": "lambert"})";
+  objects += "]";
+  const std::string many = refusal("many.json", R"({"objects": )" + objects + "}");
+  EXPECT_NE(many.find("70 objects"), std::string::npos) << many;
+  EXPECT_NE(many.find("limit of 64"), std::string::npos) << many;
+  EXPECT_EQ(many.find("nowhere.ply"), std::string::npos) << "no mesh is read before the count is checked: " << many;
+
+  Scene scene = defaultScene();
+  RenderOptions options;
+  options.level = 4;
+  options.sceneLimits.maxTriangles = 100;
+  try {
+    (void)prepareScene(scene, options);
+    ADD_FAILURE() << "a scene over the triangle limit was prepared";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("over the limit of 100"), std::string::npos) << e.what();
+  }
+  options.sceneLimits = {};
+  options.sceneLimits.maxVisibilityBytes = 1000;
+  EXPECT_THROW((void)prepareScene(scene, options), std::invalid_argument);
+}
+
+TEST(SceneFile, GroundKeyIsCheckedAndAddsAGround) {
+  EXPECT_NE(refusal("g1.json", R"({"objects": [{"mesh": {"builtin": "sphere"}, "material": "lambert"}], "ground": 3})")
+                .find("ground"),
+            std::string::npos);
+  EXPECT_NE(refusal("g2.json", R"({"objects": [{"mesh": {"builtin": "sphere"}, "material": "lambert"}], "ground": {"colour": 1}})")
+                .find("unknown key \"colour\""),
+            std::string::npos);
+  EXPECT_NE(refusal("g3.json", R"({"objects": [{"mesh": {"builtin": "sphere"}, "material": "lambert"}], "ground": {"albedo": 2}})")
+                .find("albedo"),
+            std::string::npos);
+  const auto path = std::filesystem::temp_directory_path() / "g4.json";
+  std::ofstream(path) << R"({"objects": [{"mesh": {"builtin": "sphere"}, "material": "lambert"}], "ground": {"albedo": 0.3}})";
+  const Scene s = loadScene(path.string());
+  std::filesystem::remove(path);
+  ASSERT_EQ(s.objects.size(), 2u);
+  EXPECT_TRUE(s.objects[1].ground);
+  EXPECT_DOUBLE_EQ(s.objects[1].groundAlbedo.x, 0.3);
 }
 
 }  // namespace

@@ -53,6 +53,7 @@ struct RenderOptions {
   // shadow ray per pixel each (core/light_split.h); maxLights 0 = none,
   // at most shared::kMaxPointLights.
   LightSplitOptions pointLights;
+  SceneLimits sceneLimits;                // objects, triangles, visibility memory (prepareScene)
   bool environmentBackground = true;      // false: black where no object is
   std::string cacheDir;                   // slice-table and visibility cache; empty = none
   unsigned threads = 0;                   // 0 = hardware concurrency

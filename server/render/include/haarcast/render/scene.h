@@ -17,6 +17,7 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <functional>
 #include <memory>
 #include <string>
@@ -106,9 +107,22 @@ void addGround(Scene& scene, const GroundOptions& options = {});
 
 // The built-in default: the procedural sky, a glossy sphere and a torus over a ground.
 Scene defaultScene();
+// What one scene may hold: a scene file of 10,000 objects would otherwise
+// take gigabytes of visibility before its first frame. The refusal names the
+// limit and the number asked for; an operator raises them (`serve`,
+// `render` and `reference` flags --max-scene-objects, --max-scene-triangles,
+// --max-visibility-mb).
+struct SceneLimits {
+  std::size_t maxObjects = 64;
+  std::size_t maxTriangles = 4'000'000;             // all objects together
+  std::size_t maxVisibilityBytes = std::size_t{1} << 30;  // per-vertex visibility, all objects
+};
+// Throws std::invalid_argument naming the limit and the count.
+void checkObjectCount(std::size_t objects, const SceneLimits& limits);
+
 // Throws std::runtime_error with the file name and the JSON path of the
-// offending key.
-Scene loadScene(const std::string& path);
+// offending key (and the limit, for a scene over `limits`).
+Scene loadScene(const std::string& path, const SceneLimits& limits = {});
 
 // Centre a mesh on the origin and scale it to unit bounding radius.
 void fitToUnitSphere(Mesh& mesh);
