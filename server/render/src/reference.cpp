@@ -38,6 +38,9 @@ constexpr double kDefensiveCosine = 0.1;
 constexpr double kEnvironmentFloor = 1e-3;
 // The largest double below 1: stratified uniforms are clamped to [0, 1).
 constexpr double kBelowOne = 1.0 - 0x1p-53;
+// Scene occlusion's floor on the shadow-ray offset, relative to the hit
+// point's largest coordinate: 64 float ulps (reference.h).
+constexpr double kFloatGuard = 0x1p-17;
 
 // ---- Random numbers -------------------------------------------------------
 
@@ -223,8 +226,9 @@ struct PreparedObject {
   std::shared_ptr<const Mesh> mesh;       // with normals
   const Brdf* brdf = nullptr;
   glm::dmat3 rotation{1.0};               // object → world
-  std::unique_ptr<RayScene> self;         // this object alone, object frame
-  float shift = 0.0f;                     // shadow-ray origin offset
+  glm::dmat4 objectToWorld{1.0};
+  std::unique_ptr<RayScene> self;         // this object alone, object frame (self occlusion only)
+  double shift = 0.0;                     // shadow-ray origin offset: object units (self), world units (scene)
   std::vector<SphereDistribution> brdfTables;  // per tabulated θₒ (brdf strategy)
 };
 
@@ -295,12 +299,28 @@ struct PixelHit {
   bool lit = false;              // the view is above the shading horizon
   glm::dmat3 frame{1.0};         // local → object
   glm::dvec3 woLocal{0.0};
-  glm::vec3 origin{0.0f};        // shadow-ray origin, object frame
+  glm::vec3 origin{0.0f};        // shadow-ray origin: object frame (self), world frame (scene)
   int bin0 = 0, bin1 = 0;        // brdf tables around θₒ
   double binT = 0.0;             // weight of bin1
 };
 
 }  // namespace
+
+std::optional<ReferenceOcclusion> parseReferenceOcclusion(const std::string& name) {
+  if (name == "scene") return ReferenceOcclusion::Scene;
+  if (name == "self") return ReferenceOcclusion::Self;
+  if (name == "none") return ReferenceOcclusion::None;
+  return std::nullopt;
+}
+
+const char* referenceOcclusionName(ReferenceOcclusion occlusion) {
+  switch (occlusion) {
+    case ReferenceOcclusion::Scene: return "scene";
+    case ReferenceOcclusion::Self: return "self";
+    case ReferenceOcclusion::None: return "none";
+  }
+  return "unknown";
+}
 
 std::optional<ReferenceSampling> parseReferenceSampling(const std::string& name) {
   if (name == "mis") return ReferenceSampling::Mis;
@@ -335,6 +355,10 @@ void checkReferenceOptions(const ReferenceOptions& o) {
     bad("brdf table width " + std::to_string(o.brdfTableWidth) + " must be a multiple of 4 in 8..2048");
   }
   if (!(o.shadowOffset >= 0.0f) || !std::isfinite(o.shadowOffset)) bad("shadow offset must be finite and ≥ 0");
+  if (o.occlusion != ReferenceOcclusion::Scene && o.occlusion != ReferenceOcclusion::Self &&
+      o.occlusion != ReferenceOcclusion::None) {
+    bad("unknown occlusion (valid: scene, self, none)");
+  }
   (void)strategiesOf(o.sampling);
 }
 
@@ -359,9 +383,21 @@ ReferenceResult renderReference(const Scene& scene, const ReferenceOptions& opti
     p.mesh = withNormals(so.mesh);
     p.brdf = so.material.brdf.get();
     p.rotation = so.pose.rotation();
-    p.self = std::make_unique<RayScene>(std::vector<Instance>{Instance{p.mesh.get(), glm::mat4(1.0f)}});
-    p.shift = static_cast<float>(options.shadowOffset * p.mesh->bounds().radius());
+    p.objectToWorld = so.pose.objectToWorld();
+    if (options.occlusion == ReferenceOcclusion::Self) {
+      p.self = std::make_unique<RayScene>(std::vector<Instance>{Instance{p.mesh.get(), glm::mat4(1.0f)}});
+      p.shift = static_cast<float>(options.shadowOffset * p.mesh->bounds().radius());  // as before: a float
+    }
     if (use.brdf) p.brdfTables = buildBrdfTables(*p.brdf, options, threads);
+  }
+  if (options.occlusion == ReferenceOcclusion::Scene) {
+    // World offsets (reference.h): shadowOffset × the smallest object's world
+    // radius; the per-triangle floor is taken at each hit, below.
+    double rMin = std::numeric_limits<double>::infinity();
+    for (std::size_t k = 0; k < objects.size(); ++k) {
+      rMin = std::min(rMin, objects[k].mesh->bounds().radius() * scene.objects[k].pose.scale);
+    }
+    for (PreparedObject& p : objects) p.shift = options.shadowOffset * rMin;
   }
   std::optional<SphereDistribution> envTable;
   if (use.environment) envTable.emplace(buildEnvironmentTable(env, options.environmentTableWidth, threads));
@@ -413,7 +449,17 @@ ReferenceResult renderReference(const Scene& scene, const ReferenceOptions& opti
       ph.lit = ph.woLocal.y > 0.0;
       const glm::dvec3 point = b[0] * glm::dvec3(mesh.positions[tri.x]) + b[1] * glm::dvec3(mesh.positions[tri.y]) +
                                b[2] * glm::dvec3(mesh.positions[tri.z]);
-      ph.origin = glm::vec3(point + n * static_cast<double>(p.shift));
+      if (options.occlusion == ReferenceOcclusion::Scene) {
+        // The floor: 64 ulps of the hit point's largest coordinate, in the
+        // world or in its object frame at world scale (Embree intersects
+        // instances in the latter); the origin is a float.
+        const glm::dvec3 world(p.objectToWorld * glm::dvec4(point, 1.0));
+        const double largest = std::max(glm::length(world), glm::length(point) * scene.objects[hit->object].pose.scale);
+        const double shift = std::max(p.shift, kFloatGuard * largest);
+        ph.origin = glm::vec3(world + p.rotation * n * shift);
+      } else {
+        ph.origin = glm::vec3(point + n * p.shift);
+      }
       // Linear between table centres θ_k = (k + ½)(π/2)/K, clamped at the ends.
       const double f = std::clamp(thetaOut / (kPi / 2.0) * bins - 0.5, 0.0, bins - 1.0);
       ph.bin0 = static_cast<int>(f);
@@ -462,10 +508,17 @@ ReferenceResult renderReference(const Scene& scene, const ReferenceOptions& opti
       if (!(rho.x > 0.0 || rho.y > 0.0 || rho.z > 0.0)) return glm::dvec3(0.0);
       const glm::dvec3 f = env.radiance(p.rotation * omega) * rho * l.y;
       if (!(f.x > 0.0 || f.y > 0.0 || f.z > 0.0)) return glm::dvec3(0.0);
-      Ray shadow;
-      shadow.origin = ph.origin;
-      shadow.direction = glm::vec3(omega);
-      if (p.self->occluded(shadow)) return glm::dvec3(0.0);
+      if (options.occlusion != ReferenceOcclusion::None) {
+        Ray shadow;
+        shadow.origin = ph.origin;
+        if (options.occlusion == ReferenceOcclusion::Scene) {
+          shadow.direction = glm::vec3(p.rotation * omega);  // world frame: the posed objects of `primary`
+          if (primary.occluded(shadow)) return glm::dvec3(0.0);
+        } else {
+          shadow.direction = glm::vec3(omega);
+          if (p.self->occluded(shadow)) return glm::dvec3(0.0);
+        }
+      }
       return f * (ps / sum2);
     };
     auto cosineLocal = [](double u1, double u2) {
