@@ -34,6 +34,7 @@ struct EvalOptions {
   std::string outDir = "eval";
   bool quick = false;   // the small version the test suite runs
   bool truthOnly = false;  // only the truth sections (Monte Carlo and every method, shadow scenes)
+  bool shadowsOnly = false;  // only the shadow truth (implies truthOnly)
   int truthFrame = 0;      // shadow truth frame size; 0 = 16 (quick) or 64
   bool figures = true;     // run tools/plot_report.py on report.json
   unsigned threads = 0;
