@@ -35,6 +35,31 @@ glm::uvec3 tri(std::size_t a, std::size_t b, std::size_t c) {
   return {static_cast<std::uint32_t>(a), static_cast<std::uint32_t>(b), static_cast<std::uint32_t>(c)};
 }
 
+// The box centre ± h appended to `mesh`: six faces, each its own n × n grid of
+// quads with the face's normal (makeBox's faces and winding, subdivided).
+void appendBox(Mesh& mesh, const glm::dvec3& centre, const glm::dvec3& h, int n) {
+  struct Face {
+    glm::dvec3 n, t1, t2;  // t1 × t2 = n: corners in t1-then-t2 order run counter-clockwise
+  };
+  const glm::dvec3 x(1, 0, 0), y(0, 1, 0), z(0, 0, 1);
+  const Face faces[6] = {{x, y, z}, {-x, z, y}, {y, z, x}, {-y, x, z}, {z, x, y}, {-z, y, x}};
+  for (const Face& f : faces) {
+    const std::size_t first = mesh.positions.size();
+    const glm::dvec3 c = centre + f.n * h, a = f.t1 * h, b = f.t2 * h;
+    for (int j = 0; j <= n; ++j)
+      for (int i = 0; i <= n; ++i) {
+        mesh.positions.emplace_back(c + (-1.0 + 2.0 * i / n) * a + (-1.0 + 2.0 * j / n) * b);
+        mesh.normals.emplace_back(f.n);
+      }
+    const auto v = [&](int i, int j) { return first + static_cast<std::size_t>(j) * static_cast<std::size_t>(n + 1) + static_cast<std::size_t>(i); };
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        mesh.triangles.push_back(tri(v(i, j), v(i + 1, j), v(i + 1, j + 1)));
+        mesh.triangles.push_back(tri(v(i, j), v(i + 1, j + 1), v(i, j + 1)));
+      }
+  }
+}
+
 }  // namespace
 
 Mesh makeSphere(int segments) {
@@ -132,6 +157,25 @@ Mesh makeBox(double halfExtentX, double halfExtentY, double halfExtentZ) {
     mesh.triangles.push_back(tri(first, first + 1, first + 2));
     mesh.triangles.push_back(tri(first, first + 2, first + 3));
   }
+  return mesh;
+}
+
+Mesh makePillars(int pillars, int faceSubdivisions) {
+  if (pillars < 2 || pillars > 64) throw std::invalid_argument("makePillars pillars: " + std::to_string(pillars) + " is outside [2, 64]");
+  if (faceSubdivisions < 1 || faceSubdivisions > 256) {
+    throw std::invalid_argument("makePillars faceSubdivisions: " + std::to_string(faceSubdivisions) + " is outside [1, 256]");
+  }
+  Mesh mesh;
+  mesh.name = "pillars";
+  appendBox(mesh, {0.0, -0.05, 0.0}, {1.0, 0.05, 1.0}, faceSubdivisions);
+  const int n = pillars;
+  const double cell = 2.0 / n, half = 0.3 * cell;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const double height = 1.2 * (0.4 + 0.6 * ((3 * i + 5 * j) % n) / (n - 1));
+      appendBox(mesh, {-1.0 + (i + 0.5) * cell, 0.5 * height, -1.0 + (j + 0.5) * cell}, {half, 0.5 * height, half},
+                faceSubdivisions);
+    }
   return mesh;
 }
 

@@ -18,10 +18,10 @@
 #include "haarcast/core/metrics.h"
 #include "haarcast/io/mesh_io.h"
 #include "haarcast/render/cpu_renderer.h"
-#include "haarcast/render/reference.h"
 #include "haarcast/render/renderer.h"
 #include "haarcast/render/scene.h"
 #include "haarcast/render/tonemap.h"
+#include "eval_truth.h"
 #include "progress.h"
 #include "report_figures.h"
 
@@ -132,12 +132,6 @@ std::string fmt(double v, int digits = 2) {
   return b;
 }
 
-std::string fmtSig(double v, int digits = 3) {
-  char b[64];
-  std::snprintf(b, sizeof b, "%.*g", digits, v);
-  return b;
-}
-
 // ["a", "b", 4] → "a, b, 4": lists in report.md's prose.
 std::string listed(const nlohmann::json& array) {
   std::string out;
@@ -190,7 +184,8 @@ std::string timingsTable(const nlohmann::json& timings) {
   const std::vector<std::pair<const char*, const char*>> rows = {
       {"tables_s", "Tables 1–4 and the MSE data"},
       {"glossiness_s", "glossiness grid"},
-      {"truth_s", "truth PSNR (Monte Carlo and every method)"}};
+      {"truth_s", "truth PSNR (Monte Carlo and every method)"},
+      {"shadow_truth_s", "shadow truth (three Monte Carlo renders per scene, fused and haar)"}};
   const double total = timings.value("total_s", 0.0);
   std::ostringstream md;
   auto row = [&](const std::string& name, double s) {
@@ -211,7 +206,9 @@ std::string timingsTable(const nlohmann::json& timings) {
 
 }  // namespace
 
-EvalResult runEval(const EvalOptions& o, ProgressReporter& progress) {
+EvalResult runEval(const EvalOptions& options, ProgressReporter& progress) {
+  EvalOptions o = options;
+  o.truthOnly = o.truthOnly || o.shadowsOnly;
   const auto tStart = Clock::now();
   fs::create_directories(o.outDir);
   auto log = [&](const std::string& line) { progress.message("[eval] " + line); };
@@ -351,91 +348,26 @@ EvalResult runEval(const EvalOptions& o, ProgressReporter& progress) {
   }
   report["timings"]["glossiness_s"] = since(tGloss);
 
-  // ---- Truth: every method against a converged Monte Carlo render ---------
-  // The sphere in the first environment with the second table material (blue
-  // paint): the configuration whose Monte Carlo converges within the budget
-  // here (alum-bronze's narrow lobe against Grace's 2000:1 windows does not:
-  // half-image difference 0.17 at 4096 samples). The truth's own noise is
-  // reported beside it: a truth PSNR near that floor measures the noise.
+  // ---- Truth: the methods against converged Monte Carlo renders -------------
+  const TruthRun truthRun{o, base, progress, log};
   const auto tTruth = Clock::now();
-  {
+  if (!o.shadowsOnly) {
     const auto& model = a.models.front();
     const render::Scene scene = singleObjectScene(a.environments.front().second, model.first, model.second,
                                                   a.tableMaterials.back().second, {0.0, 20.0, 0.0});
-    render::ReferenceOptions ro;
-    ro.width = ro.height = o.quick ? 16 : 48;
-    ro.environmentBackground = false;
-    ro.tolerance = o.quick ? 0.05 : 0.01;
-    ro.maxSamples = o.quick ? 256 : 65536;
-    ro.threads = o.threads;
-    const std::string mcStage = "eval truth: Monte Carlo";
-    const render::ReferenceResult mc =
-        render::renderReference(scene, ro, monteCarloProgress(progress, mcStage, ro.tolerance, ro.maxSamples));
-    progress.finish(mcStage);
-    render::RenderResult asResult;
-    asResult.image = mc.image;
-    // The average of two halves differing by RMS d has an error of RMS d/2.
-    double mean = 0.0, peak = 0.0;
-    std::size_t n = 0;
-    for (std::size_t i = 0; i < mc.objectMask.size(); ++i) {
-      if (!mc.objectMask[i]) continue;
-      for (int c = 0; c < 3; ++c) {
-        const double v = mc.image.rgb[3 * i + static_cast<std::size_t>(c)];
-        mean += v;
-        peak = std::max(peak, v);
-        ++n;
-      }
-    }
-    mean /= static_cast<double>(std::max<std::size_t>(n, 1));
-    const double noiseRms = 0.5 * mc.halfError * mean;
-    const double noiseFloor = 20.0 * std::log10(peak / noiseRms);
-    log("truth: Monte Carlo " + std::to_string(mc.samples) + " samples, half error " + fmt(mc.halfError, 4) +
-        ", noise floor " + fmt(noiseFloor) + " dB, " + fmt(mc.seconds, 1) + " s");
-    report["truth"]["config"] = {{"model", model.first}, {"environment", a.environments.front().first},
-                                 {"material", a.tableMaterials.back().first}, {"frame", ro.width},
-                                 {"mc_samples", mc.samples}, {"mc_half_error", mc.halfError},
-                                 {"mc_noise_floor_psnr", noiseFloor}};
-    struct Variant {
-      std::string name;
-      RotationMethod method;
-      HaarVariant variant;
-    };
-    // fused with and without the θₒ slice blend; level 7 for fused alone
-    // (the rotating methods there cost minutes and add nothing new).
-    const std::vector<Variant> variants = {Variant{"fused", RotationMethod::Fused, HaarVariant::Refined},
-                                           Variant{"fused/nearest", RotationMethod::Fused, HaarVariant::Refined},
-                                           Variant{"haar", RotationMethod::Haar, HaarVariant::Refined},
-                                           Variant{"haar/faithful", RotationMethod::Haar, HaarVariant::Faithful},
-                                           Variant{"spatial", RotationMethod::Spatial, HaarVariant::Refined},
-                                           Variant{"matrix", RotationMethod::Matrix, HaarVariant::Refined},
-                                           Variant{"table", RotationMethod::Table, HaarVariant::Refined}};
-    const std::vector<int> truthLevels = o.quick ? std::vector<int>{4} : std::vector<int>{5, 6, 7};
-    auto runs = [&](int level, const Variant& v) { return level <= 6 || v.method == RotationMethod::Fused; };
-    std::size_t renders = 0, rendered = 0;
-    for (int level : truthLevels)
-      for (const Variant& v : variants) renders += runs(level, v) ? 1 : 0;
-    const std::string stage = "eval truth: methods";
-    progress.update(stage, 0, renders);
-    for (int level : truthLevels) {
-      for (const Variant& v : variants) {
-        if (!runs(level, v)) continue;
-        render::RenderOptions opt = base;
-        opt.interpolateSlices = v.name != "fused/nearest";
-        opt.level = level;
-        opt.width = ro.width;
-        opt.height = ro.height;
-        opt.method = v.method;
-        opt.rotator.haarVariant = v.variant;
-        const auto t = Clock::now();
-        const render::RenderResult r = render::renderCpu(scene, opt, inner);
-        const ErrorStats e = objectError(asResult, r.image, mc.objectMask);
-        report["truth"][levelKey(level)][v.name] = {{"psnr", e.psnr}, {"mse", e.mse}, {"seconds", since(t)}};
-        log("truth level " + std::to_string(level) + " " + v.name + ": " + fmt(e.psnr) + " dB");
-        progress.update(stage, ++rendered, renders);
-      }
-    }
+    report["truth"] = runMethodTruth(truthRun, scene,
+                                     {{"model", model.first}, {"environment", a.environments.front().first},
+                                      {"material", a.tableMaterials.back().first}});
   }
   report["timings"]["truth_s"] = since(tTruth);
+  const auto tShadow = Clock::now();
+  std::vector<std::string> shadowNotes;
+  report["shadow_truth"] = runShadowTruth(truthRun, shadowNotes);
+  for (const auto& n : shadowNotes) {
+    log("note: " + n);
+    report["notes"].push_back(n);
+  }
+  report["timings"]["shadow_truth_s"] = since(tShadow);
   report["timings"]["total_s"] = since(tStart);
 
   // ---- report.json, then the figures from it, then report.md ---------------
@@ -460,11 +392,11 @@ EvalResult runEval(const EvalOptions& o, ProgressReporter& progress) {
 
   std::ostringstream md;
   md << "# haarcast evaluation\n\nGenerated by `haarcast eval --data " << o.dataDir << " --out " << o.outDir
-     << (o.quick ? " --quick" : "") << (o.truthOnly ? " --truth-only" : "") << "` in "
+     << (o.quick ? " --quick" : "") << (o.shadowsOnly ? " --shadows-only" : o.truthOnly ? " --truth-only" : "") << "` in "
      << formatDuration(report["timings"]["total_s"].get<double>())
      << ". Every number is also in report.json; the figures are drawn from it by `tools/plot_report.py` "
         "(matplotlib).\n\n";
-  for (const auto& n : a.notes) md << "- Note: " << n << "\n";
+  for (const auto& n : report["notes"]) md << "- Note: " << n.get<std::string>() << "\n";
   if (!drawn && !o.truthOnly) md << "- **Figures not drawn:** " << result.figures.problem << ".\n";
   if (!o.truthOnly) {
   md << "\n## Tables 1–4: average seed PSNR (dB)\n\nSeed PSNR = PSNR of the `haar` render against the same render with "
@@ -509,21 +441,8 @@ EvalResult runEval(const EvalOptions& o, ProgressReporter& progress) {
      << g["environment"].get<std::string>() << "; " << g["frame_size"].get<int>() << "² renders cropped to the "
      << g["tile_size"].get<int>() << "² square around the object (glossiness/).\n";
   }
-  const auto& tc = report["truth"]["config"];
-  md << "\n## Truth PSNR against Monte Carlo\n\nModel " << tc["model"].get<std::string>() << ", environment "
-     << tc["environment"].get<std::string>() << ", material " << tc["material"].get<std::string>() << ", "
-     << tc["frame"].get<int>() << "² frames. The Monte Carlo render took " << tc["mc_samples"].get<int>()
-     << " samples per pixel; its half-images differ by " << fmt(tc["mc_half_error"].get<double>(), 4)
-     << ", so its own noise allows at most " << fmt(tc["mc_noise_floor_psnr"].get<double>())
-     << " dB: figures near that floor measure the noise, not the method.\n\n"
-        "| level | method | truth PSNR (dB) | MSE | seconds |\n|---|---|---:|---:|---:|\n";
-  for (const auto& [key, methods] : report["truth"].items()) {
-    if (key == "config") continue;
-    for (const auto& [name, v] : methods.items()) {
-      md << "| " << key.substr(5) << " | " << name << " | " << fmt(v["psnr"].get<double>()) << " | "
-         << fmtSig(v["mse"].get<double>()) << " | " << fmt(v["seconds"].get<double>(), 2) << " |\n";
-    }
-  }
+  if (report.contains("truth")) md << methodTruthMarkdown(report["truth"]);
+  md << shadowTruthMarkdown(report["shadow_truth"]);
   md << "\n## Timings\n\n" << timingsTable(report["timings"]);
   std::ofstream(fs::path(o.outDir) / "report.md") << md.str();
   result.report = std::move(report);
@@ -537,7 +456,12 @@ std::function<int()> addEvalCommand(CLI::App& app) {
   c->add_option("--data", options->dataDir, "Data folder (probes/, meshes/, brdfs/); empty = built-in stand-ins");
   c->add_option("--out", options->outDir, "Output folder")->capture_default_str();
   c->add_flag("--quick", options->quick, "The small version the test suite runs");
-  c->add_flag("--truth-only", options->truthOnly, "Only the truth PSNR section (Monte Carlo against every method)");
+  c->add_flag("--truth-only", options->truthOnly,
+              "Only the truth sections (Monte Carlo against every method, and the shadow scenes)");
+  c->add_flag("--shadows-only", options->shadowsOnly,
+              "Only the shadow truth (the shadow scenes against the reference with every object occluding)");
+  c->add_option("--truth-frame", options->truthFrame,
+                "Frame size of the shadow truth (0 = 16 with --quick, else 64)")->capture_default_str();
   c->add_flag("!--no-figures", options->figures,
               "Do not run tools/plot_report.py (matplotlib) on report.json");
   c->add_flag("--json", *json, "Print report.json to stdout");
@@ -549,7 +473,7 @@ std::function<int()> addEvalCommand(CLI::App& app) {
     if (*json) std::cout << result.report.dump(2) << '\n';
     std::fprintf(stderr, "wrote %s/report.md and report.json%s\n", options->outDir.c_str(),
                  result.figures.status == FigureRun::Status::Drawn ? " and the figures" : "");
-    if (result.figures.status == FigureRun::Status::Unavailable && options->figures && !options->truthOnly) {
+    if (result.figures.status == FigureRun::Status::Unavailable && options->figures && !options->truthOnly && !options->shadowsOnly) {
       std::fprintf(stderr, "figures not drawn: %s\n", result.figures.problem.c_str());
     }
     return result.figures.status == FigureRun::Status::Failed ? 1 : 0;

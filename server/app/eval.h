@@ -10,6 +10,9 @@
 //   glossiness   three materials × 4, 16, 64, 256 light coefficients (one
 //                PNG per tile in glossiness/)
 //   truth        every rotation method against a converged Monte Carlo render
+//   shadow truth shadow-heavy scenes (objects shadowing themselves, each
+//                other and a ground) against the reference with every object
+//                occluding: whole, shadowed and lit pixels (eval_truth.h)
 //
 // The figures (MSE plots, the labelled glossiness sheet) are drawn from
 // report.json by tools/plot_report.py with matplotlib (report_figures.h).
@@ -30,13 +33,15 @@ struct EvalOptions {
   std::string dataDir;  // ../shared/data layout: probes/, meshes/, brdfs/
   std::string outDir = "eval";
   bool quick = false;   // the small version the test suite runs
-  bool truthOnly = false;  // only the truth section (Monte Carlo and every method)
+  bool truthOnly = false;  // only the truth sections (Monte Carlo and every method, shadow scenes)
+  bool shadowsOnly = false;  // only the shadow truth (implies truthOnly)
+  int truthFrame = 0;      // shadow truth frame size; 0 = 16 (quick) or 64
   bool figures = true;     // run tools/plot_report.py on report.json
   unsigned threads = 0;
 };
 
 struct EvalResult {
-  nlohmann::json report;  // keys "config", "tables", "mse", "figures", "glossiness", "truth", "timings"
+  nlohmann::json report;  // keys "config", "tables", "mse", "figures", "glossiness", "truth", "shadow_truth", "timings"
   FigureRun figures;      // whether the figures were drawn, and why not
 };
 

@@ -18,6 +18,7 @@ namespace {
 struct ReferenceArgs {
   SceneFlags scene;
   std::string sampling = "mis";
+  std::string occlusion = "scene";
   render::ReferenceOptions options;
 };
 
@@ -26,6 +27,11 @@ int run(ReferenceArgs& a) {
   if (!sampling) {
     throw std::invalid_argument("--sampling must be mis, mis-cosine, environment, brdf or cosine (got \"" + a.sampling + "\")");
   }
+  const auto occlusion = render::parseReferenceOcclusion(a.occlusion);
+  if (!occlusion) {
+    throw std::invalid_argument("--occlusion must be scene, self or none (got \"" + a.occlusion + "\")");
+  }
+  a.options.occlusion = *occlusion;
   a.options.width = a.scene.width;
   a.options.height = a.scene.height;
   a.options.environmentBackground = environmentBackground(a.scene);
@@ -41,8 +47,8 @@ int run(ReferenceArgs& a) {
   progress.finish("reference");
 
   writeOutputImages(a.scene, r.image, r.objectMask);
-  std::fprintf(stderr, "%d×%d, %s: %d samples/pixel, half-image difference %.4f (tolerance %.4f), %.2f s\n",
-               a.options.width, a.options.height, a.sampling.c_str(), r.samples, r.halfError, a.options.tolerance,
+  std::fprintf(stderr, "%d×%d, %s, occlusion %s: %d samples/pixel, half-image difference %.4f (tolerance %.4f), %.2f s\n",
+               a.options.width, a.options.height, a.sampling.c_str(), a.occlusion.c_str(), r.samples, r.halfError, a.options.tolerance,
                r.seconds);
   return 0;
 }
@@ -60,6 +66,9 @@ std::function<int()> addReferenceCommand(CLI::App& app) {
   c->add_option("--max-samples", args->options.maxSamples, "Most samples per pixel")->capture_default_str();
   c->add_option("--samples-per-pass", args->options.samplesPerPass, "Samples per pixel per pass")->capture_default_str();
   c->add_option("--sampling", args->sampling, "mis|mis-cosine|environment|brdf|cosine")->capture_default_str();
+  c->add_option("--occlusion", args->occlusion,
+                "What shadows: scene (every object, posed), self (each object alone) or none")
+      ->capture_default_str();
   c->add_option("--seed", args->options.seed, "Random seed")->capture_default_str();
   c->add_option("--threads", args->options.threads, "Worker threads (0 = all cores)")->capture_default_str();
   return [c, args]() { return c->parsed() ? run(*args) : -1; };

@@ -13,6 +13,7 @@
 
 #include "haarcast/assets/procedural_environment.h"
 #include "haarcast/assets/procedural_mesh.h"
+#include "haarcast/assets/suns_environment.h"
 #include "haarcast/io/environment.h"
 #include "haarcast/io/merl.h"
 #include "haarcast/io/mesh_io.h"
@@ -40,6 +41,14 @@ Environment builtinEnvironment() {
   e.name = "builtin sky";
   e.radiance = [](const glm::dvec3& d) { return assets::proceduralEnvironmentRadiance(d); };
   e.maps = [](int level) { return assets::proceduralEnvironment(level, 8); };
+  return e;
+}
+
+Environment sunsEnvironment() {
+  Environment e;
+  e.name = "builtin suns";
+  e.radiance = [](const glm::dvec3& d) { return assets::sunsEnvironmentRadiance(d); };
+  e.maps = [](int level) { return assets::sunsEnvironment(level); };
   return e;
 }
 
@@ -260,8 +269,10 @@ Scene sceneFromJson(const nlohmann::json& j, const std::string& path, const Scen
     const auto& e = j["environment"];
     if (e.contains("file")) {
       s.environment = environmentFromFile((base / e["file"].get<std::string>()).string(), e.value("layout", "auto"));
+    } else if (e.value("builtin", "") == "suns") {
+      s.environment = sunsEnvironment();
     } else if (e.value("builtin", "") != "sky") {
-      fail(path, "environment", "expected {\"file\": …} or {\"builtin\": \"sky\"}");
+      fail(path, "environment", "expected {\"file\": …} or {\"builtin\": \"sky\"|\"suns\"}");
     }
   }
   if (j.contains("camera")) {

@@ -4,6 +4,7 @@
 // shared or a normal of the wrong sign each break one of these.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <map>
@@ -155,6 +156,39 @@ TEST(ProceduralMesh, PlaneFacesUp) {
   }
 }
 
+TEST(ProceduralMesh, PillarsAreTheirBoxes) {
+  // The slab (2 × 0.1 × 2) and n² pillars of width w = 0.6·(2/n) and the
+  // stated heights: area and volume are the boxes' sums.
+  for (const auto& [n, k] : {std::pair{4, 1}, std::pair{3, 5}}) {
+    SCOPED_TRACE(n);
+    const Mesh m = makePillars(n, k);
+    EXPECT_NO_THROW(m.validate());
+    EXPECT_EQ(m.triangles.size(), static_cast<std::size_t>((1 + n * n) * 6 * 2 * k * k));
+    expectUnitOutwardNormals(m);
+    const double w = 0.6 * 2.0 / n;
+    double a = 2.0 * (4.0 + 0.2 + 0.2), v = 0.4, top = 0.0;
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) {
+        const double h = 1.2 * (0.4 + 0.6 * ((3 * i + 5 * j) % n) / (n - 1));
+        a += 2.0 * w * w + 4.0 * w * h;
+        v += w * w * h;
+        top = std::max(top, h);
+      }
+    EXPECT_NEAR(area(m), a, 1e-5);
+    EXPECT_NEAR(volume(m), v, 1e-5);
+    // Flat shading: every triangle's winding normal is its vertices' normal.
+    for (const glm::uvec3& t : m.triangles) {
+      const glm::dvec3 p(m.positions[t.x]), q(m.positions[t.y]), r(m.positions[t.z]);
+      const glm::dvec3 face = glm::normalize(glm::cross(q - p, r - p));
+      for (const std::uint32_t i : {t.x, t.y, t.z}) ASSERT_NEAR(glm::dot(face, glm::dvec3(m.normals[i])), 1.0, 1e-6);
+    }
+    const Bounds b = m.bounds();
+    EXPECT_NEAR(b.lo.y, -0.1, 1e-6);
+    EXPECT_NEAR(b.hi.y, top, 1e-6);
+    EXPECT_NEAR(b.hi.x, 1.0, 1e-6);
+  }
+}
+
 TEST(ProceduralMesh, RefusesBadSizes) {
   EXPECT_THROW(makeSphere(3), std::invalid_argument);
   EXPECT_THROW(makeSphere(5000), std::invalid_argument);
@@ -165,6 +199,8 @@ TEST(ProceduralMesh, RefusesBadSizes) {
   EXPECT_THROW(makeBox(1.0, std::nan(""), 1.0), std::invalid_argument);
   EXPECT_THROW(makePlane(-1.0), std::invalid_argument);
   EXPECT_THROW(makePlane(1.0, 0), std::invalid_argument);
+  EXPECT_THROW(makePillars(1), std::invalid_argument);
+  EXPECT_THROW(makePillars(4, 0), std::invalid_argument);
 }
 
 }  // namespace

@@ -44,6 +44,17 @@ TEST(SceneFile, BrokenJsonIsInvalidJson) {
   EXPECT_NE(why.find("not valid JSON"), std::string::npos) << why;
 }
 
+TEST(SceneFile, TheSunsSkyIsBuiltInAndAnUnknownOneNamesTheChoices) {
+  const auto path = std::filesystem::temp_directory_path() / "haarcast_scene_suns.json";
+  std::ofstream(path) << R"({"environment": {"builtin": "suns"}, "objects": [{"mesh": {"builtin": "box"}, "material": "lambert"}]})";
+  const Scene s = loadScene(path.string());
+  std::filesystem::remove(path);
+  EXPECT_EQ(s.environment.name, "builtin suns");
+  EXPECT_GT(s.environment.radiance({0.0, 1.0, 0.0}).z, 0.0);
+  const std::string why = refusal("haarcast_scene_moon.json", R"({"environment": {"builtin": "moon"}, "objects": []})");
+  EXPECT_NE(why.find(R"("sky"|"suns")"), std::string::npos) << why;
+}
+
 }  // namespace
 }  // namespace haarcast::render
 

@@ -31,6 +31,18 @@ Mesh makeTorus(double majorRadius = 1.0, double minorRadius = 0.35, int majorSeg
 // shading is flat (24 vertices, 12 triangles).
 Mesh makeBox(double halfExtentX = 1.0, double halfExtentY = 1.0, double halfExtentZ = 1.0);
 
+// A shape that shadows itself deeply, for shadow tests: a square slab
+// [−1, 1] × [−0.1, 0] × [−1, 1] with n × n square pillars standing on it
+// (pillar (i, j) centred in cell (i, j) of the n × n grid over the slab's
+// top, 0.6 of the cell wide, of height 1.2·(0.4 + 0.6·((3i + 5j) mod n)/(n − 1))),
+// so that the slots between them are 2–6 times deeper than wide. Every box
+// is closed, its faces flat-shaded like makeBox's, each face a
+// faceSubdivisions² grid of quads (per-vertex visibility needs vertices
+// inside a shadow). A pillar's bottom lies on the slab's top: the boxes
+// touch and do not overlap, so area and volume are the boxes' sums.
+// pillars ∈ [2, 64], faceSubdivisions ∈ [1, 256].
+Mesh makePillars(int pillars = 4, int faceSubdivisions = 6);
+
 // Square [−halfSize, halfSize]² in the XZ plane at y = 0, facing +Y, as a
 // subdivisions × subdivisions grid of quads (per-vertex visibility needs
 // vertices inside a shadow, not only at the corners). halfSize > 0,

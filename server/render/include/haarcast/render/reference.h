@@ -11,11 +11,36 @@
 //   shading normal, the view direction at φ = 0); cos θᵢ ≤ 0 contributes 0;
 // - light: Environment::radiance per direction (full resolution), the object
 //   frame being the pose's rotation of the world (L_obj(ω) = L_world(R ω));
-// - visibility: each object's SELF-occlusion only, traced at the hit point
-//   itself (not interpolated from vertices) against a ray scene holding that
-//   object alone in its object frame; the ray starts at the hit point moved
-//   along the shading normal by shadowOffset × the mesh's bounding radius
-//   (visibility.cpp's rule, with the hit point in place of the vertex);
+// - visibility V(ω): traced at the hit point itself (not interpolated from
+//   vertices), the ray starting at the hit point moved along the shading
+//   normal by an offset (below). ReferenceOptions::occlusion says against what:
+//   · scene (the default): every object of the scene, each posed by its
+//     pose, in the world frame: objects shadow each other and a ground
+//     object;
+//   · self: the hit object alone, in its object frame (what renderCpu's
+//     per-vertex visibility holds);
+//   · none: V = 1, nothing occludes (with scene, it marks shadowed pixels).
+//   The offset. self: shadowOffset × the mesh's bounding radius, object
+//   frame (visibility.cpp's rule, with the hit point in place of the
+//   vertex). scene: in world units,
+//
+//     offset = max(shadowOffset × r_min, 2⁻¹⁷ × m),
+//
+//   r_min the smallest world bounding radius of the scene's objects, m the
+//   largest coordinate magnitude of the hit point (in the world, or in the
+//   object frame times the pose's scale, whichever is larger). Why r_min and
+//   not the hit object's radius: a ray leaving a large ground plane (a
+//   radius of tens of units) would otherwise start a millimetre-scale
+//   distance above it and pass under the contact shadow of a small object
+//   standing on it; the offset stays a length below the smallest feature
+//   that can occlude. Why the floor: the ray's origin is a float, rounded by
+//   up to half an ulp of its largest coordinate, and Embree's intersection
+//   is exact to about as much, so the offset never falls under 64 ulps
+//   (2⁻¹⁷ relative): no ray re-hits the surface it leaves, whatever the
+//   sizes (50 units from the origin under a 1 mm ball, 1e-4 × its radius is
+//   1.7e-7, under the rounding's 2e-6, and a third of the ground's rays would
+//   re-hit it). With one object, or objects of one size near the origin,
+//   this is the self rule in world units;
 // - background: Environment::radiance along the pixel ray, or black.
 //
 // On a faceted mesh the hit point lies on a flat triangle while the shading
@@ -94,6 +119,17 @@ enum class ReferenceSampling {
 // "mis", "mis-cosine", "environment", "brdf", "cosine"; nullopt otherwise.
 std::optional<ReferenceSampling> parseReferenceSampling(const std::string& name);
 
+// What occludes a shadow ray (see the file comment).
+enum class ReferenceOcclusion {
+  Scene,  // every object of the scene, posed, world frame (default)
+  Self,   // the hit object alone, object frame
+  None,   // nothing: V = 1
+};
+
+// "scene", "self", "none"; nullopt otherwise.
+std::optional<ReferenceOcclusion> parseReferenceOcclusion(const std::string& name);
+const char* referenceOcclusionName(ReferenceOcclusion occlusion);
+
 struct ReferenceOptions {
   int width = 128;
   int height = 128;
@@ -107,7 +143,8 @@ struct ReferenceOptions {
   int environmentTableWidth = 1024;  // environment sampling table: width × width/2 cells; even, 8..8192
   int brdfTableThetaOut = 32;      // view elevations tabulated for brdf sampling; 1..256
   int brdfTableWidth = 256;        // φ cells of each brdf table (θ_h gets width/4); multiple of 4, 8..2048
-  float shadowOffset = 1e-4f;      // × the mesh's bounding radius, as VisibilityOptions::offset
+  float shadowOffset = 1e-4f;      // × a bounding radius (see the file comment), as VisibilityOptions::offset
+  ReferenceOcclusion occlusion = ReferenceOcclusion::Scene;
 };
 
 // Throws std::invalid_argument naming the bad option.

@@ -4,7 +4,7 @@
 // Scene file (paths relative to the file's folder; every key but "objects"
 // optional):
 //   {
-//     "environment": {"file": "probes/grace_latlong.exr", "layout": "auto"},   // or {"builtin": "sky"}
+//     "environment": {"file": "probes/grace_latlong.exr", "layout": "auto"},   // or {"builtin": "sky"|"suns"}
 //     "camera": {"eye": [0, 0.4, 3.2], "target": [0, 0, 0], "up": [0, 1, 0], "fov_y": 35},
 //     "objects": [
 //       {"name": "bunny", "mesh": "meshes/bunny.ply",            // or {"builtin": "sphere"|"torus"|"box"|"plane"}
@@ -51,6 +51,9 @@ struct Environment {
 };
 
 Environment builtinEnvironment();
+// The shadow-test sky: a dim gradient and three small bright suns carrying
+// ~80 % of an upward surface's irradiance (assets/suns_environment.h).
+Environment sunsEnvironment();
 // The same radiance from every direction: the furnace of analytic tests.
 Environment constantEnvironment(double radiance);
 // A light probe file (EXR, HDR, PFM; lat-long or angular).
