@@ -154,8 +154,13 @@ render::Scene groundedScene(const render::Environment& environment, std::vector<
                             double groundHalfSize, int groundSubdivisions) {
   render::Scene s;
   s.environment = environment;
-  s.objects.push_back({"ground", std::make_shared<Mesh>(assets::makePlane(groundHalfSize, groundSubdivisions)),
-                       render::materialFromSpec("lambert"), {}});
+  // The scene's ground (SceneObject::ground): `fused` shades it in closed
+  // form and lets it take the objects' shadows; the reference sees a plane.
+  render::SceneObject ground{"ground", std::make_shared<Mesh>(assets::makePlane(groundHalfSize, groundSubdivisions)),
+                             render::materialFromSpec("lambert"), {}};
+  ground.ground = true;
+  ground.groundAlbedo = glm::dvec3(0.8);  // materialFromSpec("lambert")'s albedo
+  s.objects.push_back(std::move(ground));
   for (render::SceneObject& o : objects) s.objects.push_back(std::move(o));
   return s;
 }
