@@ -251,12 +251,12 @@ struct ObjectInfo {
   float skipBelowY;    // `fused`: directions with cos θ' below this read only zero texels
   uint pointLights;    // `fused`: its PointLight records this frame (≤ kMaxPointLights)
   uint flags;          // kObjectGround, …
-  vec4 flat;           // a ground object: the radiance of its unshadowed map light (rgb)
+  vec4 groundRadiance; // a ground object: the radiance of its unshadowed map light (rgb)
 };
 
 // ObjectInfo::flags: the object is the scene's ground, a Lambert plane that
 // `fused` shades in closed form (its map light is the same at every point,
-// so only the point lights' shadow bits vary): radiance = flat + Σ_k bit_k·power_k.
+// so only the point lights' shadow bits vary): radiance = groundRadiance + Σ_k bit_k·power_k.
 HC_CONST uint kObjectGround = 1u;
 
 // `fused`'s point lights (core/light_split.h): the light's brightest
@@ -352,7 +352,7 @@ struct GBufferPush {
 static_assert(sizeof(FrameParams) == 128 && offsetof(FrameParams, tanHalf) == 96 &&
               offsetof(FrameParams, fusedGroups) == 124);
 static_assert(sizeof(ObjectInfo) == 96 && offsetof(ObjectInfo, sliceBase) == 48 &&
-              offsetof(ObjectInfo, skipBelowY) == 68 && offsetof(ObjectInfo, flat) == 80);
+              offsetof(ObjectInfo, skipBelowY) == 68 && offsetof(ObjectInfo, groundRadiance) == 80);
 static_assert(sizeof(PointLight) == 32);
 static_assert(sizeof(RotationSample) == 32 && offsetof(RotationSample, alpha) == 8 &&
               offsetof(RotationSample, thetaOut) == 24);
