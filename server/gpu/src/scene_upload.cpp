@@ -214,10 +214,15 @@ void VulkanRenderer::Impl::createFusedPipeline(std::uint32_t local) {
   lightTexelData.resize(prepared.objects.size() * coefficients);
 
   // No scratch: a workgroup keeps only its reduction's vec3 per invocation,
-  // so the dispatch may have as many groups as the device allows.
+  // so the dispatch may have as many groups as the device allows: 65,536 on
+  // GPUs. On a CPU device each workgroup costs a launch, which the ground's
+  // samples (a few loads each) do not amortise: 512 groups looping over the
+  // samples took 0.21 CPU-s per frame on lavapipe where one group per sample
+  // took 0.25 (default scene, 256², level 5; docs/gpu.md).
   fusedLocal = limits.fusedLocalSize ? limits.fusedLocalSize : local;
   const std::size_t maxGroups = context.properties().limits.maxComputeWorkGroupCount[0];
-  fusedGroups = static_cast<std::uint32_t>(std::min<std::size_t>(maxGroups, 1u << 16));
+  const std::size_t groups = context.info().type == "cpu" ? 512u : 1u << 16;
+  fusedGroups = static_cast<std::uint32_t>(std::min<std::size_t>(maxGroups, groups));
   if (limits.fusedGroups) fusedGroups = std::min(fusedGroups, limits.fusedGroups);
   fusedPass = std::make_unique<ComputePipeline>(
       context, "fused.comp", fusedBindings(), 0,

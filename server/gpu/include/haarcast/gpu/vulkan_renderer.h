@@ -54,7 +54,8 @@ struct VulkanRendererLimits {
   // Workgroup size of rotate_spatial.comp; 0 = 64 on CPU devices, 256 on GPUs.
   std::uint32_t spatialLocalSize = 0;
   // `fused`: workgroup size (0 = the subgroup size on CPU devices, 256 on
-  // GPUs) and the most workgroups in flight (0 = 65,536 or the device's limit).
+  // GPUs) and the most workgroups in flight (0 = 512 on CPU devices, 65,536 on
+  // GPUs, at most the device's limit).
   std::uint32_t fusedLocalSize = 0;
   std::uint32_t fusedGroups = 0;
 };
