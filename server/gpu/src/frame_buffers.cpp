@@ -86,8 +86,9 @@ void VulkanRenderer::Impl::destroyTarget(GBufferTarget& t) {
 void VulkanRenderer::Impl::releaseResolution() {
   destroyTarget(target);
   destroyTarget(subTarget);
+  maskUpload = BufferUpload();
   for (Buffer* b : {&gbufIds, &gbufNormals, &gbufPositions, &samples, &shade, &counter, &radiance, &rgba8, &rotated,
-                    &batchArgs, &subIds, &subNormals, &edges}) {
+                    &batchArgs, &subIds, &subNormals, &edges, &masks}) {
     *b = Buffer();
   }
   width = height = 0;
@@ -133,8 +134,12 @@ void VulkanRenderer::Impl::ensureResolution(int w, int h) {
   exposure->bind({&frameParams, &gbufIds, &radiance, &exposureResult});
   tonemap->bind({&frameParams, &radiance, &rgba8, &thresholds, &exposureResult});
   if (fused) {
-    fusedPass->bind({&samples, &shade, &objects, &sliceTexels, &lightTexels, &visibility, &directionTexels, &scratch,
-                     &radiance, &counter, &visibilityTexels});
+    // Each sample's point-light mask, written by the host every frame (the
+    // frame's "shadow-rays" stage) and read by the fused pass.
+    masks = Buffer(context, sampleCapacity * sizeof(std::uint32_t), kStorageUsage, MemoryUse::DeviceInput);
+    maskUpload = BufferUpload(context, masks);
+    fusedPass->bind({&samples, &shade, &objects, &sliceTexels, &lightTexels, &visibilityTexels, &directionTexels,
+                     &pointLights, &radiance, &counter, &masks});
     return;
   }
 

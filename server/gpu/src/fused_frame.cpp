@@ -1,15 +1,71 @@
-// A `fused` frame: G-buffer → rotation input (compaction, indirect arguments)
-// → fused (vkCmdDispatchIndirect, no readback of the count) → tonemap, one
-// command buffer on devices with timestamps.
+// A `fused` frame: [G-buffer → rotation input (compaction, indirect
+// arguments)] → the host's shadow rays for the covered samples read back →
+// [fused (vkCmdDispatchIndirect) → tonemap]. Two submissions (each one
+// command buffer on devices with timestamps), because each sample's
+// point-light bits come from Embree on the host (render/point_lights.h),
+// the same rays as the CPU backend's for the same hit.
 
+#include <algorithm>
 #include <cstddef>
 #include <span>
+#include <stdexcept>
+#include <string>
 
+#include "haarcast/core/check.h"
 #include "haarcast/core/fused.h"
+#include "haarcast/core/parallel.h"
+#include "haarcast/render/point_lights.h"
 
 #include "vulkan_renderer_impl.h"
 
 namespace haarcast::gpu {
+
+std::uint32_t VulkanRenderer::Impl::computeShadowMasks(const render::ResolvedFrame& resolved) {
+  CoverageCounter count{};
+  counter.read(&count, sizeof count);
+  if (count.covered > sampleCapacity) {
+    throw std::logic_error("rotation-input reported " + std::to_string(count.covered) + " samples, more than the " +
+                           std::to_string(sampleCapacity) + " the frame can have");
+  }
+  const std::size_t objectCount = prepared.objects.size();
+  for (std::size_t i = 0; i < objectCount; ++i) rays->setTransform(i, glm::mat4(resolved.objects[i].objectToWorld));
+  std::vector<glm::mat4> toWorld;
+  std::vector<glm::mat3> rotations;
+  for (const render::ResolvedObject& o : resolved.objects) {
+    toWorld.emplace_back(o.objectToWorld);
+    rotations.emplace_back(o.rotation);
+  }
+  // The samples as rotation-input wrote them (host-visible: `shade` is a
+  // Host buffer), in chunks of samples (parallelFor hands out one index at
+  // a time, under a lock).
+  const auto* sh = static_cast<const ShadeSample*>(shade.mapped());
+  std::vector<std::uint32_t>& out = maskData;
+  out.resize(count.covered);
+  constexpr std::size_t kChunk = 256;
+  const std::span<const glm::vec3> lightDirections = resolved.pointLightDirections;
+  parallelFor((count.covered + kChunk - 1) / kChunk, [&](std::size_t chunk) {
+    const std::size_t end = std::min<std::size_t>(count.covered, (chunk + 1) * kChunk);
+    for (std::size_t s = chunk * kChunk; s < end; ++s) {
+      const ShadeSample& sample = sh[s];
+      if (lightDirections.empty() || sample.object >= objectCount) {
+        out[s] = 0;
+        continue;
+      }
+      const std::size_t object = sample.object;
+      const render::PreparedObject& p = prepared.objects[object];
+      const std::uint32_t base = objectInfo[object].vertexBase;
+      // The hit triangle in the object's own vertex ids, as the CPU backend passes it.
+      const glm::uvec3 triangle(sample.vertex[0] - base, sample.vertex[1] - base, sample.vertex[2] - base);
+      out[s] = render::pointLightMask(*rays,
+                                      render::shadingPoint(*p.mesh, triangle, sample.b, toWorld[object],
+                                                           rotations[object],
+                                                           p.shadowShift * static_cast<float>(resolved.objects[object].scale)),
+                                      lightDirections);
+    }
+  }, {}, options.threads);
+  if (!out.empty()) maskUpload.write(out.data(), out.size() * sizeof(std::uint32_t));
+  return count.covered;
+}
 
 render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& request) {
   const auto start = RendererClock::now();
@@ -17,39 +73,67 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
   frame.width = request.width;
   frame.height = request.height;
 
-  // ---- light (host): resolveFrame, as the CPU backend; its pixel form uploaded
+  // ---- light (host): resolveFrame, as the CPU backend; its pixel form and
+  // point lights uploaded, the ground's closed form in its ObjectInfo
   auto t0 = RendererClock::now();
   const render::ResolvedFrame resolved = render::resolveFrame(prepared, options, request);
   ensureResolution(request.width, request.height);
   const std::size_t objectCount = prepared.objects.size();
+  const std::size_t lightCount = resolved.pointLightDirections.size();
+  HC_CHECK_LE(lightCount, std::size_t{shared::kMaxPointLights});
   for (std::size_t i = 0; i < objectCount; ++i) {
     const render::ResolvedObject& o = resolved.objects[i];
     fusedLightTexels(o.fusedLight.planes, std::span<glm::vec4>(lightTexelData).subspan(i * coefficients, coefficients));
-    for (int c = 0; c < 3; ++c) objectInfo[i].rotation[c] = glm::vec4(glm::vec3(o.rotation[c]), 0.0f);
+    ObjectInfo& info = objectInfo[i];
+    for (int c = 0; c < 3; ++c) info.rotation[c] = glm::vec4(glm::vec3(o.rotation[c]), 0.0f);
+    HC_CHECK_EQ(o.pointLights.size(), lightCount);
+    info.pointLights = static_cast<std::uint32_t>(lightCount);
+    info.groundRadiance = glm::vec4(o.groundFlat[0], o.groundFlat[1], o.groundFlat[2], 0.0f);
+    for (std::size_t k = 0; k < lightCount; ++k) {
+      const FusedPointLight& l = o.pointLights[k];
+      PointLight& out = pointLightData[i * shared::kMaxPointLights + k];
+      out.direction = glm::vec4(l.direction, 0.0f);
+      out.power = glm::vec4(l.power[0], l.power[1], l.power[2], 0.0f);
+    }
   }
   lightUpload.write(lightTexelData.data(), lightTexelData.size() * sizeof(glm::vec4));
+  pointLightUpload.write(pointLightData.data(), pointLightData.size() * sizeof(PointLight));
   objects.write(objectInfo.data(), objectInfo.size() * sizeof(ObjectInfo));
   uploadFrameUniforms(request);
   frame.stages.push_back({"light", secondsSince(t0)});
 
-  // ---- the device's part: one command buffer (timestamps) or one per stage
+  // ---- the device's first part: the samples to shade
   const glm::dmat4 viewProj = frameViewProjection(request);
   const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
   runStages({{"gbuffer", [&](VkCommandBuffer cb) { recordGBuffer(cb, request, viewProj); }},
              {"rotation-input",
               [&](VkCommandBuffer cb) {
                 vkCmdFillBuffer(cb, counter.handle(), 0, VK_WHOLE_SIZE, 0u);
-                lightUpload.record(cb);  // where the light is staged: its copy into device memory
-                computeBarrier(cb);
                 rotationInput->dispatch(cb, {groupsOf(pixels, 64), 1, 1});
-              }},
-             {"fused",
+              }}},
+            frame);
+  if (frame.cancelled) return frame;  // stopped between stages: no images
+
+  // ---- shadow-rays (host): each covered sample's point-light bits
+  frame.cancelled = cancelRequested();
+  if (frame.cancelled) return frame;
+  t0 = RendererClock::now();
+  const std::uint32_t covered = computeShadowMasks(resolved);
+  frame.stages.push_back({"shadow-rays", secondsSince(t0)});
+
+  // ---- the device's second part: the pass over the samples, the image
+  runStages({{"fused",
               [&](VkCommandBuffer cb) {
+                // Where the inputs are staged: their copies into device memory.
+                lightUpload.record(cb);
+                pointLightUpload.record(cb);
+                maskUpload.record(cb);
+                computeBarrier(cb);
                 fusedPass->dispatchIndirect(cb, counter, offsetof(CoverageCounter, groups));
               }},
              {"tonemap", [&](VkCommandBuffer cb) { recordTonemap(cb, request); }}},
             frame);
-  if (frame.cancelled) return frame;  // stopped between stages: no images
+  if (frame.cancelled) return frame;
 
   // ---- Results: RGBA8 always, the linear image only when asked for ----------
   frame.rgba8.resize(pixels * 4);
@@ -66,23 +150,18 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
   }
   finishExposure(request, frame);
 
-  // Coefficient bytes read, counted as the CPU backend counts them: the light
-  // lists, and per shaded sample core fusedPixelBytes (one slice or two, the
-  // light planes, the three vertices' entries).
+  // Coefficient bytes read, counted as the CPU backend counts them: the
+  // light, and per shaded sample core fusedPixelBytes (one slice or two, the
+  // light planes, the three vertices' visibility words); the ground reads none.
   std::size_t bytes = resolved.lightBytes;
-  CoverageCounter count{};
-  counter.read(&count, sizeof count);
   const auto* rs = static_cast<const RotationSample*>(samples.mapped());
   const auto* sh = static_cast<const ShadeSample*>(shade.mapped());
-  for (std::uint32_t i = 0; i < count.covered && i < sampleCapacity; ++i) {
-    std::size_t entries = 0;
-    for (std::uint32_t v : sh[i].vertex) entries += v < visibilityBlocks.size() ? visibilityBlocks[v] : 0;
+  const std::size_t visibilityBytes = 3 * visibilityWords * sizeof(std::uint32_t);
+  for (std::uint32_t i = 0; i < covered; ++i) {
+    if (sh[i].object >= objectCount || prepared.objects[sh[i].object].ground) continue;
     const shared::SliceBlend blend =
         shared::sliceBlendAt(rs[i].thetaOut, static_cast<shared::uint>(options.thetaSamples), options.interpolateSlices ? 1u : 0u);
-    // With the vertices' pixel forms, three planes of N floats replace the lists.
-    bytes += fusedVertexPlanes ? fusedPixelBytes(level, blend.weight != 0.0f && blend.second != blend.first, 0) +
-                                     3 * coefficients * sizeof(float)
-                               : fusedPixelBytes(level, blend.weight != 0.0f && blend.second != blend.first, entries);
+    bytes += fusedPixelBytes(level, blend.weight != 0.0f && blend.second != blend.first, visibilityBytes);
   }
   frame.coefficientBytes = bytes;
   frame.seconds = secondsSince(start);

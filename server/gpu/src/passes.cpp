@@ -38,7 +38,7 @@ void setFusedSkip(ObjectInfo& info, int level, int lastNonZeroRow) {
 
 std::vector<BindingKind> fusedBindings() {
   using enum BindingKind;
-  return {Storage, Storage, Storage, Texels, Texels, Storage, Texels, Storage, Storage, Storage, Texels};
+  return {Storage, Storage, Storage, Texels, Texels, Texels, Texels, Storage, Storage, Storage, Storage};
 }
 
 void fusedLightTexels(std::span<const float> planes, std::span<glm::vec4> out) {
@@ -56,30 +56,6 @@ std::vector<glm::vec4> pixelCentreDirections(int level) {
   out.reserve(static_cast<std::size_t>(m) * static_cast<std::size_t>(m));
   for (int i = 0; i < m; ++i) {
     for (int j = 0; j < m; ++j) out.emplace_back(glm::vec3(sphericalToDirection(rowTheta(level, i), colPhi(level, j))), 0.0f);
-  }
-  return out;
-}
-
-std::vector<std::uint32_t> packVisibilityEntries(std::span<const SparseHaar> lists, int level) {
-  const std::size_t count = static_cast<std::size_t>(mapSize(level)) * static_cast<std::size_t>(mapSize(level));
-  std::vector<std::uint32_t> out(2 * lists.size());
-  for (std::size_t n = 0; n < lists.size(); ++n) {
-    const SparseHaar& list = lists[n];
-    if (list.level != level || list.index.size() != list.value.size()) {
-      throw std::invalid_argument("packVisibilityEntries: list " + std::to_string(n) + " has level " +
-                                  std::to_string(list.level) + " (expected " + std::to_string(level) + ") or " +
-                                  "unequal index and value counts");
-    }
-    out[2 * n] = static_cast<std::uint32_t>(out.size() / 2);
-    out[2 * n + 1] = static_cast<std::uint32_t>(list.size());
-    for (std::size_t k = 0; k < list.size(); ++k) {
-      if (list.index[k] >= count) {
-        throw std::invalid_argument("packVisibilityEntries: list " + std::to_string(n) + " index " +
-                                    std::to_string(list.index[k]) + " is outside a level-" + std::to_string(level) + " map");
-      }
-      out.push_back(list.index[k]);
-      out.push_back(std::bit_cast<std::uint32_t>(list.value[k]));
-    }
   }
   return out;
 }

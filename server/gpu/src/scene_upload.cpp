@@ -1,5 +1,6 @@
 // The scene data a VulkanRenderer uploads once (slices, method data, meshes,
-// visibility, backdrop) and the compute pipelines that read it.
+// visibility, backdrop), the compute pipelines that read it and, for
+// `fused`, the ray scene of the point lights' shadow rays.
 
 #include <algorithm>
 #include <stdexcept>
@@ -25,6 +26,8 @@ void VulkanRenderer::Impl::uploadScene() {
   std::vector<glm::vec4> pos, nor;
   std::vector<std::uint32_t> tri;
   std::vector<SparseHaar> vis;
+  std::vector<std::uint32_t> bits;  // fused: every vertex's visibility words, global vertex order
+  visibilityWords = shared::visibilityWords(static_cast<shared::uint>(level));
   objectInfo.resize(objectCount);
   for (std::size_t k = 0; k < objectCount; ++k) {
     const render::PreparedObject& p = prepared.objects[k];
@@ -33,6 +36,7 @@ void VulkanRenderer::Impl::uploadScene() {
       throw std::logic_error("Vulkan backend: object " + p.name + " has a slice table unlike the options");
     }
     info.thetaSamples = static_cast<std::uint32_t>(T);
+    info.flags = p.ground ? shared::kObjectGround : 0u;
     if (fused) {
       // The slices in pixel form, RGB0 texels (core PixelSlices), slice s at s·N texels.
       const PixelSlices pixelSlices = PixelSlices::synthesize(p.table);
@@ -84,6 +88,18 @@ void VulkanRenderer::Impl::uploadScene() {
       tri.push_back(info.vertexBase + t.z);
     }
     triangleCount.push_back(static_cast<std::uint32_t>(mesh.triangles.size()));
+    if (fused) {
+      // fused reads the bits (core VisibilityBits), never the lists.
+      const VisibilityBits& b = p.visibilityBits;
+      if (b.pointCount() != mesh.positions.size() || b.level() != level || b.wordsPerPoint() != visibilityWords) {
+        throw std::logic_error("Vulkan backend: object " + p.name + " has visibility bits for " +
+                               std::to_string(b.pointCount()) + " points at level " + std::to_string(b.level()) +
+                               " for " + std::to_string(mesh.positions.size()) + " vertices at level " +
+                               std::to_string(level));
+      }
+      bits.insert(bits.end(), b.words().begin(), b.words().end());
+      continue;
+    }
     if (p.visibility.size() != mesh.positions.size()) {
       throw std::logic_error("Vulkan backend: object " + p.name + " has " + std::to_string(p.visibility.size()) +
                              " visibility maps for " + std::to_string(mesh.positions.size()) + " vertices");
@@ -108,26 +124,10 @@ void VulkanRenderer::Impl::uploadScene() {
     input(b, bytes, usage).write(data, bytes);
   };
   if (fused) {
-    visibilityBlocks.resize(vis.size());
-    for (std::size_t v = 0; v < vis.size(); ++v) visibilityBlocks[v] = vis[v].size();
-    const std::size_t planeBytes = vis.size() * n * sizeof(float);
-    fusedVertexPlanes = !limits.fusedVisibilityLists &&
-                        planeBytes <= std::min<std::size_t>(kFusedPlanesBudget,
-                                                            context.properties().limits.maxStorageBufferRange);
-    if (fusedVertexPlanes) {
-      // Every vertex's visibility in pixel form (synthesised once here):
-      // fused.comp blends three of them per direction.
-      BufferUpload& planes = input(visibility, planeBytes, kTexelUsage);
-      for (std::size_t v = 0; v < vis.size(); ++v) {
-        const SphereMap pixelsOf = inverseHaar(vis[v].toDense());
-        planes.write(pixelsOf.values().data(), n * sizeof(float), v * n * sizeof(float));
-      }
-    } else {
-      // The lists as they are: a (first, count) header per vertex, then
-      // (index, value bits) entries; fused.comp merges and synthesises them.
-      const std::vector<std::uint32_t> words = packVisibilityEntries(vis, level);
-      upload(visibility, words.data(), words.size() * sizeof(std::uint32_t));
-    }
+    // The bits as they are (W words per vertex, vertex v of object o at
+    // global vertex o's vertexBase + v): fused.comp blends three vertices'
+    // bits per direction.
+    upload(visibility, bits.data(), bits.size() * sizeof(std::uint32_t), kTexelUsage);
   } else {
     const std::vector<glm::uvec4> visPacked = packSparseLists(vis, level);
     visibilityBlocks.resize(vis.size());
@@ -161,6 +161,19 @@ void VulkanRenderer::Impl::uploadScene() {
                  fused ? objectCount * n * sizeof(glm::vec4) : objectCount * 3 * (1 + (n - 1) / 3) * sizeof(glm::uvec4),
                  fusedUsage, MemoryUse::DeviceInput);
   lightUpload = BufferUpload(context, light);
+  if (fused) {
+    // The point lights, written every frame like the light.
+    pointLightData.assign(objectCount * shared::kMaxPointLights, PointLight{});
+    pointLights = Buffer(context, pointLightData.size() * sizeof(PointLight), kStorageUsage, MemoryUse::DeviceInput);
+    pointLightUpload = BufferUpload(context, pointLights);
+    // The shadow rays' scene: every object (the ground included) at its
+    // scene pose, posed per frame (CpuRenderer::makeRays).
+    std::vector<Instance> instances;
+    for (const render::PreparedObject& p : prepared.objects) {
+      instances.push_back({p.mesh.get(), glm::mat4(p.pose.objectToWorld())});
+    }
+    rays = std::make_unique<RayScene>(std::move(instances));
+  }
   frameParams = Buffer(context, sizeof(FrameParams));
   thresholds = Buffer(context, 256 * sizeof(float));
   exposureResult = Buffer(context, sizeof(ExposureResult));
@@ -193,40 +206,29 @@ void VulkanRenderer::Impl::uploadScene() {
 
 void VulkanRenderer::Impl::createFusedPipeline(std::uint32_t local) {
   // The texel views fused.comp reads (RGBA32F slices, light and directions;
-  // R32F vertex planes, or a one-texel stand-in beside the lists).
+  // R32UI visibility words).
   sliceTexels = TexelView(context, slices, VK_FORMAT_R32G32B32A32_SFLOAT, sizeof(glm::vec4));
   lightTexels = TexelView(context, light, VK_FORMAT_R32G32B32A32_SFLOAT, sizeof(glm::vec4));
   directionTexels = TexelView(context, directions, VK_FORMAT_R32G32B32A32_SFLOAT, sizeof(glm::vec4));
-  if (!fusedVertexPlanes) texelStandIn = Buffer(context, sizeof(float), kTexelUsage, MemoryUse::DeviceOnly);
-  visibilityTexels = TexelView(context, fusedVertexPlanes ? visibility : texelStandIn, VK_FORMAT_R32_SFLOAT, sizeof(float));
+  visibilityTexels = TexelView(context, visibility, VK_FORMAT_R32_UINT, sizeof(std::uint32_t));
   lightTexelData.resize(prepared.objects.size() * coefficients);
 
-  // Scratch (the lists' synthesis only): in shared memory where the device
-  // has room for it (and the reduction's vec3 per invocation), else a slice
-  // of a global buffer per workgroup, whose size bounds the workgroups in
-  // flight. With vertex planes there is none.
-  const VkPhysicalDeviceLimits& lim = context.properties().limits;
-  const std::size_t floats = fusedScratchFloats(level, fusedVertexPlanes);
+  // No scratch: a workgroup keeps only its reduction's vec3 per invocation,
+  // so the dispatch may have as many groups as the device allows: 65,536 on
+  // GPUs. On a CPU device each workgroup costs a launch, which the ground's
+  // samples (a few loads each) do not amortise: 512 groups looping over the
+  // samples took 0.21 CPU-s per frame on lavapipe where one group per sample
+  // took 0.25 (default scene, 256², level 5; docs/gpu.md).
   fusedLocal = limits.fusedLocalSize ? limits.fusedLocalSize : local;
-  fusedShared = floats > 0 && !limits.fusedGlobalScratch &&
-                floats * sizeof(float) + fusedLocal * 4 * sizeof(float) <= lim.maxComputeSharedMemorySize;
-  const std::size_t maxGroups = lim.maxComputeWorkGroupCount[0];
-  if (floats == 0 || fusedShared) {
-    fusedGroups = static_cast<std::uint32_t>(std::min<std::size_t>(maxGroups, 1u << 16));
-    scratch = Buffer(context, sizeof(float), kStorageUsage, MemoryUse::DeviceOnly);
-  } else {
-    const std::size_t budget = std::min<std::size_t>(kFusedScratchBudget, lim.maxStorageBufferRange);
-    fusedGroups = static_cast<std::uint32_t>(std::clamp<std::size_t>(budget / (floats * sizeof(float)), 1, maxGroups));
-    scratch = Buffer(context, std::size_t{fusedGroups} * floats * sizeof(float), kStorageUsage, MemoryUse::DeviceOnly);
-  }
+  const std::size_t maxGroups = context.properties().limits.maxComputeWorkGroupCount[0];
+  const std::size_t groups = context.info().type == "cpu" ? 512u : 1u << 16;
+  fusedGroups = static_cast<std::uint32_t>(std::min<std::size_t>(maxGroups, groups));
   if (limits.fusedGroups) fusedGroups = std::min(fusedGroups, limits.fusedGroups);
   fusedPass = std::make_unique<ComputePipeline>(
       context, "fused.comp", fusedBindings(), 0,
       std::vector<SpecConstant>{{0, static_cast<std::uint32_t>(level)},
                                 {2, fusedLocal},
-                                {3, fusedShared ? static_cast<std::uint32_t>(floats) : 1u},
-                                {4, options.interpolateSlices ? 1u : 0u},
-                                {5, fusedVertexPlanes ? 1u : 0u}});
+                                {4, options.interpolateSlices ? 1u : 0u}});
 }
 
 }  // namespace haarcast::gpu

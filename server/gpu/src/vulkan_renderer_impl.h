@@ -5,7 +5,7 @@
 //   gbuffer_pass.cpp      the G-buffer's render pass, pipeline, projection, recording
 //   frame_buffers.cpp     the per-resolution images and buffers
 //   frame_stages.cpp      a frame's uniforms, its stages recorded, submitted and timed
-//   fused_frame.cpp       a `fused` frame: one command buffer, indirect dispatch
+//   fused_frame.cpp       a `fused` frame: two submissions around the host's shadow rays, indirect dispatch
 //   rotating_frame.cpp    a frame of the rotating methods: rotation and triple product in batches
 #pragma once
 
@@ -22,6 +22,7 @@
 
 #include "haarcast/gpu/compute.h"
 #include "haarcast/gpu/vulkan_renderer.h"
+#include "haarcast/render/embree_scene.h"
 
 namespace haarcast::gpu {
 
@@ -34,9 +35,7 @@ inline constexpr VkFormat kNormalFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
 inline constexpr VkFormat kIdsFormat = VK_FORMAT_R32G32B32A32_UINT;
 inline constexpr VkFormat kPositionFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
 inline constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
-inline constexpr std::size_t kRotatedBudget = 256u << 20;       // bytes of rotated coefficients per batch, at most
-inline constexpr std::size_t kFusedScratchBudget = 256u << 20;  // bytes of `fused` scratch in global memory, at most
-inline constexpr std::size_t kFusedPlanesBudget = 256u << 20;   // bytes of vertex visibility in pixel form, at most
+inline constexpr std::size_t kRotatedBudget = 256u << 20;  // bytes of rotated coefficients per batch, at most
 
 inline std::uint32_t groupsOf(std::size_t items, std::uint32_t local) {
   return static_cast<std::uint32_t>((items + local - 1) / local);
@@ -70,7 +69,7 @@ struct VulkanRenderer::Impl {
   std::vector<ObjectInfo> objectInfo;
   std::vector<std::uint32_t> triangleCount;
   std::size_t vertexCount = 0, totalTriangles = 0;
-  std::vector<std::size_t> visibilityBlocks;  // per global vertex, for the bytes-read count
+  std::vector<std::size_t> visibilityBlocks;  // per global vertex, for the bytes-read count (rotating methods)
   std::size_t rotationBytesPerChannel = 0;    // coefficient bytes one rotation reads (per object: same level)
   std::vector<std::size_t> methodBytesPerChannel;  // per object: method data one rotation reads
   Buffer slices, methodData, positions, normals, triangles, visibility, background;
@@ -80,18 +79,24 @@ struct VulkanRenderer::Impl {
   // The light is device-local (buffer.h); each frame writes it here and
   // records the copy, where it is staged, ahead of the pass that reads it.
   BufferUpload lightUpload;
-  // `fused`: the slices in pixel form (texels), the light in pixel form per
-  // frame (in `light`), the pixel-centre directions and the workgroups' scratch.
+  // `fused`: the slices in pixel form (texels), the visibility bits (in
+  // `visibility`, every vertex's words in global vertex order), the light in
+  // pixel form per frame (in `light`), the pixel-centre directions; per
+  // frame the point lights (PointLight, kMaxPointLights per object).
   bool fused = false;
-  Buffer directions, scratch;
+  Buffer directions, pointLights;
+  BufferUpload pointLightUpload;
   // fused.comp reads these through texel views (BindingKind::Texels).
-  Buffer texelStandIn;  // binding 10's stand-in where the visibility is lists
   TexelView sliceTexels, lightTexels, directionTexels, visibilityTexels;
   std::vector<glm::vec4> lightTexelData;  // this frame's light texels, before upload
+  std::vector<PointLight> pointLightData;         // this frame's point lights, before upload
   std::uint32_t fusedGroups = 0;     // the most workgroups of the fused dispatch
   std::uint32_t fusedLocal = 0;      // its local size
-  bool fusedShared = false;          // scratch in shared memory (else in `scratch`)
-  bool fusedVertexPlanes = false;    // visibility uploaded per vertex in pixel form (else as lists)
+  std::size_t visibilityWords = 0;   // W: words per vertex
+  // The point lights' shadow rays (render/point_lights.h), on the host: every
+  // prepared object as an instance, posed per frame (setTransform), as the
+  // CPU backend's ray scene.
+  std::unique_ptr<RayScene> rays;
 
   // ---- Pipelines ---------------------------------------------------------------
   std::unique_ptr<ComputePipeline> rotate, rotationInput, tripleProduct, resolve, exposure, tonemap, fusedPass,
@@ -118,6 +123,11 @@ struct VulkanRenderer::Impl {
   GBufferTarget target;     // the pixel centres
   GBufferTarget subTarget;  // antialiasing: the sub-samples, at twice the resolution
   Buffer gbufIds, gbufNormals, gbufPositions, samples, shade, counter, radiance, rgba8, rotated;
+  // `fused`: per covered sample its point-light shadow bits (bit k: sees
+  // light k), computed on the host between the frame's two submissions.
+  Buffer masks;
+  BufferUpload maskUpload;
+  std::vector<std::uint32_t> maskData;  // this frame's masks, before upload
   // Antialiasing: the sub-samples' ids and normals (else 4-byte stand-ins),
   // and each pixel's edge word (shared_layout.h kEdgeFlag).
   Buffer subIds, subNormals, edges;
@@ -186,6 +196,10 @@ struct VulkanRenderer::Impl {
 
   // fused_frame.cpp
   render::Frame renderFused(const render::FrameRequest& request);
+  // The "shadow-rays" stage: the covered samples read back, each one's
+  // point-light mask (render::pointLightMask against `rays`, posed for this
+  // frame) written for the upload. Returns the covered count.
+  std::uint32_t computeShadowMasks(const render::ResolvedFrame& resolved);
 
   // rotating_frame.cpp
   render::Frame renderRotating(const render::FrameRequest& request);

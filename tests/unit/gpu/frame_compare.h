@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include "haarcast/render/renderer.h"
 
@@ -46,6 +47,13 @@ inline render::FrameRequest requestFor(const render::Scene& scene, int width, in
   r.exposure.automatic = false;
   r.exposure.stops = -0.5;
   return r;
+}
+
+// Every object's pose in the scene (the default scene's ground included).
+inline std::vector<render::Pose> scenePoses(const render::Scene& scene) {
+  std::vector<render::Pose> poses;
+  for (const render::SceneObject& o : scene.objects) poses.push_back(o.pose);
+  return poses;
 }
 
 struct Comparison {

@@ -1,13 +1,16 @@
-// fused.comp driven alone against core fusedShade on random inputs: random
-// slice tables (some zero below the equator, which engages the skip), two
-// objects with their own light, random rotations (one at the gimbal pole),
-// random θₒ (blended and nearest slices) and random vertex visibility with
-// barycentric weights. Scratch in shared and in global memory; fewer
-// workgroups than pixels, so each group loops over several pixels.
+// fused.comp driven alone against core fusedShade (its visibility-bits and
+// point-light overload) on random inputs: random slice tables (one zero
+// below the equator, which engages the skip), two objects with their own
+// light and a ground, random rotations (one at the gimbal pole), random θₒ
+// (blended and nearest slices), random visibility bits per vertex with
+// barycentric weights, random point lights and random per-sample masks
+// (bits past the light count set too: both sides must ignore them). The
+// ground's samples against its closed form, groundRadiance + Σ_k bit_k·power_k.
+// Fewer workgroups than samples, so each group loops over several samples,
+// ground and not.
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <bit>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -18,6 +21,7 @@
 #include "gpu_test_util.h"
 #include "haarcast/core/brdf_slices.h"
 #include "haarcast/core/fused.h"
+#include "haarcast/core/visibility_bits.h"
 #include "haarcast/gpu/compute.h"
 #include "haarcast/gpu/passes.h"
 #include "../core/test_maps.h"
@@ -25,7 +29,7 @@
 namespace haarcast::gpu {
 namespace {
 
-using haarcast::testing::randomSparse;
+using haarcast::testing::randomMap;
 
 BrdfSliceTable randomTable(int level, int thetaSamples, bool upperOnly, std::mt19937& rng) {
   std::uniform_real_distribution<double> dist(0.05, 1.0);
@@ -48,9 +52,7 @@ BrdfSliceTable randomTable(int level, int thetaSamples, bool upperOnly, std::mt1
 
 struct PassCase {
   int level;
-  bool sharedScratch;
   bool interpolate;
-  bool vertexPlanes;  // visibility per vertex in pixel form (else the lists, merged per pixel)
 };
 
 class FusedPass : public ::testing::TestWithParam<PassCase> {};
@@ -60,71 +62,86 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
   const PassCase pc = GetParam();
   const int level = pc.level;
   constexpr int kThetaSamples = 4;
-  constexpr std::size_t kPixels = 13;
-  constexpr std::uint32_t kGroups = 5;  // fewer than the pixels: groups loop
+  constexpr std::size_t kPixels = 17;
+  constexpr std::size_t kObjects = 3;           // two shaded by the loop, the ground last
+  constexpr std::size_t kGround = 2;
+  constexpr std::size_t kLights = 5;            // of kMaxPointLights; mask bits 5–7 must be ignored
+  constexpr std::uint32_t kGroups = 5;          // fewer than the samples: groups loop
   std::mt19937 rng(static_cast<unsigned>(100 + level));
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  const std::size_t n = static_cast<std::size_t>(mapSize(level)) * static_cast<std::size_t>(mapSize(level));
 
-  // Two objects: their slices (pixel form) and light.
+  // The objects: their slices (pixel form), light and point lights.
   std::vector<PixelSlices> slices;
   std::vector<FusedLight> lights;
-  std::vector<ObjectInfo> objects(2);
+  std::vector<std::vector<FusedPointLight>> pointLights(kObjects);
+  std::vector<ObjectInfo> objects(kObjects);
   std::vector<float> texels;
   std::vector<glm::vec4> lightTexels;
-  for (std::size_t o = 0; o < 2; ++o) {
+  std::vector<PointLight> lightRecords(kObjects * shared::kMaxPointLights);
+  for (std::size_t o = 0; o < kObjects; ++o) {
     slices.push_back(PixelSlices::synthesize(randomTable(level, kThetaSamples, o == 1, rng)));
-    std::array<SparseHaar, 3> light;
-    for (auto& l : light) l = randomSparse(level, 64, -0.3, 0.3, rng);
-    lights.push_back(FusedLight::synthesize(light));
+    std::array<SphereMap, 3> weighted;
+    for (auto& map : weighted) map = randomMap(level, 0.0, 0.02, rng);
+    lights.push_back(FusedLight::fromWeightedMaps(weighted));
     objects[o].sliceBase = static_cast<std::uint32_t>(o * kThetaSamples);
     objects[o].thetaSamples = kThetaSamples;
+    objects[o].pointLights = static_cast<std::uint32_t>(kLights);
     setFusedSkip(objects[o], level, slices[o].lastNonZeroRow());
     texels.insert(texels.end(), slices[o].texels().begin(), slices[o].texels().end());
-    lightTexels.resize(lightTexels.size() + lights[o].planes.size() / 3);
-    fusedLightTexels(lights[o].planes, std::span<glm::vec4>(lightTexels).last(lights[o].planes.size() / 3));
+    lightTexels.resize(lightTexels.size() + n);
+    fusedLightTexels(lights[o].planes, std::span<glm::vec4>(lightTexels).last(n));
+    for (std::size_t k = 0; k < kLights; ++k) {
+      FusedPointLight l;
+      // Directions all over the sphere: some below the slices' cut (ρ = 0),
+      // most not; powers of the order of the map's whole light.
+      l.direction = glm::normalize(glm::vec3(2.0f * u(rng) - 1.0f, 2.0f * u(rng) - 1.0f, 2.0f * u(rng) - 1.0f));
+      for (float& p : l.power) p = 0.5f + 2.0f * u(rng);
+      pointLights[o].push_back(l);
+      PointLight& r = lightRecords[o * shared::kMaxPointLights + k];
+      r.direction = glm::vec4(l.direction, 0.0f);
+      r.power = glm::vec4(l.power[0], l.power[1], l.power[2], 0.0f);
+    }
   }
+  objects[kGround].flags = shared::kObjectGround;
+  objects[kGround].groundRadiance = glm::vec4(u(rng), u(rng), u(rng), 0.0f);
 
-  // Pixels: three vertex lists each, a rotation, θₒ.
-  std::vector<SparseHaar> visibility;
+  // Samples: three vertices each (their random bits), a rotation, θₒ, a mask.
+  VisibilityBits bits(level, 3 * kPixels);
+  {
+    std::vector<std::uint32_t> words(bits.pointCount() * bits.wordsPerPoint());
+    std::uniform_int_distribution<std::uint32_t> word;
+    const std::uint32_t spare = n < 32 ? (1u << n) - 1u : ~0u;  // no bit past the map's directions
+    for (std::size_t w = 0; w < words.size(); ++w) words[w] = word(rng) & spare;
+    bits.assign(words);
+  }
+  ASSERT_EQ(bits.wordsPerPoint(), shared::visibilityWords(static_cast<shared::uint>(level)));
   std::vector<RotationSample> samples(kPixels);
   std::vector<ShadeSample> shade(kPixels);
+  std::vector<std::uint32_t> masks(kPixels);
   const std::vector<EulerYXY> rotations = randomRotations(kPixels, 23);
-  std::uniform_real_distribution<float> u(0.0f, 1.0f);
   for (std::size_t i = 0; i < kPixels; ++i) {
-    for (int v = 0; v < 3; ++v) visibility.push_back(randomSparse(level, 16 + 20 * static_cast<std::size_t>(v), -0.5, 0.5, rng));
     RotationSample& s = samples[i];
     s.alpha = static_cast<float>(rotations[i].alpha);
-    s.beta = i == 0 ? 0.0f : static_cast<float>(rotations[i].beta);  // pixel 0 at the gimbal pole
+    s.beta = i == 0 ? 0.0f : static_cast<float>(rotations[i].beta);  // sample 0 at the gimbal pole
     s.gamma = static_cast<float>(rotations[i].gamma);
     s.thetaOut = u(rng) * static_cast<float>(kPi / 2.0);
     s.pixel = static_cast<std::uint32_t>(i);
     ShadeSample& sh = shade[i];
-    sh.object = static_cast<std::uint32_t>(i % 2);
+    sh.object = static_cast<std::uint32_t>(i % kObjects);
     for (std::uint32_t v = 0; v < 3; ++v) sh.vertex[v] = static_cast<std::uint32_t>(3 * i + v);
     const float a = u(rng), b = u(rng) * (1.0f - a);
     sh.b[0] = a;
     sh.b[1] = b;
     sh.b[2] = 1.0f - a - b;
     sh.pixel = static_cast<std::uint32_t>(kPixels - 1 - i);  // not the sample order
-  }
-  std::vector<std::uint32_t> visWords;
-  if (pc.vertexPlanes) {
-    for (const SparseHaar& v : visibility) {
-      const SphereMap pixels = inverseHaar(v.toDense());
-      for (float x : pixels.values()) visWords.push_back(std::bit_cast<std::uint32_t>(x));
-    }
-  } else {
-    visWords = packVisibilityEntries(visibility, level);
+    // Every light seen, none, and random masks (with bits past kLights).
+    masks[i] = i < 3 ? 0xFFu : i < 6 ? 0u : static_cast<std::uint32_t>(rng() & 0xFFu);
   }
   const std::vector<glm::vec4> dirs = pixelCentreDirections(level);
   const CoverageCounter counter{static_cast<std::uint32_t>(kPixels), {kGroups, 1, 1}};
 
   Context context(testing::testOptions());
-  const std::size_t floats = fusedScratchFloats(level, pc.vertexPlanes);
-  const std::uint32_t local = 64;
-  if (pc.sharedScratch &&
-      floats * sizeof(float) + local * 16 > context.properties().limits.maxComputeSharedMemorySize) {
-    GTEST_SKIP() << "the device's shared memory does not hold a level-" << level << " scratch";
-  }
   auto upload = [&](const void* data, std::size_t bytes) {
     Buffer b(context, bytes, kTexelUsage);
     b.write(data, bytes);
@@ -135,62 +152,79 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
   Buffer objectBuf = upload(objects.data(), objects.size() * sizeof(ObjectInfo));
   Buffer texelBuf = upload(texels.data(), texels.size() * sizeof(float));
   Buffer lightBuf = upload(lightTexels.data(), lightTexels.size() * sizeof(glm::vec4));
-  Buffer visBuf = upload(visWords.data(), visWords.size() * sizeof(std::uint32_t));
+  Buffer bitsBuf = upload(bits.words().data(), bits.storedBytes());
   Buffer dirBuf = upload(dirs.data(), dirs.size() * sizeof(glm::vec4));
-  Buffer scratch(context, pc.sharedScratch ? 4 : kGroups * floats * sizeof(float));
+  Buffer pointBuf = upload(lightRecords.data(), lightRecords.size() * sizeof(PointLight));
   Buffer radiance(context, kPixels * sizeof(glm::vec4));
   Buffer counterBuf = upload(&counter, sizeof counter);
+  Buffer maskBuf = upload(masks.data(), masks.size() * sizeof(std::uint32_t));
   const TexelView texelView(context, texelBuf, VK_FORMAT_R32G32B32A32_SFLOAT, sizeof(glm::vec4));
   const TexelView lightView(context, lightBuf, VK_FORMAT_R32G32B32A32_SFLOAT, sizeof(glm::vec4));
+  const TexelView bitsView(context, bitsBuf, VK_FORMAT_R32_UINT, sizeof(std::uint32_t));
   const TexelView dirView(context, dirBuf, VK_FORMAT_R32G32B32A32_SFLOAT, sizeof(glm::vec4));
-  const TexelView planeView(context, visBuf, VK_FORMAT_R32_SFLOAT, sizeof(float));  // read only with planes
   ComputePipeline p(context, "fused.comp", fusedBindings(), 0,
-                    {{0, static_cast<std::uint32_t>(level)},
-                     {2, local},
-                     {3, pc.sharedScratch && floats > 0 ? static_cast<std::uint32_t>(floats) : 1u},
-                     {4, pc.interpolate ? 1u : 0u},
-                     {5, pc.vertexPlanes ? 1u : 0u}});
-  p.bind({&sampleBuf, &shadeBuf, &objectBuf, &texelView, &lightView, &visBuf, &dirView, &scratch, &radiance, &counterBuf,
-          &planeView});
+                    {{0, static_cast<std::uint32_t>(level)}, {2, 64u}, {4, pc.interpolate ? 1u : 0u}});
+  p.bind({&sampleBuf, &shadeBuf, &objectBuf, &texelView, &lightView, &bitsView, &dirView, &pointBuf, &radiance,
+          &counterBuf, &maskBuf});
   context.submit([&](VkCommandBuffer cb) { p.dispatch(cb, {kGroups, 1, 1}); });
   std::vector<glm::vec4> got(kPixels);
   radiance.read(got.data(), got.size() * sizeof(glm::vec4));
 
-  double worst = 0.0, scale = 0.0;
+  double worst = 0.0, scale = 0.0, lightShare = 0.0;
   FusedScratch work;
   std::vector<std::array<float, 3>> expected(kPixels);
   for (std::size_t i = 0; i < kPixels; ++i) {
     const std::size_t o = shade[i].object;
+    if (o == kGround) {
+      // The closed form, in light order (CpuRenderer::shadeFused).
+      expected[i] = {objects[o].groundRadiance.x, objects[o].groundRadiance.y, objects[o].groundRadiance.z};
+      for (std::size_t k = 0; k < kLights; ++k)
+        if ((masks[i] >> k) & 1u)
+          for (std::size_t c = 0; c < 3; ++c) expected[i][c] += pointLights[o][k].power[c];
+      continue;
+    }
     const shared::SliceBlend blend = shared::sliceBlendAt(samples[i].thetaOut, kThetaSamples, pc.interpolate ? 1u : 0u);
-    const std::array<WeightedVisibility, 3> vis = {WeightedVisibility{&visibility[3 * i], shade[i].b[0]},
-                                                   WeightedVisibility{&visibility[3 * i + 1], shade[i].b[1]},
-                                                   WeightedVisibility{&visibility[3 * i + 2], shade[i].b[2]}};
+    const std::array<WeightedBits, 3> vis = {WeightedBits{bits.point(3 * i).data(), shade[i].b[0]},
+                                             WeightedBits{bits.point(3 * i + 1).data(), shade[i].b[1]},
+                                             WeightedBits{bits.point(3 * i + 2).data(), shade[i].b[2]}};
     const EulerYXY r{samples[i].alpha, samples[i].beta, samples[i].gamma};
-    expected[i] = fusedShade(slices[o], blend, r, lights[o], vis, work);
+    expected[i] = fusedShade(slices[o], blend, r, lights[o], vis, pointLights[o], masks[i], work);
+    // How much of the sample the point lights make (the test must see them).
+    const std::array<float, 3> mapOnly = fusedShade(slices[o], blend, r, lights[o], vis, pointLights[o], 0u, work);
+    for (std::size_t c = 0; c < 3; ++c) {
+      lightShare = std::max(lightShare, static_cast<double>(expected[i][c] - mapOnly[c]) / std::max(1e-30f, expected[i][c]));
+    }
     for (float x : expected[i]) scale = std::max(scale, std::abs(static_cast<double>(x)));
   }
+  EXPECT_GT(lightShare, 0.1) << "the point lights make too little of any sample for the test to see them";
+  std::size_t groundSamples = 0;
   for (std::size_t i = 0; i < kPixels; ++i) {
+    const glm::vec4& g = got[shade[i].pixel];
+    if (shade[i].object == kGround) {
+      ++groundSamples;
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_FLOAT_EQ(g[c], expected[i][static_cast<std::size_t>(c)]) << "ground sample " << i << " channel " << c;
+      }
+      continue;
+    }
     for (int c = 0; c < 3; ++c) {
-      const double err = std::abs(got[shade[i].pixel][c] - expected[i][static_cast<std::size_t>(c)]);
+      const double err = std::abs(g[c] - expected[i][static_cast<std::size_t>(c)]);
       worst = std::max(worst, err / scale);
     }
   }
-  std::printf("fused pass, level %d, %s scratch, %s, %s: max |gpu − cpu| / max|I| = %.3g\n", level,
-              pc.sharedScratch ? "shared" : "global", pc.interpolate ? "blended slices" : "nearest slice",
-              pc.vertexPlanes ? "vertex planes" : "vertex lists", worst);
+  EXPECT_GT(groundSamples, 3u);
+  std::printf("fused pass, level %d, %s: max |gpu − cpu| / max|I| = %.3g (point lights up to %.0f%% of a sample)\n",
+              level, pc.interpolate ? "blended slices" : "nearest slice", worst, 100.0 * lightShare);
   EXPECT_LT(worst, 1e-5);
   testing::expectNoValidationMessages(context);
 }
 
 INSTANTIATE_TEST_SUITE_P(Cases, FusedPass,
-                         ::testing::Values(PassCase{4, true, true, false}, PassCase{4, false, false, false},
-                                           PassCase{5, true, false, true}, PassCase{5, true, true, true},
-                                           PassCase{6, false, true, false}, PassCase{7, false, true, true}),
+                         ::testing::Values(PassCase{2, true}, PassCase{4, true}, PassCase{4, false}, PassCase{5, false},
+                                           PassCase{5, true}, PassCase{6, true}, PassCase{7, true}),
                          [](const auto& c) {
                            return "level" + std::to_string(c.param.level) +
-                                  (c.param.sharedScratch ? "_shared" : "_global") +
-                                  (c.param.interpolate ? "_blend" : "_nearest") +
-                                  (c.param.vertexPlanes ? "_planes" : "_lists");
+                                  (c.param.interpolate ? "_blend" : "_nearest");
                          });
 
 }  // namespace

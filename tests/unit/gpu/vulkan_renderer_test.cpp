@@ -11,6 +11,8 @@
 #include <memory>
 #include <string>
 
+#include <glm/geometric.hpp>
+
 #include "frame_compare.h"
 #include "gpu_test_util.h"
 #include "haarcast/gpu/vulkan_renderer.h"
@@ -25,6 +27,18 @@ using testing::Comparison;
 using testing::frameOptions;
 using testing::kFusedPsnrFloor;
 using testing::requestFor;
+using testing::scenePoses;
+
+// A target that turns the camera away from the objects and up from the
+// ground (63° above the horizon: the frame's lower edge, 22.5° below its
+// centre, stays above it).
+glm::dvec3 lookingAway(const render::Camera& camera) {
+  const glm::dvec3 back = camera.eye - camera.target;
+  return camera.eye + glm::normalize(glm::dvec3(back.x, 0.0, back.z)) + glm::dvec3(0.0, 2.0, 0.0);
+}
+
+// A fused frame's stages: the host's shadow rays between the two submissions.
+const std::vector<std::string> kFusedStages = {"light", "gbuffer", "rotation-input", "shadow-rays", "fused", "tonemap"};
 
 // The stages in pipeline order under the shared names, some coefficient
 // bytes read, and RGBA8 equal to the CPU encoding of the frame's own linear
@@ -96,7 +110,7 @@ TEST_P(FusedFrame, VulkanMatchesTheCpuBackend) {
   const auto cpu = render::makeCpuRenderer(scene, o);
   VulkanRenderer gpu(scene, o, testing::testOptions());
   render::FrameRequest request = requestFor(scene, o.width, o.height);
-  request.poses = {scene.objects[0].pose, scene.objects[1].pose};
+  request.poses = scenePoses(scene);
   request.poses[1].rotateDegrees += glm::dvec3(10.0, 25.0, -5.0);
   request.lightRotation = rotationMatrix({0.3, -0.4, 0.1});
   const render::Frame a = cpu->render(request);
@@ -109,7 +123,7 @@ TEST_P(FusedFrame, VulkanMatchesTheCpuBackend) {
   EXPECT_GT(c.objectPixels, 500u);
   // The GPU counts what it reads: with the vertices' pixel forms (levels
   // 4–6 here), three planes of N floats per pixel instead of the lists.
-  expectStagesAndRgba8(b, {"light", "gbuffer", "rotation-input", "fused", "tonemap"}, request.exposure.stops);
+  expectStagesAndRgba8(b, kFusedStages, request.exposure.stops);
   testing::expectNoValidationMessages(gpu.context());
 }
 
@@ -136,14 +150,14 @@ TEST(VulkanRenderer, AutoExposureMatchesTheCpuBackend) {
   request.exposure.adaptation = 0.25;
   const render::Frame c = gpu.render(request);
   EXPECT_NEAR(c.exposureStops, a.exposureStops + 1.5, 1e-3);
-  expectStagesAndRgba8(c, {"light", "gbuffer", "rotation-input", "fused", "tonemap"}, c.exposureStops);
+  expectStagesAndRgba8(c, kFusedStages, c.exposureStops);
   testing::expectNoValidationMessages(gpu.context());
 }
 
-// The fused dispatch's shape does not change a bit of the image: scratch
-// in shared or in global memory, as many workgroups as pixels or 3 that
-// loop over them all. A frame asked for RGBA8 only reads back no linear
-// image and encodes the same bytes; frames allocate no device memory.
+// The fused dispatch's shape does not change a bit of the image: as many
+// workgroups as samples or 3 that loop over them all, 64 invocations or
+// the default. A frame asked for RGBA8 only reads back no linear image and
+// encodes the same bytes; frames allocate no device memory.
 TEST(VulkanRenderer, FusedDispatchShapeAndReadback) {
   HAARCAST_REQUIRE_VULKAN();
   const render::Scene scene = render::defaultScene();
@@ -151,27 +165,24 @@ TEST(VulkanRenderer, FusedDispatchShapeAndReadback) {
   VulkanRenderer whole(scene, o, testing::testOptions());
   VulkanRendererLimits few;
   few.fusedGroups = 3;
-  few.fusedGlobalScratch = true;
-  few.fusedVisibilityLists = true;
   VulkanRenderer looped(scene, o, testing::testOptions(), {}, few);
   render::FrameRequest request = requestFor(scene, 40, 40);
   const render::Frame a = whole.render(request);
   const render::Frame b = looped.render(request);
   EXPECT_EQ(a.objectMask, b.objectMask);
-  // The two visibility paths differ by float rounding only (synthesis of the
-  // blend vs blend of the syntheses); the dispatch shape changes nothing.
-  ASSERT_EQ(a.image.rgb.size(), b.image.rgb.size());
+  EXPECT_EQ(a.image.rgb, b.image.rgb) << "every sample is computed alone, whichever workgroup takes it";
+  VulkanRendererLimits wide = few;
+  wide.fusedLocalSize = 64;
+  VulkanRenderer loopedWide(scene, o, testing::testOptions(), {}, wide);
+  const render::Frame w = loopedWide.render(request);
+  ASSERT_EQ(w.image.rgb.size(), a.image.rgb.size());
+  // Another workgroup size sums the directions in another order: float rounding only.
   double worst = 0.0, peak = 0.0;
   for (std::size_t i = 0; i < a.image.rgb.size(); ++i) {
-    worst = std::max(worst, std::abs(static_cast<double>(a.image.rgb[i]) - b.image.rgb[i]));
+    worst = std::max(worst, std::abs(static_cast<double>(a.image.rgb[i]) - w.image.rgb[i]));
     peak = std::max(peak, std::abs(static_cast<double>(a.image.rgb[i])));
   }
   EXPECT_LT(worst, 1e-5 * peak);
-  VulkanRendererLimits fewShared = few;
-  fewShared.fusedGlobalScratch = false;
-  VulkanRenderer loopedShared(scene, o, testing::testOptions(), {}, fewShared);
-  EXPECT_EQ(loopedShared.render(request).image.rgb, b.image.rgb)
-      << "every pixel is computed alone, whichever workgroup takes it and wherever its scratch is";
   const std::uint64_t allocations = whole.context().allocationCount();
   request.linearImage = false;
   const render::Frame c = whole.render(request);
@@ -180,11 +191,41 @@ TEST(VulkanRenderer, FusedDispatchShapeAndReadback) {
   EXPECT_EQ(c.objectMask, a.objectMask);
   EXPECT_EQ(whole.context().allocationCount(), allocations) << "a fused frame allocated device memory";
   // An empty frame (the camera looks away): the indirect dispatch has no groups.
-  request.camera.target = request.camera.eye + (request.camera.eye - scene.camera.target);
+  request.camera.target = lookingAway(scene.camera);
   const render::Frame d = whole.render(request);
   EXPECT_EQ(std::count(d.objectMask.begin(), d.objectMask.end(), 1), 0);
   testing::expectNoValidationMessages(whole.context());
   testing::expectNoValidationMessages(looped.context());
+}
+
+// A fused frame polls the request's cancel before each submission and
+// before the host's shadow rays: cancelled at any of those points it stops
+// with no images, and the next frame is whole.
+TEST(VulkanRenderer, FusedFrameCancelsBetweenItsSubmissions) {
+  HAARCAST_REQUIRE_VULKAN();
+  const render::Scene scene = render::defaultScene();
+  const render::RenderOptions o = frameOptions(RotationMethod::Fused, true);
+  VulkanRenderer gpu(scene, o, testing::testOptions());
+  render::FrameRequest request = requestFor(scene, 32, 32);
+  int polls = 0;
+  request.cancelled = [&] { return ++polls < 0; };
+  const render::Frame whole = gpu.render(request);
+  ASSERT_FALSE(whole.cancelled);
+  const int total = polls;
+  EXPECT_GE(total, 3) << "two submissions and the shadow rays";
+  for (int after = 0; after < total; ++after) {
+    polls = 0;
+    request.cancelled = [&, after] { return polls++ >= after; };
+    const render::Frame f = gpu.render(request);
+    EXPECT_TRUE(f.cancelled) << "cancelled after " << after << " polls";
+    EXPECT_TRUE(f.rgba8.empty());
+    EXPECT_EQ(polls, after + 1) << "nothing more polled once cancelled";
+  }
+  request.cancelled = {};
+  const render::Frame again = gpu.render(request);
+  EXPECT_FALSE(again.cancelled);
+  EXPECT_EQ(again.image.rgb, whole.image.rgb);
+  testing::expectNoValidationMessages(gpu.context());
 }
 
 // Scene data and the light in device-local memory reached only through
@@ -202,7 +243,7 @@ void expectStagedInputsChangeNothing(RotationMethod method) {
   const render::Frame first = staged.render(request);
   EXPECT_EQ(first.image.rgb, direct.render(request).image.rgb);
   const std::uint64_t allocations = staged.context().allocationCount();
-  request.poses = {scene.objects[0].pose, scene.objects[1].pose};
+  request.poses = scenePoses(scene);
   request.poses[1].rotateDegrees += glm::dvec3(10.0, 25.0, -5.0);
   request.lightRotation = rotationMatrix({0.3, -0.4, 0.1});
   const render::Frame a = direct.render(request);
@@ -234,7 +275,7 @@ TEST(VulkanRenderer, AllocatesDeviceMemoryOncePerResolution) {
   render::FrameRequest request = requestFor(scene, 32, 32);
   gpu.render(request);
   const std::uint64_t afterFirst = gpu.context().allocationCount();
-  request.poses = {scene.objects[0].pose, scene.objects[1].pose};
+  request.poses = scenePoses(scene);
   request.poses[0].rotateDegrees = {0.0, 40.0, 0.0};
   request.lightRotation = rotationMatrix({0.5, 0.2, 0.0});
   for (int i = 0; i < 3; ++i) gpu.render(request);
@@ -266,7 +307,7 @@ TEST(VulkanRenderer, BatchingTheRotationDoesNotChangeTheImage) {
   // Batches are sized on the device from the covered count (batch_args.comp):
   // a frame with no covered pixel dispatches no rotation at all.
   render::FrameRequest away = requestFor(scene, 40, 40);
-  away.camera.target = away.camera.eye + (away.camera.eye - scene.camera.target);
+  away.camera.target = lookingAway(scene.camera);
   const render::Frame empty = batched.render(away);
   EXPECT_EQ(std::count(empty.objectMask.begin(), empty.objectMask.end(), 1), 0);
   EXPECT_EQ(batched.batchesLastFrame(), 0u);

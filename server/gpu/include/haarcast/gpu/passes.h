@@ -29,6 +29,7 @@ using shared::ExposureResult;
 using shared::FrameParams;
 using shared::GBufferPush;
 using shared::ObjectInfo;
+using shared::PointLight;
 using shared::RotationSample;
 using shared::ShadeSample;
 
@@ -50,28 +51,16 @@ std::vector<glm::uvec4> packSparseLists(std::span<const SparseHaar> lists, int l
 // Entries (not headers) packSparseLists writes for one list.
 std::size_t blockCount(const SparseHaar& list);
 
-// `fused`'s visibility: per list a header (first word, entry count) and then
-// its (index, value bits) entries in list order, as uint pairs; entry
-// offsets count uvec2 pairs from the start of the buffer. Throws
-// std::invalid_argument when a list's level differs from `level`.
-std::vector<std::uint32_t> packVisibilityEntries(std::span<const SparseHaar> lists, int level);
-
 // fused.comp's directions: the unit vectors of a level's pixel centres, row
 // by row (w unused), computed in double as core fused's and rounded to float.
 std::vector<glm::vec4> pixelCentreDirections(int level);
 
-// Floats of fused.comp's scratch per workgroup: none with vertex planes;
-// with the lists, the per-pixel synthesis (the N merged coefficients, the
-// finest step's N values and the step before's N/4; shaders/fused.comp).
-inline std::size_t fusedScratchFloats(int level, bool vertexPlanes) {
-  const std::size_t n = std::size_t{1} << (2 * level);
-  return vertexPlanes ? 0 : 2 * n + n / 4;
-}
-
 // fused.comp's bindings: 0 samples, 1 shade, 2 objects (storage); 3 slice
 // texels (RGBA32F texels); 4 light (RGBA32F texels, fusedLightTexels); 5
-// visibility lists (storage); 6 directions (RGBA32F texels); 7 scratch, 8
-// radiance, 9 counter (storage); 10 vertex visibility planes (R32F texels).
+// visibility bits (R32UI texels: every vertex's shared::visibilityWords words,
+// global vertex order); 6 directions (RGBA32F texels); 7 point lights
+// (PointLight, kMaxPointLights per object), 8 radiance, 9 counter, 10 the
+// samples' point-light masks (a uint per sample) (storage).
 std::vector<BindingKind> fusedBindings();
 
 // The light of one object as fused.comp reads it: texel k = (L_r, L_g, L_b, 0)

@@ -7,8 +7,11 @@
 //                   then every batch's indirect arguments (batch_args.comp)
 //   rotation        compute: shaders/rotate_<method>.comp, in batches of covered pixels
 //   triple-product  compute: light × rotated slice × interpolated visibility
-//   fused           `fused` only, in place of the two above: shaders/fused.comp,
-//                   one indirect dispatch sized by rotation-input
+//   shadow-rays     `fused` only, host: the covered samples read back, one
+//                   Embree shadow ray per sample and point light
+//                   (render::pointLightMask), the masks uploaded
+//   fused           `fused` only, in place of rotation and triple-product:
+//                   shaders/fused.comp, one indirect dispatch sized by rotation-input
 //   tonemap         compute: backdrop and antialiased edge pixels (resolve.comp),
 //                   auto exposure measured and chosen (exposure.comp), RGBA8;
 //                   the linear image kept
@@ -17,9 +20,11 @@
 // resolution, whose pixel centres are the sub-samples; rotation-input
 // shades the covered sub-samples of edge pixels in place of their centres,
 // so every method shades them through the same sample list.
-// Every method records its frame as one command buffer (timestamps per stage
-// on GPUs; one submission per stage, host-timed, on CPU devices) and reads
-// the covered count back only when the frame is done.
+// The rotating methods record their frame as one command buffer (timestamps
+// per stage on GPUs; one submission per stage, host-timed, on CPU devices)
+// and read the covered count back only when the frame is done. `fused`
+// submits twice: [gbuffer, rotation-input], then, after the host's shadow
+// rays for the samples read back, [fused, tonemap].
 // Scene data (slices, method data, meshes, visibility, backdrop) is uploaded
 // once, into device-local memory (staged where the host cannot map it);
 // frame buffers are allocated once per resolution and reused, so a frame at
@@ -48,15 +53,11 @@ struct VulkanRendererLimits {
   std::size_t batchSamples = 0;
   // Workgroup size of rotate_spatial.comp; 0 = 64 on CPU devices, 256 on GPUs.
   std::uint32_t spatialLocalSize = 0;
-  // `fused`: workgroup size (0 = the subgroup size on CPU devices, 256 on GPUs), the most
-  // workgroups in flight (0 = as the scratch allows), the per-pixel merge
-  // and synthesis of the visibility lists even where every vertex's pixel
-  // form would fit in memory, and that synthesis's scratch in global memory
-  // even where shared memory would hold it (tests).
+  // `fused`: workgroup size (0 = the subgroup size on CPU devices, 256 on
+  // GPUs) and the most workgroups in flight (0 = 512 on CPU devices, 65,536 on
+  // GPUs, at most the device's limit).
   std::uint32_t fusedLocalSize = 0;
   std::uint32_t fusedGroups = 0;
-  bool fusedVisibilityLists = false;
-  bool fusedGlobalScratch = false;
 };
 
 class VulkanRenderer final : public render::Renderer {

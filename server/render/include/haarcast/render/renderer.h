@@ -10,6 +10,8 @@
 //   "rotation-input"  per pixel: BRDF slice index (θₒ) and Y-X-Y Euler angles
 //   "rotation"        the rotated slice's coefficients, per pixel and channel
 //   "triple-product"  light × rotated BRDF × interpolated vertex visibility
+//   "shadow-rays"     `fused` on Vulkan only: the host's point-light shadow rays for the
+//                     device's samples, between its two submissions (the CPU's are in "fused")
 //   "fused"           `fused` only: rotation and triple product in one pass
 //                     over the map directions (core/fused.h), in place of the two above
 //   "tonemap"         exposure, sRGB, RGBA8 (and the linear image kept for EXR)
