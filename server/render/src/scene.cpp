@@ -12,6 +12,7 @@
 #include "haarcast/assets/procedural_environment.h"
 #include "haarcast/assets/procedural_mesh.h"
 #include "haarcast/io/environment.h"
+#include "haarcast/io/input_file.h"
 #include "haarcast/io/merl.h"
 #include "haarcast/io/mesh_io.h"
 #include "haarcast/io/slice_cache.h"
@@ -187,6 +188,7 @@ Scene sceneFromJson(const nlohmann::json& j, const std::string& path);
 }  // namespace
 
 Scene loadScene(const std::string& path) {
+  io::requireRegularFile(path, "scene file");
   std::ifstream in(path);
   if (!in) throw std::runtime_error(path + ": cannot open scene file");
   nlohmann::json j;

@@ -1,6 +1,9 @@
 // Scene files that are not scenes: each is refused with a runtime_error that
 // names the file and what was wrong, never an exception of the JSON library
 // (which the server and the fuzz target would not expect).
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
@@ -41,6 +44,27 @@ TEST(SceneFile, AValueOfTheWrongTypeNamesTheFile) {
 TEST(SceneFile, BrokenJsonIsInvalidJson) {
   const std::string why = refusal("haarcast_scene_broken.json", R"({"camera": )");
   EXPECT_NE(why.find("not valid JSON"), std::string::npos) << why;
+}
+
+TEST(SceneFile, AFifoOrADirectoryIsRefusedBeforeItIsOpened) {
+  const auto dir = std::filesystem::temp_directory_path() / ("haarcast_scene_fifo_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const auto fifo = dir / "scene.json";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  // Opening a FIFO blocks until a writer comes: the check must come first.
+  try {
+    loadScene(fifo.string());
+    ADD_FAILURE() << "a FIFO loaded as a scene";
+  } catch (const std::exception& e) {
+    EXPECT_EQ(std::string(e.what()), fifo.string() + ": cannot read scene file: is a FIFO (named pipe), not a regular file");
+  }
+  try {
+    loadScene(dir.string());
+    ADD_FAILURE() << "a directory loaded as a scene";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("is a directory"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
