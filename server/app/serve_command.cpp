@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "haarcast/gpu/backend.h"
+#include "haarcast/net/host_check.h"
 #include "haarcast/net/server.h"
 #include "haarcast/render/renderer.h"
 #include "haarcast/render/scene.h"
@@ -139,6 +140,10 @@ int run(ServeArgs& a) {
                                     {"--max-pending-per-address", admission.pendingPerAddress}}) {
     if (value < 1) throw std::invalid_argument(std::string(flag) + " must be at least 1 (got " + std::to_string(value) + ")");
   }
+  if (admission.sessionReserve < -1) {
+    throw std::invalid_argument("--session-reserve must be -1 (automatic: min(8, --max-sessions / 4)) or at least 0 (got " +
+                                std::to_string(admission.sessionReserve) + ")");
+  }
   if (!(limits.maxFps > 0)) throw std::invalid_argument("--max-fps must be positive");
   limits.defaultFps = std::min(limits.defaultFps, limits.maxFps);
 
@@ -257,6 +262,14 @@ std::function<int()> addServeCommand(CLI::App& app) {
   c->add_option("--allow-origin", o.allowOrigins,
                  "A web origin (https://app.example.com) whose pages may open sessions, besides this server's own "
                  "(repeatable)");
+  c->add_option("--allow-host", o.allowHosts,
+                 "A host name clients reach this server by (the Host header), besides IP literals and localhost; "
+                 "others get 421 (DNS rebinding). Repeatable or comma-separated; '*' allows any")
+      ->delimiter(',')
+      ->check([](const std::string& value) -> std::string {
+        if (value == "*" || net::hostName(value)) return "";
+        return "--allow-host " + value + " is not a host name (a name like render.example.com, optionally :PORT)";
+      });
   c->add_option("--token", a->token, "Required token (?token=T or Authorization: Bearer T); default $HAARCAST_TOKEN");
   c->add_option("--backend", a->backend, "Default backend: cpu|vulkan")->capture_default_str();
   c->add_option("--backends", a->backends, "Backends clients may choose (default: only --backend)")->delimiter(',');
@@ -284,6 +297,10 @@ std::function<int()> addServeCommand(CLI::App& app) {
       ->capture_default_str();
   c->add_option("--max-pending-per-address", o.admission.pendingPerAddress,
                 "WebSocket connections waiting for their Hello, per client address")
+      ->capture_default_str();
+  c->add_option("--session-reserve", o.admission.sessionReserve,
+                "Session slots kept for client addresses that hold none, so that a few addresses cannot fill "
+                "--max-sessions (-1: min(8, --max-sessions / 4); 0 behind a proxy whose few addresses carry every client)")
       ->capture_default_str();
   c->add_option("--max-width", o.limits.maxWidth, "Largest frame width")->capture_default_str();
   c->add_option("--max-height", o.limits.maxHeight, "Largest frame height")->capture_default_str();

@@ -144,6 +144,13 @@ def check_target(target, objects, gauges, drain_s, idle_s):
         check(ref.get("optional") is not True, f"{w}: the token's Secret is optional: the pod would start without a token")
     check("--token" not in args, f"{w}: --token in args (visible in the pod spec and ps)")
 
+    # The Host rule: the Service's name and every Ingress host are allowed
+    # (else their requests get 421).
+    allowed = set(",".join(args[i + 1] for i, a in enumerate(args[:-1]) if a == "--allow-host").split(","))
+    wanted = {o["metadata"]["name"] for o in objects if o.get("kind") == "Service"}
+    wanted |= {r["host"] for o in objects if o.get("kind") == "Ingress" for r in o["spec"].get("rules", []) if "host" in r}
+    check(wanted <= allowed, f"{w}: --allow-host {sorted(allowed)} lacks {sorted(wanted - allowed)}")
+
     # Security: non-root, read-only root, nothing to escalate to.
     psc, csc = spec.get("securityContext", {}), c.get("securityContext", {})
     check(csc.get("runAsNonRoot", psc.get("runAsNonRoot")) is True, f"{w}: runAsNonRoot is not true")

@@ -1,6 +1,8 @@
 // The `.hccache` container (format in cache_file.h).
 #include "haarcast/io/cache_file.h"
 
+#include "haarcast/io/cache_rebuilds.h"
+
 #include <fcntl.h>
 #include <unistd.h>
 
@@ -266,6 +268,7 @@ std::optional<std::string> lookUpCacheEntry(const std::string& cacheDir, const C
     }
     std::optional<std::string> payload = readCacheFile(status.path, header, &status.reason);
     status.hit = payload.has_value();
+    if (const auto rebuild = classifyCacheMiss(status.reason)) noteCacheRebuild(*rebuild, status.path, status.reason);
     return payload;
   } catch (const std::exception& e) {  // a bad kind, or out of memory
     status.reason = e.what();

@@ -149,6 +149,7 @@ RgbImage readExr(const std::string& path) {
     // Our own first look, so that a missing, empty or foreign file gets a
     // plain message. The magic number is 20000630 little-endian
     // (OpenEXR "File Layout": 0x76, 0x2f, 0x31, 0x01).
+    if (auto why = whyNotRegularFile(path)) fail(path, "cannot open for reading: " + *why);
     std::ifstream in(path, std::ios::binary);
     if (!in) fail(path, "cannot open for reading");
     std::array<char, 4> magic{};

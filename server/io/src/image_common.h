@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "haarcast/io/image.h"
+#include "haarcast/io/input_file.h"
 
 namespace haarcast::io::detail {
 
@@ -59,6 +60,7 @@ inline void growPixels(std::vector<float>& pixels, std::size_t more, std::size_t
 }
 
 inline std::vector<std::uint8_t> readFileBytes(const std::string& path) {
+  if (auto why = whyNotRegularFile(path)) fail(path, "cannot open for reading: " + *why);
   std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in) fail(path, "cannot open for reading");
   const std::streamoff size = in.tellg();

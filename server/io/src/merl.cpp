@@ -18,6 +18,7 @@
 #include <glm/geometric.hpp>
 
 #include "haarcast/core/sphere_map.h"
+#include "haarcast/io/input_file.h"
 
 namespace haarcast::io {
 namespace {
@@ -231,6 +232,7 @@ std::unique_ptr<MerlBrdf> decodeMerl(const Read& read, const std::string& path, 
 }  // namespace
 
 std::unique_ptr<MerlBrdf> loadMerlBrdf(const std::string& path, const MerlLoadOptions& options) {
+  if (auto why = whyNotRegularFile(path)) fail(path, "cannot open MERL BRDF: " + *why);
   std::error_code ec;
   const std::uintmax_t size = std::filesystem::file_size(path, ec);
   if (ec) fail(path, "cannot open MERL BRDF: " + ec.message());

@@ -26,6 +26,7 @@
 #include <tiny_obj_loader.h>
 
 #include "mesh_finish.h"
+#include "haarcast/io/input_file.h"
 
 namespace haarcast::io {
 
@@ -40,10 +41,7 @@ using detail::finishMesh;
 [[noreturn]] void fail(const std::string& where, const std::string& what) { detail::meshFail(where, what); }
 
 std::string readWholeFile(const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) {
-    fail(path, ec ? "cannot open: " + ec.message() : "cannot open: not a regular file (or does not exist)");
-  }
+  if (auto why = whyNotRegularFile(path)) fail(path, "cannot open: " + *why);
   std::ifstream in(path, std::ios::binary);
   if (!in) fail(path, std::string("cannot open: ") + std::strerror(errno));
   in.seekg(0, std::ios::end);

@@ -2,6 +2,8 @@
 // is the table (layout in slice_cache.h).
 #include "haarcast/io/slice_cache.h"
 
+#include "haarcast/io/cache_rebuilds.h"
+
 #include <bit>
 #include <chrono>
 #include <cstring>
@@ -148,6 +150,7 @@ BrdfSliceTable loadOrBuildSliceTable(const Brdf& brdf, const SliceTableOptions& 
     } catch (const std::exception& e) {
       status.hit = false;
       status.reason = e.what();
+      noteCacheRebuild(CacheRebuildReason::Corrupt, status.path, status.reason);
     }
   }
 

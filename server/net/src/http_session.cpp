@@ -70,6 +70,14 @@ void HttpSession::onRead(beast::error_code ec) {
     return;
   }
   auto request = parser_->release();
+  // Framing the parser did not act on ("xchunked", "chunked, identity"):
+  // where this request's body ends is unknown, so nothing after it on this
+  // connection can be trusted either (request smuggling).
+  if (std::string bad = badTransferCoding(request); !bad.empty()) {
+    server_.metrics.addRefusal("transfer_encoding");
+    respond(request, http::status::bad_request, std::move(bad), "text/plain", false);
+    return;
+  }
   if (websocket::is_upgrade(request)) {
     upgrade(std::move(request));
     return;
@@ -79,7 +87,7 @@ void HttpSession::onRead(beast::error_code ec) {
 
 void HttpSession::upgrade(Request request) {
   if (auto refusal = checkUpgrade(request, server_.options, server_.tokenGuard, address_, Clock::now())) {
-    if (!refusal->logLine.empty()) server_.log("%s", refusal->logLine.c_str());
+    if (!refusal->metric.empty()) server_.logRefusal(address_, refusal->logLine);
     if (refusal->status == http::status::unauthorized) {
       server_.metrics.addError(errorLabel(v1::ERROR_CODE_UNAUTHORIZED));
     }
@@ -99,14 +107,15 @@ void HttpSession::upgrade(Request request) {
     return;
   }
   // The pre-Hello budget: connections that have not said Hello yet hold
-  // little, but a flood of them must not crowd out other addresses.
+  // little, but a flood of them must not crowd out other addresses (a full
+  // budget gives up the largest holder's oldest one: admission.h).
   Admission::Refusal refusal;
   auto pending = server_.admission.take(SlotKind::Pending, address_, &refusal);
   if (!pending) {
     Response res{refusal.perAddress ? http::status::too_many_requests : http::status::service_unavailable,
                  request.version()};
     res.set(http::field::retry_after, kRetryAfterSeconds);
-    refuse(request, std::move(res), refusal.reason + "\n", refusal.perAddress ? "pending_per_address" : "pending");
+    refuse(request, std::move(res), refusal.reason + "\n", refusal.label.c_str());
     return;
   }
   server_.metrics.addHttpResponse(101);
@@ -115,9 +124,9 @@ void HttpSession::upgrade(Request request) {
       ->accept(std::move(request));
 }
 
-void HttpSession::refuse(const Request& request, Response res, std::string body, const char* refusal) {
+void HttpSession::refuse(const Request& request, Response res, std::string body, const char* refusal, bool keepAlive) {
   server_.metrics.addRefusal(refusal);
-  respond(request, std::move(res), std::move(body), "text/plain", false);
+  respond(request, std::move(res), std::move(body), "text/plain", keepAlive);
 }
 
 void HttpSession::serve(const Request& request) {
@@ -141,6 +150,15 @@ void HttpSession::serve(const Request& request) {
     } else {
       respond(request, http::status::ok, "ready\n", "text/plain", keepAlive);
     }
+    return;
+  }
+  // Probes answer whatever the Host: they carry nothing a rebinding page
+  // could want, and a liveness probe must not fail over a name. Everything
+  // else is for the names the operator listed (host_check.h).
+  if (auto refusal = checkHost(request, server_.options, address_)) {
+    server_.logRefusal(address_, refusal->logLine);
+    refuse(request, Response{refusal->status, request.version()}, std::move(refusal->body), refusal->metric.c_str(),
+           keepAlive);
     return;
   }
   if (path == "/metrics") {

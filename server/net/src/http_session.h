@@ -1,6 +1,6 @@
 // One HTTP connection: GET requests for the client's files, /healthz,
 // /readyz, /metrics and /haarcast.proto, and the WebSocket upgrade at /ws
-// after its checks (path, Origin, token and its guess limit, draining, the
+// after its checks (path, Host, Origin, token and its guess limit, draining, the
 // pre-Hello budget). Every response is counted by status in /metrics.
 #pragma once
 
@@ -30,7 +30,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   void upgrade(Request request);
   void serve(const Request& request);
   // `refusal`: the /metrics reason of a refused upgrade.
-  void refuse(const Request& request, Response res, std::string body, const char* refusal);
+  void refuse(const Request& request, Response res, std::string body, const char* refusal, bool keepAlive = false);
   void respond(const Request& request, boost::beast::http::status status, std::string body, const std::string& type,
                bool keepAlive);
   void respond(const Request& request, Response res, std::string body, const std::string& type, bool keepAlive);

@@ -31,6 +31,10 @@ Admission::Limits checkedAdmission(Admission::Limits l) {
   for (const auto& [name, value] : all) {
     if (value < 1) throw std::invalid_argument(std::string("server limit ") + name + " must be at least 1 (got " + std::to_string(value) + ")");
   }
+  if (l.sessionReserve < -1) {
+    throw std::invalid_argument("server limit session reserve must be -1 (automatic) or at least 0 (got " +
+                                std::to_string(l.sessionReserve) + ")");
+  }
   return l;
 }
 
@@ -58,6 +62,7 @@ Server::Impl::Impl(ServerOptions o, Catalog c, AbandonableRendererBuilder builde
       acceptor(asio::make_strand(ioc)),
       acceptPause(acceptor.get_executor()),
       drainTimer(ioc),
+      refusalSummaryTimer(ioc),
       renderService(std::make_unique<RenderService>(std::move(builder), options.render, metrics)) {
   if (!options.webRoot.empty()) webRoot = WebRoot::load(options.webRoot);
   metrics.sessionCapacity.store(options.admission.sessions);
@@ -72,6 +77,19 @@ void Server::Impl::log(const char* format, ...) {
   std::vfprintf(stderr, format, args);
   std::fputc('\n', stderr);
   va_end(args);
+}
+
+void Server::Impl::logRefusal(const std::string& address, const std::string& line) {
+  if (refusalLog.note(address, Clock::now()) && !line.empty()) log("%s", line.c_str());
+}
+
+void Server::Impl::scheduleRefusalSummary() {
+  refusalSummaryTimer.expires_after(toDuration(RefusalLog::kPeriodSeconds));
+  refusalSummaryTimer.async_wait([this](beast::error_code ec) {
+    if (ec || stopping.load()) return;
+    if (const auto line = refusalLog.summary(Clock::now())) log("%s", line->c_str());
+    scheduleRefusalSummary();
+  });
 }
 
 void Server::Impl::listen() {
@@ -127,7 +145,7 @@ void Server::Impl::onAccept(beast::error_code ec, tcp::socket socket) {
   } else {
     // Closed unanswered: a flood from one address costs it a descriptor
     // for an instant, not a session's worth of buffers.
-    metrics.addRefusal("connections_per_address");
+    metrics.addRefusal(refusal.label);
     beast::error_code ignored;
     socket.close(ignored);
   }
@@ -140,8 +158,7 @@ std::size_t Server::Impl::sessionCount() {
 }
 
 bool Server::Impl::atCapacity() const {
-  return stopping.load() || admission.count(SlotKind::Session) >= admission.limits().sessions ||
-         renderService->atPixelBudget();
+  return stopping.load() || admission.fullForNewAddress() || renderService->atPixelBudget();
 }
 
 std::string Server::Impl::metricsText() {
@@ -185,6 +202,7 @@ void Server::Impl::watchDrain() {
     asio::post(acceptor.get_executor(), [this] {
       beast::error_code ec;
       acceptPause.cancel();
+      refusalSummaryTimer.cancel();
       acceptor.close(ec);
       ioc.stop();
     });
@@ -223,6 +241,7 @@ Server::Server(ServerOptions options, Catalog catalog, AbandonableRendererBuilde
   }
   impl_->listen();
   impl_->doAccept();
+  impl_->scheduleRefusalSummary();
 }
 
 Server::~Server() {

@@ -1,5 +1,7 @@
 #include "haarcast/net/metrics.h"
 
+#include "haarcast/io/cache_rebuilds.h"
+
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -121,6 +123,17 @@ std::string Metrics::prometheusText() const {
   out << "haarcast_http_requests_total " << httpRequests.load() << '\n';
   metric("haarcast_renderers_built_total", "counter", "Renderers prepared (scene, materials, level, method, backend).");
   out << "haarcast_renderers_built_total " << renderersBuilt.load() << '\n';
+  metric("haarcast_render_failures_total", "counter",
+         "Frames that failed to render; each is told to its client (the same message again at most once a second, "
+         "with a count).");
+  out << "haarcast_render_failures_total " << renderFailures.load() << '\n';
+  metric("haarcast_cache_rebuilds_total", "counter",
+         "Cache files (slice tables, visibility) that were there but unusable, so their result was computed again: "
+         "corrupt, stale (another version or options) or unreadable.");
+  for (const io::CacheRebuildReason reason : io::kCacheRebuildReasons) {
+    out << "haarcast_cache_rebuilds_total{reason=\"" << io::cacheRebuildReasonName(reason) << "\"} "
+        << io::cacheRebuilds(reason) << '\n';
+  }
   metric("haarcast_frames_cancelled_total", "counter",
          "Frame jobs ended without a frame: the session had gone, its request was replaced, or the server stopped.");
   out << "haarcast_frames_cancelled_total " << framesCancelled.load() << '\n';

@@ -341,6 +341,16 @@ PoseState initialPose(const render::Camera& camera, const std::vector<render::Po
   return s;
 }
 
+namespace {
+// Rotations a pose may carry, in degrees per axis: any angle is within one
+// turn of zero, and past this a double has no fraction of a degree left.
+constexpr double kMaxPoseDegrees = 1e6;
+
+bool withinDegrees(const v1::Vec3& v) {
+  return std::abs(v.x()) <= kMaxPoseDegrees && std::abs(v.y()) <= kMaxPoseDegrees && std::abs(v.z()) <= kMaxPoseDegrees;
+}
+}  // namespace
+
 std::optional<ProtocolError> applyPose(PoseState& state, const v1::PoseUpdate& update) {
   if (update.sequence() <= state.sequence) return std::nullopt;  // stale
   PoseState next = state;
@@ -374,14 +384,36 @@ std::optional<ProtocolError> applyPose(PoseState& state, const v1::PoseUpdate& u
       return error(v1::ERROR_CODE_BAD_MESSAGE, "pose " + std::to_string(update.sequence()) + ": object " +
                                                    std::to_string(o.object()) + " has a non-finite number", false);
     }
+    if (o.has_rotate_degrees() && !withinDegrees(o.rotate_degrees())) {
+      return error(v1::ERROR_CODE_BAD_MESSAGE, "pose " + std::to_string(update.sequence()) + ": object " +
+                                                   std::to_string(o.object()) + " rotation is outside ±" +
+                                                   std::to_string(static_cast<long long>(kMaxPoseDegrees)) + "°",
+                   false);
+    }
     if (o.has_rotate_degrees()) next.poses[o.object()].rotateDegrees = toGlm(o.rotate_degrees());
     if (o.has_translate()) next.poses[o.object()].translate = toGlm(o.translate());
   }
   if (update.has_light_rotate_degrees()) {
-    if (!finite(update.light_rotate_degrees())) {
-      return error(v1::ERROR_CODE_BAD_MESSAGE, "pose " + std::to_string(update.sequence()) + ": light rotation is not finite", false);
+    if (!finite(update.light_rotate_degrees()) || !withinDegrees(update.light_rotate_degrees())) {
+      return error(v1::ERROR_CODE_BAD_MESSAGE, "pose " + std::to_string(update.sequence()) +
+                                                   ": light rotation is not finite or outside ±" +
+                                                   std::to_string(static_cast<long long>(kMaxPoseDegrees)) + "°",
+                   false);
     }
     next.lightRotateDegrees = toGlm(update.light_rotate_degrees());
+  }
+  // The renderer's own check of what the pose would become, now: a pose it
+  // refuses must not be kept, or every later update (a camera-only one too)
+  // inherits the bad part and fails to render.
+  render::FrameRequest probe;
+  probe.width = probe.height = 1;
+  probe.camera = next.camera;
+  probe.poses = next.poses;
+  try {
+    render::checkFrameRequest(probe, next.poses.size());
+  } catch (const std::invalid_argument& e) {
+    return error(v1::ERROR_CODE_BAD_MESSAGE,
+                 "pose " + std::to_string(update.sequence()) + ": " + e.what() + " (the previous pose stays)", false);
   }
   next.sequence = update.sequence();
   next.clientTimeMs = std::isfinite(update.client_time_ms()) ? update.client_time_ms() : 0.0;

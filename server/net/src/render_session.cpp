@@ -309,12 +309,11 @@ void RenderSession::onRendered(const FrameContext& context, std::optional<Render
   current_.reset();
   if (closed_) return;
   if (!rendered) {
-    // Once per distinct message: a broken config must not flood the client.
-    if (error != lastRenderError_) sendError({v1::ERROR_CODE_RENDER_FAILED, error, false});
-    lastRenderError_ = error;
+    renderFailed(error, now);
     return;
   }
   lastRenderError_.clear();
+  renderErrorRepeats_ = 0;
   if (context.config.autoExposure) {
     std::lock_guard lock(mutex_);
     if (config_.autoExposure && config_.scene == context.config.scene) {
@@ -346,6 +345,34 @@ void RenderSession::onRendered(const FrameContext& context, std::optional<Render
   }
   frameUnsent_ = true;
   maybeRender(now);
+}
+
+// Every failed frame is counted and said: a new message at once; the same
+// one again at most once per kRepeatedErrorSeconds, with how many times it
+// recurred since (a broken config must neither flood the client nor go
+// silent). onTick says the last repeats when no frame comes to do it.
+void RenderSession::renderFailed(const std::string& error, Clock::time_point now) {
+  metrics_.renderFailures.fetch_add(1);
+  if (error != lastRenderError_) {
+    flushRenderErrorRepeats(now, true);
+    lastRenderError_ = error;
+    lastRenderErrorSent_ = now;
+    sendError({v1::ERROR_CODE_RENDER_FAILED, error, false});
+    return;
+  }
+  ++renderErrorRepeats_;
+  flushRenderErrorRepeats(now, false);
+}
+
+void RenderSession::flushRenderErrorRepeats(Clock::time_point now, bool force) {
+  if (renderErrorRepeats_ == 0) return;
+  if (!force && secondsBetween(lastRenderErrorSent_, now) < kRepeatedErrorSeconds) return;
+  sendError({v1::ERROR_CODE_RENDER_FAILED,
+             lastRenderError_ + " (" + std::to_string(renderErrorRepeats_) + " more time" +
+                 (renderErrorRepeats_ == 1 ? "" : "s") + " since it was last said)",
+             false});
+  renderErrorRepeats_ = 0;
+  lastRenderErrorSent_ = now;
 }
 
 void RenderSession::onSent(bool isFrame, std::size_t payloadBytes, Clock::time_point now) {
@@ -398,8 +425,9 @@ void RenderSession::onTick(Clock::time_point now) {
   } else if (secondsBetween(lastMessage_, now) > o.idleSeconds) {
     metrics_.addTimeout("idle");
     fail({v1::ERROR_CODE_TIMEOUT, format("no message for %g s (idle)", o.idleSeconds), true});
-  } else if (welcomed_ && secondsBetween(lastStats_, now) >= o.statsSeconds) {
-    sendStats(now);
+  } else {
+    flushRenderErrorRepeats(now, false);
+    if (welcomed_ && secondsBetween(lastStats_, now) >= o.statsSeconds) sendStats(now);
   }
 }
 

@@ -15,6 +15,7 @@
 #include <boost/asio.hpp>
 
 #include "haarcast/net/access.h"
+#include "haarcast/net/refusal_log.h"
 #include "haarcast/net/server.h"
 #include "haarcast/net/static_files.h"
 
@@ -29,6 +30,7 @@ struct Server::Impl {
   Metrics metrics;
   Admission admission;
   TokenGuard tokenGuard;
+  RefusalLog refusalLog;
   std::mutex logMutex;
   std::mutex sessionsMutex;
   std::map<const WsSession*, std::weak_ptr<WsSession>> sessions;  // every WebSocket, before and after Hello
@@ -45,6 +47,7 @@ struct Server::Impl {
   boost::asio::steady_timer acceptPause;
   AcceptBackoff acceptBackoff;
   boost::asio::steady_timer drainTimer;
+  boost::asio::steady_timer refusalSummaryTimer;
   Clock::time_point drainDeadline;
   std::uint16_t boundPort = 0;
   std::unique_ptr<RenderService> renderService;
@@ -52,6 +55,11 @@ struct Server::Impl {
   Impl(ServerOptions o, Catalog c, AbandonableRendererBuilder builder);
 
   void log(const char* format, ...) __attribute__((format(printf, 2, 3)));
+  // A refused request from `address`: `line` is written if it is the
+  // address's first this period (refusal_log.h); "" counts it only.
+  void logRefusal(const std::string& address, const std::string& line);
+  // Every RefusalLog::kPeriodSeconds: the summary line, when one is due.
+  void scheduleRefusalSummary();
   void listen();
   void doAccept();
   void onAccept(boost::system::error_code ec, boost::asio::ip::tcp::socket socket);

@@ -17,6 +17,37 @@ void limitRequestParser(http::request_parser<http::string_body>& parser) {
   parser.body_limit(kMaxHttpBodyBytes);
 }
 
+std::optional<UpgradeRefusal> checkHost(const HttpRequest& request, const ServerOptions& options,
+                                        const std::string& address) {
+  const std::string_view host = view(request[http::field::host]);
+  if (hostAllowed(host, options.allowHosts)) return std::nullopt;
+  UpgradeRefusal r;
+  r.status = http::status::misdirected_request;
+  r.body = misdirectedBody(host);
+  r.metric = "host";
+  r.logLine = "request from " + address + " refused: Host \"" + sanitizeForLog(host) + "\" is not --allow-host";
+  return r;
+}
+
+std::string badTransferCoding(const HttpRequest& request) {
+  // Every Transfer-Encoding field, joined as one list (RFC 9110 §5.3).
+  std::string codings;
+  bool present = false;
+  for (const auto& field : request.base()) {
+    if (field.name() != http::field::transfer_encoding) continue;
+    present = true;
+    if (!codings.empty()) codings += ", ";
+    codings += std::string(view(field.value()));
+  }
+  if (!present) return "";
+  std::string_view s = codings;
+  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
+  while (!s.empty() && (s.back() == ' ' || s.back() == '\t')) s.remove_suffix(1);
+  if (boost::beast::iequals(boost::beast::string_view(s.data(), s.size()), "chunked")) return "";
+  return "bad request: Transfer-Encoding \"" + sanitizeForLog(codings) +
+         "\" is not supported (only \"chunked\" alone)\n";
+}
+
 std::optional<UpgradeRefusal> checkUpgrade(const HttpRequest& request, const ServerOptions& options,
                                            TokenGuard& guard, const std::string& address, Clock::time_point now) {
   const std::string_view target = view(request.target());
@@ -27,6 +58,8 @@ std::optional<UpgradeRefusal> checkUpgrade(const HttpRequest& request, const Ser
     r.body = "no WebSocket at " + sanitizeForLog(path, 256) + " (use /ws)\n";
     return r;
   }
+  // Before the Origin: a rebound name sends a matching Origin and Host.
+  if (auto r = checkHost(request, options, address)) return r;
   // A page on another site must not drive the server with the user's
   // network position (cross-site WebSocket hijacking).
   if (const auto origin = view(request[http::field::origin]);
@@ -40,17 +73,24 @@ std::optional<UpgradeRefusal> checkUpgrade(const HttpRequest& request, const Ser
     return r;
   }
   if (options.token.empty()) return std::nullopt;
-  if (guard.locked(address, now)) {
+  if (const auto lock = guard.check(address, now); lock != TokenGuard::Lock::None) {
+    const bool server = lock == TokenGuard::Lock::Server;
     UpgradeRefusal r;
     r.status = http::status::too_many_requests;
-    r.body = "too many wrong tokens from " + address + ": try again later\n";
-    r.metric = "token_rate";
+    r.body = server ? "too many wrong tokens on this server from many addresses: try again later\n"
+                    : "too many wrong tokens from " + address + ": try again later\n";
+    r.metric = server ? "token_rate_server" : "token_rate";
+    r.logLine = "upgrade from " + address + " refused: " +
+                (server ? "the server-wide wrong-token limit is in force" : "the address's wrong-token limit is in force");
     r.retryAfter = std::to_string(static_cast<int>(options.tokenGuard.lockoutSeconds));
     return r;
   }
   std::string given = queryParameter(target, "token");
   if (given.empty()) given = bearerToken(view(request[http::field::authorization]));
-  if (tokensEqual(given, options.token)) return std::nullopt;
+  if (tokensEqual(given, options.token)) {
+    guard.succeeded(address, now);  // a known client: it passes a server-wide lock
+    return std::nullopt;
+  }
   if (!given.empty()) guard.failed(address, now);  // a guess; no token is not one
   UpgradeRefusal r;
   r.status = http::status::unauthorized;

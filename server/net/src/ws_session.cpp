@@ -60,7 +60,25 @@ void WsSession::accept(http::request<http::string_body> request) {
     server_.sessions.emplace(this, weak_from_this());
     registered_ = true;
   }
+  // A newcomer may take this connection's pre-Hello slot while the budget
+  // is full (admission.h): then it ends, on its own strand.
+  const bool held = pendingSlot_.onEvicted([weak = weak_from_this(), executor = executor_] {
+    asio::post(executor, [weak] {
+      if (auto self = weak.lock()) self->evicted();
+    });
+  });
   ws_.async_accept(request, [self = shared_from_this()](beast::error_code ec) { self->onAccept(ec); });
+  if (!held) evicted();
+}
+
+void WsSession::evicted() {
+  if (gone_ || sessionSlot_) return;  // said Hello in the meantime: a session now
+  if (pendingSlot_) {
+    pendingSlot_.release();  // no longer counted (the eviction uncounted it)
+    server_.metrics.pending.fetch_sub(1);
+  }
+  server_.metrics.addCut("pending_evicted");
+  hardClose("no Hello yet, and the pre-Hello budget is full: a connection from another address took its place");
 }
 
 void WsSession::shutdown() {
@@ -215,7 +233,7 @@ std::optional<ProtocolError> WsSession::admit() {
   Admission::Refusal refusal;
   auto slot = server_.admission.take(SlotKind::Session, address_, &refusal);
   if (!slot) {
-    server_.metrics.addRefusal(refusal.perAddress ? "sessions_per_address" : "sessions");
+    server_.metrics.addRefusal(refusal.label);
     return ProtocolError{v1::ERROR_CODE_TOO_MANY_SESSIONS, refusal.reason, true};
   }
   sessionSlot_ = std::move(*slot);

@@ -41,6 +41,8 @@ class WsSession : public std::enable_shared_from_this<WsSession>, private Sessio
   };
 
   void onAccept(boost::beast::error_code ec);
+  // A newcomer took this connection's pre-Hello slot: close it.
+  void evicted();
   void doRead();
   void onRead(boost::beast::error_code ec);
   void doWrite();

@@ -15,6 +15,7 @@
 #include "haarcast/assets/procedural_mesh.h"
 #include "haarcast/assets/suns_environment.h"
 #include "haarcast/io/environment.h"
+#include "haarcast/io/input_file.h"
 #include "haarcast/io/merl.h"
 #include "haarcast/io/mesh_io.h"
 #include "haarcast/io/slice_cache.h"
@@ -241,6 +242,7 @@ void checkObjectCount(std::size_t objects, const SceneLimits& limits) {
 }
 
 Scene loadScene(const std::string& path, const SceneLimits& limits) {
+  io::requireRegularFile(path, "scene file");
   std::ifstream in(path);
   if (!in) throw std::runtime_error(path + ": cannot open scene file");
   nlohmann::json j;

@@ -11,6 +11,8 @@
 #include <stdexcept>
 #include <system_error>
 
+#include "haarcast/io/cache_rebuilds.h"
+
 namespace haarcast {
 namespace {
 
@@ -171,6 +173,7 @@ std::vector<SparseHaar> loadOrComputeVertexVisibility(
     } catch (const std::exception& e) {
       status.hit = false;
       status.reason = e.what();
+      io::noteCacheRebuild(io::CacheRebuildReason::Corrupt, status.path, status.reason);
     }
   }
 
@@ -243,6 +246,7 @@ VisibilityBits loadOrComputeVisibilityBits(const Mesh& mesh, const VisibilityOpt
     } catch (const std::exception& e) {
       status.hit = false;
       status.reason = e.what();
+      io::noteCacheRebuild(io::CacheRebuildReason::Corrupt, status.path, status.reason);
     }
   }
   VisibilityBits bits = computeVisibilityBits(mesh, options, progress);

@@ -2,6 +2,7 @@
 // limits, slots per address, the accept back-off, text for logs and close
 // frames, and the served-files list.
 #include "haarcast/net/access.h"
+#include "haarcast/net/host_check.h"
 
 #include <cerrno>
 #include <fstream>
@@ -30,6 +31,31 @@ TEST(Access, OriginSameHostOrAllowListedOrAbsent) {
   EXPECT_TRUE(originAllowed("https://APP.example.com", "127.0.0.1:8080", allow));
   EXPECT_FALSE(originAllowed("https://app.example.com.evil", "127.0.0.1:8080", allow));
   EXPECT_FALSE(originAllowed("http://a", "", none));  // no Host: nothing to be the same as
+}
+
+TEST(Access, HostMustBeAnIpLiteralLocalhostOrAllowed) {
+  const std::vector<std::string> none;
+  const std::vector<std::string> allow = {"Render.Example.com", "svc:80"};
+  EXPECT_TRUE(hostAllowed("127.0.0.1:8080", none));
+  EXPECT_TRUE(hostAllowed("10.1.2.3", none));  // a Kubernetes probe by pod IP
+  EXPECT_TRUE(hostAllowed("[::1]:8080", none));
+  EXPECT_TRUE(hostAllowed("LOCALHOST:8080", none));
+  EXPECT_TRUE(hostAllowed("localhost.", none));
+  EXPECT_TRUE(hostAllowed("", none));  // HTTP/1.0: no name at all
+  EXPECT_FALSE(hostAllowed("evil.example:8080", none));
+  EXPECT_FALSE(hostAllowed("127.0.0.1.evil.example", none));
+  EXPECT_FALSE(hostAllowed("localhost.evil.example", none));
+  EXPECT_TRUE(hostAllowed("render.example.com:443", allow));
+  EXPECT_TRUE(hostAllowed("render.example.com.", allow));
+  EXPECT_TRUE(hostAllowed("svc", allow));  // the allowed entry's port does not matter
+  EXPECT_FALSE(hostAllowed("render.example.com.evil", allow));
+  EXPECT_TRUE(hostAllowed("anything.example", {"*"}));
+  // Not host[:port]: refused, whatever the allow-list.
+  for (const char* bad : {"::1", "[::1", "[::1]x", "a b", "host:", "host:123456", "host:80x", "[abc]"}) {
+    EXPECT_FALSE(hostAllowed(bad, {"*"})) << bad;
+  }
+  EXPECT_EQ(hostName("Render.Example.:8080"), "render.example");
+  EXPECT_EQ(hostName("[::1]:80"), "::1");
 }
 
 TEST(Access, BearerSchemeIsCaseInsensitive) {

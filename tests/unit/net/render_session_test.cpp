@@ -276,5 +276,81 @@ TEST(RenderSession, FatalErrorsCloseOnceWithAReasonCutOnUtf8) {
   EXPECT_NE(f.metrics.prometheusText().find("haarcast_session_cuts_total{reason=\"bad_message\"} 1"), std::string::npos);
 }
 
+// The errors in what was sent, in order.
+std::vector<v1::Error> errorsIn(const std::deque<v1::ServerMessage>& sent) {
+  std::vector<v1::Error> out;
+  for (const auto& m : sent) {
+    if (m.has_error()) out.push_back(m.error());
+  }
+  return out;
+}
+
+TEST(RenderSession, APoseThatFailsValidationIsNotKept) {
+  Fixture f;
+  f.welcome();
+  f.finishRender(f.t0 + 5ms);
+  // Finite, but past what the renderer takes: every later pose would fail.
+  v1::ClientMessage huge;
+  huge.mutable_pose()->set_sequence(1);
+  auto* o = huge.mutable_pose()->add_objects();
+  o->set_object(0);
+  o->mutable_rotate_degrees()->set_x(1e308);
+  o->mutable_rotate_degrees()->set_y(1e308);
+  f.receive(huge, f.t0 + 10ms);
+  v1::ClientMessage wide;  // a fov the protocol's old bound let through, the renderer's does not
+  wide.mutable_pose()->set_sequence(2);
+  wide.mutable_pose()->mutable_camera()->set_fov_y_degrees(175);
+  f.receive(wide, f.t0 + 20ms);
+  auto errors = errorsIn(f.port.sent);
+  ASSERT_EQ(errors.size(), 2u);
+  EXPECT_EQ(errors[0].code(), v1::ERROR_CODE_BAD_MESSAGE);
+  EXPECT_FALSE(errors[0].fatal());
+  EXPECT_NE(errors[0].message().find("rotation is outside"), std::string::npos) << errors[0].message();
+  EXPECT_NE(errors[1].message().find("fov"), std::string::npos) << errors[1].message();
+  EXPECT_NE(errors[1].message().find("the previous pose stays"), std::string::npos) << errors[1].message();
+  // A camera-only pose after them renders, with the object as it was.
+  v1::ClientMessage camera;
+  camera.mutable_pose()->set_sequence(3);
+  camera.mutable_pose()->mutable_camera()->set_fov_y_degrees(50);
+  f.receive(camera, f.t0 + 30ms);
+  f.session.onPace(f.t0 + 100ms);
+  ASSERT_EQ(f.port.orders.size(), 2u);
+  const auto request = f.session.takeRequest(*f.port.orders.back().context);
+  ASSERT_TRUE(request);
+  ASSERT_FALSE(request->poses.empty());
+  EXPECT_EQ(request->poses[0].rotateDegrees, glm::dvec3(0.0));
+  EXPECT_EQ(request->camera.fovYDegrees, 50.0);
+  EXPECT_NO_THROW(render::checkFrameRequest(*request, request->poses.size()));
+}
+
+TEST(RenderSession, RepeatedRenderErrorsAreResentWithACount) {
+  Fixture f;
+  f.welcome();
+  const auto fail = [&](Clock::time_point at) {
+    ASSERT_FALSE(f.port.orders.empty());
+    FrameOrder order = f.port.orders.back();
+    ASSERT_TRUE(f.session.takeRequest(*order.context));
+    f.session.onRendered(*order.context, std::nullopt, "device lost", at);
+  };
+  fail(f.t0 + 5ms);
+  ASSERT_EQ(errorsIn(f.port.sent).size(), 1u);
+  // The same failure twice more within the second: folded, not dropped.
+  for (int i = 1; i <= 2; ++i) {
+    f.receive(pose(static_cast<std::uint64_t>(i)), f.t0 + i * 100ms + 1ms);
+    f.session.onPace(f.t0 + i * 100ms + 5ms);
+    fail(f.t0 + i * 100ms + 10ms);
+  }
+  EXPECT_EQ(errorsIn(f.port.sent).size(), 1u);
+  // No frame comes to say it: the tick does, with the count.
+  f.session.onTick(f.t0 + 1100ms);
+  const auto errors = errorsIn(f.port.sent);
+  ASSERT_EQ(errors.size(), 2u);
+  EXPECT_EQ(errors[1].code(), v1::ERROR_CODE_RENDER_FAILED);
+  EXPECT_EQ(errors[1].message(), "device lost (2 more times since it was last said)");
+  f.session.onTick(f.t0 + 2200ms);
+  EXPECT_EQ(errorsIn(f.port.sent).size(), 2u) << "nothing new to say";
+  EXPECT_NE(f.metrics.prometheusText().find("haarcast_render_failures_total 3"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace haarcast::net

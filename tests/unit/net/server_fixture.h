@@ -302,7 +302,8 @@ class HealthySession {
   std::thread thread_;
 };
 
-inline std::string httpGet(std::uint16_t port, const std::string& target, http::status* status = nullptr) {
+inline std::string httpGet(std::uint16_t port, const std::string& target, http::status* status = nullptr,
+                           const std::string& host = "127.0.0.1") {
   // (Connect, GET, read: a short request on its own connection.)
   asio::io_context ioc;
   beast::tcp_stream stream(ioc);
@@ -311,7 +312,7 @@ inline std::string httpGet(std::uint16_t port, const std::string& target, http::
   stream.expires_after(std::chrono::seconds(10));
   stream.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), port));
   http::request<http::empty_body> req{http::verb::get, target, 11};
-  req.set(http::field::host, "127.0.0.1");
+  req.set(http::field::host, host);
   http::write(stream, req);
   beast::flat_buffer buffer;
   http::response<http::string_body> res;
@@ -321,10 +322,16 @@ inline std::string httpGet(std::uint16_t port, const std::string& target, http::
 }
 
 // The HTTP status of a WebSocket upgrade request (101 when accepted).
+// `from`: the local address to connect from (as Client's).
 inline http::status upgradeStatus(std::uint16_t port, const std::string& target, const std::string& authorization = "",
-                                  const std::string& origin = "", const std::string& host = "127.0.0.1") {
+                                  const std::string& origin = "", const std::string& host = "127.0.0.1",
+                                  const std::string& from = "") {
   asio::io_context ioc;
   beast::tcp_stream stream(ioc);
+  if (!from.empty()) {
+    stream.socket().open(tcp::v4());
+    stream.socket().bind(tcp::endpoint(asio::ip::make_address(from), 0));
+  }
   stream.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), port));
   http::request<http::empty_body> req{http::verb::get, target, 11};
   req.set(http::field::host, host);

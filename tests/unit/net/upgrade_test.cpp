@@ -20,6 +20,7 @@ HttpRequest request(const std::string& target, const std::string& origin = "", c
 
 ServerOptions withToken() {
   ServerOptions o;
+  o.allowHosts = {"render.example"};
   o.token = "secret";
   o.tokenGuard.maxFailures = 2;
   o.tokenGuard.lockoutSeconds = 30;
@@ -76,8 +77,46 @@ TEST(Upgrade, WrongTokensAreGuessesAndMissingOnesAreNot) {
   EXPECT_FALSE(checkUpgrade(request("/ws?token=secret"), o, guard, "b", now));
 }
 
+TEST(Upgrade, HostIsCheckedBeforeOrigin) {
+  ServerOptions o = withToken();
+  TokenGuard guard(o.tokenGuard);
+  const auto now = Clock::now();
+  // DNS rebinding: evil.example resolves to this server, and its page sends
+  // an Origin that matches its Host. The Host is what gives it away.
+  HttpRequest rebound = request("/ws?token=secret", "http://evil.example:8080");
+  rebound.set(http::field::host, "evil.example:8080");
+  auto r = checkUpgrade(rebound, o, guard, "a", now);
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, http::status::misdirected_request);
+  EXPECT_EQ(r->metric, "host");
+  EXPECT_EQ(r->body,
+            "misdirected request: Host \"evil.example\" is not a name of this server (allow it with --allow-host "
+            "evil.example)\n");
+  o.allowHosts.push_back("evil.example");
+  EXPECT_FALSE(checkUpgrade(rebound, o, guard, "a", now)) << "an allowed name goes on to the Origin and token";
+  // A request without a Host names nothing and is not refused for it.
+  HttpRequest bare{http::verb::get, "/ws?token=secret", 10};
+  EXPECT_FALSE(checkUpgrade(bare, withToken(), guard, "a", now));
+}
+
+TEST(Upgrade, OnlyChunkedAloneIsAcceptedAsTransferEncoding) {
+  HttpRequest r{http::verb::get, "/", 11};
+  EXPECT_EQ(badTransferCoding(r), "");
+  r.set(http::field::transfer_encoding, "Chunked");
+  EXPECT_EQ(badTransferCoding(r), "");
+  for (const char* bad : {"xchunked", "chunked, identity", "gzip, chunked", "identity", "chunked;x=1", ""}) {
+    r.set(http::field::transfer_encoding, bad);
+    EXPECT_NE(badTransferCoding(r), "") << bad;
+  }
+  // Two fields are one list: "chunked, chunked".
+  r.set(http::field::transfer_encoding, "chunked");
+  r.insert(http::field::transfer_encoding, "chunked");
+  EXPECT_NE(badTransferCoding(r), "");
+}
+
 TEST(Upgrade, NoTokenConfiguredLetsAnyTokenThrough) {
   ServerOptions o;
+  o.allowHosts = {"render.example"};
   TokenGuard guard(o.tokenGuard);
   EXPECT_FALSE(checkUpgrade(request("/ws?token=whatever"), o, guard, "a", Clock::now()));
 }

@@ -1,7 +1,13 @@
 // Scene files that are not scenes: each is refused with a runtime_error that
 // names the file and what was wrong, never an exception of the JSON library
 // (which the server and the fuzz target would not expect).
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <chrono>
 #include <filesystem>
+#include <future>
 #include <fstream>
 #include <stdexcept>
 #include <string>
@@ -104,6 +110,36 @@ TEST(SceneFile, GroundKeyIsCheckedAndAddsAGround) {
   ASSERT_EQ(s.objects.size(), 2u);
   EXPECT_TRUE(s.objects[1].ground);
   EXPECT_DOUBLE_EQ(s.objects[1].groundAlbedo.x, 0.3);
+}
+
+TEST(SceneFile, AFifoOrADirectoryIsRefusedBeforeItIsOpened) {
+  const auto dir = std::filesystem::temp_directory_path() / ("haarcast_scene_fifo_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const auto fifo = dir / "scene.json";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  // Opening a FIFO blocks until a writer comes: the check must come first.
+  // Should it not, a writer is opened after 5 s so that the test fails
+  // instead of hanging.
+  auto error = std::async(std::launch::async, [&] {
+    try {
+      loadScene(fifo.string());
+      return std::string("a FIFO loaded as a scene");
+    } catch (const std::exception& e) {
+      return std::string(e.what());
+    }
+  });
+  if (error.wait_for(std::chrono::seconds(5)) != std::future_status::ready) {
+    const int fd = ::open(fifo.c_str(), O_WRONLY | O_NONBLOCK);
+    if (fd >= 0) ::close(fd);
+  }
+  EXPECT_EQ(error.get(), fifo.string() + ": cannot read scene file: is a FIFO (named pipe), not a regular file");
+  try {
+    loadScene(dir.string());
+    ADD_FAILURE() << "a directory loaded as a scene";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("is a directory"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

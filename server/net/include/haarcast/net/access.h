@@ -1,8 +1,8 @@
 // Who may connect and how much they may hold: the Origin check at the
-// WebSocket upgrade, the token's Authorization scheme, a per-address limit
-// on token guesses, the connection / pre-Hello / session slots (server-wide
-// and per address), and the accept loop's back-off when file descriptors
-// run out. Plain classes over strings and clocks, tested without sockets.
+// WebSocket upgrade, the token's Authorization scheme (the guess limits are
+// in token_guard.h; the slots in admission.h), the client groups that
+// per-address limits count, and the accept loop's back-off when file
+// descriptors run out. Plain classes over strings and clocks, tested without sockets.
 #pragma once
 
 #include <algorithm>
@@ -16,9 +16,10 @@
 #include <string_view>
 #include <vector>
 
-namespace haarcast::net {
+#include "haarcast/net/admission.h"
+#include "haarcast/net/token_guard.h"
 
-using Clock = std::chrono::steady_clock;
+namespace haarcast::net {
 
 // Seconds → a Clock duration (negative: 0).
 inline std::chrono::nanoseconds toDuration(double seconds) {
@@ -50,89 +51,6 @@ bool isLoopbackAddress(std::string_view address);
 // IPv6 address as its /64 ("2001:db8:1:2::/64"), since one host may pick
 // any address in its /64. Anything unparsable is its own key.
 std::string clientGroup(std::string_view address);
-
-// Token guesses per address: after `maxFailures` wrong tokens within
-// `windowSeconds`, the address is refused (HTTP 429) for `lockoutSeconds`.
-class TokenGuard {
- public:
-  struct Options {
-    int maxFailures = 5;
-    double windowSeconds = 60.0;
-    double lockoutSeconds = 60.0;
-  };
-  explicit TokenGuard(Options options);
-
-  bool locked(const std::string& address, Clock::time_point now);
-  void failed(const std::string& address, Clock::time_point now);
-
- private:
-  struct Entry {
-    Clock::time_point windowStart;
-    int failures = 0;
-    Clock::time_point lockedUntil;
-  };
-  void prune(Clock::time_point now);  // keeps the table bounded under a spray of addresses
-  Options options_;
-  std::mutex mutex_;
-  std::map<std::string, Entry> entries_;
-};
-
-// Slots, counted server-wide and per peer address. A connection slot is held
-// from accept to close; a pending slot from the upgrade to the Hello (the
-// pre-Hello budget); a session slot from a valid Hello to close — only then
-// does a client count toward --max-sessions.
-enum class SlotKind { Connection, Pending, Session };
-std::string_view slotKindName(SlotKind kind);  // "connection", "pending", "session"
-
-class Admission {
- public:
-  struct Limits {
-    int connectionsPerAddress = 32;
-    int pending = 64;
-    int pendingPerAddress = 8;
-    int sessions = 64;
-    int sessionsPerAddress = 16;
-  };
-
-  // Releases its slot when destroyed. Move-only; an empty Slot holds none.
-  class Slot {
-   public:
-    Slot() = default;
-    Slot(Slot&& other) noexcept;
-    Slot& operator=(Slot&& other) noexcept;
-    ~Slot();
-    explicit operator bool() const { return owner_ != nullptr; }
-    void release();
-
-   private:
-    friend class Admission;
-    Slot(Admission* owner, SlotKind kind, std::string address);
-    Admission* owner_ = nullptr;
-    SlotKind kind_ = SlotKind::Connection;
-    std::string address_;
-  };
-
-  // Why a slot was refused: "" when taken.
-  struct Refusal {
-    bool perAddress = false;  // the address's own cap (429), else the server's (503)
-    std::string reason;       // names the limit and its value
-  };
-
-  explicit Admission(Limits limits);
-  // The slot, or why not. The Admission must outlive its slots.
-  std::optional<Slot> take(SlotKind kind, const std::string& address, Refusal* refusal = nullptr);
-
-  int count(SlotKind kind) const;                                   // server-wide
-  int count(SlotKind kind, const std::string& address) const;       // one address
-  const Limits& limits() const { return limits_; }
-
- private:
-  void give(SlotKind kind, const std::string& address);
-  Limits limits_;
-  mutable std::mutex mutex_;
-  int total_[3] = {0, 0, 0};
-  std::map<std::string, std::array<int, 3>> perAddress_;
-};
 
 // The accept loop's pause after an error: EMFILE, ENFILE, ENOBUFS and
 // ENOMEM mean a retry at once fails again (a busy loop that floods the log),

@@ -28,6 +28,7 @@ class Metrics {
   std::atomic<std::uint64_t> bytesTotal{0};        // frame payload bytes sent
   std::atomic<std::uint64_t> httpRequests{0};
   std::atomic<std::uint64_t> renderersBuilt{0};
+  std::atomic<std::uint64_t> renderFailures{0};    // frames that failed to render (each one, said or folded)
   std::atomic<std::uint64_t> framesCancelled{0};   // frame jobs ended without a frame (session gone, request replaced, stop)
   // Gauges of the render service, copied in just before each exposition
   // (Server: the service owns the numbers).

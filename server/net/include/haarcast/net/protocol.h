@@ -145,8 +145,10 @@ PoseState initialPose(const render::Camera& camera, const std::vector<render::Po
 
 // Applies an update. Returns nothing and leaves the state unchanged for an
 // update whose sequence is not newer (stale: the latest pose wins). An
-// object index out of range or a non-finite number is BAD_MESSAGE (not
-// fatal) and nothing of the update is applied.
+// object index out of range, a non-finite number, a rotation past ±1e6°, or
+// a result the renderer would refuse (render::checkFrameRequest: the fov,
+// the eye's distance, a pose whose numbers overflow) is BAD_MESSAGE (not
+// fatal) and nothing of the update is applied: the last valid pose stays.
 std::optional<ProtocolError> applyPose(PoseState& state, const v1::PoseUpdate& update);
 
 // The render request for a pose under a config (exposure: the config's mode;

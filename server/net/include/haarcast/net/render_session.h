@@ -103,6 +103,9 @@ class SessionPort {
 
 class RenderSession {
  public:
+  // The same render failure again is re-sent at most this often, with a count.
+  static constexpr double kRepeatedErrorSeconds = 1.0;
+
   RenderSession(const ServerOptions& options, const Catalog& catalog, Metrics& metrics, SessionPort& port,
                 std::string id, Clock::time_point opened);
 
@@ -147,6 +150,9 @@ class RenderSession {
   void prepareRenderer();
   void maybeRender(Clock::time_point now);
   void badMessage(ProtocolError e);
+  void renderFailed(const std::string& error, Clock::time_point now);
+  // The repeats of lastRenderError_ not yet said: when due, or now (force).
+  void flushRenderErrorRepeats(Clock::time_point now, bool force);
   void sendError(const ProtocolError& e);
   void sendStats(Clock::time_point now);
   void log(const std::string& line) { port_.log(id_ + ": " + line); }
@@ -170,7 +176,9 @@ class RenderSession {
   std::uint64_t frameSequence_ = 0, framesSent_ = 0, framesDropped_ = 0, bytesSent_ = 0;
   std::uint64_t periodFrames_ = 0, periodRendered_ = 0;
   double periodRenderSeconds_ = 0.0;
-  std::string lastRenderError_;
+  std::string lastRenderError_;            // the last frame's failure, "" after a frame
+  std::uint64_t renderErrorRepeats_ = 0;   // times it recurred since it was last sent
+  Clock::time_point lastRenderErrorSent_;
 
   // Shared with the render worker (takeRequest): under mutex_. config_ is
   // written on the strand under the lock and read there without it.

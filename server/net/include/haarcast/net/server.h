@@ -9,7 +9,8 @@
 //   /ws                   WebSocket: one protobuf message per binary message,
 //                         ClientMessage in, ServerMessage out (proto/haarcast.proto)
 //
-// At the upgrade: the Origin (access.h: same host or --allow-origin, else
+// Before any route but /healthz and /readyz: the Host (host_check.h: an IP
+// literal, localhost or --allow-host, else 421). At the upgrade: the Origin (access.h: same host or --allow-origin, else
 // 403), the token if set (`?token=T` or `Authorization: Bearer T`, else
 // 401; repeated wrong tokens from one address: 429 for a while) and the
 // pre-Hello budget. A session counts toward the session budget from its
@@ -50,6 +51,9 @@ struct ServerOptions {
   // Origins besides the serving host whose pages may open a WebSocket
   // ("https://app.example.com"); see originAllowed().
   std::vector<std::string> allowOrigins;
+  // Host names besides IP literals and "localhost" that requests may carry
+  // (--allow-host; host_check.h): the names clients reach the server by.
+  std::vector<std::string> allowHosts;
   std::filesystem::path webRoot;    // the browser client's files; empty: none served
   std::filesystem::path protoFile;  // served at /haarcast.proto; empty: 404
   Limits limits;

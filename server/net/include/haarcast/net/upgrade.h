@@ -14,6 +14,7 @@
 #include <boost/beast/websocket.hpp>
 
 #include "haarcast/net/access.h"
+#include "haarcast/net/host_check.h"
 #include "haarcast/net/server.h"
 
 namespace haarcast::net {
@@ -36,12 +37,25 @@ struct UpgradeRefusal {
   bool bearerChallenge = false;  // WWW-Authenticate: Bearer (a 401)
 };
 
-// The checks in order: the path (/ws), the Origin (originAllowed against the
+// The Host rule (hostAllowed against options.allowHosts) as a refusal: 421
+// Misdirected Request naming the host and --allow-host, or nullopt.
+std::optional<UpgradeRefusal> checkHost(const HttpRequest& request, const ServerOptions& options,
+                                        const std::string& address);
+
+// The framing rule of RFC 9112 §6.1: a request whose Transfer-Encoding is
+// anything but exactly "chunked" (the one coding this server decodes: not
+// "xchunked", not "chunked, identity", not "gzip, chunked") gets 400, since
+// where its body ends is not known. "" when the request is fine, else why.
+std::string badTransferCoding(const HttpRequest& request);
+
+// The checks in order: the path (/ws), the Host (checkHost), the Origin (originAllowed against the
 // Host and options.allowOrigins), then, when the server has a token, the
 // address's guess limit and the token (`?token=T` or `Authorization: Bearer
-// T`). A wrong token counts toward `guard`'s limit for `address`; a missing
-// one does not (it is not a guess). nullopt: the request may go on to the
-// draining and slot checks, which need the server's state.
+// T`). A wrong token counts toward `guard`'s limits (the address's and the
+// server's); a missing one does not (it is not a guess); the right one makes
+// `address` a known client, which a server-wide lock lets through.
+// nullopt: the request may go on to the draining and slot checks, which
+// need the server's state.
 std::optional<UpgradeRefusal> checkUpgrade(const HttpRequest& request, const ServerOptions& options,
                                            TokenGuard& guard, const std::string& address, Clock::time_point now);
 
