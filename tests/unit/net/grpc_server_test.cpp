@@ -224,7 +224,7 @@ TEST(GrpcServer, StopSendsShuttingDownAndReturnsPromptly) {
   client.send(hello());
   ASSERT_TRUE(client.frameFor(0));
   const auto start = Clock::now();
-  std::thread stopper([&] {
+  std::jthread stopper([&] {  // joined also when an assertion returns early
     server.server().stop();
     server.server().wait();
   });
