@@ -67,6 +67,10 @@ BUILD_PACKAGES=(
   libavcodec-dev
   libavutil-dev
   libswscale-dev
+  # The gRPC transport (serve --grpc-port): libgrpc++ (reflection included)
+  # and the protoc plugins for C++ and for the Python stubs of the docs' client.
+  libgrpc++-dev
+  protobuf-compiler-grpc
 )
 # runtime: the shared libraries `haarcast` and `haarcast-client` name as
 # NEEDED (readelf -d), the Vulkan loader and Mesa's Vulkan drivers (lavapipe:
@@ -86,6 +90,10 @@ RUNTIME_PACKAGES=(
   libavcodec59
   libavutil57
   libswscale6
+  # gRPC: libgrpc++ and its reflection library, libgrpc's libgpr, Abseil.
+  libgrpc++1.51
+  libgrpc29
+  libabsl20220623
   libvulkan1
   mesa-vulkan-drivers
   vulkan-tools
@@ -99,6 +107,9 @@ TEST_PACKAGES=(
   python3-matplotlib
   python3-yaml
   kubernetes-client
+  # The gRPC transport's Python client in docs/service.md, run by its test.
+  python3-grpcio
+  python3-protobuf
   # deploy/fuzz.sh: libFuzzer targets built with clang.
   clang
   libfuzzer-14-dev

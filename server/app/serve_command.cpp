@@ -33,6 +33,7 @@ struct ServeArgs {
   net::ServerOptions server;
   std::string token;
   int port = 8080;  // checked, then narrowed into server.port
+  int grpcPort = 0;  // 0: no gRPC listener
   std::string antialias = "auto";
   std::string backend = "cpu", method = "fused", encoding = "jpeg";
   std::vector<std::string> backends;  // enabled for clients; empty: just --backend
@@ -123,6 +124,10 @@ int run(ServeArgs& a) {
   else if (a.encoding == "h264") d.encoding = net::FrameEncoding::H264;
   else throw std::invalid_argument("--encoding must be jpeg, png, raw, exr or h264 (got \"" + a.encoding + "\")");
   a.server.port = static_cast<std::uint16_t>(a.port);
+  if (a.grpcPort != 0) {
+    if (a.grpcPort == a.port) throw std::invalid_argument("--grpc-port must differ from --port (both " + std::to_string(a.port) + ")");
+    a.server.grpcPort = static_cast<std::uint16_t>(a.grpcPort);
+  }
   auto& limits = a.server.limits;
   if (limits.maxLevel < render::kMinRenderLevel || limits.maxLevel > render::kMaxRenderLevel) {
     throw std::invalid_argument("--max-level " + std::to_string(limits.maxLevel) + " is outside " +
@@ -254,6 +259,11 @@ std::function<int()> addServeCommand(CLI::App& app) {
   auto* c = app.add_subcommand("serve", "Serve frames over WebSocket to CLI and browser clients (HTTP on the same port)");
   auto& o = a->server;
   c->add_option("--port", a->port, "TCP port 0..65535 (0 = any free one; the bound one is printed)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 65535));
+  c->add_option("--grpc-port", a->grpcPort,
+                 "TCP port of the gRPC listener (haarcast.v1.Render, grpc.health.v1.Health, reflection) on the "
+                 "--bind address; 0 = none")
       ->capture_default_str()
       ->check(CLI::Range(0, 65535));
   c->add_option("--bind", o.bindAddress,

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Renders deploy/k8s (base and the nvidia and cpu overlays) with `kubectl
 kustomize` and checks the objects against what the server really does: the
-probes hit the container's port at /readyz and /healthz, the token comes from
+probes hit the container's ports (gRPC health for readiness, /healthz for
+liveness, --port and --grpc-port as declared), the token comes from
 a Secret, the pod runs non-root on a read-only root filesystem with writable
 cache and /tmp volumes, the grace period covers the server's drain, the
 HPA's metric is a gauge the server exports (read from a running server's
@@ -126,10 +127,21 @@ def check_target(target, objects, gauges, drain_s, idle_s):
         p = probe.get("httpGet", {}).get("port")
         return ports.get(p) if isinstance(p, str) else p
 
-    for name, path in (("readinessProbe", "/readyz"), ("livenessProbe", "/healthz")):
-        probe = c.get(name, {})
-        check(probe.get("httpGet", {}).get("path") == path, f"{w}: {name} path {probe.get('httpGet', {}).get('path')}, expected {path}")
-        check(probe_port(probe) == port, f"{w}: {name} port {probe.get('httpGet', {}).get('port')} is not the container's {port}")
+    probe = c.get("livenessProbe", {})
+    check(probe.get("httpGet", {}).get("path") == "/healthz", f"{w}: livenessProbe path {probe.get('httpGet', {}).get('path')}, expected /healthz")
+    check(probe_port(probe) == port, f"{w}: livenessProbe port {probe.get('httpGet', {}).get('port')} is not the container's {port}")
+
+    # gRPC: the port the server is told, the one declared, the readiness
+    # probe's (the health service, which follows /readyz). Kubernetes takes
+    # only a number for a grpc probe's port.
+    grpc_port = ports.get("grpc")
+    check(grpc_port is not None, f"{w}: no container port named grpc")
+    check(arg_after(args, "--grpc-port") == str(grpc_port), f"{w}: --grpc-port {arg_after(args, '--grpc-port')} is not the containerPort {grpc_port}")
+    check(grpc_port != port, f"{w}: the gRPC port is the HTTP port {port}")
+    ready = c.get("readinessProbe", {})
+    check("grpc" in ready and "httpGet" not in ready, f"{w}: the readinessProbe is not a grpc probe ({sorted(ready)})")
+    check(ready.get("grpc", {}).get("port") == grpc_port, f"{w}: readinessProbe grpc port {ready.get('grpc', {}).get('port')} is not the container's {grpc_port}")
+    check(ready.get("grpc", {}).get("service", "") == "", f"{w}: the readinessProbe asks for service {ready.get('grpc', {}).get('service')}; the server's readiness is service \"\"")
     annotations = pod["metadata"].get("annotations", {})
     check(annotations.get("prometheus.io/port") == str(port), f"{w}: prometheus.io/port {annotations.get('prometheus.io/port')} is not {port}")
     check(annotations.get("prometheus.io/path") == "/metrics", f"{w}: prometheus.io/path is not /metrics")
@@ -180,7 +192,8 @@ def check_target(target, objects, gauges, drain_s, idle_s):
     if svc:
         check(svc["spec"]["selector"].items() <= labels.items(), f"{w}: the Service's selector misses the pods")
         svc_ports = svc["spec"]["ports"]
-        check(all(p["targetPort"] in ("http", port) for p in svc_ports), f"{w}: a Service targetPort is not the container port")
+        check(all(p["targetPort"] in ("http", port, "grpc", grpc_port) for p in svc_ports), f"{w}: a Service targetPort is not a container port")
+        check(any(p["targetPort"] in ("grpc", grpc_port) for p in svc_ports), f"{w}: the Service has no port for gRPC")
     if ing and svc:
         backend = ing["spec"]["rules"][0]["http"]["paths"][0]["backend"]["service"]
         check(backend["name"] == svc["metadata"]["name"], f"{w}: the Ingress routes to {backend['name']}, not the Service")

@@ -6,6 +6,7 @@
 
 #include <boost/beast/core.hpp>
 
+#include "grpc_server.h"
 #include "http_session.h"
 #include "server_impl.h"
 #include "ws_session.h"
@@ -66,6 +67,12 @@ Server::Impl::Impl(ServerOptions o, Catalog c, AbandonableRendererBuilder builde
       renderService(std::make_unique<RenderService>(std::move(builder), options.render, metrics)) {
   if (!options.webRoot.empty()) webRoot = WebRoot::load(options.webRoot);
   metrics.sessionCapacity.store(options.admission.sessions);
+}
+
+// The gRPC server shuts down (GrpcServer::join) before the io_context its
+// sessions post to is destroyed.
+Server::Impl::~Impl() {
+  if (grpc) grpc->join();
 }
 
 void Server::Impl::log(const char* format, ...) {
@@ -154,7 +161,7 @@ void Server::Impl::onAccept(beast::error_code ec, tcp::socket socket) {
 
 std::size_t Server::Impl::sessionCount() {
   std::lock_guard lock(sessionsMutex);
-  return sessions.size();
+  return sessions.size() + (grpc ? grpc->sessionCount() : 0);
 }
 
 bool Server::Impl::atCapacity() const {
@@ -183,6 +190,7 @@ void Server::Impl::stop() {
   // Outside the lock: a session's destructor takes it.
   for (auto& s : open) asio::post(s->executor(), [s] { s->shutdown(); });
   open.clear();
+  if (grpc) grpc->stopSessions();
   asio::post(ioc, [this] {
     if (signals) signals->cancel();
     drainDeadline = Clock::now() + toDuration(options.drainSeconds + kDrainMarginSeconds);
@@ -199,13 +207,23 @@ void Server::Impl::watchDrain() {
     const std::size_t left = sessionCount();
     for (std::size_t i = 0; i < left; ++i) metrics.addCut("drain_deadline");
     log("stopped (%zu sessions cut)", left);
-    asio::post(acceptor.get_executor(), [this] {
-      beast::error_code ec;
-      acceptPause.cancel();
-      refusalSummaryTimer.cancel();
-      acceptor.close(ec);
-      ioc.stop();
-    });
+    auto closeAndStop = [this] {
+      asio::post(acceptor.get_executor(), [this] {
+        beast::error_code ec;
+        acceptPause.cancel();
+        refusalSummaryTimer.cancel();
+        acceptor.close(ec);
+        ioc.stop();
+      });
+    };
+    // The gRPC server's shutdown blocks until its streams have finished,
+    // which they do on the I/O threads: it runs on a thread of its own and
+    // stops the io_context after.
+    if (grpc) {
+      grpc->shutdownThen(std::move(closeAndStop));
+    } else {
+      closeAndStop();
+    }
     return;
   }
   drainTimer.expires_after(kDrainPoll);
@@ -242,6 +260,7 @@ Server::Server(ServerOptions options, Catalog catalog, AbandonableRendererBuilde
   impl_->listen();
   impl_->doAccept();
   impl_->scheduleRefusalSummary();
+  if (impl_->options.grpcPort) impl_->grpc = std::make_unique<GrpcServer>(*impl_);
 }
 
 Server::~Server() {
@@ -251,6 +270,8 @@ Server::~Server() {
 }
 
 std::uint16_t Server::port() const { return impl_->boundPort; }
+
+std::uint16_t Server::grpcPort() const { return impl_->grpc ? impl_->grpc->port() : 0; }
 
 void Server::start() {
   for (int i = 0; i < std::max(1, impl_->options.ioThreads); ++i) {
@@ -274,6 +295,7 @@ void Server::wait() {
     if (t.joinable()) t.join();
   }
   impl_->threads.clear();
+  if (impl_->grpc) impl_->grpc->join();
 }
 
 bool Server::atCapacity() const { return impl_->atCapacity(); }

@@ -88,7 +88,7 @@ std::string Metrics::prometheusText() const {
     metric("process_resident_memory_bytes", "gauge", "Resident memory of the server process, in bytes.");
     out << "process_resident_memory_bytes " << rss << '\n';
   }
-  metric("haarcast_sessions", "gauge", "WebSocket sessions open now (counted from a valid Hello).");
+  metric("haarcast_sessions", "gauge", "Sessions open now, WebSocket and gRPC (counted from a valid Hello).");
   out << "haarcast_sessions " << sessions.load() << '\n';
   metric("haarcast_pending_connections", "gauge", "WebSocket connections waiting for their Hello.");
   out << "haarcast_pending_connections " << pending.load() << '\n';
@@ -110,7 +110,7 @@ std::string Metrics::prometheusText() const {
   out << "haarcast_queued_builds " << queuedBuilds.load() << '\n';
   metric("haarcast_draining", "gauge", "1 while the server drains for shutdown.");
   out << "haarcast_draining " << (draining.load() ? 1 : 0) << '\n';
-  metric("haarcast_sessions_total", "counter", "WebSocket sessions accepted since start.");
+  metric("haarcast_sessions_total", "counter", "Sessions accepted since start, WebSocket and gRPC.");
   out << "haarcast_sessions_total " << sessionsTotal.load() << '\n';
   metric("haarcast_frames_total", "counter", "Frames sent to clients.");
   out << "haarcast_frames_total " << framesTotal.load() << '\n';
@@ -119,6 +119,16 @@ std::string Metrics::prometheusText() const {
   out << "haarcast_frames_dropped_total " << framesDropped.load() << '\n';
   metric("haarcast_bytes_total", "counter", "Encoded frame bytes sent to clients.");
   out << "haarcast_bytes_total " << bytesTotal.load() << '\n';
+  // The gRPC share of the four above (transport="grpc"); the WebSocket
+  // share is the difference.
+  metric("haarcast_transport_sessions", "gauge", "Sessions open now, by transport.");
+  out << "haarcast_transport_sessions{transport=\"grpc\"} " << grpcSessions.load() << '\n';
+  metric("haarcast_transport_sessions_total", "counter", "Sessions accepted since start, by transport.");
+  out << "haarcast_transport_sessions_total{transport=\"grpc\"} " << grpcSessionsTotal.load() << '\n';
+  metric("haarcast_transport_frames_total", "counter", "Frames sent, by transport.");
+  out << "haarcast_transport_frames_total{transport=\"grpc\"} " << grpcFramesTotal.load() << '\n';
+  metric("haarcast_transport_bytes_total", "counter", "Encoded frame bytes sent, by transport.");
+  out << "haarcast_transport_bytes_total{transport=\"grpc\"} " << grpcBytesTotal.load() << '\n';
   metric("haarcast_http_requests_total", "counter", "Plain HTTP requests served.");
   out << "haarcast_http_requests_total " << httpRequests.load() << '\n';
   metric("haarcast_renderers_built_total", "counter", "Renderers prepared (scene, materials, level, method, backend).");

@@ -22,6 +22,7 @@
 namespace haarcast::net {
 
 class WsSession;
+class GrpcServer;  // grpc_server.h
 
 struct Server::Impl {
   ServerOptions options;
@@ -37,6 +38,10 @@ struct Server::Impl {
   std::atomic<bool> stopping{false};
   std::atomic<std::uint64_t> nextSessionId{1};
   std::vector<std::thread> threads;
+  // The gRPC listener (options.grpcPort): before the io_context, because
+  // its sessions' destructors (run when the io_context drops their
+  // handlers) take it out of its registry.
+  std::unique_ptr<GrpcServer> grpc;
 
   // Declared after everything sessions touch in their destructors, so that
   // the handlers the io_context destroys find them alive; the render service
@@ -53,6 +58,7 @@ struct Server::Impl {
   std::unique_ptr<RenderService> renderService;
 
   Impl(ServerOptions o, Catalog c, AbandonableRendererBuilder builder);
+  ~Impl();
 
   void log(const char* format, ...) __attribute__((format(printf, 2, 3)));
   // A refused request from `address`: `line` is written if it is the

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "haarcast/net/upgrade.h"
+#include "session_jobs.h"
 
 namespace haarcast::net {
 namespace {
@@ -175,59 +176,9 @@ void WsSession::armPace(Clock::time_point at) {
   });
 }
 
-void WsSession::prepare(const SessionConfig& config) {
-  // Per session the latest prepare wins (render_service.h): an earlier one
-  // is answered Superseded, and onPrepared ignores a key that is not the
-  // config's anyway.
-  server_.renderService->prepare(config, id_, [weak = weak_from_this(), key = config.rendererKey()](PrepareOutcome o) {
-    if (o.status == PrepareStatus::Superseded) return;
-    auto self = weak.lock();
-    if (!self) return;
-    // Refused: the server's build queue is full, which is the server's
-    // load, not the client's mistake.
-    const v1::ErrorCode code =
-        o.status == PrepareStatus::Refused ? v1::ERROR_CODE_OVERLOADED : v1::ERROR_CODE_RENDER_FAILED;
-    if (o.status != PrepareStatus::Ready) o.renderer.reset();
-    asio::post(self->executor_, [self, key, code, o = std::move(o)]() mutable {
-      if (!self->gone_) self->session_.onPrepared(key, std::move(o.renderer), o.error, Clock::now(), code);
-    });
-  });
-}
+void WsSession::prepare(const SessionConfig& config) { submitPrepare(server_, shared_from_this(), config); }
 
-void WsSession::render(FrameOrder order) {
-  RenderJob job;
-  job.renderer = std::move(order.renderer);
-  job.encoding = order.encoding;
-  job.jpegQuality = order.jpegQuality;
-  job.pixels = order.pixels;
-  job.encode = std::move(order.encode);
-  // Polled by a render worker at every tile or batch boundary: atomics and
-  // a weak pointer only, never the session's strand or the service's lock.
-  // The server's `stopping` outlives the service's threads (server_impl.h:
-  // the service is destroyed first).
-  job.cancelled = [weak = weak_from_this(), context = order.context, &stopping = server_.stopping] {
-    return context->cancelled.load() || stopping.load() || weak.expired();
-  };
-  job.take = [weak = weak_from_this(), context = order.context]() -> std::optional<render::FrameRequest> {
-    const auto self = weak.lock();
-    if (!self) return std::nullopt;
-    return self->session_.takeRequest(*context);
-  };
-  job.done = [weak = weak_from_this(), context = order.context](std::optional<RenderedFrame> frame, std::string error) {
-    if (auto self = weak.lock()) {
-      asio::post(self->executor_, [self, context, frame = std::move(frame), error = std::move(error)]() mutable {
-        self->session_.onRendered(*context, std::move(frame), error, Clock::now());
-      });
-    }
-  };
-  job.onCancelled = [weak = weak_from_this(), context = order.context, &metrics = server_.metrics] {
-    metrics.framesCancelled.fetch_add(1);  // also when the session has gone
-    if (auto self = weak.lock()) {
-      asio::post(self->executor_, [self, context] { self->session_.onCancelled(*context, Clock::now()); });
-    }
-  };
-  server_.renderService->submit(std::move(job));
-}
+void WsSession::render(FrameOrder order) { submitFrame(server_, shared_from_this(), std::move(order)); }
 
 std::optional<ProtocolError> WsSession::admit() {
   Admission::Refusal refusal;

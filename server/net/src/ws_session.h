@@ -32,6 +32,10 @@ class WsSession : public std::enable_shared_from_this<WsSession>, private Sessio
   // From Server::stop(), posted to the strand.
   void shutdown();
   const boost::asio::any_io_executor& executor() const { return executor_; }
+  // For session_jobs.h: on the strand (renderSession(), gone()) or anywhere (sessionId()).
+  RenderSession& renderSession() { return session_; }
+  bool gone() const { return gone_; }
+  const std::string& sessionId() const { return id_; }
 
  private:
   struct Outgoing {

@@ -18,7 +18,7 @@ namespace haarcast::net {
 
 class Metrics {
  public:
-  std::atomic<std::int64_t> sessions{0};           // gauge: sessions open now (after a valid Hello)
+  std::atomic<std::int64_t> sessions{0};           // gauge: sessions open now (after a valid Hello), both transports
   std::atomic<std::int64_t> pending{0};            // gauge: WebSocket connections waiting for their Hello
   std::atomic<std::int64_t> sessionCapacity{0};    // gauge: --max-sessions
   std::atomic<bool> draining{false};               // stop() called: /readyz answers 503
@@ -26,6 +26,12 @@ class Metrics {
   std::atomic<std::uint64_t> framesTotal{0};       // frames sent
   std::atomic<std::uint64_t> framesDropped{0};     // rendered, replaced before sending
   std::atomic<std::uint64_t> bytesTotal{0};        // frame payload bytes sent
+  // The gRPC transport's share of sessions, sessionsTotal, framesTotal and
+  // bytesTotal (which count both transports).
+  std::atomic<std::int64_t> grpcSessions{0};
+  std::atomic<std::uint64_t> grpcSessionsTotal{0};
+  std::atomic<std::uint64_t> grpcFramesTotal{0};
+  std::atomic<std::uint64_t> grpcBytesTotal{0};
   std::atomic<std::uint64_t> httpRequests{0};
   std::atomic<std::uint64_t> renderersBuilt{0};
   std::atomic<std::uint64_t> renderFailures{0};    // frames that failed to render (each one, said or folded)

@@ -9,6 +9,10 @@
 //   /ws                   WebSocket: one protobuf message per binary message,
 //                         ClientMessage in, ServerMessage out (proto/haarcast.proto)
 //
+// and, with ServerOptions::grpcPort, a gRPC port: the same session as the
+// bidirectional stream haarcast.v1.Render/Session, the standard health
+// service and server reflection (grpc_server.h).
+//
 // Before any route but /healthz and /readyz: the Host (host_check.h: an IP
 // literal, localhost or --allow-host, else 421). At the upgrade: the Origin (access.h: same host or --allow-origin, else
 // 403), the token if set (`?token=T` or `Authorization: Bearer T`, else
@@ -47,6 +51,9 @@ struct ServerOptions {
   // operator's choice (--bind 0.0.0.0), and should come with a token.
   std::string bindAddress = "127.0.0.1";
   std::uint16_t port = 8080;  // 0: any free port (see Server::port())
+  // The gRPC listener (the Render service, health and reflection) on the
+  // same address: unset = none; 0 = any free port (see Server::grpcPort()).
+  std::optional<std::uint16_t> grpcPort;
   std::string token;          // empty: no authentication
   // Origins besides the serving host whose pages may open a WebSocket
   // ("https://app.example.com"); see originAllowed().
@@ -92,6 +99,7 @@ class Server {
   Server& operator=(const Server&) = delete;
 
   std::uint16_t port() const;  // the bound port
+  std::uint16_t grpcPort() const;  // the bound gRPC port; 0 without one
 
   // Runs the I/O threads in the background / blocks until stopped and
   // drained (and the render threads have finished).

@@ -1,0 +1,191 @@
+#include "grpc_server.h"
+
+#include <algorithm>
+#include <atomic>
+#include <condition_variable>
+#include <limits>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <stdexcept>
+#include <thread>
+
+#include <boost/asio/post.hpp>
+#include <grpcpp/ext/proto_server_reflection_plugin.h>
+#include <grpcpp/grpcpp.h>
+#include <grpcpp/health_check_service_interface.h>
+
+#include "grpc_session.h"
+#include "haarcast/proto/haarcast.grpc.pb.h"
+
+namespace haarcast::net {
+namespace {
+
+// How often the health status is brought in line with atCapacity().
+constexpr auto kHealthPoll = std::chrono::milliseconds(200);
+// Past the drain, how long gRPC's Shutdown waits before it cancels the
+// streams still open (the drain has already given them drainSeconds).
+constexpr auto kShutdownGrace = std::chrono::milliseconds(500);
+// The service name the health service reports besides the server's ("").
+constexpr const char* kServiceName = "haarcast.v1.Render";
+
+// The Render service with its one method as raw bytes: the session parses
+// them itself (RenderSession::onMessage), as it does a WebSocket message.
+class RenderGrpcService final : public v1::Render::WithRawCallbackMethod_Session<v1::Render::Service> {
+ public:
+  RenderGrpcService(Server::Impl& server, GrpcServer& owner) : server_(server), owner_(owner) {}
+
+  grpc::ServerBidiReactor<grpc::ByteBuffer, grpc::ByteBuffer>* Session(grpc::CallbackServerContext* context) override {
+    return std::make_shared<GrpcSession>(server_, owner_, context)->start();
+  }
+
+ private:
+  Server::Impl& server_;
+  GrpcServer& owner_;
+};
+
+std::string listenAddress(const ServerOptions& o) {
+  const bool v6 = o.bindAddress.find(':') != std::string::npos;
+  return (v6 ? "[" + o.bindAddress + "]" : o.bindAddress) + ":" + std::to_string(*o.grpcPort);
+}
+
+}  // namespace
+
+struct GrpcServer::State {
+  State(Server::Impl& s, GrpcServer& owner) : server(s), service(s, owner) {}
+
+  Server::Impl& server;
+  RenderGrpcService service;  // outlives grpc (declared first)
+  std::unique_ptr<grpc::Server> grpc;
+  int port = 0;
+
+  mutable std::mutex mutex;
+  std::map<const GrpcSession*, std::weak_ptr<GrpcSession>> sessions;
+
+  std::mutex healthMutex;
+  std::condition_variable healthWake;
+  bool healthStop = false;
+  std::thread health;
+
+  std::atomic<bool> shutdownBegun{false}, shutdownDone{false};
+  std::thread stopper;
+
+  void setServing(bool serving) {
+    auto* h = grpc->GetHealthCheckService();
+    h->SetServingStatus(kServiceName, serving);
+    h->SetServingStatus("", serving);
+  }
+
+  // Until stopped: SERVING exactly when /readyz would answer 200.
+  void watchHealth() {
+    std::unique_lock lock(healthMutex);
+    std::optional<bool> last;
+    while (!healthStop) {
+      const bool serving = !server.atCapacity();
+      if (serving != last) setServing(serving);
+      last = serving;
+      healthWake.wait_for(lock, kHealthPoll, [this] { return healthStop; });
+    }
+  }
+
+  void stopHealth() {
+    {
+      std::lock_guard lock(healthMutex);
+      healthStop = true;
+    }
+    healthWake.notify_all();
+    if (health.joinable()) health.join();
+  }
+};
+
+GrpcServer::GrpcServer(Server::Impl& server) : state_(std::make_unique<State>(server, *this)) {
+  const ServerOptions& o = server.options;
+  // Both are process-wide switches read by the builder.
+  grpc::EnableDefaultHealthCheckService(true);
+  grpc::reflection::InitProtoReflectionServerBuilderPlugin();
+  const std::string where = listenAddress(o);
+  grpc::ServerBuilder builder;
+  builder.AddListeningPort(where, grpc::InsecureServerCredentials(), &state_->port);
+  builder.RegisterService(&state_->service);
+  // As the WebSocket's read limit (upgrade.h): messages up to 4× the
+  // protocol's limit reach the session, which answers MESSAGE_TOO_LARGE;
+  // larger ones gRPC refuses before buffering (RESOURCE_EXHAUSTED).
+  const std::size_t maxReceive = std::min<std::size_t>(4 * o.limits.maxMessageBytes, std::numeric_limits<int>::max());
+  builder.SetMaxReceiveMessageSize(static_cast<int>(maxReceive));
+  // Streams per HTTP/2 connection: what one address may hold anyway
+  // (pre-Hello and session slots); the slots are the real limit.
+  builder.AddChannelArgument(GRPC_ARG_MAX_CONCURRENT_STREAMS,
+                             o.admission.pendingPerAddress + o.admission.sessionsPerAddress);
+  // gRPC sets SO_REUSEPORT by default on Linux, which would let a second
+  // server share the port silently: a port in use must be an error.
+  builder.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
+  state_->grpc = builder.BuildAndStart();
+  if (!state_->grpc || state_->port == 0) {
+    throw std::runtime_error("cannot listen for gRPC on " + where + " (address in use, or not one of this machine's)");
+  }
+  state_->setServing(!server.atCapacity());
+  state_->health = std::thread([s = state_.get()] { s->watchHealth(); });
+  server.log("gRPC on %s (port %d): haarcast.v1.Render, grpc.health.v1.Health, reflection", where.c_str(),
+             state_->port);
+}
+
+GrpcServer::~GrpcServer() { join(); }
+
+std::uint16_t GrpcServer::port() const { return static_cast<std::uint16_t>(state_->port); }
+
+std::size_t GrpcServer::sessionCount() const {
+  std::lock_guard lock(state_->mutex);
+  return state_->sessions.size();
+}
+
+void GrpcServer::add(const GrpcSession* session, std::weak_ptr<GrpcSession> weak) {
+  std::lock_guard lock(state_->mutex);
+  state_->sessions.emplace(session, std::move(weak));
+}
+
+void GrpcServer::remove(const GrpcSession* session) {
+  std::lock_guard lock(state_->mutex);
+  state_->sessions.erase(session);
+}
+
+void GrpcServer::stopSessions() {
+  state_->setServing(false);  // at once; the health thread agrees (atCapacity() is true while stopping)
+  std::vector<std::shared_ptr<GrpcSession>> open;
+  {
+    std::lock_guard lock(state_->mutex);
+    for (auto& [ptr, weak] : state_->sessions) {
+      if (auto s = weak.lock()) open.push_back(std::move(s));
+    }
+  }
+  // Outside the lock: a session's destructor takes it.
+  for (auto& s : open) boost::asio::post(s->executor(), [s] { s->shutdown(); });
+}
+
+void GrpcServer::shutdownThen(std::function<void()> then) {
+  if (state_->shutdownBegun.exchange(true)) {
+    if (then) then();
+    return;
+  }
+  state_->stopHealth();
+  state_->stopper = std::thread([s = state_.get(), then = std::move(then)] {
+    s->grpc->Shutdown(std::chrono::system_clock::now() + kShutdownGrace);
+    s->shutdownDone.store(true);
+    if (then) then();
+  });
+}
+
+void GrpcServer::join() {
+  if (!state_->shutdownBegun.load()) {
+    shutdownThen(nullptr);
+    // No I/O thread runs (the Server was never started, or is being
+    // destroyed): the streams finish on their strands, so run them here.
+    auto& ioc = state_->server.ioc;
+    while (!state_->shutdownDone.load()) {
+      ioc.restart();
+      ioc.run_for(std::chrono::milliseconds(20));
+    }
+  }
+  if (state_->stopper.joinable()) state_->stopper.join();
+}
+
+}  // namespace haarcast::net

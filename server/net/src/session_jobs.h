@@ -1,0 +1,83 @@
+// How a transport (ws_session.cpp, grpc_session.cpp) hands its
+// RenderSession's renderer builds and frames to the render service, and
+// posts the answers back to its strand. The two transports differ in bytes
+// and timers, not in this, so it is written once.
+//
+// `Transport` has: executor() (its strand), renderSession(), gone() (read on
+// the strand), sessionId(), and derives from enable_shared_from_this. Jobs
+// hold it weakly: a session that has gone is not kept alive by its frames.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+
+#include <boost/asio/post.hpp>
+
+#include "haarcast/net/render_session.h"
+#include "server_impl.h"
+
+namespace haarcast::net {
+
+// Build or find the renderer for `config` → RenderSession::onPrepared on the strand.
+template <class Transport>
+void submitPrepare(Server::Impl& server, const std::shared_ptr<Transport>& transport, const SessionConfig& config) {
+  // Per session the latest prepare wins (render_service.h): an earlier one
+  // is answered Superseded, and onPrepared ignores a key that is not the
+  // config's anyway.
+  std::weak_ptr<Transport> weak = transport;
+  server.renderService->prepare(config, transport->sessionId(), [weak, key = config.rendererKey()](PrepareOutcome o) {
+    if (o.status == PrepareStatus::Superseded) return;
+    auto self = weak.lock();
+    if (!self) return;
+    // Refused: the server's build queue is full, which is the server's
+    // load, not the client's mistake.
+    const v1::ErrorCode code =
+        o.status == PrepareStatus::Refused ? v1::ERROR_CODE_OVERLOADED : v1::ERROR_CODE_RENDER_FAILED;
+    if (o.status != PrepareStatus::Ready) o.renderer.reset();
+    boost::asio::post(self->executor(), [self, key, code, o = std::move(o)]() mutable {
+      if (!self->gone()) self->renderSession().onPrepared(key, std::move(o.renderer), o.error, Clock::now(), code);
+    });
+  });
+}
+
+// Render `order` → RenderSession::onRendered (or onCancelled) on the strand.
+template <class Transport>
+void submitFrame(Server::Impl& server, const std::shared_ptr<Transport>& transport, FrameOrder order) {
+  std::weak_ptr<Transport> weak = transport;
+  RenderJob job;
+  job.renderer = std::move(order.renderer);
+  job.encoding = order.encoding;
+  job.jpegQuality = order.jpegQuality;
+  job.pixels = order.pixels;
+  job.encode = std::move(order.encode);
+  // Polled by a render worker at every tile or batch boundary: atomics and
+  // a weak pointer only, never the session's strand or the service's lock.
+  // The server's `stopping` outlives the service's threads (server_impl.h:
+  // the service is destroyed first).
+  job.cancelled = [weak, context = order.context, &stopping = server.stopping] {
+    return context->cancelled.load() || stopping.load() || weak.expired();
+  };
+  job.take = [weak, context = order.context]() -> std::optional<render::FrameRequest> {
+    const auto self = weak.lock();
+    if (!self) return std::nullopt;
+    return self->renderSession().takeRequest(*context);
+  };
+  job.done = [weak, context = order.context](std::optional<RenderedFrame> frame, std::string error) {
+    if (auto self = weak.lock()) {
+      boost::asio::post(self->executor(), [self, context, frame = std::move(frame), error = std::move(error)]() mutable {
+        self->renderSession().onRendered(*context, std::move(frame), error, Clock::now());
+      });
+    }
+  };
+  job.onCancelled = [weak, context = order.context, &metrics = server.metrics] {
+    metrics.framesCancelled.fetch_add(1);  // also when the session has gone
+    if (auto self = weak.lock()) {
+      boost::asio::post(self->executor(), [self, context] { self->renderSession().onCancelled(*context, Clock::now()); });
+    }
+  };
+  server.renderService->submit(std::move(job));
+}
+
+}  // namespace haarcast::net

@@ -1,0 +1,273 @@
+// The gRPC transport end to end: the server in process with a gRPC port on
+// loopback, driven by the generated stub (haarcast.v1.Render) and, for the
+// health service, by gRPC's generic stub with the two tiny messages
+// encoded by hand (Debian ships no health.proto).
+#include <future>
+#include <thread>
+
+#include <grpcpp/generic/generic_stub.h>
+#include <grpcpp/grpcpp.h>
+
+#include "haarcast/proto/haarcast.grpc.pb.h"
+#include "server_fixture.h"
+
+namespace haarcast::net::test {
+namespace {
+
+ServerOptions grpcOptions() {
+  ServerOptions o = testOptions();
+  o.grpcPort = 0;  // any free port
+  return o;
+}
+
+std::shared_ptr<grpc::Channel> channelTo(std::uint16_t port) {
+  // A connection of its own per client: gRPC would otherwise share one
+  // between channels with the same target, and the tests want clients
+  // that are independent on the wire.
+  grpc::ChannelArguments args;
+  args.SetInt(GRPC_ARG_USE_LOCAL_SUBCHANNEL_POOL, 1);
+  args.SetMaxReceiveMessageSize(64 << 20);
+  return grpc::CreateCustomChannel("127.0.0.1:" + std::to_string(port), grpc::InsecureChannelCredentials(), args);
+}
+
+class GrpcClient {
+ public:
+  explicit GrpcClient(std::uint16_t port, const std::string& authorization = std::string("Bearer ") + kToken)
+      : stub_(v1::Render::NewStub(channelTo(port))) {
+    if (!authorization.empty()) context_.AddMetadata("authorization", authorization);
+    context_.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(60));
+    stream_ = stub_->Session(&context_);
+  }
+
+  bool send(const v1::ClientMessage& m) { return stream_->Write(m); }
+  std::optional<v1::ServerMessage> read() {
+    v1::ServerMessage m;
+    if (!stream_->Read(&m)) return std::nullopt;
+    return m;
+  }
+  // The next message of this kind (Stats and others are skipped).
+  std::optional<v1::ServerMessage> expect(v1::ServerMessage::BodyCase body) {
+    while (auto m = read()) {
+      if (m->body_case() == body) return m;
+    }
+    return std::nullopt;
+  }
+  // The next frame answering pose `sequence` or a later one.
+  std::optional<v1::Frame> frameFor(std::uint64_t sequence) {
+    while (auto m = expect(v1::ServerMessage::kFrame)) {
+      if (m->frame().pose_sequence() >= sequence) return m->frame();
+    }
+    return std::nullopt;
+  }
+  // Half-closes, reads what is left, and returns the status.
+  grpc::Status finish() {
+    stream_->WritesDone();
+    while (read()) {
+    }
+    return stream_->Finish();
+  }
+  grpc::Status statusAfterReading() {
+    while (read()) {
+    }
+    return stream_->Finish();
+  }
+  grpc::ClientContext& context() { return context_; }
+
+ private:
+  std::unique_ptr<v1::Render::Stub> stub_;
+  grpc::ClientContext context_;
+  std::unique_ptr<grpc::ClientReaderWriter<v1::ClientMessage, v1::ServerMessage>> stream_;
+};
+
+// grpc.health.v1.Health/Check: HealthCheckRequest{string service = 1} in,
+// HealthCheckResponse{ServingStatus status = 1} out (SERVING = 1,
+// NOT_SERVING = 2). Returns the status, or -1 when the call failed.
+int healthStatus(std::uint16_t port, const std::string& service = "") {
+  grpc::GenericStub stub(channelTo(port));
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(10));
+  std::string request;
+  if (!service.empty()) {
+    request.push_back('\x0a');
+    request.push_back(static_cast<char>(service.size()));
+    request += service;
+  }
+  grpc::Slice slice(request);
+  grpc::ByteBuffer in(&slice, 1), out;
+  std::promise<grpc::Status> done;
+  stub.UnaryCall(&context, "/grpc.health.v1.Health/Check", grpc::StubOptions(), &in, &out,
+                 [&](grpc::Status s) { done.set_value(std::move(s)); });
+  if (!done.get_future().get().ok()) return -1;
+  std::vector<grpc::Slice> slices;
+  (void)out.Dump(&slices);
+  std::string bytes;
+  for (const auto& s : slices) bytes.append(reinterpret_cast<const char*>(s.begin()), s.size());
+  return bytes.size() >= 2 && bytes[0] == '\x08' ? bytes[1] : 0;  // absent: UNKNOWN (0)
+}
+
+bool eventually(const std::function<bool()>& condition, std::chrono::milliseconds timeout = 10s) {
+  const auto end = Clock::now() + timeout;
+  while (Clock::now() < end) {
+    if (condition()) return true;
+    std::this_thread::sleep_for(20ms);
+  }
+  return condition();
+}
+
+TEST(GrpcServer, HelloWelcomePoseFrameAndTheGrpcMetrics) {
+  TestServer server(grpcOptions());
+  ASSERT_NE(server.server().grpcPort(), 0);
+  ASSERT_NE(server.server().grpcPort(), server.port());
+  GrpcClient client(server.server().grpcPort());
+  ASSERT_TRUE(client.send(hello(32, 32, v1::ENCODING_PNG)));
+  const auto welcome = client.expect(v1::ServerMessage::kWelcome);
+  ASSERT_TRUE(welcome) << client.statusAfterReading().error_message();
+  EXPECT_EQ(welcome->welcome().width(), 32u);
+  EXPECT_EQ(welcome->welcome().encoding(), v1::ENCODING_PNG);
+  EXPECT_EQ(welcome->welcome().session_id().front(), 'g') << "gRPC sessions are named g1, g2 …";
+
+  const auto first = client.frameFor(0);
+  ASSERT_TRUE(first);
+  EXPECT_EQ(first->pose_sequence(), 0u);
+  ASSERT_TRUE(client.send(pose(1, 40)));
+  const auto turned = client.frameFor(1);
+  ASSERT_TRUE(turned);
+  EXPECT_EQ(turned->pose_sequence(), 1u);
+  EXPECT_EQ(turned->width(), 32u);
+  EXPECT_EQ(turned->client_time_ms(), 1001.0) << "echoed from the pose";
+  ASSERT_GT(turned->data().size(), 8u);
+  EXPECT_EQ(turned->data().substr(1, 3), "PNG");
+  EXPECT_NE(turned->data(), first->data()) << "the turned object is another picture";
+
+  const auto& m = server.server().metrics();
+  EXPECT_EQ(m.grpcSessions.load(), 1);
+  EXPECT_EQ(m.sessions.load(), 1) << "the server-wide gauge counts gRPC sessions too";
+  EXPECT_TRUE(client.finish().ok()) << "a client that half-closes gets OK";
+  EXPECT_GE(m.grpcFramesTotal.load(), 2u);
+  EXPECT_EQ(m.grpcFramesTotal.load(), m.framesTotal.load());
+  EXPECT_EQ(m.grpcSessionsTotal.load(), 1u);
+  EXPECT_TRUE(eventually([&] { return m.grpcSessions.load() == 0 && m.sessions.load() == 0; }));
+  const std::string text = httpGet(server.port(), "/metrics");
+  EXPECT_NE(text.find("haarcast_transport_frames_total{transport=\"grpc\"} " + std::to_string(m.grpcFramesTotal.load())),
+            std::string::npos);
+}
+
+TEST(GrpcServer, AWrongOrMissingTokenIsUnauthenticated) {
+  TestServer server(grpcOptions());
+  const auto port = server.server().grpcPort();
+  {
+    GrpcClient client(port, "Bearer not-the-token");
+    client.send(hello());
+    const auto status = client.statusAfterReading();
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::UNAUTHENTICATED);
+    EXPECT_EQ(status.error_message(), "wrong token");
+  }
+  {
+    GrpcClient client(port, "");
+    client.send(hello());
+    const auto status = client.statusAfterReading();
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::UNAUTHENTICATED);
+  }
+  {
+    // The right metadata but another token in Hello: the protocol's Error,
+    // then the status that says the same.
+    GrpcClient client(port);
+    auto h = hello();
+    h.mutable_hello()->set_auth_token("other");
+    client.send(h);
+    const auto error = client.expect(v1::ServerMessage::kError);
+    ASSERT_TRUE(error);
+    EXPECT_EQ(error->error().code(), v1::ERROR_CODE_UNAUTHORIZED);
+    EXPECT_TRUE(error->error().fatal());
+    EXPECT_EQ(client.statusAfterReading().error_code(), grpc::StatusCode::UNAUTHENTICATED);
+  }
+  EXPECT_EQ(server.server().metrics().sessionsTotal.load(), 0u);
+}
+
+TEST(GrpcServer, HealthIsServingUntilTheSessionBudgetIsFull) {
+  ServerOptions o = grpcOptions();
+  o.admission.sessions = 1;
+  TestServer server(o);
+  const auto port = server.server().grpcPort();
+  EXPECT_EQ(healthStatus(port), 1) << "SERVING";
+  EXPECT_EQ(healthStatus(port, "haarcast.v1.Render"), 1);
+  {
+    GrpcClient client(port);
+    client.send(hello());
+    ASSERT_TRUE(client.expect(v1::ServerMessage::kWelcome));
+    EXPECT_TRUE(eventually([&] { return healthStatus(port) == 2; })) << "NOT_SERVING at capacity, as /readyz";
+    EXPECT_EQ(healthStatus(port, "haarcast.v1.Render"), 2);
+    client.finish();
+  }
+  EXPECT_TRUE(eventually([&] { return healthStatus(port) == 1; })) << "SERVING again once the slot is free";
+}
+
+TEST(GrpcServer, SessionSlotsAreSharedWithWebSocketSessions) {
+  ServerOptions o = grpcOptions();
+  o.admission.sessionsPerAddress = 1;
+  TestServer server(o);
+  Client ws(server.port());
+  ASSERT_TRUE(ws.connected());
+  ws.handshake();
+  GrpcClient client(server.server().grpcPort());
+  client.send(hello());
+  const auto error = client.expect(v1::ServerMessage::kError);
+  ASSERT_TRUE(error);
+  EXPECT_EQ(error->error().code(), v1::ERROR_CODE_TOO_MANY_SESSIONS);
+  EXPECT_NE(error->error().message().find("each address may have 1"), std::string::npos) << error->error().message();
+  EXPECT_EQ(client.statusAfterReading().error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+}
+
+TEST(GrpcServer, StopSendsShuttingDownAndReturnsPromptly) {
+  TestServer server(grpcOptions());
+  GrpcClient client(server.server().grpcPort());
+  client.send(hello());
+  ASSERT_TRUE(client.frameFor(0));
+  const auto start = Clock::now();
+  std::jthread stopper([&] {  // joined also when an assertion returns early
+    server.server().stop();
+    server.server().wait();
+  });
+  const auto error = client.expect(v1::ServerMessage::kError);
+  ASSERT_TRUE(error);
+  EXPECT_EQ(error->error().code(), v1::ERROR_CODE_SHUTTING_DOWN);
+  const auto status = client.statusAfterReading();
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::UNAVAILABLE) << status.error_message();
+  stopper.join();
+  const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  EXPECT_LT(seconds, 1.5) << "the session closed at once, so the drain did not wait for its deadline";
+}
+
+TEST(GrpcServer, AClientThatStopsReadingIsCutAndAnotherGoesOn) {
+  TestServer server(grpcOptions());
+  const auto port = server.server().grpcPort();
+  GrpcClient stalled(port);
+  stalled.send(hello(256, 256, v1::ENCODING_RAW_RGBA8, 30));
+  ASSERT_TRUE(stalled.expect(v1::ServerMessage::kWelcome));
+  GrpcClient other(port);
+  other.send(hello(32, 32));
+  ASSERT_TRUE(other.frameFor(0));
+  // The stalled client sends poses and never reads: its 256 KiB frames fill
+  // the HTTP/2 windows, the server's write stops completing, and after
+  // writeStallSeconds (1.5 s here) the server cuts it.
+  const auto& m = server.server().metrics();
+  std::uint64_t sequence = 0;
+  int otherFrames = 0;
+  const auto end = Clock::now() + 20s;
+  while (m.grpcSessions.load() == 2 && Clock::now() < end) {
+    ++sequence;
+    stalled.send(pose(sequence, static_cast<double>(sequence)));
+    other.send(pose(sequence, static_cast<double>(sequence)));
+    if (other.frameFor(sequence)) ++otherFrames;
+  }
+  EXPECT_EQ(m.grpcSessions.load(), 1) << "the stalled session was cut";
+  EXPECT_NE(httpGet(server.port(), "/metrics").find("haarcast_session_cuts_total{reason=\"write_stall\"} 1"),
+            std::string::npos);
+  EXPECT_GE(otherFrames, 10) << "the other client got frames meanwhile";
+  other.send(pose(++sequence, 5));
+  EXPECT_TRUE(other.frameFor(sequence)) << "and goes on after the cut";
+  EXPECT_EQ(stalled.statusAfterReading().error_code(), grpc::StatusCode::CANCELLED);
+}
+
+}  // namespace
+}  // namespace haarcast::net::test
