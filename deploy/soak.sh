@@ -52,7 +52,7 @@ rss_kib() { [[ -n "$pid" && -r "/proc/$pid/status" ]] && awk '/^VmRSS:/ { print 
 if [[ -z "$url" ]]; then
   [[ -x "$server_bin" ]] || { echo "soak: no $server_bin (deploy/run.sh build)" >&2; exit 1; }
   args=(serve --port 0 --backend cpu --max-sessions "$clients" --max-sessions-per-address "$clients"
-        --max-connections-per-address "$((clients * 2))" --max-pending-per-address "$clients"
+        --max-connections-per-address "$((clients * 2))" --max-pending-per-address "$clients" --session-reserve 0
         "${serve_args[@]}")
   [[ -n "$token" ]] && args+=(--token "$token")
   echo "soak: starting $server_bin ${args[*]}"

@@ -30,6 +30,7 @@ void addSceneFlags(CLI::App& c, SceneFlags& f) {
       ->capture_default_str();
   c.add_option("--out", f.out, "Output .exr (a .png is written beside it) or .png")->capture_default_str();
   c.add_option("--exposure", f.exposure, "PNG exposure in stops (default: auto, the lit object pixels' log-average luminance → 0.18)");
+  c.add_flag("--ground", f.ground, "With --mesh: stand it on a ground that takes its shadows (scene files: the \"ground\" key)");
   addSceneLimitFlags(c, f.limits);
 }
 
@@ -46,11 +47,13 @@ void addSceneLimitFlags(CLI::App& c, render::SceneLimits& limits) {
 render::Scene sceneFromFlags(const SceneFlags& f) {
   if (!f.scene.empty()) {
     if (!f.mesh.empty() || !f.env.empty()) throw std::invalid_argument("give either --scene or --env/--mesh, not both");
+    if (f.ground) throw std::invalid_argument("--ground applies to --mesh (a scene file says \"ground\": true)");
     return render::loadScene(f.scene, f.limits);
   }
   if (f.mesh.empty()) {
     // The built-in scene's objects have their own materials and poses.
     if (!f.env.empty()) throw std::invalid_argument("--env needs --mesh (or use --scene)");
+    if (f.ground) throw std::invalid_argument("--ground applies to --mesh (the default scene has its own ground)");
     if (!f.material.empty()) throw std::invalid_argument("--material applies to --mesh (the default scene's objects have their own)");
     if (!f.rotate.empty()) throw std::invalid_argument("--rotate applies to --mesh (the default scene's objects have their own poses)");
     return render::defaultScene();
@@ -67,6 +70,7 @@ render::Scene sceneFromFlags(const SceneFlags& f) {
   }
   scene.objects.push_back(object);
   scene.camera.eye = {0.0, 0.3, 3.0};
+  if (f.ground) render::addGround(scene);
   return scene;
 }
 

@@ -24,6 +24,7 @@ struct SceneFlags {
   std::string background = "env";
   std::string out;
   std::optional<double> exposure;
+  bool ground = false;  // with --mesh: a ground under it (render::addGround)
   render::SceneLimits limits;
 };
 
