@@ -51,6 +51,8 @@ rss_kib() { [[ -n "$pid" && -r "/proc/$pid/status" ]] && awk '/^VmRSS:/ { print 
 
 if [[ -z "$url" ]]; then
   [[ -x "$server_bin" ]] || { echo "soak: no $server_bin (deploy/run.sh build)" >&2; exit 1; }
+  # Every client comes from 127.0.0.1: no session slots are kept for new
+  # addresses (--session-reserve 0), as behind an ingress.
   args=(serve --port 0 --backend cpu --max-sessions "$clients" --max-sessions-per-address "$clients"
         --max-connections-per-address "$((clients * 2))" --max-pending-per-address "$clients" --session-reserve 0
         "${serve_args[@]}")
