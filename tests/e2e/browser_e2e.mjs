@@ -425,7 +425,7 @@ try {
   check(JSON.stringify(scenes) === JSON.stringify(['default', 'e2e-box']),
         `the scene picker lists the served scenes (${scenes.join(', ')})`);
   let objs = await objects();
-  check(JSON.stringify(objs.map((o) => [o.name, o.material])) === JSON.stringify([['sphere', 'phong:64'], ['torus', 'ggx:0.3']]),
+  check(JSON.stringify(objs.map((o) => [o.name, o.material])) === JSON.stringify([['sphere', 'phong:64'], ['torus', 'ggx:0.3'], ['ground', 'lambert']]),
         `the default scene's objects are named, each with its material (${JSON.stringify(objs.map((o) => [o.name, o.material]))})`);
   check(objs.every((o) => o.offered > 1), `each object's material select lists the offered materials (${objs.map((o) => o.offered)})`);
 
@@ -456,7 +456,7 @@ try {
         `e2e-box's objects are listed (${JSON.stringify(objs.map((o) => [o.name, o.material]))})`);
   await switchScene('default');
   objs = await objects();
-  check(objs.length === 2 && objs[0].material === 'phong:64', `back on default, sphere is phong:64 again (${objs[0] && objs[0].material})`);
+  check(objs.length === 3 && objs[0].material === 'phong:64', `back on default, sphere is phong:64 again (${objs[0] && objs[0].material})`);
 
   // A material change: answered with a SceneInfo that the select shows.
   await page.locator('#objects select').first().selectOption('lambert');

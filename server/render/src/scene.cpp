@@ -1,6 +1,7 @@
 #include "haarcast/render/scene.h"
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -109,7 +110,7 @@ Material materialFromSpec(const std::string& spec, const std::string& baseDir) {
   // Analytic defaults: a warm metal-like specular with a little diffuse.
   const glm::dvec3 kd(0.06, 0.05, 0.04), ks(0.9, 0.75, 0.55);
   if (kind == "lambert") {
-    m.brdf = makeLambert(glm::dvec3(0.8));
+    m.brdf = makeLambert(glm::dvec3(kLambertAlbedo));
   } else if (kind == "phong") {
     m.brdf = makePhong(kd, ks, number("an exponent"));
   } else if (kind == "blinn-phong") {
@@ -144,6 +145,7 @@ void fitToUnitSphere(Mesh& mesh) {
 }
 
 void addGround(Scene& scene, const GroundOptions& options) {
+  static_assert(GroundOptions{}.albedo == kLambertAlbedo);
   if (!(options.albedo >= 0.0 && options.albedo <= 1.0)) {
     throw std::invalid_argument("ground: albedo " + std::to_string(options.albedo) + " is outside [0, 1]");
   }
@@ -170,9 +172,14 @@ void addGround(Scene& scene, const GroundOptions& options) {
   // A finely divided plane: the G-buffer rasterises it like any mesh, and
   // vertex visibility (not used by fused's closed form) stays cheap.
   g.mesh = std::make_shared<Mesh>(assets::makePlane(1.0, 8));
-  g.material.name = "lambert:" + std::to_string(options.albedo);
-  g.material.cacheKey = "lambert-albedo-" + std::to_string(options.albedo);
-  g.material.brdf = makeLambert(g.groundAlbedo);
+  g.material = materialFromSpec("lambert");
+  if (options.albedo != kLambertAlbedo) {
+    char albedo[32];
+    std::snprintf(albedo, sizeof albedo, "%g", options.albedo);
+    g.material.name = std::string("lambert (albedo ") + albedo + ")";
+    g.material.cacheKey = "lambert-albedo-" + std::string(albedo);
+    g.material.brdf = makeLambert(g.groundAlbedo);
+  }
   g.pose.scale = options.extent * std::max(radius, 1e-6);
   g.pose.translate = {0.5 * (lo.x + hi.x), lo.y, 0.5 * (lo.z + hi.z)};
   scene.objects.push_back(std::move(g));

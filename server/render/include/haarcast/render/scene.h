@@ -66,6 +66,9 @@ struct Material {
   std::string warning;   // non-empty when the file needed a repair (shown to the user)
 };
 
+// The albedo of the "lambert" material.
+inline constexpr double kLambertAlbedo = 0.8;
+
 // "lambert", "phong:EXP", "blinn-phong:EXP", "ggx:ROUGHNESS", or a MERL
 // .binary path (relative to baseDir). Throws std::invalid_argument naming
 // the spec.
@@ -102,8 +105,11 @@ struct Scene {
 // the lowest point of their bounds at the scene's poses. Appended as the
 // last object, named "ground". Throws std::invalid_argument for an albedo
 // outside [0, 1], a non-positive extent, no objects, or a second ground.
+// The default albedo is the "lambert" material's, so the ground is named
+// "lambert" like any material a client may pick; another is named
+// "lambert (albedo A)".
 struct GroundOptions {
-  double albedo = 0.5;
+  double albedo = 0.8;
   double extent = 12.0;
 };
 void addGround(Scene& scene, const GroundOptions& options = {});
