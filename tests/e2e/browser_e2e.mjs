@@ -356,6 +356,8 @@ try {
   const diffLight = meanAbsDiff(luma(shot2), luma(shot3));
   check(diffLight > 0.5, `the frame changed after the light drag (mean |Δluma| ${diffLight.toFixed(2)} > 0.5)`);
   await dragAndWait('shift-drag (object)', 'Shift');
+  // The moved object's shadow on the ground is in the frame that answers the drag.
+  if (opts.out) writeFileSync(join(opts.out, 'object.png'), await canvas.screenshot(shotOptions));
   // An object's turns start from the scene's own pose (SceneInfo): the
   // default scene's torus is turned (60, 20, 0) and translated to x = 0.8.
   const torus = await page.evaluate(() => window.haarcast.objectPose(1));
