@@ -40,7 +40,8 @@ LightSplit splitLight(const std::array<SphereMap, 3>& light, const LightSplitOpt
   std::vector<std::size_t> seeds;
   for (std::size_t i = 0; i < n; ++i)
     if (lum[i] >= seedLevel) seeds.push_back(i);
-  std::stable_sort(seeds.begin(), seeds.end(), [&](std::size_t a, std::size_t b) { return lum[a] > lum[b]; });
+  // Brightest first, ties in map order (a total order: the same lights on every platform).
+  std::sort(seeds.begin(), seeds.end(), [&](std::size_t a, std::size_t b) { return lum[a] != lum[b] ? lum[a] > lum[b] : a < b; });
 
   auto direction = [&](std::size_t i) {
     return sphericalToDirection(rowTheta(level, static_cast<int>(i) / m), colPhi(level, static_cast<int>(i) % m));
