@@ -15,8 +15,11 @@
 //                     slice rotated (the three channels together for haar),
 //                     then one triple product per channel
 //
-// Visibility is each object's own (self-shadowing); objects do not shadow
-// each other, as in precomputed-transfer renderers whose objects move.
+// Per-vertex visibility is each object's own (self-shadowing). `fused` adds
+// per-pixel shadow rays toward the light's point lights against the whole
+// posed scene, so objects shadow each other and the ground from those
+// (docs/design.md, "Visibility in `fused`"); the Haar methods keep the
+// seed's self-shadowing only.
 #pragma once
 
 #include <cstddef>
