@@ -57,6 +57,21 @@ void checkMeshForVisibility(const Mesh& mesh) {
 }
 
 
+// compute(scene, mesh) with the mesh alone as the occluders; a mesh without
+// normals gets area-weighted ones (Mesh::computeNormals) on a copy first.
+template <typename Compute>
+auto againstItself(const Mesh& mesh, Compute&& compute) {
+  mesh.validate();
+  if (mesh.normals.empty()) {
+    Mesh withNormals = mesh;
+    withNormals.computeNormals();
+    const RayScene scene({Instance{&withNormals}});
+    return compute(scene, withNormals);
+  }
+  const RayScene scene({Instance{&mesh}});
+  return compute(scene, mesh);
+}
+
 }  // namespace
 
 void checkVisibilityOptions(const VisibilityOptions& options) {
@@ -76,15 +91,9 @@ std::vector<SparseHaar> computeVertexVisibility(
     const Mesh& mesh, const VisibilityOptions& options,
     const std::function<void(std::size_t done, std::size_t total)>& progress) {
   checkVisibilityOptions(options);
-  mesh.validate();
-  if (mesh.normals.empty()) {
-    Mesh withNormals = mesh;
-    withNormals.computeNormals();
-    const RayScene scene({Instance{&withNormals}});
-    return computeVertexVisibility(scene, withNormals, options, progress);
-  }
-  const RayScene scene({Instance{&mesh}});
-  return computeVertexVisibility(scene, mesh, options, progress);
+  return againstItself(mesh, [&](const RayScene& scene, const Mesh& m) {
+    return computeVertexVisibility(scene, m, options, progress);
+  });
 }
 
 std::vector<SparseHaar> computeVertexVisibility(
@@ -112,15 +121,9 @@ std::vector<SparseHaar> computeVertexVisibility(
 VisibilityBits computeVisibilityBits(const Mesh& mesh, const VisibilityOptions& options,
                                      const std::function<void(std::size_t done, std::size_t total)>& progress) {
   checkVisibilityOptions(options);
-  mesh.validate();
-  if (mesh.normals.empty()) {
-    Mesh withNormals = mesh;
-    withNormals.computeNormals();
-    const RayScene scene({Instance{&withNormals}});
-    return computeVisibilityBits(scene, withNormals, options, progress);
-  }
-  const RayScene scene({Instance{&mesh}});
-  return computeVisibilityBits(scene, mesh, options, progress);
+  return againstItself(mesh, [&](const RayScene& scene, const Mesh& m) {
+    return computeVisibilityBits(scene, m, options, progress);
+  });
 }
 
 VisibilityBits computeVisibilityBits(const RayScene& occluders, const Mesh& mesh, const VisibilityOptions& options,

@@ -42,6 +42,53 @@ class ContentHasher {
   std::uint64_t hash_ = io::kFnv1a64Basis;
 };
 
+// The shortest decimal that reads back as the same number: exact, and
+// readable in a hex dump.
+template <typename T>
+std::string shortestDecimal(T value) {
+  char text[32];
+  const std::to_chars_result r = std::to_chars(text, text + sizeof text, value);
+  return r.ec == std::errc() ? std::string(text, r.ptr) : std::string("?");
+}
+
+// The cache's one path for both kinds: bad input first (the same error hit
+// or miss), then a valid file's payload decoded, else computed and stored.
+// A payload that does not decode is counted and logged as a rebuild.
+template <typename Decode, typename Compute, typename Encode>
+auto loadOrCompute(const Mesh& mesh, const VisibilityOptions& options, const std::string& cacheDir,
+                   const io::CacheHeader& entry, VisibilityCacheStatus* statusOut, Decode&& decode, Compute&& compute,
+                   Encode&& encode) -> decltype(compute()) {
+  VisibilityCacheStatus local;
+  VisibilityCacheStatus& status = statusOut ? *statusOut : local;
+  status = VisibilityCacheStatus{};
+  const bool warnOnStderr = statusOut == nullptr;
+  checkVisibilityOptions(options);
+  mesh.validate();
+  if (cacheDir.empty()) {
+    status.reason = "no cache directory";
+    return compute();
+  }
+  if (const std::optional<std::string> payload = io::lookUpCacheEntry(cacheDir, entry, status)) {
+    try {
+      return decode(*payload);
+    } catch (const std::exception& e) {
+      status.hit = false;
+      status.reason = e.what();
+      io::noteCacheRebuild(io::CacheRebuildReason::Corrupt, status.path, status.reason);
+    }
+  }
+  auto computed = compute();
+  std::string payload;
+  try {
+    payload = encode(computed);
+  } catch (const std::exception& e) {
+    io::reportCacheError(status, warnOnStderr, entry.kind, e.what());
+    return computed;
+  }
+  io::storeCacheEntry(cacheDir, entry, payload, status, warnOnStderr);
+  return computed;
+}
+
 }  // namespace
 
 std::string meshContentKey(const Mesh& mesh) {
@@ -73,13 +120,8 @@ std::string meshContentKey(const Mesh& mesh) {
 }
 
 std::string visibilityOptionsText(const VisibilityOptions& options) {
-  // The shortest decimal that reads back as the same float: exact, and
-  // readable in a hex dump.
-  char offset[32];
-  const std::to_chars_result r = std::to_chars(offset, offset + sizeof offset, options.offset);
-  const std::string offsetText = r.ec == std::errc() ? std::string(offset, r.ptr) : std::string("?");
   return "level=" + std::to_string(options.level) + " supersampling=" + std::to_string(options.supersampling) +
-         " keep=" + std::to_string(options.keep) + " offset=" + offsetText;
+         " keep=" + std::to_string(options.keep) + " offset=" + shortestDecimal(options.offset);
 }
 
 std::string encodeVisibilityPayload(const std::vector<SparseHaar>& visibility) {
@@ -153,52 +195,20 @@ std::vector<SparseHaar> decodeVisibilityPayload(std::string_view payload, std::s
 std::vector<SparseHaar> loadOrComputeVertexVisibility(
     const Mesh& mesh, const VisibilityOptions& options, const std::string& cacheDir,
     const std::function<void(std::size_t done, std::size_t total)>& progress, VisibilityCacheStatus* statusOut) {
-  VisibilityCacheStatus local;
-  VisibilityCacheStatus& status = statusOut ? *statusOut : local;
-  status = VisibilityCacheStatus{};
-  const bool warnOnStderr = statusOut == nullptr;
-
-  // Bad input is the same error whether or not the cache holds an answer.
-  checkVisibilityOptions(options);
-  mesh.validate();
-  if (cacheDir.empty()) {
-    status.reason = "no cache directory";
-    return computeVertexVisibility(mesh, options, progress);
-  }
-
-  const io::CacheHeader entry{kKind, kVisibilityCacheVersion, meshContentKey(mesh), visibilityOptionsText(options)};
-  if (const std::optional<std::string> payload = io::lookUpCacheEntry(cacheDir, entry, status)) {
-    try {
-      return decodeVisibilityPayload(*payload, mesh.positions.size(), options);
-    } catch (const std::exception& e) {
-      status.hit = false;
-      status.reason = e.what();
-      io::noteCacheRebuild(io::CacheRebuildReason::Corrupt, status.path, status.reason);
-    }
-  }
-
-  std::vector<SparseHaar> visibility = computeVertexVisibility(mesh, options, progress);
-  std::string payload;
-  try {
-    payload = encodeVisibilityPayload(visibility);
-  } catch (const std::exception& e) {
-    io::reportCacheError(status, warnOnStderr, kKind, e.what());
-    return visibility;
-  }
-  io::storeCacheEntry(cacheDir, entry, payload, status, warnOnStderr);
-  return visibility;
+  const io::CacheHeader entry{kKind, kVisibilityCacheVersion, cacheDir.empty() ? std::string() : meshContentKey(mesh),
+                              visibilityOptionsText(options)};
+  return loadOrCompute(
+      mesh, options, cacheDir, entry, statusOut,
+      [&](std::string_view payload) { return decodeVisibilityPayload(payload, mesh.positions.size(), options); },
+      [&] { return computeVertexVisibility(mesh, options, progress); },
+      [](const std::vector<SparseHaar>& v) { return encodeVisibilityPayload(v); });
 }
 
 namespace {
 
 std::string bitsOptionsText(const VisibilityOptions& options) {
-  char offset[32];
-  const std::to_chars_result r = std::to_chars(offset, offset + sizeof offset, options.offset);
-  const std::string offsetText = r.ec == std::errc() ? std::string(offset, r.ptr) : std::string("?");
-  char skip[32];
-  const std::to_chars_result s = std::to_chars(skip, skip + sizeof skip, kBitsSkipBelowDegrees);
-  const std::string skipText = s.ec == std::errc() ? std::string(skip, s.ptr) : std::string("?");
-  return "level=" + std::to_string(options.level) + " offset=" + offsetText + " skip=" + skipText;
+  return "level=" + std::to_string(options.level) + " offset=" + shortestDecimal(options.offset) +
+         " skip=" + shortestDecimal(kBitsSkipBelowDegrees);
 }
 
 VisibilityBits decodeBits(std::string_view payload, std::size_t vertexCount, int level) {
@@ -229,33 +239,19 @@ VisibilityBits decodeBits(std::string_view payload, std::size_t vertexCount, int
 VisibilityBits loadOrComputeVisibilityBits(const Mesh& mesh, const VisibilityOptions& options, const std::string& cacheDir,
                                            const std::function<void(std::size_t done, std::size_t total)>& progress,
                                            VisibilityCacheStatus* statusOut) {
-  VisibilityCacheStatus local;
-  VisibilityCacheStatus& status = statusOut ? *statusOut : local;
-  status = VisibilityCacheStatus{};
-  const bool warnOnStderr = statusOut == nullptr;
-  checkVisibilityOptions(options);
-  mesh.validate();
-  if (cacheDir.empty()) {
-    status.reason = "no cache directory";
-    return computeVisibilityBits(mesh, options, progress);
-  }
-  const io::CacheHeader entry{"visibility-bits", kVisibilityBitsCacheVersion, meshContentKey(mesh), bitsOptionsText(options)};
-  if (const std::optional<std::string> payload = io::lookUpCacheEntry(cacheDir, entry, status)) {
-    try {
-      return decodeBits(*payload, mesh.positions.size(), options.level);
-    } catch (const std::exception& e) {
-      status.hit = false;
-      status.reason = e.what();
-      io::noteCacheRebuild(io::CacheRebuildReason::Corrupt, status.path, status.reason);
-    }
-  }
-  VisibilityBits bits = computeVisibilityBits(mesh, options, progress);
-  std::string payload;
-  payload.reserve(8 + bits.storedBytes());
-  io::appendLittleEndian<std::uint64_t>(payload, bits.pointCount());
-  for (const std::uint32_t w : bits.words()) io::appendLittleEndian<std::uint32_t>(payload, w);
-  io::storeCacheEntry(cacheDir, entry, payload, status, warnOnStderr);
-  return bits;
+  const io::CacheHeader entry{"visibility-bits", kVisibilityBitsCacheVersion,
+                              cacheDir.empty() ? std::string() : meshContentKey(mesh), bitsOptionsText(options)};
+  return loadOrCompute(
+      mesh, options, cacheDir, entry, statusOut,
+      [&](std::string_view payload) { return decodeBits(payload, mesh.positions.size(), options.level); },
+      [&] { return computeVisibilityBits(mesh, options, progress); },
+      [](const VisibilityBits& bits) {
+        std::string payload;
+        payload.reserve(8 + bits.storedBytes());
+        io::appendLittleEndian<std::uint64_t>(payload, bits.pointCount());
+        for (const std::uint32_t w : bits.words()) io::appendLittleEndian<std::uint32_t>(payload, w);
+        return payload;
+      });
 }
 
 }  // namespace haarcast
