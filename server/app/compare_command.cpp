@@ -5,6 +5,7 @@
 #include <cmath>
 #include <span>
 #include <tuple>
+#include <cstdint>
 #include <cstdio>
 #include <memory>
 #include <stdexcept>
@@ -23,6 +24,8 @@ struct CompareOptions {
   std::string test;
   std::string unoccluded;   // the reference without occlusion: marks shadowed pixels
   double shadowThreshold = 0.02;
+  std::string errorImage;   // a PNG of the signed error, when set
+  double errorScale = 0.2;  // the relative error drawn at full colour
 };
 
 double luminanceAt(const io::RgbImage& image, std::size_t pixel) {
@@ -42,6 +45,39 @@ void printRow(const char* name, std::size_t pixels, std::size_t total, const Err
   std::printf("| %s | %zu (%.1f %%) | %.2f | %.3g | %.2f %% | %.4f | %.1f %% |\n", name, pixels,
               100.0 * static_cast<double>(pixels) / static_cast<double>(std::max<std::size_t>(total, 1)), e.psnr, e.mse,
               100.0 * e.relativeL2, e.brightnessRatio, 100.0 * errorShare);
+}
+
+// Where a render errs: each object pixel's luminance error as a fraction of
+// the reference's mean object luminance (so the picture weighs pixels as
+// relative L2 does: a dark pixel's large relative error shows faint), red
+// where the render is too bright and blue where too dark, at full colour
+// from ±scale on; under it, a dim grey of the reference so that the shapes
+// stay readable. Other pixels black.
+void writeErrorImage(const std::string& path, const io::RgbImage& reference, const io::RgbImage& test,
+                     const std::vector<bool>& object, double scale) {
+  const std::size_t pixels = object.size();
+  double peak = 0.0, sum = 0.0, count = 0.0;
+  for (std::size_t p = 0; p < pixels; ++p) {
+    peak = std::max(peak, luminanceAt(reference, p));
+    if (object[p]) sum += luminanceAt(reference, p), count += 1.0;
+  }
+  const double mean = std::max(sum / std::max(count, 1.0), 1e-30);
+  std::vector<std::uint8_t> rgba(4 * pixels, 0);
+  for (std::size_t p = 0; p < pixels; ++p) {
+    rgba[4 * p + 3] = 255;
+    if (!object[p]) continue;
+    const double r = luminanceAt(reference, p);
+    const double e = std::clamp((luminanceAt(test, p) - r) / mean / scale, -1.0, 1.0);
+    const double grey = 60.0 * std::sqrt(r / std::max(peak, 1e-30));
+    const double strong = grey + (255.0 - grey) * std::abs(e);
+    const double weak = grey * (1.0 - std::abs(e));
+    rgba[4 * p + 0] = static_cast<std::uint8_t>(std::lround(e > 0 ? strong : weak));
+    rgba[4 * p + 1] = static_cast<std::uint8_t>(std::lround(weak));
+    rgba[4 * p + 2] = static_cast<std::uint8_t>(std::lround(e < 0 ? strong : weak));
+  }
+  io::writePngRgba8(path, rgba, reference.width, reference.height);
+  std::printf("wrote %s: red = render too bright, blue = too dark, full colour at ±%.0f %% of the reference's mean\n",
+              path.c_str(), 100.0 * scale);
 }
 
 int run(const CompareOptions& o) {
@@ -88,6 +124,7 @@ int run(const CompareOptions& o) {
       printRow(name, count, covered, e, totalSquared > 0.0 ? e.mse * static_cast<double>(3 * count) / totalSquared : 0.0);
     }
   }
+  if (!o.errorImage.empty()) writeErrorImage(o.errorImage, reference, test, object, o.errorScale);
   return 0;
 }
 
@@ -104,6 +141,11 @@ std::function<int()> addCompareCommand(CLI::App& app) {
   c->add_option("--shadow-threshold", o->shadowThreshold, "A pixel is shadowed when the reference is darker than this fraction below the unoccluded one")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));
+  c->add_option("--error-image", o->errorImage,
+                "Write a PNG of the per-pixel error (luminance, over the reference's mean): red where the test is brighter than the reference, blue where darker");
+  c->add_option("--error-scale", o->errorScale, "The error, as a fraction of the reference's mean object luminance, that --error-image draws at full colour")
+      ->capture_default_str()
+      ->check(CLI::Range(1e-4, 10.0));
   return [c, o] { return c->parsed() ? run(*o) : -1; };
 }
 

@@ -90,6 +90,10 @@ std::function<int()> addRenderCommand(CLI::App& app) {
       ->capture_default_str();
   c->add_option("--visibility-coeffs", args->options.visibility.keep, "Visibility coefficients kept per vertex")
       ->capture_default_str();
+  c->add_option("--visibility-refine", args->options.refine.rounds,
+                "fused: rounds of refining the mesh where its vertices' visibility disagrees (0 = off)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 16));
   c->add_option("--backend", args->backend, "cpu|vulkan")->capture_default_str();
   c->add_option("--antialias", args->antialias, "auto|on|off: edge pixels as the mean of 4 sub-samples (auto: on)")
       ->capture_default_str();

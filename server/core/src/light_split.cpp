@@ -95,4 +95,10 @@ LightSplit splitLight(const std::array<SphereMap, 3>& light, const LightSplitOpt
   return out;
 }
 
+LightSplit splitLight(const std::array<SphereMap, 3>& fine, int level, const LightSplitOptions& options) {
+  LightSplit out = splitLight(fine, options);
+  for (SphereMap& rest : out.rest) rest = rest.downsampled(level);
+  return out;
+}
+
 }  // namespace haarcast

@@ -1,6 +1,7 @@
 #include "haarcast/core/sphere_map.h"
 
 #include <algorithm>
+#include <stdexcept>
 #include <string>
 
 namespace haarcast {
@@ -42,6 +43,32 @@ SphereMap SphereMap::fromFunction(int level, const std::function<double(const gl
     }
   }
   return map;
+}
+
+SphereMap SphereMap::downsampled(int coarser) const {
+  checkLevel(coarser, "SphereMap::downsampled");
+  if (coarser > level_) {
+    throw std::invalid_argument("SphereMap::downsampled: level " + std::to_string(coarser) + " is finer than the map's " +
+                                std::to_string(level_));
+  }
+  const int f = 1 << (level_ - coarser);
+  SphereMap out(coarser);
+  const int m = out.size();
+  for (int i = 0; i < m; ++i) {
+    // Rows of one band share their solid angle across the band's columns.
+    double bandSolid = 0.0;
+    for (int di = 0; di < f; ++di) bandSolid += pixelSolidAngle(level_, i * f + di);
+    for (int j = 0; j < m; ++j) {
+      double sum = 0.0;
+      for (int di = 0; di < f; ++di) {
+        double row = 0.0;
+        for (int dj = 0; dj < f; ++dj) row += at(i * f + di, j * f + dj);
+        sum += row * pixelSolidAngle(level_, i * f + di);
+      }
+      out.at(i, j) = static_cast<float>(sum / (bandSolid * f));
+    }
+  }
+  return out;
 }
 
 double SphereMap::integral() const {

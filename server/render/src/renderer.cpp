@@ -28,6 +28,7 @@ void checkRenderOptions(const RenderOptions& o) {
   }
   if (o.lightCoefficients == 0) bad("light coefficients must be at least 1");
   if (o.thetaSamples < 1 || o.thetaSamples > 256) bad("theta samples must be in 1..256");
+  checkRefineOptions(o.refine);
   if (o.pointLights.maxLights > shared::kMaxPointLights) {
     bad("point lights " + std::to_string(o.pointLights.maxLights) + " is over " + std::to_string(shared::kMaxPointLights));
   }
@@ -94,7 +95,13 @@ PreparedScene prepareScene(const Scene& scene, const RenderOptions& options, con
       if (progress) progress("visibility " + object.name, done, total);
     };
     if (options.method == RotationMethod::Fused) {
-      p.visibilityBits = loadOrComputeVisibilityBits(*p.mesh, vis, options.cacheDir, visibilityProgress);
+      if (p.ground || options.refine.rounds == 0) {
+        p.visibilityBits = loadOrComputeVisibilityBits(*p.mesh, vis, options.cacheDir, visibilityProgress);
+      } else {
+        RefinedVisibility r = loadOrComputeRefinedVisibility(*p.mesh, vis, options.refine, options.cacheDir, visibilityProgress);
+        p.mesh = std::make_shared<const Mesh>(std::move(r.mesh));
+        p.visibilityBits = std::move(r.bits);
+      }
     } else {
       p.visibility = loadOrComputeVertexVisibility(*p.mesh, vis, options.cacheDir, visibilityProgress);
     }
@@ -102,7 +109,9 @@ PreparedScene prepareScene(const Scene& scene, const RenderOptions& options, con
   prepared.light = scene.environment.maps(options.level);
   prepared.background = scene.environment.maps(kBackgroundLevel);
   if (options.method == RotationMethod::Fused) {
-    LightSplit split = splitLight(prepared.light, options.pointLights);
+    // Lights found on the backdrop's fine map (light_split.h: their
+    // directions to a tenth of a degree), the rest at the render's level.
+    LightSplit split = splitLight(prepared.background, options.level, options.pointLights);
     prepared.pointLights = std::move(split.lights);
     prepared.restLight = std::move(split.rest);
   }

@@ -10,6 +10,7 @@
 #include <glm/geometric.hpp>
 
 #include "haarcast/core/brdf_slices.h"
+#include "haarcast/core/check.h"
 #include "haarcast/core/parallel.h"
 
 namespace haarcast {
@@ -129,7 +130,19 @@ VisibilityBits computeVisibilityBits(const Mesh& mesh, const VisibilityOptions& 
 VisibilityBits computeVisibilityBits(const RayScene& occluders, const Mesh& mesh, const VisibilityOptions& options,
                                      const std::function<void(std::size_t done, std::size_t total)>& progress) {
   checkVisibilityOptions(options);
+  VisibilityBits out(options.level, mesh.positions.size());
+  computeVisibilityBitsFrom(occluders, mesh, options, 0, out, progress);
+  return out;
+}
+
+void computeVisibilityBitsFrom(const RayScene& occluders, const Mesh& mesh, const VisibilityOptions& options,
+                               std::size_t first, VisibilityBits& out,
+                               const std::function<void(std::size_t done, std::size_t total)>& progress) {
+  checkVisibilityOptions(options);
   checkMeshForVisibility(mesh);
+  HC_CHECK_EQ(out.level(), options.level);
+  HC_CHECK_EQ(out.pointCount(), mesh.positions.size());
+  HC_CHECK_LE(first, mesh.positions.size());
   const int level = options.level;
   const int m = mapSize(level);
   const std::size_t n = static_cast<std::size_t>(m) * static_cast<std::size_t>(m);
@@ -139,11 +152,11 @@ VisibilityBits computeVisibilityBits(const RayScene& occluders, const Mesh& mesh
       directions[static_cast<std::size_t>(i * m + j)] = glm::vec3(sphericalToDirection(rowTheta(level, i), colPhi(level, j)));
   const float skipBelow = static_cast<float>(-std::sin(kBitsSkipBelowDegrees * kPi / 180.0));
   const float shift = shiftOf(mesh, options);
-  const std::size_t total = mesh.positions.size();
-  VisibilityBits out(level, total);
+  const std::size_t total = mesh.positions.size() - first;
   parallelFor(
       total,
-      [&](std::size_t v) {
+      [&](std::size_t k) {
+        const std::size_t v = first + k;
         // Per worker thread, kept across vertices.
         thread_local std::vector<glm::vec3> traced;
         thread_local std::vector<std::uint32_t> which;
@@ -162,13 +175,13 @@ VisibilityBits computeVisibilityBits(const RayScene& occluders, const Mesh& mesh
         blocked.resize(traced.size());
         occluders.occludedFrom(start.origin, start.tnear, traced, blocked);
         const std::span<std::uint32_t> words = out.point(v);
-        for (std::size_t k = 0; k < traced.size(); ++k)
-          if (!blocked[k]) words[which[k] / 32] |= 1u << (which[k] % 32);
+        std::fill(words.begin(), words.end(), 0u);
+        for (std::size_t t = 0; t < traced.size(); ++t)
+          if (!blocked[t]) words[which[t] / 32] |= 1u << (which[t] % 32);
       },
       [&](std::size_t done) {
         if (progress) progress(done, total);
       });
-  return out;
 }
 
 SphereMap vertexVisibilityMap(const RayScene& occluders, const Mesh& mesh, std::size_t vertex,

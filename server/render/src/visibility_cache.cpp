@@ -254,4 +254,85 @@ VisibilityBits loadOrComputeVisibilityBits(const Mesh& mesh, const VisibilityOpt
       });
 }
 
+namespace {
+
+std::string refinedOptionsText(const VisibilityOptions& options, const RefineOptions& r) {
+  return bitsOptionsText(options) + " rounds=" + std::to_string(r.rounds) + " threshold=" + shortestDecimal(r.threshold) +
+         " min-edge=" + shortestDecimal(r.minEdge) + " growth=" + shortestDecimal(r.growth) +
+         " floor=" + std::to_string(r.floor);
+}
+
+std::string encodeRefined(const RefinedVisibility& r) {
+  std::string out;
+  out.reserve(24 + 24 * r.mesh.positions.size() + 12 * r.mesh.triangles.size() + r.bits.storedBytes());
+  io::appendLittleEndian<std::uint64_t>(out, r.mesh.positions.size());
+  io::appendLittleEndian<std::uint64_t>(out, r.mesh.triangles.size());
+  io::appendLittleEndian<std::uint32_t>(out, static_cast<std::uint32_t>(r.rounds));
+  for (std::size_t v = 0; v < r.mesh.positions.size(); ++v)
+    for (const glm::vec3& x : {r.mesh.positions[v], r.mesh.normals[v]})
+      for (int c = 0; c < 3; ++c) io::appendLittleEndian<float>(out, x[c]);
+  for (const glm::uvec3& t : r.mesh.triangles)
+    for (int c = 0; c < 3; ++c) io::appendLittleEndian<std::uint32_t>(out, t[c]);
+  for (const std::uint32_t w : r.bits.words()) io::appendLittleEndian<std::uint32_t>(out, w);
+  return out;
+}
+
+// The refined mesh must start with the original's vertices unchanged (the
+// refinement only adds), have valid triangles and bits of the right size.
+RefinedVisibility decodeRefined(std::string_view payload, const Mesh& original, const VisibilityOptions& options,
+                                const RefineOptions& refine) {
+  io::PayloadReader in(payload);
+  const auto vertices = in.take<std::uint64_t>();
+  const auto triangles = in.take<std::uint64_t>();
+  const auto rounds = in.take<std::uint32_t>();
+  const std::size_t words = visibilityWordsPerPoint(options.level);
+  if (vertices < original.positions.size() || rounds > static_cast<std::uint32_t>(refine.rounds) ||
+      in.remaining() != vertices * (24 + 4 * words) + 12 * triangles) {
+    throw std::runtime_error("invalid contents: " + std::to_string(vertices) + " vertices, " +
+                             std::to_string(triangles) + " triangles and " + std::to_string(in.remaining()) +
+                             " bytes do not fit the mesh's " + std::to_string(original.positions.size()) + " vertices");
+  }
+  RefinedVisibility r;
+  r.rounds = static_cast<int>(rounds);
+  r.mesh.name = original.name;
+  r.mesh.positions.resize(vertices);
+  r.mesh.normals.resize(vertices);
+  for (std::size_t v = 0; v < vertices; ++v) {
+    for (glm::vec3* x : {&r.mesh.positions[v], &r.mesh.normals[v]})
+      for (int c = 0; c < 3; ++c) (*x)[c] = in.take<float>();
+    if (v < original.positions.size() &&
+        (r.mesh.positions[v] != original.positions[v] || r.mesh.normals[v] != original.normals[v])) {
+      throw std::runtime_error("invalid contents: vertex " + std::to_string(v) + " differs from the mesh's");
+    }
+  }
+  r.mesh.triangles.resize(triangles);
+  for (glm::uvec3& t : r.mesh.triangles)
+    for (int c = 0; c < 3; ++c) t[c] = in.take<std::uint32_t>();
+  try {
+    r.mesh.validate();
+    r.bits = VisibilityBits(options.level, vertices);
+    std::vector<std::uint32_t> w(vertices * words);
+    for (std::uint32_t& x : w) x = in.take<std::uint32_t>();
+    r.bits.assign(w);
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(std::string("invalid contents: ") + e.what());
+  }
+  return r;
+}
+
+}  // namespace
+
+RefinedVisibility loadOrComputeRefinedVisibility(const Mesh& mesh, const VisibilityOptions& options,
+                                                 const RefineOptions& refine, const std::string& cacheDir,
+                                                 const std::function<void(std::size_t done, std::size_t total)>& progress,
+                                                 VisibilityCacheStatus* statusOut) {
+  checkRefineOptions(refine);
+  const io::CacheHeader entry{"visibility-refined", kRefinedVisibilityCacheVersion,
+                              cacheDir.empty() ? std::string() : meshContentKey(mesh), refinedOptionsText(options, refine)};
+  return loadOrCompute(
+      mesh, options, cacheDir, entry, statusOut,
+      [&](std::string_view payload) { return decodeRefined(payload, mesh, options, refine); },
+      [&] { return computeRefinedVisibility(mesh, options, refine, progress); }, encodeRefined);
+}
+
 }  // namespace haarcast

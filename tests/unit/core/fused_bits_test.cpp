@@ -176,5 +176,54 @@ TEST(LightSplit, FindsASmallSunAndLosesNothing) {
   EXPECT_THROW(splitLight(light, tooMany), std::invalid_argument);
 }
 
+// A sun of 1° radius placed inside one level-6 texel, off its centre: split
+// on that map its light sits at the texel's centre, on a level-9 map of the
+// same sky within a tenth of a degree; and the coarse rest plus the light
+// still hold all the power.
+TEST(LightSplit, OnAFinerMapTheSunIsWhereItIsAndNothingIsLost) {
+  // θ = 45.7°, φ = 32.9°: a level-6 texel spans 2.8° × 5.6° and is centred
+  // at (46.4°, 33.75°), so the sun lies 1.0° from its texel's centre.
+  const glm::dvec3 sun = sphericalToDirection(45.7 * kPi / 180.0, 32.9 * kPi / 180.0);
+  auto sky = [&](int level) {
+    std::array<SphereMap, 3> light;
+    for (std::size_t c = 0; c < 3; ++c)
+      light[c] = supersampledMap(level, level >= 9 ? 2 : 16, [&](const glm::dvec3& d) {
+        return glm::dot(d, sun) > std::cos(1.0 * kPi / 180.0) ? 20000.0 : 0.3 + 0.1 * d.y;
+      });
+    return light;
+  };
+  const std::array<SphereMap, 3> coarse = sky(6), fine = sky(9);
+  const LightSplit onCoarse = splitLight(coarse);
+  const LightSplit onFine = splitLight(fine, 6);
+  ASSERT_EQ(onCoarse.lights.size(), 1u);
+  ASSERT_EQ(onFine.lights.size(), 1u);
+  const double coarseOff = std::acos(std::min(1.0, glm::dot(onCoarse.lights[0].direction, sun))) * 180.0 / kPi;
+  const double fineOff = std::acos(std::min(1.0, glm::dot(onFine.lights[0].direction, sun))) * 180.0 / kPi;
+  EXPECT_GT(coarseOff, 0.5) << "the coarse texel's centre is off the sun";
+  EXPECT_LT(fineOff, 0.1);
+  ASSERT_EQ(onFine.rest[0].level(), 6);
+  for (std::size_t c = 0; c < 3; ++c) {
+    EXPECT_NEAR(onFine.rest[c].integral() + onFine.lights[0].power[c], fine[c].integral(), 1e-5 * fine[c].integral());
+  }
+  EXPECT_THROW(splitLight(coarse, 7), std::invalid_argument) << "the rest cannot be finer than the map";
+}
+
+TEST(SphereMap, DownsampledIsTheSolidAngleMeanAndKeepsTheIntegral) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(0.0f, 2.0f);
+  SphereMap fine(5);
+  for (float& v : fine.values()) v = u(rng);
+  const SphereMap coarse = fine.downsampled(3);
+  ASSERT_EQ(coarse.level(), 3);
+  EXPECT_NEAR(coarse.integral(), fine.integral(), 1e-5 * fine.integral());
+  // One pixel by brute force: the 4×4 fine pixels it covers, by solid angle.
+  double sum = 0.0, solid = 0.0;
+  for (int r = 4; r < 8; ++r)
+    for (int c = 20; c < 24; ++c) sum += fine.at(r, c) * pixelSolidAngle(5, r), solid += pixelSolidAngle(5, r);
+  EXPECT_NEAR(coarse.at(1, 5), sum / solid, 1e-5);
+  EXPECT_EQ(fine.downsampled(5).values()[7], fine.values()[7]);
+  EXPECT_THROW((void)fine.downsampled(6), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace haarcast

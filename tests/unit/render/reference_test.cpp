@@ -298,7 +298,7 @@ TEST(Reference, AgreesWithTheHaarRendererOnALambertSphereInTheSky) {
   ro.visibility.supersampling = 1;
   ro.environmentBackground = false;
   const RenderResult haar = renderCpu(scene, ro);
-  ReferenceOptions o = smallOptions(size, 2048);
+  ReferenceOptions o = smallOptions(size, 8192);
   o.samplesPerPass = 64;
   o.environmentTableWidth = 1024;
   const ReferenceResult mc = renderReference(scene, o);
@@ -312,11 +312,12 @@ TEST(Reference, AgreesWithTheHaarRendererOnALambertSphereInTheSky) {
   std::cout << "truth PSNR (haar level 5 vs MC, lambert sphere, sky): " << e.psnr << " dB, MSE " << e.mse
             << ", peak " << e.peak << "; MC noise " << noise << " (" << 10.0 * std::log10(e.peak * e.peak / (noise * noise))
             << " dB), half error " << mc.halfError << ", " << mc.samples << " samples, " << mc.seconds << " s\n";
-  // Measured 35.9 dB (MC noise alone would allow ~55 dB); the same
-  // comparison gives 31.2 dB at level 4 and 48.5 dB at level 6, so the gap is
-  // the Haar render's band limit, not the reference.
-  EXPECT_GT(e.psnr, 33.0);
-  EXPECT_GT(10.0 * std::log10(e.peak * e.peak / (noise * noise)), e.psnr + 10.0);  // the reference is not the limit
+  // Measured 52.5 dB with the sun a point light found on the fine backdrop
+  // map (light_split.h), 35.9 dB when it was found on the level-5 map; the MC
+  // noise alone allows ~60 dB at 8192 samples, so the reference is not the
+  // limit.
+  EXPECT_GT(e.psnr, 45.0);
+  EXPECT_GT(10.0 * std::log10(e.peak * e.peak / (noise * noise)), e.psnr + 3.0);  // the reference is not the limit
 }
 
 TEST(Reference, BadOptionsAreRefusedByName) {

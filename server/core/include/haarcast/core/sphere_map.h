@@ -100,6 +100,12 @@ class SphereMap {
   // the light enters the triple product (DESIGN.md "Solid angle").
   SphereMap weightedBySolidAngle() const;
 
+  // The map at `coarser` ≤ level(): each pixel the solid-angle mean of the
+  // 2^k × 2^k pixels it covers, so the integral is kept, and a map of area
+  // means (Environment::maps) becomes the area means of the coarser level.
+  // Throws std::invalid_argument for a finer or invalid level.
+  SphereMap downsampled(int coarser) const;
+
  private:
   std::size_t index(int row, int col) const {
     return static_cast<std::size_t>(row) * static_cast<std::size_t>(size()) +

@@ -31,6 +31,7 @@
 #include "haarcast/io/image.h"
 #include "haarcast/render/scene.h"
 #include "haarcast/render/visibility.h"
+#include "haarcast/render/visibility_refine.h"
 
 namespace haarcast::render {
 
@@ -56,6 +57,7 @@ struct RenderOptions {
   // shadow ray per pixel each (core/light_split.h); maxLights 0 = none,
   // at most shared::kMaxPointLights.
   LightSplitOptions pointLights;
+  RefineOptions refine;                   // fused: the mesh refined where visibility changes (visibility_refine.h)
   SceneLimits sceneLimits;                // objects, triangles, visibility memory (prepareScene)
   bool environmentBackground = true;      // false: black where no object is
   std::string cacheDir;                   // slice-table and visibility cache; empty = none

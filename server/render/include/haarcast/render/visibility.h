@@ -84,6 +84,13 @@ std::vector<SparseHaar> computeVertexVisibility(
 inline constexpr double kBitsSkipBelowDegrees = 15.0;
 VisibilityBits computeVisibilityBits(const RayScene& occluders, const Mesh& mesh, const VisibilityOptions& options,
                                      const std::function<void(std::size_t done, std::size_t total)>& progress = {});
+// The bits of vertices first… of `mesh` into `out` (pointCount() = the
+// mesh's vertices, level = options.level), the others left as they are:
+// what refining a mesh (visibility_refine.h) computes for the vertices it
+// adds. progress counts those vertices.
+void computeVisibilityBitsFrom(const RayScene& occluders, const Mesh& mesh, const VisibilityOptions& options,
+                               std::size_t first, VisibilityBits& out,
+                               const std::function<void(std::size_t done, std::size_t total)>& progress = {});
 // The same against the mesh alone (normals made on a copy when it has none).
 VisibilityBits computeVisibilityBits(const Mesh& mesh, const VisibilityOptions& options,
                                      const std::function<void(std::size_t done, std::size_t total)>& progress = {});

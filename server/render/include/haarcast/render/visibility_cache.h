@@ -30,6 +30,7 @@
 #include "haarcast/core/mesh.h"
 #include "haarcast/io/cache_file.h"
 #include "haarcast/render/visibility.h"
+#include "haarcast/render/visibility_refine.h"
 
 namespace haarcast {
 
@@ -64,6 +65,18 @@ inline constexpr std::uint32_t kVisibilityBitsCacheVersion = 1;
 VisibilityBits loadOrComputeVisibilityBits(const Mesh& mesh, const VisibilityOptions& options, const std::string& cacheDir,
                                            const std::function<void(std::size_t done, std::size_t total)>& progress = {},
                                            VisibilityCacheStatus* status = nullptr);
+
+// `fused`'s refined mesh and its bits (computeRefinedVisibility), files of
+// kind "visibility-refined" keyed by the original mesh: options text the
+// bits' plus "rounds=… threshold=… min-edge=… growth=… floor=…"; payload
+// u64 V, u64 T, u32 rounds, V × (position, normal: 6 f32), T × 3 u32, V·W
+// u32 words. A refined mesh whose first vertices are not the original's, a
+// triangle out of range or a payload of the wrong size is a miss.
+inline constexpr std::uint32_t kRefinedVisibilityCacheVersion = 1;
+RefinedVisibility loadOrComputeRefinedVisibility(const Mesh& mesh, const VisibilityOptions& options,
+                                                 const RefineOptions& refine, const std::string& cacheDir,
+                                                 const std::function<void(std::size_t done, std::size_t total)>& progress = {},
+                                                 VisibilityCacheStatus* status = nullptr);
 
 // "mesh-fnv1a64:<16 hex digits> vertices=<V> triangles=<T>": FNV-1a 64 over
 // the counts and the little-endian bytes of positions, normals and triangles
