@@ -6,9 +6,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <map>
-#include <mutex>
-#include <cstdlib>
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
@@ -478,35 +475,6 @@ std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const RayScen
     }
     std::array<WeightedBits, 3> vis;
     for (std::size_t v = 0; v < 3; ++v) vis[v] = {p.visibilityBits.point(in.vertex[v]).data(), b[v]};
-    thread_local std::vector<std::uint32_t> exact;
-    if (std::getenv("HC_EXACTVIS")) {
-      static std::mutex mu;
-      static std::map<const Mesh*, std::unique_ptr<RayScene>> selfScenes;
-      const RayScene* self;
-      {
-        std::lock_guard lock(mu);
-        auto& e = selfScenes[p.mesh.get()];
-        if (!e) e = std::make_unique<RayScene>(std::vector<Instance>{Instance{p.mesh.get()}});
-        self = e.get();
-      }
-      const int level = p.visibilityBits.level();
-      const int m = mapSize(level);
-      const std::size_t n = static_cast<std::size_t>(m) * m;
-      thread_local std::vector<glm::vec3> dirs;
-      thread_local std::vector<std::uint8_t> blocked;
-      dirs.resize(n); blocked.resize(n);
-      for (int i = 0; i < m; ++i)
-        for (int j = 0; j < m; ++j) dirs[static_cast<std::size_t>(i * m + j)] = glm::vec3(sphericalToDirection(rowTheta(level, i), colPhi(level, j)));
-      const Mesh& mesh = *p.mesh;
-      glm::vec3 pos(0.0f), nrm(0.0f);
-      for (int v = 0; v < 3; ++v) { pos += b[v] * mesh.positions[in.vertex[v]]; nrm += b[v] * mesh.normals[in.vertex[v]]; }
-      nrm = glm::normalize(nrm);
-      const float shift = static_cast<float>(options_.visibility.offset * mesh.bounds().radius());
-      self->occludedFrom(pos + nrm * shift, 0.0f, dirs, blocked);
-      exact.assign(p.visibilityBits.wordsPerPoint(), 0u);
-      for (std::size_t k = 0; k < n; ++k) if (!blocked[k]) exact[k / 32] |= 1u << (k % 32);
-      vis[0] = {exact.data(), 1.0f}; vis[1] = {exact.data(), 0.0f}; vis[2] = {exact.data(), 0.0f};
-    }
     const PixelSlices& slices = pixelSlices_[object];
     const shared::SliceBlend blend = shared::sliceBlendAt(static_cast<float>(in.rotation.thetaOut),
                                                           static_cast<shared::uint>(slices.thetaSamples()),

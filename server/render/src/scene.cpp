@@ -229,7 +229,7 @@ std::shared_ptr<Mesh> meshAt(const nlohmann::json& j, const std::string& file, c
     else if (name == "torus") mesh = assets::makeTorus();
     else if (name == "box") mesh = assets::makeBox();
     else if (name == "plane") mesh = assets::makePlane(1.0, 8);
-    else if (name == "pillars") mesh = assets::makePillars(4, std::getenv("PSUB") ? std::atoi(std::getenv("PSUB")) : 6);
+    else if (name == "pillars") mesh = assets::makePillars();
     else fail(file, where + ".builtin", "unknown built-in mesh \"" + name + "\" (sphere, torus, box, plane, pillars)");
   } else {
     fail(file, where, "expected a file name or {\"builtin\": …}");
