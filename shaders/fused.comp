@@ -155,10 +155,11 @@ void shadePixel(uint s) {
   const uint seen = masks[s];
 
   // The ground: its map light is the same at every point (closed form on
-  // the host); only the point lights' shadow bits vary.
+  // the host) less the share the objects hide (the word's upper half); the
+  // point lights' shadow bits vary.
   if ((o.flags & kObjectGround) != 0u) {
     if (lid == 0u) {
-      vec3 sum = o.groundRadiance.rgb;
+      vec3 sum = groundSkyKept(seen) * o.groundRadiance.rgb;
       for (uint k = 0u; k < o.pointLights; ++k) {
         if (((seen >> k) & 1u) != 0u) sum += pointLights[sh.object * kMaxPointLights + k].power.rgb;
       }

@@ -14,7 +14,7 @@ namespace haarcast {
 LightSplit splitLight(const std::array<SphereMap, 3>& light, const LightSplitOptions& o) {
   if (o.maxLights > 32) throw std::invalid_argument("light split: at most 32 lights, asked for " + std::to_string(o.maxLights));
   if (!(o.seedRatio > 0.0) || !(o.growRatio >= 0.0 && o.growRatio <= 1.0) || !(o.maxRadiusDegrees > 0.0) ||
-      !(o.minShare >= 0.0 && o.minShare <= 1.0)) {
+      !(o.minShare >= 0.0 && o.minShare <= 1.0) || (o.parts != 1 && o.parts != 4)) {
     throw std::invalid_argument("light split: options out of range");
   }
   const int level = light[0].level();
@@ -50,7 +50,7 @@ LightSplit splitLight(const std::array<SphereMap, 3>& light, const LightSplitOpt
   std::vector<char> claimed(n, 0);
   std::vector<std::size_t> region, stack;
   for (const std::size_t seed : seeds) {
-    if (out.lights.size() == o.maxLights) break;
+    if (out.lights.size() + o.parts > o.maxLights) break;
     if (claimed[seed]) continue;
     const glm::dvec3 axis = direction(seed);
     const double floorLum = o.growRatio * lum[seed];
@@ -73,24 +73,40 @@ LightSplit splitLight(const std::array<SphereMap, 3>& light, const LightSplitOpt
         }
       }
     }
-    DirectionalLight l;
-    glm::dvec3 weighted(0.0);
+    // The region's power and centre, then its parts: the texels on each side
+    // of two planes through the centre (a region of one texel is one part).
+    glm::dvec3 centre(0.0);
     double power = 0.0;
     for (const std::size_t i : region) {
-      const int r = static_cast<int>(i) / m, c = static_cast<int>(i) % m;
-      const double w = solid[static_cast<std::size_t>(r)];
-      for (std::size_t ch = 0; ch < 3; ++ch) l.power[ch] += light[ch].at(r, c) * w;
-      power += std::max(lum[i], 0.0) * w;
-      weighted += std::max(lum[i], 0.0) * w * direction(i);
+      const double w = std::max(lum[i], 0.0) * solid[static_cast<std::size_t>(static_cast<int>(i) / m)];
+      power += w;
+      centre += w * direction(i);
     }
     // Too faint to be worth a ray per pixel: its texels stay in the map
     // (and stay claimed, so no later seed grows into them).
     if (power < o.minShare * total) continue;
-    l.direction = glm::normalize(weighted);
-    l.texels = region.size();
+    centre = glm::normalize(centre);
+    const glm::dvec3 helper = std::abs(centre.y) < 0.9 ? glm::dvec3(0.0, 1.0, 0.0) : glm::dvec3(1.0, 0.0, 0.0);
+    const glm::dvec3 t1 = glm::normalize(glm::cross(helper, centre));
+    const glm::dvec3 t2 = glm::cross(centre, t1);
+    std::array<DirectionalLight, 4> parts{};
+    std::array<glm::dvec3, 4> weighted{};
+    for (const std::size_t i : region) {
+      const int r = static_cast<int>(i) / m, c = static_cast<int>(i) % m;
+      const double w = solid[static_cast<std::size_t>(r)];
+      const glm::dvec3 d = direction(i);
+      const std::size_t q = o.parts == 1 ? 0 : (glm::dot(d, t1) >= 0.0 ? 1 : 0) + (glm::dot(d, t2) >= 0.0 ? 2 : 0);
+      for (std::size_t ch = 0; ch < 3; ++ch) parts[q].power[ch] += light[ch].at(r, c) * w;
+      weighted[q] += std::max(lum[i], 0.0) * w * d;
+      ++parts[q].texels;
+    }
+    for (std::size_t q = 0; q < 4; ++q) {
+      if (parts[q].texels == 0) continue;
+      parts[q].direction = glm::length(weighted[q]) > 0.0 ? glm::normalize(weighted[q]) : centre;
+      out.lights.push_back(parts[q]);
+    }
     for (const std::size_t i : region)
       for (std::size_t ch = 0; ch < 3; ++ch) out.rest[ch].at(static_cast<int>(i) / m, static_cast<int>(i) % m) = 0.0f;
-    out.lights.push_back(l);
   }
   return out;
 }

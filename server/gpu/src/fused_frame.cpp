@@ -47,7 +47,7 @@ std::uint32_t VulkanRenderer::Impl::computeShadowMasks(const render::ResolvedFra
     const std::size_t end = std::min<std::size_t>(count.covered, (chunk + 1) * kChunk);
     for (std::size_t s = chunk * kChunk; s < end; ++s) {
       const ShadeSample& sample = sh[s];
-      if (lightDirections.empty() || sample.object >= objectCount) {
+      if (sample.object >= objectCount) {
         out[s] = 0;
         continue;
       }
@@ -56,11 +56,11 @@ std::uint32_t VulkanRenderer::Impl::computeShadowMasks(const render::ResolvedFra
       const std::uint32_t base = objectInfo[object].vertexBase;
       // The hit triangle in the object's own vertex ids, as the CPU backend passes it.
       const glm::uvec3 triangle(sample.vertex[0] - base, sample.vertex[1] - base, sample.vertex[2] - base);
-      out[s] = render::pointLightMask(*rays,
-                                      render::shadingPoint(*p.mesh, triangle, sample.b, toWorld[object],
-                                                           rotations[object],
-                                                           p.shadowShift * static_cast<float>(resolved.objects[object].scale)),
-                                      lightDirections);
+      const render::ShadingPoint point =
+          render::shadingPoint(*p.mesh, triangle, sample.b, toWorld[object], rotations[object],
+                               p.shadowShift * static_cast<float>(resolved.objects[object].scale));
+      out[s] = render::pointLightMask(*rays, point, lightDirections);
+      if (p.ground) out[s] = render::withGroundOcclusion(out[s], render::groundSkyOcclusion(*rays, point, resolved.groundSky));
     }
   }, {}, options.threads);
   if (!out.empty()) maskUpload.write(out.data(), out.size() * sizeof(std::uint32_t));

@@ -462,12 +462,14 @@ std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const RayScen
     const glm::uvec3 triangle(in.vertex[0], in.vertex[1], in.vertex[2]);
     const float b[3] = {static_cast<float>(in.b[0]), static_cast<float>(in.b[1]), static_cast<float>(in.b[2])};
     // The point lights this sample sees: one shadow ray each (point_lights.h).
-    const std::uint32_t seen =
-        pointLightMask(rays, shadingPoint(*p.mesh, triangle, b, toWorld[object], rotations[object],
-                                          p.shadowShift * static_cast<float>(o.scale)),
-                       resolved.pointLightDirections);
+    const ShadingPoint point = shadingPoint(*p.mesh, triangle, b, toWorld[object], rotations[object],
+                                            p.shadowShift * static_cast<float>(o.scale));
+    std::uint32_t seen = pointLightMask(rays, point, resolved.pointLightDirections);
     if (p.ground) {
-      rgb = o.groundFlat;
+      // The word the Vulkan backend reads too: bits, then the sky's occlusion.
+      seen = withGroundOcclusion(seen, groundSkyOcclusion(rays, point, resolved.groundSky));
+      const float kept = shared::groundSkyKept(seen);
+      for (std::size_t c = 0; c < 3; ++c) rgb[c] = kept * o.groundFlat[c];
       for (std::size_t k = 0; k < o.pointLights.size(); ++k)
         if ((seen >> k) & 1u)
           for (std::size_t c = 0; c < 3; ++c) rgb[c] += o.pointLights[k].power[c];

@@ -273,6 +273,30 @@ ResolvedFrame resolveFrame(const PreparedScene& prepared, const RenderOptions& o
   }
   std::optional<glm::dvec3> groundNormal;
   if (prepared.ground) groundNormal = out.objects[*prepared.ground].rotation * glm::dvec3(0.0, 1.0, 0.0);
+  if (fused && prepared.ground) {
+    // The ground's sky occlusion (point_lights.h): the other objects'
+    // bounding spheres as posed, the map light's luminance and its total
+    // over the ground's hemisphere.
+    GroundSky& sky = out.groundSky;
+    sky.normal = glm::vec3(*groundNormal);
+    sky.toEnvironment = glm::mat3(glm::transpose(request.lightRotation));
+    for (std::size_t i = 0; i < out.objects.size(); ++i) {
+      if (prepared.objects[i].ground) continue;
+      const Bounds b = prepared.objects[i].mesh->bounds();
+      const glm::dvec3 centre = glm::dvec3(out.objects[i].objectToWorld * glm::dvec4(b.centre(), 1.0));
+      sky.occluders.emplace_back(glm::vec3(centre), static_cast<float>(b.radius() * out.objects[i].scale));
+    }
+    const int level = prepared.restLight[0].level();
+    sky.luminance = SphereMap(level);
+    for (int r = 0; r < sky.luminance.size(); ++r) {
+      for (int c = 0; c < sky.luminance.size(); ++c) {
+        const double l = luminance709(prepared.restLight[0].at(r, c), prepared.restLight[1].at(r, c), prepared.restLight[2].at(r, c));
+        sky.luminance.at(r, c) = static_cast<float>(l);
+        const double cosine = glm::dot(request.lightRotation * sphericalToDirection(rowTheta(level, r), colPhi(level, c)), *groundNormal);
+        if (cosine > 0.0) sky.total += l * cosine * pixelSolidAngle(level, r);
+      }
+    }
+  }
   for (std::size_t i = 0; i < out.objects.size(); ++i) {
     ResolvedObject& o = out.objects[i];
     if (fused) {

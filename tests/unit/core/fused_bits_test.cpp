@@ -152,7 +152,9 @@ TEST(LightSplit, FindsASmallSunAndLosesNothing) {
       return glm::dot(d, sun) > std::cos(2.0 * kPi / 180.0) ? 5000.0 * (1.0 + 0.1 * static_cast<double>(c)) : sky;
     });
   }
-  const LightSplit split = splitLight(light);
+  LightSplitOptions whole;
+  whole.parts = 1;
+  const LightSplit split = splitLight(light, whole);
   ASSERT_EQ(split.lights.size(), 1u);
   // Within a third of a level-6 texel (2.8°): the power-weighted centre of
   // the texels the sun covers.
@@ -167,6 +169,26 @@ TEST(LightSplit, FindsASmallSunAndLosesNothing) {
     }
     EXPECT_NEAR(rest + split.lights[0].power[c], total, 1e-6 * total);
     EXPECT_GT(split.lights[0].power[c], 0.5 * total) << "the sun carries most of this sky's power";
+  }
+  // In parts: the same power and rest, the parts' power-weighted mean
+  // direction the whole's, each part inside the sun (2°) and off its centre.
+  const LightSplit quarters = splitLight(light);
+  // (The sun covers a few level-6 texels: some quadrants may hold none.)
+  ASSERT_GE(quarters.lights.size(), 2u);
+  ASSERT_LE(quarters.lights.size(), 4u);
+  glm::dvec3 mean(0.0);
+  std::array<double, 3> sum{};
+  for (const DirectionalLight& q : quarters.lights) {
+    const double cosine = glm::dot(q.direction, split.lights[0].direction);
+    EXPECT_LT(cosine, std::cos(0.2 * kPi / 180.0));
+    EXPECT_GT(cosine, std::cos(2.0 * kPi / 180.0));
+    mean += luminance709(q.power[0], q.power[1], q.power[2]) * q.direction;
+    for (std::size_t c = 0; c < 3; ++c) sum[c] += q.power[c];
+  }
+  EXPECT_GT(glm::dot(glm::normalize(mean), split.lights[0].direction), std::cos(0.01 * kPi / 180.0));
+  for (std::size_t c = 0; c < 3; ++c) {
+    EXPECT_NEAR(sum[c], split.lights[0].power[c], 1e-9 * sum[c]);
+    EXPECT_EQ(quarters.rest[c].values()[100], split.rest[c].values()[100]);
   }
   LightSplitOptions none;
   none.maxLights = 0;
@@ -193,8 +215,10 @@ TEST(LightSplit, OnAFinerMapTheSunIsWhereItIsAndNothingIsLost) {
     return light;
   };
   const std::array<SphereMap, 3> coarse = sky(6), fine = sky(9);
-  const LightSplit onCoarse = splitLight(coarse);
-  const LightSplit onFine = splitLight(fine, 6);
+  LightSplitOptions whole;
+  whole.parts = 1;
+  const LightSplit onCoarse = splitLight(coarse, whole);
+  const LightSplit onFine = splitLight(fine, 6, whole);
   ASSERT_EQ(onCoarse.lights.size(), 1u);
   ASSERT_EQ(onFine.lights.size(), 1u);
   const double coarseOff = std::acos(std::min(1.0, glm::dot(onCoarse.lights[0].direction, sun))) * 180.0 / kPi;

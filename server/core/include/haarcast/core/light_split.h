@@ -34,11 +34,15 @@
 namespace haarcast {
 
 struct LightSplitOptions {
-  std::size_t maxLights = 8;        // ≤ 32: one bit per light per pixel
+  std::size_t maxLights = 16;       // ≤ 32: one bit per light per pixel
   double seedRatio = 16.0;          // × mean radiance
   double growRatio = 0.05;          // × the seed's luminance
   double maxRadiusDegrees = 6.0;    // a region's extent from its seed
   double minShare = 0.005;          // of the total power
+  // Each region becomes this many lights, 1 or 4: its texels parted in four
+  // quadrants about its centre (a penumbra in five steps instead of a hard
+  // edge). Regions are taken while their lights fit in maxLights.
+  std::size_t parts = 4;
 };
 
 struct DirectionalLight {

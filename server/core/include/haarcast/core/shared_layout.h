@@ -267,7 +267,16 @@ HC_CONST uint kObjectGround = 1u;
 // albedo/π·cos θ·power). Each covered sample s has a word of shadow bits,
 // bit k = 1 when the sample sees light k (render/point_lights.h computes
 // them on the host for both backends).
-HC_CONST uint kMaxPointLights = 8u;
+HC_CONST uint kMaxPointLights = 16u;
+// A ground sample's word carries, above the light bits, the share of its
+// map light that the scene's objects hide (render/point_lights.h,
+// groundSkyOcclusion) in 16 bits: radiance = (1 − share)·groundRadiance +
+// Σ_k bit_k·power_k.
+HC_CONST uint kGroundOcclusionShift = 16u;
+HC_CONST float kGroundOcclusionSteps = 65535.0;
+HC_FUNCTION float groundSkyKept(uint word) {
+  return 1.0 - float(word >> kGroundOcclusionShift) / kGroundOcclusionSteps;
+}
 struct PointLight {
   vec4 direction;
   vec4 power;
@@ -354,6 +363,7 @@ static_assert(sizeof(FrameParams) == 128 && offsetof(FrameParams, tanHalf) == 96
 static_assert(sizeof(ObjectInfo) == 96 && offsetof(ObjectInfo, sliceBase) == 48 &&
               offsetof(ObjectInfo, skipBelowY) == 68 && offsetof(ObjectInfo, groundRadiance) == 80);
 static_assert(sizeof(PointLight) == 32);
+static_assert(kMaxPointLights <= kGroundOcclusionShift, "the light bits and the ground's occlusion share one word");
 static_assert(sizeof(RotationSample) == 32 && offsetof(RotationSample, alpha) == 8 &&
               offsetof(RotationSample, thetaOut) == 24);
 static_assert(sizeof(ShadeSample) == 32 && offsetof(ShadeSample, b) == 16 && offsetof(ShadeSample, pixel) == 28);

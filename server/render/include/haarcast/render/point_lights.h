@@ -12,12 +12,14 @@
 
 #include <cstdint>
 #include <span>
+#include <vector>
 
 #include <glm/mat3x3.hpp>
 #include <glm/mat4x4.hpp>
 #include <glm/vec3.hpp>
 
 #include "haarcast/core/mesh.h"
+#include "haarcast/core/sphere_map.h"
 #include "haarcast/render/embree_scene.h"
 
 namespace haarcast::render {
@@ -41,5 +43,32 @@ ShadingPoint shadingPoint(const Mesh& mesh, const glm::uvec3& triangle, const fl
 // Bit k set when the point sees direction k (world frame, unit): n·d_k > 0
 // and the ray from position + shift·n toward d_k escapes. At most 32 directions.
 std::uint32_t pointLightMask(const RayScene& world, const ShadingPoint& p, std::span<const glm::vec3> directions);
+
+// What the objects hide of a ground's map light (the sky less its point
+// lights): the ground is shaded in closed form, the same at every point,
+// so without this an object standing on it casts no contact shadow from
+// the sky. Per ground sample, rays go toward each object's bounding
+// sphere — a cone of 3 × 8 stratified directions, the same pattern at
+// every sample so the result is smooth and steady from frame to frame —
+// against the whole posed scene; each blocked direction takes its share
+// of Σ L·cos·ΔΩ. Objects whose cone can hide less than `minShare` of the
+// sky are skipped, so rays go only near the objects.
+struct GroundSky {
+  std::vector<glm::vec4> occluders;  // world bounding spheres of the objects other than the ground (centre, radius)
+  SphereMap luminance;               // the map light's luminance, in the environment's frame
+  glm::mat3 toEnvironment{1.0f};     // world → environment (lightRotationᵀ)
+  glm::vec3 normal{0.0f, 1.0f, 0.0f};  // the ground's, world
+  double total = 0.0;                // Σ luminance·cos·ΔΩ over the ground's upper hemisphere
+  double minShare = 0.004;
+};
+inline constexpr int kGroundSkyRings = 3;
+inline constexpr int kGroundSkySectors = 8;
+
+// The share in [0, 1] of the ground's map light that the scene hides from p.
+float groundSkyOcclusion(const RayScene& world, const ShadingPoint& p, const GroundSky& sky);
+
+// A ground sample's word: its light bits and the occlusion above them
+// (shared_layout.h, kGroundOcclusionShift).
+std::uint32_t withGroundOcclusion(std::uint32_t lightBits, float occlusion);
 
 }  // namespace haarcast::render

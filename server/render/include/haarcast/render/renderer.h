@@ -38,6 +38,7 @@
 #include "haarcast/core/sphere_map.h"
 #include "haarcast/io/image.h"
 #include "haarcast/render/cpu_renderer.h"
+#include "haarcast/render/point_lights.h"
 #include "haarcast/render/scene.h"
 #include "haarcast/render/tonemap.h"
 
@@ -210,6 +211,7 @@ struct ResolvedFrame {
   std::vector<ResolvedObject> objects;
   std::size_t lightBytes = 0;         // the light lists, index + value per entry
   std::vector<glm::vec3> pointLightDirections;  // fused: world frame, unit, toward each light
+  GroundSky groundSky;                // fused with a ground: what its samples' rays need (point_lights.h)
 };
 ResolvedFrame resolveFrame(const PreparedScene& prepared, const RenderOptions& options, const FrameRequest& request);
 
