@@ -12,11 +12,12 @@ namespace {
 constexpr double kLineSeconds = 5.0;
 constexpr int kLinePercentStep = 10;
 
+// From done and total, not `fraction`: 29 / 100 is 28.999… as a double.
 int percentOf(const v1::BuildProgress& p) {
   if (p.total() == 0) return -1;
   if (p.done() >= p.total()) return 100;
-  const double f = std::isfinite(p.fraction()) ? p.fraction() : 0.0;
-  return std::clamp(static_cast<int>(f * 100.0), 0, 99);  // never 100 before the end
+  const long double percent = static_cast<long double>(p.done()) * 100 / static_cast<long double>(p.total());
+  return std::min(99, static_cast<int>(percent));  // never 100 before the end
 }
 
 }  // namespace

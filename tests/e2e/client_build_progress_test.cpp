@@ -42,6 +42,7 @@ TEST(BuildProgressText, StagePercentAndTheStagesEstimate) {
   EXPECT_EQ(buildProgressText(progress("visibility bunny", 1, 42, 100, 3.14)),
             "visibility bunny  42 % (~3.1 s left in this stage)");
   EXPECT_EQ(buildProgressText(progress("slices gold", 0, 0, 32)), "slices gold   0 %");
+  EXPECT_EQ(buildProgressText(progress("slices gold", 0, 29, 100)), "slices gold  29 %") << "not 28: 0.29 × 100 < 29";
   EXPECT_EQ(buildProgressText(progress("slices gold", 0, 999, 1000, 0.01)), "slices gold  99 % (~0.0 s left in this stage)");
   EXPECT_EQ(buildProgressText(progress("slices gold", 0, 32, 32, 5.0)), "slices gold 100 %") << "done: no time left to say";
   EXPECT_EQ(buildProgressText(progress("rotators ring", 2, 5, 0)), "rotators ring") << "total unknown";
