@@ -215,6 +215,11 @@ TEST(RenderSession, SceneSwitchAnnouncesSceneInfoAndBuildsItsRenderer) {
   ASSERT_EQ(f.port.prepared.size(), 2u);
   EXPECT_EQ(f.port.prepared.back().scene, "other");
   EXPECT_EQ(f.session.config().scene, "other");
+  // Its build's progress follows the SceneInfo; the old renderer's build has none.
+  f.session.onBuildProgress(f.port.prepared.front().rendererKey(), {"slices a", 0, 1, 2, 0.1, 0.0});
+  f.session.onBuildProgress(f.port.prepared.back().rendererKey(), {"slices b", 0, 1, 2, 0.1, 0.0});
+  EXPECT_EQ(f.port.sent.back().build_progress().stage(), "slices b");
+  EXPECT_TRUE(f.port.sent[f.port.sent.size() - 2].has_scene_info());
   // A material change on the same scene is a SceneChoice too: SceneInfo again.
   m.mutable_scene()->mutable_object_materials()->insert({1, "phong:16"});
   f.receive(m, f.t0);
