@@ -15,6 +15,7 @@
 #include <boost/asio/io_context.hpp>
 #include <nlohmann/json.hpp>
 
+#include "build_progress.h"
 #include "client_options.h"
 #include "pose_path.h"
 #include "run_stats.h"
@@ -27,17 +28,38 @@ using Clock = std::chrono::steady_clock;
 
 // The progress display on stderr: one line redrawn in place on a terminal,
 // a line every tenth of the run otherwise (logs and CI). A total of 0 means
-// unknown (--duration): a line every 10 frames, and no bar.
+// unknown (--duration): a line every 10 frames, and no bar. Before the
+// frames, the server's renderer build (build_progress.h), the same way.
 class Progress {
  public:
   Progress(std::uint64_t total, bool quiet, bool perFrame)
-      : total_(total), quiet_(quiet), perFrame_(perFrame), tty_(isatty(STDERR_FILENO) != 0) {}
+      : total_(total),
+        quiet_(quiet),
+        perFrame_(perFrame),
+        tty_(isatty(STDERR_FILENO) != 0),
+        build_(tty_ && !perFrame, [](const std::string& text) {
+          std::fputs(text.c_str(), stderr);
+          std::fflush(stderr);
+        }) {}
+
+  // A BuildProgress of client `client`'s renderer; nullptr: it is ready.
+  void build(std::size_t /*client: the sessions of a run share one build*/, const haarcast::v1::BuildProgress* p) {
+    if (quiet_) return;
+    const double now = std::chrono::duration<double>(Clock::now() - created_).count();
+    if (!p) {
+      build_.ready(now);
+      return;
+    }
+    endFrameLine();
+    build_.update(*p, now);
+  }
 
   void frame(const FrameEvent& e) {
     ++done_;
     bytes_ += e.bytes;
     lastLatency_ = e.latencyMs;
     if (quiet_) return;
+    build_.endLine();
     const auto now = Clock::now();
     if (done_ == 1) start_ = now;
     if (perFrame_) {
@@ -67,8 +89,8 @@ class Progress {
   }
 
   void endLine() {
-    if (lineOpen_) std::fputc('\n', stderr);
-    lineOpen_ = false;
+    build_.endLine();
+    endFrameLine();
   }
 
  private:
@@ -88,10 +110,17 @@ class Progress {
     return text;
   }
 
+  void endFrameLine() {
+    if (lineOpen_) std::fputc('\n', stderr);
+    lineOpen_ = false;
+  }
+
   std::uint64_t total_;
   bool quiet_;
   bool perFrame_;
   bool tty_;
+  BuildProgressDisplay build_;
+  Clock::time_point created_ = Clock::now();
   bool lineOpen_ = false;
   std::uint64_t done_ = 0;
   std::uint64_t bytes_ = 0;
@@ -283,7 +312,8 @@ int run(int argc, char** argv) {
     }
     sessions.emplace_back(
         io, i, std::move(config), summary.sessions[i], [&progress](const FrameEvent& e) { progress.frame(e); },
-        [&progress](const std::string& line) { progress.message(line); });
+        [&progress](const std::string& line) { progress.message(line); },
+        [&progress](std::size_t client, const haarcast::v1::BuildProgress* p) { progress.build(client, p); });
     sessions.back().start();
   }
   io.run();

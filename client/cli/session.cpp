@@ -15,6 +15,7 @@
 #include <boost/beast/http.hpp>
 #include <boost/beast/websocket.hpp>
 
+#include "build_progress.h"
 #include "frame_image.h"
 
 namespace haarcast::client {
@@ -28,12 +29,13 @@ using Clock = std::chrono::steady_clock;
 
 struct Session::Impl : std::enable_shared_from_this<Session::Impl> {
   Impl(asio::io_context& io, std::size_t clientIndex, SessionConfig sessionConfig, SessionStats& sessionStats,
-       FrameCallback frameCallback, MessageCallback messageCallback)
+       FrameCallback frameCallback, MessageCallback messageCallback, BuildCallback buildCallback)
       : index(clientIndex),
         config(std::move(sessionConfig)),
         stats(sessionStats),
         onFrame(std::move(frameCallback)),
         onMessage(std::move(messageCallback)),
+        onBuild(std::move(buildCallback)),
         resolver(io),
         ws(io),
         watchdog(io),
@@ -44,6 +46,7 @@ struct Session::Impl : std::enable_shared_from_this<Session::Impl> {
   SessionStats& stats;
   FrameCallback onFrame;
   MessageCallback onMessage;
+  BuildCallback onBuild;
 
   tcp::resolver resolver;
   websocket::stream<beast::tcp_stream> ws;
@@ -227,13 +230,30 @@ struct Session::Impl : std::enable_shared_from_this<Session::Impl> {
         break;
       case v1::ServerMessage::kError: onError(message.error()); break;
       case v1::ServerMessage::kPong: break;
-      default: return fail("the server sent a ServerMessage with no body");
+      case v1::ServerMessage::kSceneInfo: break;  // this client changes no scene after Hello
+      case v1::ServerMessage::kBuildProgress: onBuildProgress(message.build_progress()); break;
+      case v1::ServerMessage::BODY_NOT_SET:
+        // A newer server's message type arrives as unknown fields: ignored,
+        // as the protocol's "fields are only ever added" asks. Nothing at
+        // all is a broken server.
+        if (message.GetReflection()->GetUnknownFields(message).empty()) {
+          return fail("the server sent a ServerMessage with no body");
+        }
+        break;
     }
     if (!closing) doRead();
   }
 
+  // The renderer is being built: shown, and proof that the server works on
+  // it, so the wait (for Welcome, or the next frame) starts again.
+  void onBuildProgress(const v1::BuildProgress& progress) {
+    if (onBuild) onBuild(index, &progress);
+    armWatchdog(welcomed ? phase : "Welcome (the renderer build last reported: " + buildProgressText(progress) + ")");
+  }
+
   void onWelcome(const v1::Welcome& w) {
     if (welcomed) return fail("the server sent a second Welcome");
+    if (onBuild) onBuild(index, nullptr);
     welcome = w;
     welcomed = true;
     scheduleKeepalive();
@@ -431,8 +451,9 @@ struct Session::Impl : std::enable_shared_from_this<Session::Impl> {
 };
 
 Session::Session(asio::io_context& io, std::size_t index, SessionConfig config, SessionStats& stats,
-                 FrameCallback onFrame, MessageCallback onMessage)
-    : impl_(std::make_shared<Impl>(io, index, std::move(config), stats, std::move(onFrame), std::move(onMessage))) {}
+                 FrameCallback onFrame, MessageCallback onMessage, BuildCallback onBuild)
+    : impl_(std::make_shared<Impl>(io, index, std::move(config), stats, std::move(onFrame), std::move(onMessage),
+                                   std::move(onBuild))) {}
 
 void Session::start() { impl_->start(); }
 

@@ -1,6 +1,6 @@
 // One client session over Beast's WebSocket: connect, upgrade (token in the
-// Authorization header), Hello → Welcome, then play the pose path and count
-// the frames that answer it. Several sessions share one io_context for
+// Authorization header), Hello → (BuildProgress …) → Welcome, then play the
+// pose path and count the frames that answer it. Several sessions share one io_context for
 // `--clients N`; each reads and writes on its own, one write in flight.
 #pragma once
 
@@ -49,9 +49,12 @@ class Session {
  public:
   using FrameCallback = std::function<void(const FrameEvent&)>;
   using MessageCallback = std::function<void(const std::string&)>;  // a line for stderr
+  // The server builds this session's renderer: a BuildProgress (client
+  // index, the message), then nullptr once the renderer is ready (Welcome).
+  using BuildCallback = std::function<void(std::size_t client, const v1::BuildProgress* progress)>;
 
   Session(boost::asio::io_context& io, std::size_t index, SessionConfig config, SessionStats& stats,
-          FrameCallback onFrame, MessageCallback onMessage);
+          FrameCallback onFrame, MessageCallback onMessage, BuildCallback onBuild = {});
   void start();
   // The Welcome as received (empty before it arrives).
   const v1::Welcome& welcome() const;

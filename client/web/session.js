@@ -100,6 +100,10 @@ export function connect() {
     else if (m.sceneInfo) handlers.sceneInfo(m.sceneInfo);
     else if (m.stats) handlers.stats(m.stats);
     else if (m.error) onError(m.error);
+    // BuildProgress (the renderer is being built) is not shown by the page
+    // yet; Pong needs no answer. Any other message type a newer server adds
+    // decodes to none of the above and is ignored too.
+    else if (m.buildProgress || m.pong) { /* nothing to do */ }
   };
   socket.onclose = (event) => {
     if (gen !== generation) return;

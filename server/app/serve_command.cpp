@@ -201,9 +201,12 @@ int run(ServeArgs& a) {
   antialiasFor(antialias, a.backend);  // a bad flag fails at start, not in a session
   // Abandonable: once nobody waits for the build (its sessions closed, or
   // the server stops) the next progress step throws, so a SIGTERM during a
-  // build of seconds still exits at once.
+  // build of seconds still exits at once. Every progress step also goes to
+  // the waiting clients (`toClients`: BuildProgress messages, throttled by
+  // the render service) besides the log.
   net::AbandonableRendererBuilder builder = [sharedScenes, materialFiles, base, vulkanOptions, quiet, antialias](
-                                                const net::SessionConfig& c, const std::function<bool()>& abandoned) {
+                                                const net::SessionConfig& c, const std::function<bool()>& abandoned,
+                                                const render::RenderProgress& toClients) {
     const auto it = std::find_if(sharedScenes->begin(), sharedScenes->end(),
                                  [&](const SceneSource& s) { return s.name == c.scene; });
     if (it == sharedScenes->end()) throw std::invalid_argument("unknown scene \"" + c.scene + "\"");
@@ -228,6 +231,7 @@ int run(ServeArgs& a) {
     const render::RenderProgress stages = [&](const std::string& stage, std::size_t done, std::size_t total) {
       if (abandoned()) throw std::runtime_error("renderer build abandoned: nobody waits for it");
       if (shown) shown(stage, done, total);
+      if (toClients) toClients(stage, done, total);
     };
     prepared->renderer = gpu::makeRenderer(backend, scene, options, vulkanOptions, stages);
     if (!quiet) {

@@ -106,9 +106,15 @@ class FuzzSession : private SessionPort {
 
   void settle() {
     // Every third build fails, so the RENDER_FAILED path is reached too.
+    // Each reports progress first, under a name with a path and a control
+    // character in it (BuildProgress must still parse), and once for a key
+    // that is not the config's (ignored).
     if (build_) {
       const SessionConfig config = *build_;
       build_.reset();
+      const auto step = static_cast<std::size_t>(received_);
+      session_.onBuildProgress(config.rendererKey(), {"visibility /srv/x\x1b/ball", 1, step, 2 * step, 0.5, 1.0});
+      session_.onBuildProgress("an older key", {"slices ball", 0, 1, 2, 0.1, 0.1});
       if (++builds_ % 3 == 0) {
         session_.onPrepared(config.rendererKey(), nullptr, "the build failed", now_);
       } else {

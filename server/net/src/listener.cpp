@@ -232,17 +232,8 @@ void Server::Impl::watchDrain() {
   });
 }
 
-namespace {
-AbandonableRendererBuilder abandonable(RendererBuilder builder) {
-  if (!builder) return {};
-  return [builder = std::move(builder)](const SessionConfig& config, const std::function<bool()>&) {
-    return builder(config);
-  };
-}
-}  // namespace
-
 Server::Server(ServerOptions options, Catalog catalog, RendererBuilder builder)
-    : Server(std::move(options), std::move(catalog), abandonable(std::move(builder))) {}
+    : Server(std::move(options), std::move(catalog), asAbandonable(std::move(builder))) {}
 
 Server::Server(ServerOptions options, Catalog catalog, AbandonableRendererBuilder builder)
     : impl_(std::make_shared<Impl>(std::move(options), std::move(catalog), std::move(builder))) {

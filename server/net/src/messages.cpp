@@ -90,6 +90,19 @@ std::string errorMessage(const ProtocolError& e) {
   return serialize(m);
 }
 
+std::string buildProgressMessage(const BuildProgressUpdate& update) {
+  v1::ServerMessage m;
+  auto* b = m.mutable_build_progress();
+  b->set_stage(publicStageName(update.stage));
+  b->set_stage_index(static_cast<std::uint32_t>(update.stageIndex));
+  b->set_done(update.done);
+  b->set_total(update.total);
+  b->set_fraction(update.fraction());
+  b->set_elapsed_seconds(std::max(0.0, update.elapsedSeconds));
+  b->set_estimated_stage_seconds_left(std::max(0.0, update.stageSecondsLeft));
+  return serialize(m);
+}
+
 std::string utf8Prefix(std::string_view text, std::size_t maxBytes) {
   if (text.size() <= maxBytes) return std::string(text);
   std::size_t end = maxBytes;

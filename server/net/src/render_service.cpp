@@ -15,6 +15,7 @@
 #include <utility>
 
 #include "haarcast/net/encode.h"
+#include "task_queue.h"
 
 namespace haarcast::net {
 namespace {
@@ -23,66 +24,25 @@ using Clock = std::chrono::steady_clock;
 
 double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-// A FIFO of tasks served by a fixed set of threads (the encoders).
-class TaskQueue {
- public:
-  void start(int threads) {
-    for (int i = 0; i < threads; ++i) threads_.emplace_back([this] { loop(); });
-  }
-  void push(std::function<void()> task) {
-    {
-      std::lock_guard lock(mutex_);
-      if (stopping_) return;
-      tasks_.push_back(std::move(task));
-    }
-    cv_.notify_one();
-  }
-  void stop() {
-    std::deque<std::function<void()>> dropped;  // destroyed outside the lock
-    {
-      std::lock_guard lock(mutex_);
-      stopping_ = true;
-      dropped.swap(tasks_);
-    }
-    cv_.notify_all();
-    for (auto& t : threads_) {
-      if (t.joinable()) t.join();
-    }
-    threads_.clear();
-  }
-
- private:
-  void loop() {
-    for (;;) {
-      std::function<void()> task;
-      {
-        std::unique_lock lock(mutex_);
-        cv_.wait(lock, [this] { return stopping_ || !tasks_.empty(); });
-        if (stopping_) return;
-        task = std::move(tasks_.front());
-        tasks_.pop_front();
-      }
-      task();
-    }
-  }
-
-  std::mutex mutex_;
-  std::condition_variable cv_;
-  std::deque<std::function<void()>> tasks_;
-  std::vector<std::thread> threads_;
-  bool stopping_ = false;
-};
-
 void checkOptions(const RenderService::Options& o) {
   auto bad = [](const std::string& what) { throw std::invalid_argument("RenderService options: " + what); };
   if (o.workers < 1) bad("workers must be at least 1 (got " + std::to_string(o.workers) + ")");
   if (o.encoders < 1) bad("encoders must be at least 1 (got " + std::to_string(o.encoders) + ")");
   if (o.maxSessionPixels < 1) bad("maxSessionPixels must be at least 1");
   if (o.maxQueuedBuilds < 1) bad("maxQueuedBuilds must be at least 1");
+  if (!(o.progressIntervalSeconds >= 0.0)) bad("progressIntervalSeconds must be at least 0");
 }
 
 // A prepare's answer, made under the cache lock and given outside it.
 using Answer = std::pair<RenderService::PrepareDone, PrepareOutcome>;
+
+// What prepare() hands out once the lock is released: the answers, and the
+// running build's latest progress for the prepare that joined it.
+struct PrepareResult {
+  std::vector<Answer> answers;
+  RenderService::ProgressSink progressSink;
+  std::optional<BuildProgressUpdate> progress;
+};
 
 }  // namespace
 
@@ -93,11 +53,21 @@ struct RenderService::Impl {
 
   // ---- Renderers: the cache, the builds, who waits for what --------------
   // A build of one key, queued or running, with the prepares waiting for it.
+  struct Waiter {
+    std::string owner;
+    PrepareDone done;
+    ProgressSink progress;  // may be empty
+  };
   struct Build {
     SessionConfig config;
     std::string key;
-    std::vector<std::pair<std::string, PrepareDone>> waiters;  // owner, callback
+    std::vector<Waiter> waiters;
     std::atomic<bool> abandoned{false};
+    // Set when the builder thread takes it; under cacheMutex. `latest` is
+    // the last progress update published: what a prepare joining the
+    // running build gets at once.
+    Clock::time_point started;
+    std::optional<BuildProgressUpdate> latest;
   };
   std::mutex cacheMutex;
   std::list<std::shared_ptr<PreparedRenderer>> ready;  // LRU order, front = most recent
@@ -150,8 +120,8 @@ struct RenderService::Impl {
     ownerWaits.erase(it);
     auto& w = build->waiters;
     for (auto k = w.begin(); k != w.end(); ++k) {
-      if (k->first != owner) continue;
-      if (answers) answers->push_back({std::move(k->second), {PrepareStatus::Superseded, nullptr, {}}});
+      if (k->owner != owner) continue;
+      if (answers) answers->push_back({std::move(k->done), {PrepareStatus::Superseded, nullptr, {}}});
       w.erase(k);
       break;
     }
@@ -164,18 +134,30 @@ struct RenderService::Impl {
     if (const auto b = builds.find(build->key); b != builds.end() && b->second == build) builds.erase(b);
   }
 
-  // When the owner already waits for a build of `key`, its new callback
-  // takes the old one's place (answered Superseded) and the build goes on.
+  // When the owner already waits for a build of `key`, its new callbacks
+  // take the old ones' place (answered Superseded) and the build goes on.
   // Under cacheMutex.
-  bool replaceWaiter(const std::string& owner, const std::string& key, PrepareDone& done, std::vector<Answer>& answers) {
+  bool replaceWaiter(const std::string& owner, const std::string& key, PrepareDone& done, ProgressSink& progress,
+                     PrepareResult& result) {
     const auto it = ownerWaits.find(owner);
     if (it == ownerWaits.end() || it->second->key != key || it->second->abandoned) return false;
-    for (auto& [who, callback] : it->second->waiters) {
-      if (who != owner) continue;
-      answers.push_back({std::exchange(callback, std::move(done)), {PrepareStatus::Superseded, nullptr, {}}});
+    for (Waiter& w : it->second->waiters) {
+      if (w.owner != owner) continue;
+      result.answers.push_back({std::exchange(w.done, std::move(done)), {PrepareStatus::Superseded, nullptr, {}}});
+      w.progress = std::move(progress);
+      joinProgress(*it->second, w.progress, result);
       return true;
     }
     return false;
+  }
+
+  // The build's latest progress for a prepare that has just joined it (its
+  // elapsed time brought up to now). Under cacheMutex.
+  static void joinProgress(const Build& build, const ProgressSink& sink, PrepareResult& result) {
+    if (!sink || !build.latest) return;
+    result.progressSink = sink;
+    result.progress = build.latest;
+    result.progress->elapsedSeconds = secondsSince(build.started);
   }
 
   // The cached renderer of `key`, made the most recently used; null if none.
@@ -190,21 +172,22 @@ struct RenderService::Impl {
     return nullptr;
   }
 
-  std::vector<Answer> prepare(const SessionConfig& config, const std::string& owner, PrepareDone done) {
-    std::vector<Answer> answers;
+  PrepareResult prepare(const SessionConfig& config, const std::string& owner, PrepareDone done, ProgressSink progress) {
+    PrepareResult result;
+    std::vector<Answer>& answers = result.answers;
     const std::string key = config.rendererKey();
     std::lock_guard lock(cacheMutex);
     if (!owner.empty()) {  // the latest wins
-      if (replaceWaiter(owner, key, done, answers)) return answers;
+      if (replaceWaiter(owner, key, done, progress, result)) return result;
       detachOwner(owner, &answers);
     }
     if (buildsStopping) {
       answers.push_back({std::move(done), {PrepareStatus::Refused, nullptr, "the render service is stopping"}});
-      return answers;
+      return result;
     }
     if (auto cached = cachedLocked(key)) {
       answers.push_back({std::move(done), {PrepareStatus::Ready, std::move(cached), {}}});
-      return answers;
+      return result;
     }
     std::shared_ptr<Build>& build = builds[key];  // an abandoned build is not in `builds`
     if (!build) {
@@ -214,7 +197,7 @@ struct RenderService::Impl {
                            {PrepareStatus::Refused, nullptr,
                             "the server has " + std::to_string(buildQueue.size()) +
                                 " renderer builds queued, its limit (max-queued-builds); try again later"}});
-        return answers;
+        return result;
       }
       build = std::make_shared<Build>();
       build->config = config;
@@ -222,9 +205,10 @@ struct RenderService::Impl {
       buildQueue.push_back(build);
       buildCv.notify_one();
     }
-    build->waiters.emplace_back(owner, std::move(done));
+    joinProgress(*build, progress, result);
+    build->waiters.push_back({owner, std::move(done), std::move(progress)});
     if (!owner.empty()) ownerWaits[owner] = build;
-    return answers;
+    return result;
   }
 
   // The queued build to start next (see ownerServed); the queue is not empty.
@@ -233,7 +217,7 @@ struct RenderService::Impl {
     auto served = [&](const Build& b) {
       std::uint64_t least = std::numeric_limits<std::uint64_t>::max();
       for (const auto& waiter : b.waiters) {
-        const auto it = ownerServed.find(waiter.first);
+        const auto it = ownerServed.find(waiter.owner);
         least = std::min(least, it == ownerServed.end() ? std::uint64_t{0} : it->second);
       }
       return least;
@@ -262,16 +246,21 @@ struct RenderService::Impl {
         buildQueue.erase(next);
         ++buildsStarted;
         for (const auto& waiter : build->waiters) {
-          if (!waiter.first.empty()) ownerServed[waiter.first] = buildsStarted;
+          if (!waiter.owner.empty()) ownerServed[waiter.owner] = buildsStarted;
         }
         runningBuild = build;
+        build->started = Clock::now();
         cached = cachedLocked(build->key);  // an abandoned build of this key may have finished meanwhile
       }
       std::shared_ptr<PreparedRenderer> renderer = cached;
       std::string error;
       if (!renderer) {
+        BuildProgressTracker tracker(build->started, options.progressIntervalSeconds);
+        const render::RenderProgress progress = [&](const std::string& stage, std::size_t done, std::size_t total) {
+          if (auto update = tracker.step(stage, done, total, Clock::now())) publish(*build, std::move(*update));
+        };
         try {
-          renderer = builder(build->config, [&build] { return build->abandoned.load(); });
+          renderer = builder(build->config, [&build] { return build->abandoned.load(); }, progress);
           if (!renderer || !renderer->renderer) error = "the renderer builder returned nothing";
         } catch (const std::exception& e) {
           error = e.what();
@@ -281,6 +270,26 @@ struct RenderService::Impl {
         if (!error.empty()) renderer.reset();
       }
       finishBuild(build, std::move(renderer), error, !cached);
+    }
+  }
+
+  // One progress update to every waiter of the running build, outside the
+  // lock; kept for those that join later. On the builder thread.
+  void publish(Build& build, BuildProgressUpdate update) {
+    std::vector<ProgressSink> sinks;
+    {
+      std::lock_guard lock(cacheMutex);
+      for (const Waiter& w : build.waiters) {
+        if (w.progress) sinks.push_back(w.progress);
+      }
+      build.latest = update;
+    }
+    for (const ProgressSink& sink : sinks) {
+      try {
+        sink(update);
+      } catch (...) {
+        // Progress is information: a sink that fails must not fail the build.
+      }
     }
   }
 
@@ -299,10 +308,10 @@ struct RenderService::Impl {
         while (ready.size() > options.maxRenderers) ready.pop_back();  // sessions keep theirs alive
       }
       if (buildsStopping) return;  // the waiters are dropped unanswered
-      for (auto& [owner, done] : build->waiters) {
-        if (const auto o = ownerWaits.find(owner); o != ownerWaits.end() && o->second == build) ownerWaits.erase(o);
-        answers.push_back({std::move(done), renderer ? PrepareOutcome{PrepareStatus::Ready, renderer, {}}
-                                                     : PrepareOutcome{PrepareStatus::Failed, nullptr, error}});
+      for (Waiter& w : build->waiters) {
+        if (const auto o = ownerWaits.find(w.owner); o != ownerWaits.end() && o->second == build) ownerWaits.erase(o);
+        answers.push_back({std::move(w.done), renderer ? PrepareOutcome{PrepareStatus::Ready, renderer, {}}
+                                                       : PrepareOutcome{PrepareStatus::Failed, nullptr, error}});
       }
       build->waiters.clear();
     }
@@ -433,17 +442,16 @@ struct RenderService::Impl {
   }
 };
 
-namespace {
-AbandonableRendererBuilder abandonable(RendererBuilder builder) {
+AbandonableRendererBuilder asAbandonable(RendererBuilder builder) {
   if (!builder) return {};
-  return [builder = std::move(builder)](const SessionConfig& config, const std::function<bool()>&) {
+  return [builder = std::move(builder)](const SessionConfig& config, const std::function<bool()>&,
+                                        const render::RenderProgress&) {
     return builder(config);  // cannot stop early: an abandoned build finishes into the cache
   };
 }
-}  // namespace
 
 RenderService::RenderService(RendererBuilder builder, Options options, Metrics& metrics)
-    : RenderService(abandonable(std::move(builder)), options, metrics) {}
+    : RenderService(asAbandonable(std::move(builder)), options, metrics) {}
 
 RenderService::RenderService(AbandonableRendererBuilder builder, Options options, Metrics& metrics) {
   checkOptions(options);
@@ -458,9 +466,12 @@ RenderService::RenderService(AbandonableRendererBuilder builder, Options options
 
 RenderService::~RenderService() { stop(); }
 
-void RenderService::prepare(const SessionConfig& config, const std::string& owner, PrepareDone done) {
+void RenderService::prepare(const SessionConfig& config, const std::string& owner, PrepareDone done,
+                            ProgressSink progress) {
   if (!done) throw std::invalid_argument("RenderService::prepare: no callback");
-  for (auto& [callback, outcome] : impl_->prepare(config, owner, std::move(done))) callback(std::move(outcome));
+  PrepareResult result = impl_->prepare(config, owner, std::move(done), std::move(progress));
+  if (result.progress) result.progressSink(*result.progress);
+  for (auto& [callback, outcome] : result.answers) callback(std::move(outcome));
 }
 
 void RenderService::prepare(const SessionConfig& config, PrepareCallback done) {

@@ -3,12 +3,13 @@
 #include <algorithm>
 #include <cstdarg>
 #include <cstdio>
+#include <utility>
 
 namespace haarcast::net {
 namespace {
 
-// Stats are the one message that may be skipped: none is queued behind this
-// many control messages.
+// Stats and BuildProgress are the messages that may be skipped or held: none
+// is queued behind this many control messages.
 constexpr std::size_t kMaxBacklogForStats = 4;
 
 double secondsBetween(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
@@ -197,12 +198,27 @@ void RenderSession::adopt(SessionConfig next, bool announceScene, Clock::time_po
 
 void RenderSession::prepareRenderer() {
   renderer_.reset();  // no frames until the renderer for the new config is ready
+  heldProgress_.clear();  // an older build's
   port_.prepare(config_);
+}
+
+void RenderSession::onBuildProgress(const std::string& key, const BuildProgressUpdate& update) {
+  if (closed_ || renderer_ || key != config_.rendererKey()) return;  // ready, or superseded
+  heldProgress_ = buildProgressMessage(update);  // the latest wins
+  flushBuildProgress();
+}
+
+// A client that reads slowly gets the latest progress when it catches up,
+// not a queue of stale ones (and is never cut for them: see kMaxControlQueue).
+void RenderSession::flushBuildProgress() {
+  if (heldProgress_.empty() || closed_ || port_.backlog() >= kMaxBacklogForStats) return;
+  port_.send(std::exchange(heldProgress_, std::string()));
 }
 
 void RenderSession::onPrepared(const std::string& key, std::shared_ptr<PreparedRenderer> renderer,
                                const std::string& error, Clock::time_point now, v1::ErrorCode code) {
   if (closed_ || key != config_.rendererKey()) return;  // superseded
+  heldProgress_.clear();  // the build is over
   if (!renderer) {
     const ProtocolError e{code, "cannot prepare the renderer: " + error, !welcomed_};
     if (e.fatal) {
@@ -376,6 +392,7 @@ void RenderSession::flushRenderErrorRepeats(Clock::time_point now, bool force) {
 }
 
 void RenderSession::onSent(bool isFrame, std::size_t payloadBytes, Clock::time_point now) {
+  flushBuildProgress();
   if (!isFrame) return;
   frameUnsent_ = false;
   ++framesSent_;
@@ -427,6 +444,7 @@ void RenderSession::onTick(Clock::time_point now) {
     fail({v1::ERROR_CODE_TIMEOUT, format("no message for %g s (idle)", o.idleSeconds), true});
   } else {
     flushRenderErrorRepeats(now, false);
+    flushBuildProgress();
     if (welcomed_ && secondsBetween(lastStats_, now) >= o.statsSeconds) sendStats(now);
   }
 }

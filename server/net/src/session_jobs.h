@@ -9,6 +9,7 @@
 #pragma once
 
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <utility>
@@ -20,14 +21,48 @@
 
 namespace haarcast::net {
 
-// Build or find the renderer for `config` → RenderSession::onPrepared on the strand.
+// A build's progress on its way from the builder thread to one session's
+// strand: at most one post is pending per session, and it carries the
+// latest update when it runs, so a busy strand never piles up stale ones.
+struct ProgressMailbox {
+  std::mutex mutex;
+  std::optional<BuildProgressUpdate> latest;
+  bool posted = false;
+};
+
+template <class Transport>
+RenderService::ProgressSink progressSink(const std::weak_ptr<Transport>& weak, const std::string& key) {
+  return [weak, key, mailbox = std::make_shared<ProgressMailbox>()](const BuildProgressUpdate& update) {
+    auto self = weak.lock();
+    if (!self) return;
+    {
+      std::lock_guard lock(mailbox->mutex);
+      mailbox->latest = update;
+      if (mailbox->posted) return;  // the pending post takes this one
+      mailbox->posted = true;
+    }
+    boost::asio::post(self->executor(), [self, key, mailbox] {
+      std::optional<BuildProgressUpdate> latest;
+      {
+        std::lock_guard lock(mailbox->mutex);
+        latest.swap(mailbox->latest);
+        mailbox->posted = false;
+      }
+      if (latest && !self->gone()) self->renderSession().onBuildProgress(key, *latest);
+    });
+  };
+}
+
+// Build or find the renderer for `config` → RenderSession::onPrepared on the
+// strand, and its progress while it is built → RenderSession::onBuildProgress.
 template <class Transport>
 void submitPrepare(Server::Impl& server, const std::shared_ptr<Transport>& transport, const SessionConfig& config) {
   // Per session the latest prepare wins (render_service.h): an earlier one
   // is answered Superseded, and onPrepared ignores a key that is not the
   // config's anyway.
   std::weak_ptr<Transport> weak = transport;
-  server.renderService->prepare(config, transport->sessionId(), [weak, key = config.rendererKey()](PrepareOutcome o) {
+  const std::string key = config.rendererKey();
+  server.renderService->prepare(config, transport->sessionId(), [weak, key](PrepareOutcome o) {
     if (o.status == PrepareStatus::Superseded) return;
     auto self = weak.lock();
     if (!self) return;
@@ -39,7 +74,7 @@ void submitPrepare(Server::Impl& server, const std::shared_ptr<Transport>& trans
     boost::asio::post(self->executor(), [self, key, code, o = std::move(o)]() mutable {
       if (!self->gone()) self->renderSession().onPrepared(key, std::move(o.renderer), o.error, Clock::now(), code);
     });
-  });
+  }, progressSink(weak, key));
 }
 
 // Render `order` → RenderSession::onRendered (or onCancelled) on the strand.

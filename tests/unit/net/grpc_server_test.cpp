@@ -269,5 +269,50 @@ TEST(GrpcServer, AClientThatStopsReadingIsCutAndAnotherGoesOn) {
   EXPECT_EQ(stalled.statusAfterReading().error_code(), grpc::StatusCode::CANCELLED);
 }
 
+// Both transports carry a build's progress: the same RenderSession, the
+// same submitPrepare (session_jobs.h). Each client asks for a renderer of
+// its own (another level), so each sees a build from its start.
+TEST(GrpcServer, BuildProgressReachesBothTransportsBeforeWelcome) {
+  const RendererBuilder real = testBuilder();
+  AbandonableRendererBuilder builder = [real](const SessionConfig& c, const std::function<bool()>&,
+                                              const render::RenderProgress& progress) {
+    for (std::size_t i = 0; i <= 10; ++i) {
+      progress("visibility /srv/meshes/ball", i, 10);
+      std::this_thread::sleep_for(30ms);
+    }
+    return real(c);
+  };
+  TestServer server(grpcOptions(), builder);
+  // The messages before the first frame: BuildProgress …, then Welcome.
+  const auto check = [](const std::vector<v1::ServerMessage>& messages, const char* transport) {
+    ASSERT_GE(messages.size(), 2u) << transport;
+    EXPECT_TRUE(messages.back().has_welcome()) << transport;
+    for (std::size_t i = 0; i + 1 < messages.size(); ++i) {
+      ASSERT_TRUE(messages[i].has_build_progress()) << transport << ": " << messages[i].DebugString();
+      EXPECT_EQ(messages[i].build_progress().stage(), "visibility ball") << transport;
+    }
+  };
+  auto untilWelcome = [](auto& client) {
+    std::vector<v1::ServerMessage> messages;
+    while (auto m = client.read()) {
+      if (m->has_stats()) continue;
+      messages.push_back(*m);
+      if (m->has_welcome() || m->has_error()) break;
+    }
+    return messages;
+  };
+  GrpcClient grpcClient(server.server().grpcPort());
+  v1::ClientMessage h = hello();
+  h.mutable_hello()->mutable_settings()->set_level(3);
+  ASSERT_TRUE(grpcClient.send(h));
+  check(untilWelcome(grpcClient), "gRPC");
+  Client wsClient(server.port());
+  ASSERT_TRUE(wsClient.connected());
+  h.mutable_hello()->mutable_settings()->set_level(5);
+  wsClient.send(h);
+  check(untilWelcome(wsClient), "WebSocket");
+  EXPECT_TRUE(grpcClient.finish().ok());
+}
+
 }  // namespace
 }  // namespace haarcast::net::test

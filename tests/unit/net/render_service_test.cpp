@@ -370,7 +370,8 @@ TEST(RenderService, ASettingsFloodKeepsOneBuildQueuedPerOwnerAndDelaysAnotherByO
   std::mutex m;
   std::vector<int> started;  // levels, in the order their builds started
   std::atomic<bool> release{false}, firstAbandoned{false};
-  AbandonableRendererBuilder builder = [&](const SessionConfig& c, const std::function<bool()>& abandoned) {
+  AbandonableRendererBuilder builder = [&](const SessionConfig& c, const std::function<bool()>& abandoned,
+                                             const render::RenderProgress&) {
     {
       std::lock_guard lock(m);
       started.push_back(c.level);

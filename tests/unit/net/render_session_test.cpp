@@ -4,7 +4,11 @@
 // checked message by message and instant by instant.
 #include "haarcast/net/render_session.h"
 
+#include <condition_variable>
 #include <deque>
+#include <functional>
+#include <mutex>
+#include <thread>
 
 #include <gtest/gtest.h>
 
@@ -23,7 +27,7 @@ class RecordingPort : public SessionPort {
     frames.push_back(parse(bytes));
     return false;
   }
-  std::size_t backlog() const override { return 0; }
+  std::size_t backlog() const override { return backlogSize; }
   void close(std::string error, CloseCode code, std::string reason) override {
     sent.push_back(parse(error));
     closeCode = code;
@@ -53,6 +57,7 @@ class RecordingPort : public SessionPort {
   std::vector<SessionConfig> prepared;
   std::vector<FrameOrder> orders;
   bool full = false;
+  std::size_t backlogSize = 0;  // control messages "waiting to be written"
   int admitted = 0, wrongTokens = 0;
   std::vector<std::string> logs;
 };
@@ -210,6 +215,11 @@ TEST(RenderSession, SceneSwitchAnnouncesSceneInfoAndBuildsItsRenderer) {
   ASSERT_EQ(f.port.prepared.size(), 2u);
   EXPECT_EQ(f.port.prepared.back().scene, "other");
   EXPECT_EQ(f.session.config().scene, "other");
+  // Its build's progress follows the SceneInfo; the old renderer's build has none.
+  f.session.onBuildProgress(f.port.prepared.front().rendererKey(), {"slices a", 0, 1, 2, 0.1, 0.0});
+  f.session.onBuildProgress(f.port.prepared.back().rendererKey(), {"slices b", 0, 1, 2, 0.1, 0.0});
+  EXPECT_EQ(f.port.sent.back().build_progress().stage(), "slices b");
+  EXPECT_TRUE(f.port.sent[f.port.sent.size() - 2].has_scene_info());
   // A material change on the same scene is a SceneChoice too: SceneInfo again.
   m.mutable_scene()->mutable_object_materials()->insert({1, "phong:16"});
   f.receive(m, f.t0);
@@ -350,6 +360,147 @@ TEST(RenderSession, RepeatedRenderErrorsAreResentWithACount) {
   f.session.onTick(f.t0 + 2200ms);
   EXPECT_EQ(errorsIn(f.port.sent).size(), 2u) << "nothing new to say";
   EXPECT_NE(f.metrics.prometheusText().find("haarcast_render_failures_total 3"), std::string::npos);
+}
+
+// ------------------------------------------------------------------ renderer build progress
+
+// A port whose prepare() goes to a real RenderService, with the test thread
+// as the strand: the service's answers and progress wait in `posted` until
+// pump() runs them, as session_jobs.h posts them to a transport's strand.
+class ServicePort : public RecordingPort {
+ public:
+  ServicePort(RenderService& service, std::string owner) : service_(service), owner_(std::move(owner)) {}
+  RenderSession* session = nullptr;
+
+  void prepare(const SessionConfig& config) override {
+    RecordingPort::prepare(config);
+    const std::string key = config.rendererKey();
+    service_.prepare(
+        config, owner_,
+        [this, key](PrepareOutcome o) {
+          post([this, key, o] { session->onPrepared(key, o.renderer, o.error, Clock::now()); });
+        },
+        [this, key](const BuildProgressUpdate& u) { post([this, key, u] { session->onBuildProgress(key, u); }); });
+  }
+  // Runs what was posted, in order, until `done` holds; false after 10 s.
+  bool pump(const std::function<bool()>& done) {
+    const auto deadline = Clock::now() + 10s;
+    std::unique_lock lock(mutex_);
+    while (!done()) {
+      if (!cv_.wait_until(lock, deadline, [&] { return !posted_.empty(); })) return false;
+      auto task = std::move(posted_.front());
+      posted_.pop_front();
+      lock.unlock();
+      task();
+      lock.lock();
+    }
+    return true;
+  }
+
+ private:
+  void post(std::function<void()> task) {
+    {
+      std::lock_guard lock(mutex_);
+      posted_.push_back(std::move(task));
+    }
+    cv_.notify_one();
+  }
+  RenderService& service_;
+  std::string owner_;
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  std::deque<std::function<void()>> posted_;
+};
+
+TEST(RenderSession, AHelloForAnUncachedConfigGetsBuildProgressBeforeWelcome) {
+  Metrics metrics;
+  // Two stages of ten steps, 10 ms apart: about 0.2 s of build.
+  AbandonableRendererBuilder builder = [](const SessionConfig&, const std::function<bool()>&,
+                                          const render::RenderProgress& progress) {
+    for (const char* stage : {"slices a", "visibility a"}) {
+      for (std::size_t i = 0; i <= 10; ++i) {
+        progress(stage, i, 10);
+        std::this_thread::sleep_for(10ms);
+      }
+    }
+    return Fixture::prepared();
+  };
+  RenderService::Options serviceOptions;
+  serviceOptions.progressIntervalSeconds = 0.03;
+  RenderService service(builder, serviceOptions, metrics);
+  const ServerOptions o = options();
+  const Catalog c = catalog();
+  ServicePort port(service, "s1");
+  RenderSession session(o, c, metrics, port, "s1", Clock::now());
+  port.session = &session;
+  session.onMessage(hello().SerializeAsString(), true, Clock::now());
+  ASSERT_TRUE(port.pump([&] { return session.welcomed(); }));
+
+  ASSERT_GE(port.sent.size(), 3u);
+  EXPECT_TRUE(port.sent.back().has_welcome()) << port.sent.back().DebugString();
+  std::vector<v1::BuildProgress> progress;
+  std::vector<std::string> stages;
+  for (std::size_t i = 0; i + 1 < port.sent.size(); ++i) {
+    ASSERT_TRUE(port.sent[i].has_build_progress()) << "message " << i << " before Welcome: " << port.sent[i].DebugString();
+    progress.push_back(port.sent[i].build_progress());
+    if (stages.empty() || stages.back() != progress.back().stage()) stages.push_back(progress.back().stage());
+  }
+  EXPECT_EQ(stages, (std::vector<std::string>{"slices a", "visibility a"}));
+  for (std::size_t i = 0; i < progress.size(); ++i) {
+    const auto& p = progress[i];
+    EXPECT_GE(p.fraction(), 0.0);
+    EXPECT_LE(p.fraction(), 1.0);
+    if (i == 0) continue;
+    const auto& q = progress[i - 1];
+    ASSERT_LE(q.stage_index(), p.stage_index()) << i;
+    if (q.stage_index() == p.stage_index()) {
+      EXPECT_LE(q.fraction(), p.fraction()) << i;
+    }
+  }
+
+  // Another session with the same config: the renderer is cached, so the
+  // Welcome comes with no BuildProgress before it.
+  ServicePort port2(service, "s2");
+  RenderSession session2(o, c, metrics, port2, "s2", Clock::now());
+  port2.session = &session2;
+  session2.onMessage(hello().SerializeAsString(), true, Clock::now());
+  ASSERT_TRUE(port2.pump([&] { return session2.welcomed(); }));
+  ASSERT_EQ(port2.sent.size(), 1u);
+  EXPECT_TRUE(port2.sent.front().has_welcome());
+}
+
+TEST(RenderSession, BuildProgressWaitsBehindABacklogLatestOnlyAndEndsWithTheRenderer) {
+  Fixture f;
+  f.receive(hello(), f.t0);
+  const std::string key = f.port.prepared.back().rendererKey();
+  f.session.onBuildProgress("another key", {"slices a", 0, 1, 10, 0.1, 0.0});
+  EXPECT_TRUE(f.port.sent.empty()) << "a superseded build's progress is not this session's";
+  f.session.onBuildProgress(key, {"slices a", 0, 1, 10, 0.1, 0.0});
+  ASSERT_EQ(f.port.sent.size(), 1u);
+  EXPECT_TRUE(f.port.sent.back().has_build_progress());
+  // A client that does not read: progress is held, the latest replacing
+  // the one before, and sent once the backlog drains.
+  f.port.backlogSize = 10;
+  f.session.onBuildProgress(key, {"slices a", 0, 5, 10, 0.5, 0.4});
+  f.session.onBuildProgress(key, {"slices a", 0, 8, 10, 0.8, 0.1});
+  f.session.onTick(f.t0 + 100ms);
+  EXPECT_EQ(f.port.sent.size(), 1u) << "held behind the backlog";
+  f.port.backlogSize = 0;
+  f.session.onSent(false, 0, f.t0 + 150ms);
+  ASSERT_EQ(f.port.sent.size(), 2u);
+  EXPECT_EQ(f.port.sent.back().build_progress().done(), 8u) << "the latest";
+  f.session.onTick(f.t0 + 200ms);
+  EXPECT_EQ(f.port.sent.size(), 2u) << "once";
+  // Held again when the renderer comes: dropped, the Welcome goes, and
+  // later progress (a race with the build's end) is ignored.
+  f.port.backlogSize = 10;
+  f.session.onBuildProgress(key, {"visibility a", 1, 3, 10, 0.9, 0.2});
+  f.port.backlogSize = 0;
+  f.session.onPrepared(key, Fixture::prepared(), "", f.t0 + 300ms);
+  f.session.onBuildProgress(key, {"visibility a", 1, 9, 10, 1.0, 0.0});
+  f.session.onTick(f.t0 + 400ms);
+  ASSERT_EQ(f.port.sent.size(), 3u);
+  EXPECT_TRUE(f.port.sent.back().has_welcome());
 }
 
 }  // namespace

@@ -91,6 +91,10 @@ class TestServer {
       : server_(std::make_unique<Server>(std::move(options), testCatalog(render::defaultScene()), testBuilder())) {
     server_->start();
   }
+  TestServer(ServerOptions options, AbandonableRendererBuilder builder)
+      : server_(std::make_unique<Server>(std::move(options), testCatalog(render::defaultScene()), std::move(builder))) {
+    server_->start();
+  }
   ~TestServer() {
     server_->stop();
     server_->wait();

@@ -1,5 +1,5 @@
 // The ServerMessages a session emits (Welcome, Frame, Stats, SceneInfo,
-// Pong, Error), built from plain values, and the text that leaves the
+// Pong, Error, BuildProgress), built from plain values, and the text that leaves the
 // server for a peer or a log: a close reason cut on a UTF-8 boundary, a
 // client-given string made safe for one log line. Pure functions, tested
 // without sockets.
@@ -11,6 +11,7 @@
 #include <string_view>
 #include <vector>
 
+#include "haarcast/net/build_progress.h"
 #include "haarcast/net/protocol.h"
 #include "haarcast/render/renderer.h"
 
@@ -68,6 +69,8 @@ std::string errorLabel(v1::ErrorCode code);
 std::string sceneInfoMessage(const SessionConfig& config, const Catalog& catalog);
 std::string pongMessage(std::uint64_t nonce);
 std::string errorMessage(const ProtocolError& error);
+// The stage goes out through publicStageName (build_progress.h).
+std::string buildProgressMessage(const BuildProgressUpdate& update);
 
 // The longest prefix of `text` of at most `maxBytes` bytes that does not
 // split a UTF-8 sequence (a truncated close reason must still be valid

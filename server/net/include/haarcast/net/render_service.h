@@ -11,7 +11,11 @@
 //              was served longest ago (never served first), so a new session
 //              waits at most for the build running when it arrives. At most
 //              Options::maxQueuedBuilds builds wait across the server;
-//              beyond that prepare is Refused.
+//              beyond that prepare is Refused. While a build runs, its
+//              progress goes to every prepare waiting for it (at most one
+//              update per Options::progressIntervalSeconds, plus one at
+//              each new stage), and a prepare that joins it later gets the
+//              latest at once; a cached renderer has none.
 //   submit()   queues one frame job. Jobs start in FIFO order on
 //              Options::workers threads, and each session keeps at most one
 //              job queued or running, so the queue is a round robin over the
@@ -35,6 +39,7 @@
 #include <string>
 #include <vector>
 
+#include "haarcast/net/build_progress.h"
 #include "haarcast/net/metrics.h"
 #include "haarcast/net/protocol.h"
 #include "haarcast/render/renderer.h"
@@ -50,13 +55,18 @@ struct PreparedRenderer {
 // Builds the renderer for a config; runs on the builder thread. Throws with
 // a message naming what was wrong.
 using RendererBuilder = std::function<std::shared_ptr<PreparedRenderer>(const SessionConfig& config)>;
-// A builder that may stop early: `abandoned()` turns true once nobody waits
-// for the build any more (every waiter superseded or withdrawn) or the
-// service stops. The builder polls it between its precompute stages (a
-// RenderProgress callback is a good place) and then throws anything: the
-// build ends quietly, unanswered.
+// A builder that may stop early and says how far it is. `abandoned()` turns
+// true once nobody waits for the build any more (every waiter superseded or
+// withdrawn) or the service stops; the builder polls it between its
+// precompute stages (its RenderProgress callback is a good place) and then
+// throws anything: the build ends quietly, unanswered. `progress` takes the
+// builder's render::RenderProgress reports (stage, done, total) for the
+// sessions that wait; it is cheap to call often (it throttles) and never
+// blocks on a client.
 using AbandonableRendererBuilder = std::function<std::shared_ptr<PreparedRenderer>(
-    const SessionConfig& config, const std::function<bool()>& abandoned)>;
+    const SessionConfig& config, const std::function<bool()>& abandoned, const render::RenderProgress& progress)>;
+// A builder that can neither stop early nor report progress, as one that can.
+AbandonableRendererBuilder asAbandonable(RendererBuilder builder);
 
 struct RenderedFrame {
   render::Frame frame;
@@ -128,6 +138,10 @@ class RenderService {
     // Renderer builds waiting (not running) across the server; a prepare()
     // that needs one more is Refused.
     std::size_t maxQueuedBuilds = 8;
+    // A running build's progress goes to its waiters at most this often,
+    // besides one update at each new stage (build_progress.h): about 4 a
+    // second, enough for a moving display, few enough for any link.
+    double progressIntervalSeconds = 0.25;
   };
 
   // Throws std::invalid_argument naming an option out of range.
@@ -138,11 +152,21 @@ class RenderService {
   RenderService& operator=(const RenderService&) = delete;
 
   using PrepareDone = std::function<void(PrepareOutcome)>;
+  // Called with each progress update of the build this prepare waits for:
+  // on the builder thread, or on the caller's thread from within prepare()
+  // (the latest update of a build already running), never under the
+  // service's lock. It must be quick and must not block or call into the
+  // service: a session posts the update to its strand. Every update comes
+  // before `done`, except the one from within prepare(), which may race a
+  // build that finishes meanwhile; a session ignores progress once it has
+  // its renderer.
+  using ProgressSink = std::function<void(const BuildProgressUpdate&)>;
   // done(outcome) once, on a service thread, or on the caller's thread when
   // the answer is immediate (cached, superseded, refused). `owner` names
   // the session: its newer prepare supersedes this one ("" = nobody's:
-  // never superseded).
-  void prepare(const SessionConfig& config, const std::string& owner, PrepareDone done);
+  // never superseded). `progress` (may be empty): see ProgressSink; a
+  // cached renderer, or a build that reports nothing, gives none.
+  void prepare(const SessionConfig& config, const std::string& owner, PrepareDone done, ProgressSink progress = {});
   // The owner's waiting prepare, if any, is dropped unanswered (its session
   // has gone); a build then waited for by nobody is dropped or abandoned.
   void withdraw(const std::string& owner);

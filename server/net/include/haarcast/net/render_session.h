@@ -1,9 +1,10 @@
 // One client's session without a socket: the application state machine.
 //
 //   Hello      → token, config (protocol.h), a session slot (SessionPort::admit),
-//                a renderer (prepare) → Welcome
+//                a renderer (prepare) → BuildProgress while it is built → Welcome
 //   Settings / SceneChoice → a new config; a new renderer when its key
-//                changed; SceneInfo for an accepted SceneChoice
+//                changed (BuildProgress while it is built); SceneInfo for an
+//                accepted SceneChoice
 //   PoseUpdate → the latest pose wins; a frame is rendered at most once per
 //                1/fps (pacing), one at a time
 //   Ping       → Pong;  ticks → Hello and idle timeouts, Stats
@@ -90,7 +91,8 @@ class SessionPort {
   virtual void close(std::string error, CloseCode code, std::string reason) = 0;
   // Call RenderSession::onPace at `at` (one armed at a time).
   virtual void armPace(Clock::time_point at) = 0;
-  // Build or find the renderer for a config → RenderSession::onPrepared.
+  // Build or find the renderer for a config → RenderSession::onPrepared,
+  // and RenderSession::onBuildProgress while it is built.
   virtual void prepare(const SessionConfig& config) = 0;
   // Render → RenderSession::onRendered(order.context, …).
   virtual void render(FrameOrder order) = 0;
@@ -114,6 +116,11 @@ class RenderSession {
   // that failed, OVERLOADED for one the server's build queue refused.
   void onPrepared(const std::string& key, std::shared_ptr<PreparedRenderer> renderer, const std::string& error,
                   Clock::time_point now, v1::ErrorCode code = v1::ERROR_CODE_RENDER_FAILED);
+  // How far the build of the renderer for `key` has got → BuildProgress.
+  // Ignored once the renderer is here, or for a key that is no longer the
+  // config's. Like Stats it may wait behind a backlog of control messages,
+  // where only the latest waits (sent when the backlog drains).
+  void onBuildProgress(const std::string& key, const BuildProgressUpdate& update);
   void onRendered(const FrameContext& context, std::optional<RenderedFrame> rendered, const std::string& error,
                   Clock::time_point now);
   // The job of `context` ended without a frame (cancelled, or its session
@@ -148,6 +155,7 @@ class RenderSession {
   void onPose(const v1::PoseUpdate& update, Clock::time_point now);
   void adopt(SessionConfig next, bool announceScene, Clock::time_point now);
   void prepareRenderer();
+  void flushBuildProgress();
   void maybeRender(Clock::time_point now);
   void badMessage(ProtocolError e);
   void renderFailed(const std::string& error, Clock::time_point now);
@@ -179,6 +187,7 @@ class RenderSession {
   std::string lastRenderError_;            // the last frame's failure, "" after a frame
   std::uint64_t renderErrorRepeats_ = 0;   // times it recurred since it was last sent
   Clock::time_point lastRenderErrorSent_;
+  std::string heldProgress_;               // a BuildProgress waiting for the backlog to drain; "" = none
 
   // Shared with the render worker (takeRequest): under mutex_. config_ is
   // written on the strand under the lock and read there without it.

@@ -92,7 +92,8 @@ class Server {
   Server(ServerOptions options, Catalog catalog, RendererBuilder builder);
   // A builder that stops early once nobody waits for its build (the
   // session closed, or the server stops): what lets SIGTERM end a running
-  // build at its next precompute step.
+  // build at its next precompute step. Its progress reaches the waiting
+  // clients as BuildProgress messages.
   Server(ServerOptions options, Catalog catalog, AbandonableRendererBuilder builder);
   ~Server();  // stop() and wait()
   Server(const Server&) = delete;

@@ -1,0 +1,93 @@
+#include "build_progress.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace haarcast::client {
+namespace {
+
+// A plain line at most this often within a stage, or when this many more
+// percent are done than at the last one (logs and CI read these).
+constexpr double kLineSeconds = 5.0;
+constexpr int kLinePercentStep = 10;
+
+// From done and total, not `fraction`: 29 / 100 is 28.999… as a double.
+int percentOf(const v1::BuildProgress& p) {
+  if (p.total() == 0) return -1;
+  if (p.done() >= p.total()) return 100;
+  const long double percent = static_cast<long double>(p.done()) * 100 / static_cast<long double>(p.total());
+  return std::min(99, static_cast<int>(percent));  // never 100 before the end
+}
+
+}  // namespace
+
+std::string formatSeconds(double seconds) {
+  char b[48];
+  if (!(seconds >= 0.0)) seconds = 0.0;
+  if (seconds < 9.95) {
+    std::snprintf(b, sizeof b, "%.1f s", seconds);
+  } else if (seconds < 59.5) {
+    std::snprintf(b, sizeof b, "%.0f s", seconds);
+  } else {
+    const long s = std::lround(std::min(seconds, 1e9));
+    std::snprintf(b, sizeof b, "%ld min %02ld s", s / 60, s % 60);
+  }
+  return b;
+}
+
+std::string buildProgressText(const v1::BuildProgress& p) {
+  // The server's text goes to a terminal: no escape sequence gets through.
+  std::string out;
+  for (const char ch : p.stage().substr(0, 120)) {
+    const auto c = static_cast<unsigned char>(ch);
+    out += c < 0x20 || c == 0x7F ? '?' : ch;
+  }
+  if (out.empty()) out = "renderer";
+  const int percent = percentOf(p);
+  if (percent >= 0) {
+    char pct[16];
+    std::snprintf(pct, sizeof pct, " %3d %%", percent);
+    out += pct;
+  }
+  const double left = p.estimated_stage_seconds_left();
+  if (percent >= 0 && percent < 100 && std::isfinite(left) && left > 0.0) {
+    out += " (~" + formatSeconds(left) + " left in this stage)";
+  }
+  return out;
+}
+
+void BuildProgressDisplay::update(const v1::BuildProgress& p, double now) {
+  lastElapsed_ = std::isfinite(p.elapsed_seconds()) ? p.elapsed_seconds() : 0.0;
+  lastAt_ = now;
+  const std::string text = "building: " + buildProgressText(p);
+  const int percent = percentOf(p);
+  if (terminal_) {
+    sink_("\r" + text + "\x1b[K");
+    lineOpen_ = true;
+  } else {
+    const bool newStage = !shown_ || p.stage_index() != lastStage_;
+    if (!newStage && percent - lastPercent_ < kLinePercentStep && now - lastLineAt_ < kLineSeconds) return;
+    sink_(text + "\n");
+    lastLineAt_ = now;
+  }
+  shown_ = true;
+  lastStage_ = p.stage_index();
+  lastPercent_ = percent;
+}
+
+void BuildProgressDisplay::ready(double now) {
+  if (!shown_) return;
+  const std::string text = "building: ready after " + formatSeconds(lastElapsed_ + std::max(0.0, now - lastAt_));
+  sink_(terminal_ ? "\r" + text + "\x1b[K\n" : text + "\n");
+  lineOpen_ = false;
+  shown_ = false;
+  lastPercent_ = -1;
+}
+
+void BuildProgressDisplay::endLine() {
+  if (lineOpen_) sink_("\n");
+  lineOpen_ = false;
+}
+
+}  // namespace haarcast::client
