@@ -71,6 +71,18 @@ PreparedScene prepareScene(const Scene& scene, const RenderOptions& options, con
                                 " MB at level " + std::to_string(options.level) + ", over the limit of " +
                                 std::to_string(options.sceneLimits.maxVisibilityBytes >> 20) + " MB (--max-visibility-mb)");
   }
+  // Refinement adds vertices (visibility_refine.h: up to max(growth × V,
+  // floor) an object); where that could pass the limit, the scene is drawn
+  // unrefined rather than over the operator's memory cap.
+  RefineOptions refine = options.refine;
+  if (options.method == RotationMethod::Fused && refine.rounds > 0) {
+    std::size_t bound = 0;
+    for (const SceneObject& object : scene.objects) {
+      const std::size_t v = object.mesh->positions.size();
+      bound += perVertex * (object.ground ? v : std::max(static_cast<std::size_t>(refine.growth * static_cast<double>(v)), refine.floor));
+    }
+    if (bound > options.sceneLimits.maxVisibilityBytes) refine.rounds = 0;
+  }
   PreparedScene prepared;
   prepared.scene = scene;
   prepared.objects.resize(scene.objects.size());
@@ -95,10 +107,10 @@ PreparedScene prepareScene(const Scene& scene, const RenderOptions& options, con
       if (progress) progress("visibility " + object.name, done, total);
     };
     if (options.method == RotationMethod::Fused) {
-      if (p.ground || options.refine.rounds == 0) {
+      if (p.ground || refine.rounds == 0) {
         p.visibilityBits = loadOrComputeVisibilityBits(*p.mesh, vis, options.cacheDir, visibilityProgress);
       } else {
-        RefinedVisibility r = loadOrComputeRefinedVisibility(*p.mesh, vis, options.refine, options.cacheDir, visibilityProgress);
+        RefinedVisibility r = loadOrComputeRefinedVisibility(*p.mesh, vis, refine, options.cacheDir, visibilityProgress);
         p.mesh = std::make_shared<const Mesh>(std::move(r.mesh));
         p.visibilityBits = std::move(r.bits);
       }

@@ -21,6 +21,7 @@
 
 #include "haarcast/assets/procedural_mesh.h"
 #include "haarcast/render/embree_scene.h"
+#include "haarcast/render/renderer.h"
 #include "haarcast/render/visibility_cache.h"
 
 #include "../test_files.h"
@@ -200,6 +201,22 @@ TEST(VisibilityRefine, TheCacheGivesBackTheRefinedMeshAndBits) {
   VisibilityCacheStatus third;
   (void)loadOrComputeRefinedVisibility(mesh, level4(), other, tmp.path().string(), {}, &third);
   EXPECT_FALSE(third.hit);
+}
+
+// prepareScene refines `fused`'s meshes, and draws them unrefined where the
+// refinement could pass the operator's visibility memory limit.
+TEST(VisibilityRefine, PrepareSceneRefinesWithinTheVisibilityLimit) {
+  render::Scene scene;
+  scene.environment = render::sunsEnvironment();
+  scene.objects.push_back({"pillars", std::make_shared<Mesh>(slabWithPillars()), render::materialFromSpec("lambert"), {}});
+  render::RenderOptions o;
+  o.level = 4;
+  o.method = RotationMethod::Fused;
+  const std::size_t original = scene.objects[0].mesh->positions.size();
+  EXPECT_GT(render::prepareScene(scene, o).objects[0].mesh->positions.size(), original);
+  // Room for the mesh, not for the refinement's bound (the floor's vertices).
+  o.sceneLimits.maxVisibilityBytes = 4 * visibilityWordsPerPoint(4) * (o.refine.floor - 1);
+  EXPECT_EQ(render::prepareScene(scene, o).objects[0].mesh->positions.size(), original);
 }
 
 }  // namespace
