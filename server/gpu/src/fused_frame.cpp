@@ -43,6 +43,36 @@ std::uint32_t VulkanRenderer::Impl::computeShadowMasks(const render::ResolvedFra
   out.resize(count.covered);
   constexpr std::size_t kChunk = 256;
   const std::span<const glm::vec3> lightDirections = resolved.pointLightDirections;
+  auto pointOf = [&](const ShadeSample& sample) {
+    const std::size_t object = sample.object;
+    const render::PreparedObject& p = prepared.objects[object];
+    const std::uint32_t base = objectInfo[object].vertexBase;
+    // The hit triangle in the object's own vertex ids, as the CPU backend passes it.
+    const glm::uvec3 triangle(sample.vertex[0] - base, sample.vertex[1] - base, sample.vertex[2] - base);
+    return render::shadingPoint(*p.mesh, triangle, sample.b, toWorld[object], rotations[object],
+                                p.shadowShift * static_cast<float>(resolved.objects[object].scale));
+  };
+  // The ground's hidden sky on the coarse grid (render/point_lights.h),
+  // from the interior pixels' centre samples (slot < pixels), as the CPU.
+  const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  render::GroundSkyGrid sky(static_cast<int>(width), static_cast<int>(height));
+  if (prepared.ground) {
+    std::vector<std::uint32_t> centreOf(pixels, ~0u);
+    for (std::size_t s = 0; s < count.covered; ++s)
+      if (sh[s].pixel < pixels && sh[s].object < objectCount) centreOf[sh[s].pixel] = static_cast<std::uint32_t>(s);
+    auto ground = [&](std::size_t pixel) {
+      const std::uint32_t s = centreOf[pixel];
+      return s != ~0u && prepared.objects[sh[s].object].ground;
+    };
+    sky.compute(*rays, resolved.groundSky, [&](std::size_t pixel) -> std::optional<render::ShadingPoint> {
+      // Interior ground pixels only (the 3×3 rule of shared_layout.h), with
+      // antialiasing or without: with it, only they have a centre sample.
+      if (!ground(pixel)) return std::nullopt;
+      if (!options.antialias && !render::interiorPixel(pixel, static_cast<std::size_t>(width), static_cast<std::size_t>(height), ground))
+        return std::nullopt;
+      return pointOf(sh[centreOf[pixel]]);
+    }, options.threads);
+  }
   parallelFor((count.covered + kChunk - 1) / kChunk, [&](std::size_t chunk) {
     const std::size_t end = std::min<std::size_t>(count.covered, (chunk + 1) * kChunk);
     for (std::size_t s = chunk * kChunk; s < end; ++s) {
@@ -51,16 +81,14 @@ std::uint32_t VulkanRenderer::Impl::computeShadowMasks(const render::ResolvedFra
         out[s] = 0;
         continue;
       }
-      const std::size_t object = sample.object;
-      const render::PreparedObject& p = prepared.objects[object];
-      const std::uint32_t base = objectInfo[object].vertexBase;
-      // The hit triangle in the object's own vertex ids, as the CPU backend passes it.
-      const glm::uvec3 triangle(sample.vertex[0] - base, sample.vertex[1] - base, sample.vertex[2] - base);
-      const render::ShadingPoint point =
-          render::shadingPoint(*p.mesh, triangle, sample.b, toWorld[object], rotations[object],
-                               p.shadowShift * static_cast<float>(resolved.objects[object].scale));
+      const render::ShadingPoint point = pointOf(sample);
       out[s] = render::pointLightMask(*rays, point, lightDirections);
-      if (p.ground) out[s] = render::withGroundOcclusion(out[s], render::groundSkyOcclusion(*rays, point, resolved.groundSky));
+      if (prepared.objects[sample.object].ground) {
+        // Its pixel: the slot itself, or the edge pixel a sub-sample's slot belongs to.
+        const std::size_t pixel = sample.pixel < pixels ? sample.pixel : (sample.pixel - pixels) / shared::kSubsamples;
+        out[s] = render::withGroundOcclusion(
+            out[s], sky.at(pixel, [&] { return render::groundSkyOcclusion(*rays, point, resolved.groundSky); }));
+      }
     }
   }, {}, options.threads);
   if (!out.empty()) maskUpload.write(out.data(), out.size() * sizeof(std::uint32_t));

@@ -143,6 +143,7 @@ class CpuRenderer final : public Renderer {
   // sub-sample of an edge pixel (shared::kSubsamples of them).
   struct Sample {
     Hit hit;
+    std::uint32_t pixel = 0;    // y·width + x of its pixel (sub-samples too)
     glm::dvec3 direction{0.0};  // of the camera ray, world frame
     PixelInput input;           // filled by the rotation-input stage
   };
@@ -203,7 +204,7 @@ glm::dvec3 CpuRenderer::subsampleDirection(const CameraRays& camera, int x, int 
 void CpuRenderer::traceGBuffer(const RayScene& rays, const CameraRays& camera, int w, int h, GBuffer& g,
                                const CancelPoint& cancelPoint) const {
   const std::size_t pixels = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
-  auto trace = [&](const glm::dvec3& direction) -> std::optional<Sample> {
+  auto trace = [&](const glm::dvec3& direction, std::size_t pixel) -> std::optional<Sample> {
     Ray r;
     r.origin = glm::vec3(camera.origin());
     r.direction = glm::vec3(direction);
@@ -211,6 +212,7 @@ void CpuRenderer::traceGBuffer(const RayScene& rays, const CameraRays& camera, i
     if (!hit) return std::nullopt;
     Sample s;
     s.hit = *hit;
+    s.pixel = static_cast<std::uint32_t>(pixel);
     s.direction = direction;
     return s;
   };
@@ -219,7 +221,10 @@ void CpuRenderer::traceGBuffer(const RayScene& rays, const CameraRays& camera, i
   g.height = static_cast<std::size_t>(h);
   parallelFor(static_cast<std::size_t>(h), [&](std::size_t y) {
     cancelPoint();
-    for (int x = 0; x < w; ++x) g.centre[y * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)] = trace(camera.direction(x, static_cast<int>(y)));
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = y * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
+      g.centre[i] = trace(camera.direction(x, static_cast<int>(y)), i);
+    }
   }, {}, options_.threads);
 
   // Edge pixels (shared_layout.h): the 3×3 centres do not agree on the object.
@@ -249,7 +254,8 @@ void CpuRenderer::traceGBuffer(const RayScene& rays, const CameraRays& camera, i
     for (int x = 0; x < w; ++x) {
       const std::uint32_t e = g.edge[y * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)];
       if (e == kInterior) continue;
-      for (unsigned k = 0; k < shared::kSubsamples; ++k) g.sub[e][k] = trace(subsampleDirection(camera, x, static_cast<int>(y), k));
+      for (unsigned k = 0; k < shared::kSubsamples; ++k)
+        g.sub[e][k] = trace(subsampleDirection(camera, x, static_cast<int>(y), k), y * static_cast<std::size_t>(w) + static_cast<std::size_t>(x));
     }
   }, {}, options_.threads);
 }
@@ -452,6 +458,23 @@ std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const RayScen
     toWorld.emplace_back(o.objectToWorld);
     rotations.emplace_back(o.rotation);
   }
+  // The ground's hidden sky on the coarse grid (point_lights.h), from the
+  // interior pixels' centre samples, as the Vulkan backend takes them.
+  GroundSkyGrid sky(frame.width, frame.height);
+  if (prepared_.ground) {
+    sky.compute(rays, resolved.groundSky, [&](std::size_t pixel) -> std::optional<ShadingPoint> {
+      auto ground = [&](std::size_t i) { return g.centre[i] && prepared_.objects[g.centre[i]->hit.object].ground; };
+      // Interior ground pixels only (the 3×3 rule of shared_layout.h), with
+      // antialiasing or without, as the Vulkan backend.
+      if (!ground(pixel) || !interiorPixel(pixel, g.width, g.height, ground)) return std::nullopt;
+      const std::optional<Sample>& c = g.centre[pixel];
+      const std::size_t object = c->hit.object;
+      const float b[3] = {static_cast<float>(c->input.b[0]), static_cast<float>(c->input.b[1]), static_cast<float>(c->input.b[2])};
+      return shadingPoint(*prepared_.objects[object].mesh, glm::uvec3(c->input.vertex[0], c->input.vertex[1], c->input.vertex[2]),
+                          b, toWorld[object], rotations[object],
+                          prepared_.objects[object].shadowShift * static_cast<float>(resolved.objects[object].scale));
+    }, options_.threads);
+  }
   const std::size_t bytes = shadePixels(g, request, camera, frame, [&](const Sample& sample, std::array<float, 3>& rgb) {
     // Per worker thread, kept across pixels: no allocation per pixel.
     thread_local FusedScratch scratch;
@@ -467,7 +490,7 @@ std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const RayScen
     std::uint32_t seen = pointLightMask(rays, point, resolved.pointLightDirections);
     if (p.ground) {
       // The word the Vulkan backend reads too: bits, then the sky's occlusion.
-      seen = withGroundOcclusion(seen, groundSkyOcclusion(rays, point, resolved.groundSky));
+      seen = withGroundOcclusion(seen, sky.at(sample.pixel, [&] { return groundSkyOcclusion(rays, point, resolved.groundSky); }));
       const float kept = shared::groundSkyKept(seen);
       for (std::size_t c = 0; c < 3; ++c) rgb[c] = kept * o.groundFlat[c];
       for (std::size_t k = 0; k < o.pointLights.size(); ++k)

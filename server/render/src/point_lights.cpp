@@ -8,6 +8,7 @@
 #include <glm/geometric.hpp>
 
 #include "haarcast/core/check.h"
+#include "haarcast/core/parallel.h"
 #include "haarcast/core/shared_layout.h"
 
 namespace haarcast::render {
@@ -43,8 +44,12 @@ float groundSkyOcclusion(const RayScene& world, const ShadingPoint& p, const Gro
   if (!(sky.total > 0.0) || sky.occluders.empty()) return 0.0f;
   const glm::vec3 origin = p.position + p.normal * p.shift;
   constexpr int kSamples = kGroundSkyRings * kGroundSkySectors;
-  std::vector<glm::vec3> directions;
-  std::vector<float> weights;  // luminance·cos·ΔΩ of each direction
+  // Per thread, kept across samples: no allocation per sample.
+  thread_local std::vector<glm::vec3> directions;
+  thread_local std::vector<float> weights;  // luminance·cos·ΔΩ of each direction
+  thread_local std::vector<std::uint8_t> blocked;
+  directions.clear();
+  weights.clear();
   for (std::size_t k = 0; k < sky.occluders.size(); ++k) {
     const glm::vec3 centre(sky.occluders[k]);
     const float radius = sky.occluders[k].w;
@@ -60,7 +65,12 @@ float groundSkyOcclusion(const RayScene& world, const ShadingPoint& p, const Gro
     const float cosAxis = glm::dot(axis, p.normal);
     const float sinAxis = std::sqrt(std::max(0.0f, 1.0f - cosAxis * cosAxis));
     const float cosMax = cosAxis >= cosAlpha ? 1.0f : cosAxis * cosAlpha + sinAxis * sinAlpha;
-    if (cosMax <= 0.0f || solid * cosMax / static_cast<float>(kPi) < sky.minShare) continue;
+    const float bound = solid * cosMax / static_cast<float>(kPi);
+    if (cosMax <= 0.0f || bound < sky.minShare) continue;
+    // Faded in over [minShare, 2·minShare] of the bound, so no step marks
+    // where the rays begin.
+    const float t = std::min(1.0f, bound / static_cast<float>(sky.minShare) - 1.0f);
+    const float fade = t * t * (3.0f - 2.0f * t);
     const glm::vec3 helper = std::abs(axis.y) < 0.9f ? glm::vec3(0.0f, 1.0f, 0.0f) : glm::vec3(1.0f, 0.0f, 0.0f);
     const glm::vec3 t1 = glm::normalize(glm::cross(helper, axis));
     const glm::vec3 t2 = glm::cross(axis, t1);
@@ -85,16 +95,80 @@ float groundSkyOcclusion(const RayScene& world, const ShadingPoint& p, const Gro
         if (earlier) continue;
         const Spherical s = directionToSpherical(glm::dvec3(sky.toEnvironment * d));
         directions.push_back(d);
-        weights.push_back(static_cast<float>(sky.luminance.sampleBilinear(s.theta, s.phi)) * cosine * solid / kSamples);
+        weights.push_back(fade * static_cast<float>(sky.luminance.sampleBilinear(s.theta, s.phi)) * cosine * solid / kSamples);
       }
     }
   }
   if (directions.empty()) return 0.0f;
-  std::vector<std::uint8_t> blocked(directions.size());
+  blocked.resize(directions.size());
   world.occludedFrom(origin, 0.0f, directions, blocked);
   double hidden = 0.0;
   for (std::size_t i = 0; i < directions.size(); ++i) hidden += blocked[i] ? weights[i] : 0.0f;
   return static_cast<float>(std::clamp(hidden / sky.total, 0.0, 1.0));
+}
+
+bool interiorPixel(std::size_t pixel, std::size_t width, std::size_t height, const std::function<bool(std::size_t)>& ground) {
+  const long x = static_cast<long>(pixel % width), y = static_cast<long>(pixel / width);
+  for (long dy = -1; dy <= 1; ++dy)
+    for (long dx = -1; dx <= 1; ++dx) {
+      const long xx = std::clamp(x + dx, 0L, static_cast<long>(width) - 1), yy = std::clamp(y + dy, 0L, static_cast<long>(height) - 1);
+      if (!ground(static_cast<std::size_t>(yy) * width + static_cast<std::size_t>(xx))) return false;
+    }
+  return true;
+}
+
+GroundSkyGrid::GroundSkyGrid(int width, int height)
+    : width_(width),
+      height_(height),
+      columns_((width - 1) / kGroundSkyStep + 2),
+      rows_((height - 1) / kGroundSkyStep + 2) {
+  HC_CHECK_LT(0, width);
+  HC_CHECK_LT(0, height);
+  value_.assign(static_cast<std::size_t>(columns_) * static_cast<std::size_t>(rows_), -1.0f);
+}
+
+int GroundSkyGrid::gridX(int i) const { return std::min(i * kGroundSkyStep, width_ - 1); }
+int GroundSkyGrid::gridY(int j) const { return std::min(j * kGroundSkyStep, height_ - 1); }
+
+void GroundSkyGrid::compute(const RayScene& world, const GroundSky& sky,
+                            const std::function<std::optional<ShadingPoint>(std::size_t pixel)>& point,
+                            unsigned threads) {
+  parallelFor(static_cast<std::size_t>(rows_), [&](std::size_t j) {
+    for (int i = 0; i < columns_; ++i) {
+      const std::size_t pixel = static_cast<std::size_t>(gridY(static_cast<int>(j))) * static_cast<std::size_t>(width_) +
+                                static_cast<std::size_t>(gridX(i));
+      const std::optional<ShadingPoint> p = point(pixel);
+      value_[j * static_cast<std::size_t>(columns_) + static_cast<std::size_t>(i)] =
+          p ? groundSkyOcclusion(world, *p, sky) : -1.0f;
+    }
+  }, {}, threads);
+}
+
+float GroundSkyGrid::at(std::size_t pixel, const std::function<float()>& direct) const {
+  const int x = static_cast<int>(pixel % static_cast<std::size_t>(width_));
+  const int y = static_cast<int>(pixel / static_cast<std::size_t>(width_));
+  HC_CHECK_LT(y, height_);
+  const int i = std::min(x / kGroundSkyStep, columns_ - 2), j = std::min(y / kGroundSkyStep, rows_ - 2);
+  const int x0 = gridX(i), x1 = gridX(i + 1), y0 = gridY(j), y1 = gridY(j + 1);
+  const float tx = x1 > x0 ? static_cast<float>(x - x0) / static_cast<float>(x1 - x0) : 0.0f;
+  const float ty = y1 > y0 ? static_cast<float>(y - y0) / static_cast<float>(y1 - y0) : 0.0f;
+  float sum = 0.0f, weight = 0.0f;
+  for (int dj = 0; dj < 2; ++dj) {
+    for (int di = 0; di < 2; ++di) {
+      const float v = value_[static_cast<std::size_t>(j + dj) * static_cast<std::size_t>(columns_) + static_cast<std::size_t>(i + di)];
+      if (v < 0.0f) continue;
+      const float w = (di ? tx : 1.0f - tx) * (dj ? ty : 1.0f - ty);
+      sum += w * v;
+      weight += w;
+    }
+  }
+  // A corner of weight 0 still counts as ground; all four off the ground: own rays.
+  bool any = false;
+  for (int dj = 0; dj < 2; ++dj)
+    for (int di = 0; di < 2; ++di)
+      any = any || value_[static_cast<std::size_t>(j + dj) * static_cast<std::size_t>(columns_) + static_cast<std::size_t>(i + di)] >= 0.0f;
+  if (!any) return direct();
+  return weight > 0.0f ? sum / weight : direct();
 }
 
 std::uint32_t withGroundOcclusion(std::uint32_t lightBits, float occlusion) {

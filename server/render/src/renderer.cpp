@@ -96,6 +96,8 @@ PreparedScene prepareScene(const Scene& scene, const RenderOptions& options, con
     p.table = objectSliceTable(object, options, progress);
     p.ground = object.ground;
     p.groundAlbedo = object.groundAlbedo;
+    p.sphereCentre = p.mesh->bounds().centre();
+    for (const glm::vec3& v : p.mesh->positions) p.sphereRadius = std::max(p.sphereRadius, glm::length(glm::dvec3(v) - p.sphereCentre));
     if (p.ground) {
       if (prepared.ground) throw std::invalid_argument("render: the scene has two grounds");
       prepared.ground = k;
@@ -294,9 +296,9 @@ ResolvedFrame resolveFrame(const PreparedScene& prepared, const RenderOptions& o
     sky.toEnvironment = glm::mat3(glm::transpose(request.lightRotation));
     for (std::size_t i = 0; i < out.objects.size(); ++i) {
       if (prepared.objects[i].ground) continue;
-      const Bounds b = prepared.objects[i].mesh->bounds();
-      const glm::dvec3 centre = glm::dvec3(out.objects[i].objectToWorld * glm::dvec4(b.centre(), 1.0));
-      sky.occluders.emplace_back(glm::vec3(centre), static_cast<float>(b.radius() * out.objects[i].scale));
+      const PreparedObject& p = prepared.objects[i];
+      const glm::dvec3 centre = glm::dvec3(out.objects[i].objectToWorld * glm::dvec4(p.sphereCentre, 1.0));
+      sky.occluders.emplace_back(glm::vec3(centre), static_cast<float>(p.sphereRadius * out.objects[i].scale));
     }
     const int level = prepared.restLight[0].level();
     sky.luminance = SphereMap(level);

@@ -11,6 +11,8 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -48,24 +50,53 @@ std::uint32_t pointLightMask(const RayScene& world, const ShadingPoint& p, std::
 // lights): the ground is shaded in closed form, the same at every point,
 // so without this an object standing on it casts no contact shadow from
 // the sky. Per ground sample, rays go toward each object's bounding
-// sphere — a cone of 3 × 8 stratified directions, the same pattern at
+// sphere — a cone of 2 × 8 stratified directions, the same pattern at
 // every sample so the result is smooth and steady from frame to frame —
 // against the whole posed scene; each blocked direction takes its share
 // of Σ L·cos·ΔΩ. Objects whose cone can hide less than `minShare` of the
-// sky are skipped, so rays go only near the objects.
+// sky are skipped (and faded in above it, so no edge shows), so rays go
+// only near the objects.
 struct GroundSky {
   std::vector<glm::vec4> occluders;  // world bounding spheres of the objects other than the ground (centre, radius)
   SphereMap luminance;               // the map light's luminance, in the environment's frame
   glm::mat3 toEnvironment{1.0f};     // world → environment (lightRotationᵀ)
   glm::vec3 normal{0.0f, 1.0f, 0.0f};  // the ground's, world
   double total = 0.0;                // Σ luminance·cos·ΔΩ over the ground's upper hemisphere
-  double minShare = 0.004;
+  double minShare = 0.03;  // faded in up to twice this
 };
-inline constexpr int kGroundSkyRings = 3;
+inline constexpr int kGroundSkyRings = 2;
 inline constexpr int kGroundSkySectors = 8;
 
 // The share in [0, 1] of the ground's map light that the scene hides from p.
 float groundSkyOcclusion(const RayScene& world, const ShadingPoint& p, const GroundSky& sky);
+
+// groundSkyOcclusion on a coarse grid of the frame, the pixels (i·step, j·step)
+// and the last row and column, then for every ground sample the bilinear
+// blend of its cell's corners that are ground (renormalised), or its own
+// rays when none is: the hidden sky changes slowly over the ground, and rays
+// at every pixel would cost most of a frame. Both backends fill the grid
+// from the same samples (interior pixels' centres) and blend alike.
+inline constexpr int kGroundSkyStep = 4;
+
+// The antialiasing's interior rule (shared_layout.h): pixel and its 3×3
+// neighbours (clamped at the frame's border) all `ground`.
+bool interiorPixel(std::size_t pixel, std::size_t width, std::size_t height, const std::function<bool(std::size_t)>& ground);
+class GroundSkyGrid {
+ public:
+  GroundSkyGrid(int width, int height);
+  // point(pixel) is the ground's shading point at that interior pixel's
+  // centre, or nullopt (not the ground, an edge pixel, nothing).
+  void compute(const RayScene& world, const GroundSky& sky,
+               const std::function<std::optional<ShadingPoint>(std::size_t pixel)>& point, unsigned threads);
+  // The occlusion for a ground sample of pixel y·width + x.
+  float at(std::size_t pixel, const std::function<float()>& direct) const;
+
+ private:
+  int width_, height_, columns_, rows_;
+  std::vector<float> value_;  // per grid point; < 0 where it is not the ground
+  int gridX(int i) const;     // pixel column of grid column i
+  int gridY(int j) const;
+};
 
 // A ground sample's word: its light bits and the occlusion above them
 // (shared_layout.h, kGroundOcclusionShift).

@@ -121,6 +121,11 @@ struct PreparedObject {
   bool ground = false;                 // the scene's ground (SceneObject::ground)
   glm::dvec3 groundAlbedo{0.0};        // its Lambert albedo
   float shadowShift = 0.0f;            // point-light rays' origin shift, object units (× pose scale)
+  // A sphere around the mesh, object frame: its bounds' centre and the
+  // farthest vertex from it (tighter than half the diagonal: the rays
+  // toward an object's sphere, point_lights.h, hit it more often).
+  glm::dvec3 sphereCentre{0.0};
+  double sphereRadius = 0.0;
 };
 
 struct PreparedScene {
