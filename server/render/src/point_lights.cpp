@@ -117,18 +117,21 @@ bool interiorPixel(std::size_t pixel, std::size_t width, std::size_t height, con
   return true;
 }
 
+int groundSkyStep(int width, int height) { return std::clamp((std::max(width, height) + 24) / 48, 4, 16); }
+
 GroundSkyGrid::GroundSkyGrid(int width, int height)
     : width_(width),
       height_(height),
-      columns_((width - 1) / kGroundSkyStep + 2),
-      rows_((height - 1) / kGroundSkyStep + 2) {
+      step_(groundSkyStep(width, height)),
+      columns_((width - 1) / step_ + 2),
+      rows_((height - 1) / step_ + 2) {
   HC_CHECK_LT(0, width);
   HC_CHECK_LT(0, height);
   value_.assign(static_cast<std::size_t>(columns_) * static_cast<std::size_t>(rows_), -1.0f);
 }
 
-int GroundSkyGrid::gridX(int i) const { return std::min(i * kGroundSkyStep, width_ - 1); }
-int GroundSkyGrid::gridY(int j) const { return std::min(j * kGroundSkyStep, height_ - 1); }
+int GroundSkyGrid::gridX(int i) const { return std::min(i * step_, width_ - 1); }
+int GroundSkyGrid::gridY(int j) const { return std::min(j * step_, height_ - 1); }
 
 void GroundSkyGrid::compute(const RayScene& world, const GroundSky& sky,
                             const std::function<std::optional<ShadingPoint>(std::size_t pixel)>& point,
@@ -148,7 +151,7 @@ float GroundSkyGrid::at(std::size_t pixel, const std::function<float()>& direct)
   const int x = static_cast<int>(pixel % static_cast<std::size_t>(width_));
   const int y = static_cast<int>(pixel / static_cast<std::size_t>(width_));
   HC_CHECK_LT(y, height_);
-  const int i = std::min(x / kGroundSkyStep, columns_ - 2), j = std::min(y / kGroundSkyStep, rows_ - 2);
+  const int i = std::min(x / step_, columns_ - 2), j = std::min(y / step_, rows_ - 2);
   const int x0 = gridX(i), x1 = gridX(i + 1), y0 = gridY(j), y1 = gridY(j + 1);
   const float tx = x1 > x0 ? static_cast<float>(x - x0) / static_cast<float>(x1 - x0) : 0.0f;
   const float ty = y1 > y0 ? static_cast<float>(y - y0) / static_cast<float>(y1 - y0) : 0.0f;

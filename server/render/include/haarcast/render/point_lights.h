@@ -76,7 +76,9 @@ float groundSkyOcclusion(const RayScene& world, const ShadingPoint& p, const Gro
 // rays when none is: the hidden sky changes slowly over the ground, and rays
 // at every pixel would cost most of a frame. Both backends fill the grid
 // from the same samples (interior pixels' centres) and blend alike.
-inline constexpr int kGroundSkyStep = 4;
+// The grid's spacing: a 48th of the frame's larger side, 4 to 16 pixels (a
+// contact shadow spans a share of the frame, not a number of pixels).
+int groundSkyStep(int width, int height);
 
 // The antialiasing's interior rule (shared_layout.h): pixel and its 3×3
 // neighbours (clamped at the frame's border) all `ground`.
@@ -92,7 +94,7 @@ class GroundSkyGrid {
   float at(std::size_t pixel, const std::function<float()>& direct) const;
 
  private:
-  int width_, height_, columns_, rows_;
+  int width_, height_, step_, columns_, rows_;
   std::vector<float> value_;  // per grid point; < 0 where it is not the ground
   int gridX(int i) const;     // pixel column of grid column i
   int gridY(int j) const;
