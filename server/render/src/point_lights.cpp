@@ -117,7 +117,7 @@ bool interiorPixel(std::size_t pixel, std::size_t width, std::size_t height, con
   return true;
 }
 
-int groundSkyStep(int width, int height) { return std::clamp((std::max(width, height) + 24) / 48, 4, 16); }
+int groundSkyStep(int width, int height) { return std::clamp((std::max(width, height) + 20) / 40, 4, 16); }
 
 GroundSkyGrid::GroundSkyGrid(int width, int height)
     : width_(width),

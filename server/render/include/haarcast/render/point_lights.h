@@ -76,7 +76,7 @@ float groundSkyOcclusion(const RayScene& world, const ShadingPoint& p, const Gro
 // rays when none is: the hidden sky changes slowly over the ground, and rays
 // at every pixel would cost most of a frame. Both backends fill the grid
 // from the same samples (interior pixels' centres) and blend alike.
-// The grid's spacing: a 48th of the frame's larger side, 4 to 16 pixels (a
+// The grid's spacing: a 40th of the frame's larger side, 4 to 16 pixels (a
 // contact shadow spans a share of the frame, not a number of pixels).
 int groundSkyStep(int width, int height);
 
