@@ -18,7 +18,6 @@ namespace asio = boost::asio;
 constexpr auto kTick = std::chrono::milliseconds(100);
 constexpr std::size_t kMaxControlQueue = 64;
 
-double secondsBetween(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
 
 grpc::Status status(GrpcCode code, const std::string& message) {
   return {static_cast<grpc::StatusCode>(static_cast<int>(code)), message};
@@ -291,10 +290,7 @@ void GrpcSession::finishCall(grpc::Status finalStatus) {
   paceTimer_.cancel();
   if (!registered_) return;  // refused before it opened: nothing was started
   server_.renderService->withdraw(id_);
-  server_.log("%s: closed (%llu frames, %llu dropped, %llu bytes)", id_.c_str(),
-              static_cast<unsigned long long>(session_.framesSent()),
-              static_cast<unsigned long long>(session_.framesDropped()),
-              static_cast<unsigned long long>(session_.bytesSent()));
+  logClosed(server_, id_, session_);
 }
 
 // Cuts the call: operations in flight fail, the client sees CANCELLED.
@@ -316,18 +312,9 @@ void GrpcSession::tick() {
 
 void GrpcSession::onTick() {
   if (gone_) return;
-  const auto& o = server_.options;
   const auto now = Clock::now();
-  if (writing_ && secondsBetween(writeStarted_, now) > o.writeStallSeconds) {
-    server_.metrics.addError(errorLabel(v1::ERROR_CODE_TIMEOUT));  // no Error can reach a client that does not read
-    server_.metrics.addTimeout("write");
-    server_.metrics.addCut("write_stall");
-    hardClose("a write has not completed for too long (the client stopped reading)");
-    return;
-  }
-  if (closeRequested_ && secondsBetween(closeAt_, now) > o.drainSeconds) {
-    server_.metrics.addTimeout("close");
-    hardClose("the close did not complete in time");
+  if (const char* why = watchdogCut(server_, writing_, writeStarted_, closeRequested_, closeAt_, now)) {
+    hardClose(why);
     return;
   }
   if (!closeRequested_) session_.onTick(now);

@@ -8,6 +8,7 @@
 // hold it weakly: a session that has gone is not kept alive by its frames.
 #pragma once
 
+#include <chrono>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -113,6 +114,33 @@ void submitFrame(Server::Impl& server, const std::shared_ptr<Transport>& transpo
     }
   };
   server.renderService->submit(std::move(job));
+}
+
+// The watchdog both transports run on each tick: why to cut the session —
+// one write in flight past writeStallSeconds (the client stopped reading)
+// or a close not done within drainSeconds — with the metrics counted, or
+// nullptr when it may go on.
+inline const char* watchdogCut(Server::Impl& server, bool writing, Clock::time_point writeStarted, bool closeRequested,
+                               Clock::time_point closeAt, Clock::time_point now) {
+  auto seconds = [](Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); };
+  if (writing && seconds(writeStarted, now) > server.options.writeStallSeconds) {
+    server.metrics.addError(errorLabel(v1::ERROR_CODE_TIMEOUT));  // no Error can reach a client that does not read
+    server.metrics.addTimeout("write");
+    server.metrics.addCut("write_stall");
+    return "a write has not completed for too long (the client stopped reading)";
+  }
+  if (closeRequested && seconds(closeAt, now) > server.options.drainSeconds) {
+    server.metrics.addTimeout("close");
+    return "the close did not complete in time";
+  }
+  return nullptr;
+}
+
+// The session's last log line.
+inline void logClosed(Server::Impl& server, const std::string& id, const RenderSession& session) {
+  server.log("%s: closed (%llu frames, %llu dropped, %llu bytes)", id.c_str(),
+             static_cast<unsigned long long>(session.framesSent()), static_cast<unsigned long long>(session.framesDropped()),
+             static_cast<unsigned long long>(session.bytesSent()));
 }
 
 }  // namespace haarcast::net

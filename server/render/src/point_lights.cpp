@@ -41,7 +41,7 @@ std::uint32_t pointLightMask(const RayScene& world, const ShadingPoint& p, std::
 }
 
 float groundSkyOcclusion(const RayScene& world, const ShadingPoint& p, const GroundSky& sky) {
-  if (!(sky.total > 0.0) || sky.occluders.empty()) return 0.0f;
+  if (!(sky.total > 0.0) || sky.occluders.empty() || !sky.luminance) return 0.0f;
   const glm::vec3 origin = p.position + p.normal * p.shift;
   constexpr int kSamples = kGroundSkyRings * kGroundSkySectors;
   // Per thread, kept across samples: no allocation per sample.
@@ -95,7 +95,7 @@ float groundSkyOcclusion(const RayScene& world, const ShadingPoint& p, const Gro
         if (earlier) continue;
         const Spherical s = directionToSpherical(glm::dvec3(sky.toEnvironment * d));
         directions.push_back(d);
-        weights.push_back(fade * static_cast<float>(sky.luminance.sampleBilinear(s.theta, s.phi)) * cosine * solid / kSamples);
+        weights.push_back(fade * static_cast<float>(sky.luminance->sampleBilinear(s.theta, s.phi)) * cosine * solid / kSamples);
       }
     }
   }
@@ -155,6 +155,8 @@ float GroundSkyGrid::at(std::size_t pixel, const std::function<float()>& direct)
   const int x0 = gridX(i), x1 = gridX(i + 1), y0 = gridY(j), y1 = gridY(j + 1);
   const float tx = x1 > x0 ? static_cast<float>(x - x0) / static_cast<float>(x1 - x0) : 0.0f;
   const float ty = y1 > y0 ? static_cast<float>(y - y0) / static_cast<float>(y1 - y0) : 0.0f;
+  // The corners that are ground, by their bilinear weights renormalised;
+  // none of them (or only ones of weight 0): the sample's own rays.
   float sum = 0.0f, weight = 0.0f;
   for (int dj = 0; dj < 2; ++dj) {
     for (int di = 0; di < 2; ++di) {
@@ -165,12 +167,6 @@ float GroundSkyGrid::at(std::size_t pixel, const std::function<float()>& direct)
       weight += w;
     }
   }
-  // A corner of weight 0 still counts as ground; all four off the ground: own rays.
-  bool any = false;
-  for (int dj = 0; dj < 2; ++dj)
-    for (int di = 0; di < 2; ++di)
-      any = any || value_[static_cast<std::size_t>(j + dj) * static_cast<std::size_t>(columns_) + static_cast<std::size_t>(i + di)] >= 0.0f;
-  if (!any) return direct();
   return weight > 0.0f ? sum / weight : direct();
 }
 

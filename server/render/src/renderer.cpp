@@ -128,6 +128,11 @@ PreparedScene prepareScene(const Scene& scene, const RenderOptions& options, con
     LightSplit split = splitLight(prepared.background, options.level, options.pointLights);
     prepared.pointLights = std::move(split.lights);
     prepared.restLight = std::move(split.rest);
+    const std::array<SphereMap, 3>& rest = prepared.restLight;
+    prepared.restLuminance = SphereMap(rest[0].level());
+    for (int r = 0; r < rest[0].size(); ++r)
+      for (int c = 0; c < rest[0].size(); ++c)
+        prepared.restLuminance.at(r, c) = static_cast<float>(luminance709(rest[0].at(r, c), rest[1].at(r, c), rest[2].at(r, c)));
   }
   return prepared;
 }
@@ -300,14 +305,12 @@ ResolvedFrame resolveFrame(const PreparedScene& prepared, const RenderOptions& o
       const glm::dvec3 centre = glm::dvec3(out.objects[i].objectToWorld * glm::dvec4(p.sphereCentre, 1.0));
       sky.occluders.emplace_back(glm::vec3(centre), static_cast<float>(p.sphereRadius * out.objects[i].scale));
     }
-    const int level = prepared.restLight[0].level();
-    sky.luminance = SphereMap(level);
-    for (int r = 0; r < sky.luminance.size(); ++r) {
-      for (int c = 0; c < sky.luminance.size(); ++c) {
-        const double l = luminance709(prepared.restLight[0].at(r, c), prepared.restLight[1].at(r, c), prepared.restLight[2].at(r, c));
-        sky.luminance.at(r, c) = static_cast<float>(l);
+    sky.luminance = &prepared.restLuminance;
+    const int level = prepared.restLuminance.level();
+    for (int r = 0; r < prepared.restLuminance.size(); ++r) {
+      for (int c = 0; c < prepared.restLuminance.size(); ++c) {
         const double cosine = glm::dot(request.lightRotation * sphericalToDirection(rowTheta(level, r), colPhi(level, c)), *groundNormal);
-        if (cosine > 0.0) sky.total += l * cosine * pixelSolidAngle(level, r);
+        if (cosine > 0.0) sky.total += prepared.restLuminance.at(r, c) * cosine * pixelSolidAngle(level, r);
       }
     }
   }

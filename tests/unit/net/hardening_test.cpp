@@ -10,15 +10,6 @@
 namespace haarcast::net::test {
 namespace {
 
-std::string ws(const std::string& query = "") { return std::string("/ws?token=") + kToken + query; }
-
-// The value of one sample line of /metrics ("-1" when absent).
-long long metric(std::uint16_t port, const std::string& sample) {
-  const std::string text = httpGet(port, "/metrics");
-  const auto at = text.find("\n" + sample + " ");  // a sample line, not a HELP line
-  return at == std::string::npos ? -1 : std::stoll(text.substr(at + sample.size() + 2));
-}
-
 TEST(ServerHardening, ForeignOriginIs403NoOriginAndAllowedOnesPass) {
   auto options = testOptions();
   options.allowOrigins = {"https://app.example.com"};

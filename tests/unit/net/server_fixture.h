@@ -357,4 +357,14 @@ inline http::status upgradeStatus(std::uint16_t port, const std::string& target,
 // ---------------------------------------------------------------- round trip
 
 
+// The WebSocket target with the test token (and more query).
+inline std::string ws(const std::string& query = "") { return std::string("/ws?token=") + kToken + query; }
+
+// The value of one sample line of /metrics ("-1" when absent).
+inline long long metric(std::uint16_t port, const std::string& sample) {
+  const std::string text = httpGet(port, "/metrics");
+  const auto at = text.find("\n" + sample + " ");  // a sample line, not a HELP line
+  return at == std::string::npos ? -1 : std::stoll(text.substr(at + sample.size() + 2));
+}
+
 }  // namespace haarcast::net::test

@@ -58,7 +58,7 @@ std::uint32_t pointLightMask(const RayScene& world, const ShadingPoint& p, std::
 // only near the objects.
 struct GroundSky {
   std::vector<glm::vec4> occluders;  // world bounding spheres of the objects other than the ground (centre, radius)
-  SphereMap luminance;               // the map light's luminance, in the environment's frame
+  const SphereMap* luminance = nullptr;  // the map light's luminance, environment frame (PreparedScene::restLuminance)
   glm::mat3 toEnvironment{1.0f};     // world → environment (lightRotationᵀ)
   glm::vec3 normal{0.0f, 1.0f, 0.0f};  // the ground's, world
   double total = 0.0;                // Σ luminance·cos·ΔΩ over the ground's upper hemisphere

@@ -137,6 +137,7 @@ struct PreparedScene {
   // frame: its point lights, and the map without them.
   std::vector<DirectionalLight> pointLights;
   std::array<SphereMap, 3> restLight;
+  SphereMap restLuminance;              // its Rec. 709 luminance (the ground's hidden sky, point_lights.h)
   std::optional<std::size_t> ground;    // index of the ground object, if any
 };
 
