@@ -20,9 +20,14 @@
 //      triangle's three vertices' visibility bits blended by the
 //      barycentrics, V = b0·bit0 + b1·bit1 + b2·bit2 (core blendVisibility);
 //      accumulated with W_c = L_c·V;
-//   2. the partial sums are reduced in invocation order; invocation 0 adds
-//      the point lights whose bit is set, in light order, each with the same
-//      rhoAt at the light's direction; radiance[pixel] = Σ.
+//   2. the partial sums are reduced in invocation order; invocation 0 puts
+//      the lobe's energy back (× ∫ρ / Σ ΔΩ·ρ, the second sum of step 1:
+//      core fused.cpp energyKept), adds the point lights whose bit is set,
+//      in light order, each with the same rhoAt at the light's direction,
+//      and blends in the lobe path by its share; radiance[pixel] = Σ.
+// A sample whose lobe is narrower than the map's texels (shared_layout.h,
+// "The lobe path") skips steps 1–2: invocation 0 reads the prefiltered
+// light over the lobe's K·J stratified directions (lobeShade).
 //
 // The large read-only arrays of step 1 (slice texels, light, directions,
 // visibility words) are uniform texel buffers read with texelFetch: on a CPU
@@ -37,6 +42,7 @@
 layout(local_size_x_id = 2) in;
 layout(constant_id = 0) const uint LEVEL = 5u;
 layout(constant_id = 4) const uint INTERPOLATE = 1u;    // RenderOptions::interpolateSlices
+layout(constant_id = 5) const uint PREFILTER_FINEST = 9u;  // the prefiltered light's finest level
 
 const uint LOCAL = gl_WorkGroupSize.x;
 const uint M = 1u << LEVEL;
@@ -56,8 +62,13 @@ layout(std430, set = 0, binding = 7) readonly buffer PointLights { PointLight po
 layout(std430, set = 0, binding = 8) buffer Radiance { vec4 radiance[]; };
 layout(std430, set = 0, binding = 9) readonly buffer Counter { CoverageCounter counter; };
 layout(std430, set = 0, binding = 10) readonly buffer Masks { uint masks[]; };  // sample s: bit k = sees light k
+layout(std430, set = 0, binding = 11) readonly buffer SliceEnergies { vec4 sliceEnergy[]; };  // global slice: ∫ρ_c (rgb)
+layout(std430, set = 0, binding = 12) readonly buffer Lobes { SliceLobe lobes[]; };          // global slice: its lobe
+// Level l of the prefiltered light at prefilterOffset(l), RGB0 (core PrefilteredLight).
+layout(set = 0, binding = 13) uniform samplerBuffer lobeLight;
 
 shared vec3 partial[LOCAL];
+shared vec3 partialSum[LOCAL];  // Σ ΔΩ·ρ_c: the lobe's energy as the directions sample it
 
 void sync() {
   memoryBarrierShared();
@@ -123,10 +134,13 @@ float bitOf(uint v, uint i) {
 // 1. Σ over the directions of this invocation (i ≡ lid mod LOCAL). Called
 // with a constant `blended`, so each call is its own loop without the other
 // kind of lookup (SIMD devices such as lavapipe would otherwise run both).
-vec3 sumDirections(const bool blended, PixelSetup p) {
+vec3 sumDirections(const bool blended, PixelSetup p, out vec3 norm) {
   vec3 acc = vec3(0.0);
+  norm = vec3(0.0);
   for (uint i = p.firstRow * M + gl_LocalInvocationID.x; i < p.endRow * M; i += LOCAL) {
-    const vec3 rho = rhoAt(blended, p, texelFetch(directions, int(i)).xyz);
+    const vec4 dir = texelFetch(directions, int(i));  // xyz, and w = ΔΩ
+    const vec3 rho = rhoAt(blended, p, dir.xyz);
+    norm += dir.w * rho;
     // V = ((0 + b0·bit0) + b1·bit1) + b2·bit2, blendVisibility's order (the
     // products are exact, so a fused multiply-add changes nothing).
     const float vis = p.sh.b[0] * bitOf(p.sh.vertex[0], i) + p.sh.b[1] * bitOf(p.sh.vertex[1], i) +
@@ -135,6 +149,52 @@ vec3 sumDirections(const bool blended, PixelSetup p) {
     acc += w * rho;
   }
   return acc;
+}
+
+// Level `level` of the prefiltered light, bilinear at direction d (core
+// PrefilteredLight::sampleLevel).
+vec3 prefilteredAt(uint level, vec3 d) {
+  const LatLongTaps t = latLongTaps(level, atan2Fast(sqrt(d.x * d.x + d.z * d.z), d.y), atan2Fast(d.x, d.z));
+  const int base = int(prefilterOffset(level)), m = int(1u << level);
+  const vec3 a = texelFetch(lobeLight, base + int(t.row0) * m + int(t.col0)).rgb;
+  const vec3 b = texelFetch(lobeLight, base + int(t.row0) * m + int(t.col1)).rgb;
+  const vec3 c = texelFetch(lobeLight, base + int(t.row1) * m + int(t.col0)).rgb;
+  const vec3 e = texelFetch(lobeLight, base + int(t.row1) * m + int(t.col1)).rgb;
+  const vec3 top = t.tCol * (b - a) + a;
+  const vec3 bottom = t.tCol * (e - c) + c;
+  return t.tRow * (bottom - top) + top;
+}
+
+// Trilinear: ⌊λ⌋ and ⌊λ⌋ + 1 blended by λ's fraction (PrefilteredLight::sample).
+vec3 prefilteredAt(float level, vec3 d) {
+  const float lambda = clamp(level, 0.0, float(PREFILTER_FINEST));
+  const uint l0 = uint(lambda);
+  const float t = lambda - float(l0);
+  const vec3 a = prefilteredAt(l0, d);
+  if (t == 0.0 || l0 == PREFILTER_FINEST) return a;
+  return a + t * (prefilteredAt(l0 + 1u, d) - a);
+}
+
+// The lobe path (shared_layout.h, core fused.cpp lobeShade): E_c·the mean
+// of the prefiltered light over the lobe's K·J stratified directions.
+vec3 lobeShade(ObjectInfo o, RotationSample rs, SliceBlend blend, uint seen) {
+  if ((seen & kLobeSeenBit) == 0u) return vec3(0.0);
+  const SliceLobe lobe = blendLobes(lobes[o.sliceBase + blend.first], lobes[o.sliceBase + blend.second], blend.weight);
+  const vec2 sc = sinCosPrecise(lobe.energy.w);
+  const mat3 toLight = mat3(o.toLight[0].xyz, o.toLight[1].xyz, o.toLight[2].xyz) * rotationYXY(rs.alpha, rs.beta, rs.gamma);
+  const vec3 axis = toLight * vec3(0.0, sc.y, -sc.x);
+  const vec3 u = toLight * vec3(1.0, 0.0, 0.0);
+  const vec3 v = toLight * vec3(0.0, -sc.x, -sc.y);
+  const float sector = kTwoPi / float(kLobeSectors);
+  vec3 sum = vec3(0.0);
+  for (uint k = 0u; k < kLobeRings; ++k) {
+    const vec2 ak = sinCosPrecise(lobe.angle[k]);
+    for (uint j = 0u; j < kLobeSectors; ++j) {
+      const vec2 bj = sinCosPrecise(lobeAzimuthSectors(k, j) * sector);
+      sum += prefilteredAt(lobe.level[k], ak.y * axis + ak.x * (bj.y * u + bj.x * v));
+    }
+  }
+  return lobe.energy.rgb * (sum / float(kLobeRings * kLobeSectors));
 }
 
 // sum + Σ_k bit_k·power_k·ρ(Rᵀd_k) over the lights the sample sees, added
@@ -171,6 +231,17 @@ void shadePixel(uint s) {
   const RotationSample rs = samples[s];
   const SliceBlend blend = sliceBlendAt(rs.thetaOut, o.thetaSamples, INTERPOLATE);
   const bool blended = blend.weight != 0.0 && blend.second != blend.first;
+
+  // The lobe path's share (fused.h lobePathShareAt); all of it: no pass.
+  float share = 0.0;
+  if ((o.flags & kObjectLobePath) != 0u) {
+    const SliceLobe a = lobes[o.sliceBase + blend.first], b = lobes[o.sliceBase + blend.second];
+    share = lobePathShare(a.median.x + blend.weight * (b.median.x - a.median.x), LEVEL);
+  }
+  if (share >= 1.0) {
+    if (lid == 0u) radiance[sh.pixel] = vec4(lobeShade(o, rs, blend, seen), 1.0);
+    return;  // uniform over the workgroup
+  }
   PixelSetup p;
   p.sh = sh;
   p.base0 = (o.sliceBase + blend.first) * N;
@@ -209,18 +280,28 @@ void shadePixel(uint s) {
 
   // Two slices: each tap blends its two texels (ρ is linear in the slice),
   // with no pass over the slice first and no scratch.
-  const vec3 acc = blended ? sumDirections(true, p) : sumDirections(false, p);
+  vec3 norm;
+  const vec3 acc = blended ? sumDirections(true, p, norm) : sumDirections(false, p, norm);
 
-  // 2. Reduce in invocation order, then the point lights.
+  // 2. Reduce in invocation order, put the lobe's energy back (fused.cpp
+  // energyKept: ×∫ρ / Σ ΔΩ·ρ), then the point lights and the lobe path.
   partial[lid] = acc;
+  partialSum[lid] = norm;
   sync();
   if (lid == 0u) {
-    vec3 sum = vec3(0.0);
+    vec3 sum = vec3(0.0), sampled = vec3(0.0);
     for (uint k = 0u; k < LOCAL; ++k) sum += partial[k];
-    if (seen != 0u) {
+    for (uint k = 0u; k < LOCAL; ++k) sampled += partialSum[k];
+    const vec3 e0 = sliceEnergy[o.sliceBase + blend.first].rgb, e1 = sliceEnergy[o.sliceBase + blend.second].rgb;
+    const vec3 energy = e0 + blend.weight * (e1 - e0);
+    for (int c = 0; c < 3; ++c) {
+      if (sampled[c] > 0.0) sum[c] *= energy[c] / sampled[c];
+    }
+    if ((seen & 0xFFFFu) != 0u) {
       sum = blended ? addPointLights(true, p, sh.object, o.pointLights, seen, sum)
                     : addPointLights(false, p, sh.object, o.pointLights, seen, sum);
     }
+    if (share > 0.0) sum += share * (lobeShade(o, rs, blend, seen) - sum);
     radiance[sh.pixel] = vec4(sum, 1.0);
   }
   sync();  // `partial` is reused by the next sample

@@ -56,7 +56,7 @@ void checkFusedLevel(int level) {
 namespace detail {
 const PixelDirections& pixelDirections(int level) {
   struct Table {
-    std::vector<float> x, y, z;
+    std::vector<float> x, y, z, solidAngle;
     PixelDirections view;
   };
   // Built once for every level `fused` takes (thread-safe static initialisation).
@@ -66,14 +66,16 @@ const PixelDirections& pixelDirections(int level) {
       const int m = mapSize(l);
       Table& table = t[static_cast<std::size_t>(l)];
       for (int i = 0; i < m; ++i) {
+        const float omega = static_cast<float>(pixelSolidAngle(l, i));
         for (int j = 0; j < m; ++j) {
+          table.solidAngle.push_back(omega);
           const glm::dvec3 dir = sphericalToDirection(rowTheta(l, i), colPhi(l, j));
           table.x.push_back(static_cast<float>(dir.x));
           table.y.push_back(static_cast<float>(dir.y));
           table.z.push_back(static_cast<float>(dir.z));
         }
       }
-      table.view = {table.x.data(), table.y.data(), table.z.data()};
+      table.view = {table.x.data(), table.y.data(), table.z.data(), table.solidAngle.data()};
     }
     return t;
   }();
@@ -88,6 +90,7 @@ PixelSlices PixelSlices::synthesize(const BrdfSliceTable& table) {
   out.thetaSamples_ = table.thetaSamples();
   const std::size_t n = static_cast<std::size_t>(mapSize(out.level_)) * static_cast<std::size_t>(mapSize(out.level_));
   out.texels_.assign(static_cast<std::size_t>(out.thetaSamples_) * n * shared::kTexelFloats, 0.0f);
+  out.energy_.assign(static_cast<std::size_t>(out.thetaSamples_), {});
   const int m = mapSize(out.level_);
   for (int t = 0; t < out.thetaSamples_; ++t) {
     for (int c = 0; c < BrdfSliceTable::kChannels; ++c) {
@@ -98,6 +101,7 @@ PixelSlices PixelSlices::synthesize(const BrdfSliceTable& table) {
         dst[p * shared::kTexelFloats + static_cast<std::size_t>(c)] = values[p];
         if (values[p] != 0.0f) out.lastNonZeroRow_ = std::max(out.lastNonZeroRow_, static_cast<int>(p) / m);
       }
+      out.energy_[static_cast<std::size_t>(t)][static_cast<std::size_t>(c)] = static_cast<float>(pixels.integral());
     }
   }
   return out;
@@ -230,13 +234,34 @@ detail::FusedPass makePass(const PixelSlices& slices, const float* slice, const 
   return pass;
 }
 
+// The pass, with the lobe's energy put back: the M² map directions sample
+// ρ(Rᵀω) at points, so a lobe about as narrow as a texel is over- or
+// under-counted depending on where it falls between them — rings as R turns
+// across a surface. Σ ΔΩ·ρ(Rᵀω) measures that count in the same pass, and
+// ∫ρ of the slice is what it should be.
+std::array<float, 3> energyKept(const detail::FusedPass& pass, const PixelSlices& slices,
+                                const shared::SliceBlend& blend) {
+  float sums[6] = {};
+  detail::fusedSample(pass, sums);
+  const std::array<float, 3>& e0 = slices.energy(static_cast<int>(blend.first));
+  const std::array<float, 3>& e1 = slices.energy(static_cast<int>(blend.second));
+  std::array<float, 3> out{};
+  for (std::size_t c = 0; c < 3; ++c) {
+    const float energy = e0[c] + blend.weight * (e1[c] - e0[c]);
+    out[c] = sums[3 + c] > 0.0f ? sums[c] * (energy / sums[3 + c]) : sums[c];
+  }
+  return out;
+}
+
 }  // namespace
 
 std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBlend& blend, const EulerYXY& r,
                                 const FusedLight& light, std::span<const WeightedBits> visibility,
                                 std::span<const FusedPointLight> lights, std::uint32_t visibleLights,
-                                FusedScratch& scratch) {
+                                FusedScratch& scratch, const LobePath* lobe) {
   const int level = slices.level();
+  const float share = lobe ? lobePathShareAt(*lobe, blend, level) : 0.0f;
+  if (share >= 1.0f) return lobeShade(*lobe, blend, r, visibleLights);
   checkSameLevel(light.level, level, "the light");
   const std::size_t n = static_cast<std::size_t>(mapSize(level)) * static_cast<std::size_t>(mapSize(level));
   scratch.visibility.resize(n);
@@ -245,12 +270,15 @@ std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBl
   detail::FusedPass pass = makePass(slices, blendedSlice(slices, blend, scratch), r);
   pass.light = light.planes.data();
   pass.visibility = scratch.visibility.data();
-  std::array<float, 3> out{};
-  detail::fusedSample(pass, out.data());
+  std::array<float, 3> out = energyKept(pass, slices, blend);
   for (std::size_t k = 0; k < lights.size(); ++k) {
     if (((visibleLights >> k) & 1u) == 0) continue;
     const std::array<float, 3> rho = sliceAt(pass, lights[k].direction);
     for (std::size_t c = 0; c < 3; ++c) out[c] += lights[k].power[c] * rho[c];
+  }
+  if (share > 0.0f) {
+    const std::array<float, 3> mirror = lobeShade(*lobe, blend, r, visibleLights);
+    for (std::size_t c = 0; c < 3; ++c) out[c] += share * (mirror[c] - out[c]);
   }
   return out;
 }
@@ -274,9 +302,30 @@ std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBl
   detail::FusedPass pass = makePass(slices, blendedSlice(slices, blend, scratch), r);
   pass.light = light.planes.data();
   pass.visibility = scratch.visibility.data();
-  std::array<float, 3> out{};
-  detail::fusedSample(pass, out.data());
-  return out;
+  return energyKept(pass, slices, blend);
+}
+
+float lobePathShareAt(const LobePath& path, const shared::SliceBlend& blend, int level) {
+  if (path.everyLobe) return 1.0f;
+  const shared::SliceLobe& a = path.lobes[blend.first];
+  const shared::SliceLobe& b = path.lobes[blend.second];
+  const float median = a.median.x + blend.weight * (b.median.x - a.median.x);
+  return shared::lobePathShare(median, static_cast<shared::uint>(level));
+}
+
+std::array<float, 3> lobeShade(const LobePath& path, const shared::SliceBlend& blend, const EulerYXY& r,
+                               std::uint32_t word) {
+  if ((word & shared::kLobeSeenBit) == 0u) return {0.0f, 0.0f, 0.0f};
+  const shared::SliceLobe lobe = shared::blendLobes(path.lobes[blend.first], path.lobes[blend.second], blend.weight);
+  // The axis in the slice's frame (φ = π side) and two directions across
+  // it, turned by R into the object's frame, then into the light's.
+  const float c = std::cos(lobe.energy.w), s = std::sin(lobe.energy.w);
+  const glm::mat3 toLight = path.toLight * glm::mat3(rotationMatrix(r));
+  const glm::vec3 axis = toLight * glm::vec3(0.0f, c, -s);
+  const glm::vec3 u = toLight * glm::vec3(1.0f, 0.0f, 0.0f);
+  const glm::vec3 v = toLight * glm::vec3(0.0f, -s, -c);
+  const glm::vec3 light = path.light->lobe(lobe, axis, u, v);
+  return {lobe.energy.r * light.r, lobe.energy.g * light.g, lobe.energy.b * light.b};
 }
 
 std::string fusedTargetName() { return detail::fusedTarget(); }

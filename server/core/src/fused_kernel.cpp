@@ -69,6 +69,8 @@ void FusedSample(const FusedPass& p, float* HWY_RESTRICT out) {
   const float* HWY_RESTRICT vis = p.visibility;
 
   VF accR = zero, accG = zero, accB = zero;
+  VF sumR = zero, sumG = zero, sumB = zero;
+  const float* HWY_RESTRICT omega = p.directions.solidAngle;
   // n ≥ 16 ≥ lanes on every target for level ≥ 2, and both are powers of two.
   for (std::size_t i = 0; i < n; i += lanes) {
     const VF x0 = hn::LoadU(d, p.directions.x + i);
@@ -110,13 +112,21 @@ void FusedSample(const FusedPass& p, float* HWY_RESTRICT out) {
     };
     // W_c = (L_c·ΔΩ)·V, formed only for the directions that are not skipped.
     const VF v = hn::LoadU(d, vis + i);
-    accR = hn::MulAdd(hn::Mul(hn::LoadU(d, l0 + i), v), lookup(red), accR);
-    accG = hn::MulAdd(hn::Mul(hn::LoadU(d, l1 + i), v), lookup(green), accG);
-    accB = hn::MulAdd(hn::Mul(hn::LoadU(d, l2 + i), v), lookup(blue), accB);
+    const VF dOmega = hn::LoadU(d, omega + i);
+    const VF rhoR = lookup(red), rhoG = lookup(green), rhoB = lookup(blue);
+    accR = hn::MulAdd(hn::Mul(hn::LoadU(d, l0 + i), v), rhoR, accR);
+    accG = hn::MulAdd(hn::Mul(hn::LoadU(d, l1 + i), v), rhoG, accG);
+    accB = hn::MulAdd(hn::Mul(hn::LoadU(d, l2 + i), v), rhoB, accB);
+    sumR = hn::MulAdd(dOmega, rhoR, sumR);
+    sumG = hn::MulAdd(dOmega, rhoG, sumG);
+    sumB = hn::MulAdd(dOmega, rhoB, sumB);
   }
   out[0] = hn::GetLane(hn::SumOfLanes(d, accR));
   out[1] = hn::GetLane(hn::SumOfLanes(d, accG));
   out[2] = hn::GetLane(hn::SumOfLanes(d, accB));
+  out[3] = hn::GetLane(hn::SumOfLanes(d, sumR));
+  out[4] = hn::GetLane(hn::SumOfLanes(d, sumG));
+  out[5] = hn::GetLane(hn::SumOfLanes(d, sumB));
 }
 
 const char* FusedTarget() { return hwy::TargetName(HWY_TARGET); }
@@ -130,7 +140,7 @@ namespace haarcast::detail {
 HWY_EXPORT(FusedSample);
 HWY_EXPORT(FusedTarget);
 
-void fusedSample(const FusedPass& pass, float out[3]) { HWY_DYNAMIC_DISPATCH(FusedSample)(pass, out); }
+void fusedSample(const FusedPass& pass, float out[6]) { HWY_DYNAMIC_DISPATCH(FusedSample)(pass, out); }
 const char* fusedTarget() { return HWY_DYNAMIC_DISPATCH(FusedTarget)(); }
 }  // namespace haarcast::detail
 #endif

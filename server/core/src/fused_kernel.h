@@ -11,6 +11,7 @@ struct PixelDirections {
   const float* x = nullptr;
   const float* y = nullptr;
   const float* z = nullptr;
+  const float* solidAngle = nullptr;  // ΔΩ of each pixel
 };
 const PixelDirections& pixelDirections(int level);
 
@@ -29,7 +30,9 @@ struct FusedPass {
   float skipBelowY = -2.0f;   // directions with cos θ' below this read only zero texels
 };
 
-void fusedSample(const FusedPass& pass, float out[3]);
+// out[0..2]: Σ W_c·ρ_c; out[3..5]: Σ ΔΩ·ρ_c, the lobe's energy as the map's
+// directions sample it.
+void fusedSample(const FusedPass& pass, float out[6]);
 const char* fusedTarget();
 
 }  // namespace haarcast::detail

@@ -139,7 +139,7 @@ void VulkanRenderer::Impl::ensureResolution(int w, int h) {
     masks = Buffer(context, sampleCapacity * sizeof(std::uint32_t), kStorageUsage, MemoryUse::DeviceInput);
     maskUpload = BufferUpload(context, masks);
     fusedPass->bind({&samples, &shade, &objects, &sliceTexels, &lightTexels, &visibilityTexels, &directionTexels,
-                     &pointLights, &radiance, &counter, &masks});
+                     &pointLights, &radiance, &counter, &masks, &sliceEnergy, &lobes, &lobeLightTexels});
     return;
   }
 

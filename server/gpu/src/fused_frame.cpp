@@ -15,12 +15,13 @@
 #include "haarcast/core/fused.h"
 #include "haarcast/core/parallel.h"
 #include "haarcast/render/point_lights.h"
+#include "haarcast/render/shading.h"
 
 #include "vulkan_renderer_impl.h"
 
 namespace haarcast::gpu {
 
-std::uint32_t VulkanRenderer::Impl::computeShadowMasks(const render::ResolvedFrame& resolved) {
+std::uint32_t VulkanRenderer::Impl::computeShadowMasks(const render::ResolvedFrame& resolved, const glm::vec3& eye) {
   CoverageCounter count{};
   counter.read(&count, sizeof count);
   if (count.covered > sampleCapacity) {
@@ -83,6 +84,7 @@ std::uint32_t VulkanRenderer::Impl::computeShadowMasks(const render::ResolvedFra
       }
       const render::ShadingPoint point = pointOf(sample);
       out[s] = render::pointLightMask(*rays, point, lightDirections);
+      if (prepared.objects[sample.object].lobePath) out[s] |= render::lobeRayBit(*rays, point, eye);
       if (prepared.objects[sample.object].ground) {
         // Its pixel: the slot itself, or the edge pixel a sub-sample's slot belongs to.
         const std::size_t pixel = sample.pixel < pixels ? sample.pixel : (sample.pixel - pixels) / shared::kSubsamples;
@@ -114,6 +116,7 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
     fusedLightTexels(o.fusedLight.planes, std::span<glm::vec4>(lightTexelData).subspan(i * coefficients, coefficients));
     ObjectInfo& info = objectInfo[i];
     for (int c = 0; c < 3; ++c) info.rotation[c] = glm::vec4(glm::vec3(o.rotation[c]), 0.0f);
+    for (int c = 0; c < 3; ++c) info.toLight[c] = glm::vec4(o.toLight[c], 0.0f);
     HC_CHECK_EQ(o.pointLights.size(), lightCount);
     info.pointLights = static_cast<std::uint32_t>(lightCount);
     info.groundRadiance = glm::vec4(o.groundFlat[0], o.groundFlat[1], o.groundFlat[2], 0.0f);
@@ -146,7 +149,8 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
   frame.cancelled = cancelRequested();
   if (frame.cancelled) return frame;
   t0 = RendererClock::now();
-  const std::uint32_t covered = computeShadowMasks(resolved);
+  const std::uint32_t covered =
+      computeShadowMasks(resolved, glm::vec3(render::CameraRays(request.camera, request.width, request.height).origin()));
   frame.stages.push_back({"shadow-rays", secondsSince(t0)});
 
   // ---- the device's second part: the pass over the samples, the image

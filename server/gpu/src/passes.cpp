@@ -38,7 +38,7 @@ void setFusedSkip(ObjectInfo& info, int level, int lastNonZeroRow) {
 
 std::vector<BindingKind> fusedBindings() {
   using enum BindingKind;
-  return {Storage, Storage, Storage, Texels, Texels, Texels, Texels, Storage, Storage, Storage, Storage};
+  return {Storage, Storage, Storage, Texels, Texels, Texels, Texels, Storage, Storage, Storage, Storage, Storage, Storage, Texels};
 }
 
 void fusedLightTexels(std::span<const float> planes, std::span<glm::vec4> out) {
@@ -55,7 +55,9 @@ std::vector<glm::vec4> pixelCentreDirections(int level) {
   std::vector<glm::vec4> out;
   out.reserve(static_cast<std::size_t>(m) * static_cast<std::size_t>(m));
   for (int i = 0; i < m; ++i) {
-    for (int j = 0; j < m; ++j) out.emplace_back(glm::vec3(sphericalToDirection(rowTheta(level, i), colPhi(level, j))), 0.0f);
+    // w: the pixel's solid angle, as core fused's table holds it (float).
+    const auto omega = static_cast<float>(pixelSolidAngle(level, i));
+    for (int j = 0; j < m; ++j) out.emplace_back(glm::vec3(sphericalToDirection(rowTheta(level, i), colPhi(level, j))), omega);
   }
   return out;
 }

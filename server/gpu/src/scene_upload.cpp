@@ -27,6 +27,8 @@ void VulkanRenderer::Impl::uploadScene() {
   std::vector<std::uint32_t> tri;
   std::vector<SparseHaar> vis;
   std::vector<std::uint32_t> bits;  // fused: every vertex's visibility words, global vertex order
+  std::vector<glm::vec4> energies;           // fused: per global slice, ∫ρ_c (rgb)
+  std::vector<shared::SliceLobe> lobeData;   // fused: per global slice, its lobe (zero: none)
   visibilityWords = shared::visibilityWords(static_cast<shared::uint>(level));
   objectInfo.resize(objectCount);
   for (std::size_t k = 0; k < objectCount; ++k) {
@@ -43,6 +45,12 @@ void VulkanRenderer::Impl::uploadScene() {
       info.sliceBase = static_cast<std::uint32_t>(sliceData.size() / (shared::kTexelFloats * n));
       sliceData.insert(sliceData.end(), pixelSlices.texels().begin(), pixelSlices.texels().end());
       setFusedSkip(info, level, pixelSlices.lastNonZeroRow());
+      for (std::size_t t = 0; t < T; ++t) {
+        const std::array<float, 3>& e = pixelSlices.energy(static_cast<int>(t));
+        energies.emplace_back(e[0], e[1], e[2], 0.0f);
+        lobeData.push_back(p.lobes.empty() ? shared::SliceLobe{} : p.lobes[t]);
+      }
+      if (p.lobePath) info.flags |= shared::kObjectLobePath;
     } else {
       info.sliceBase = static_cast<std::uint32_t>(sliceData.size() / (3 * n));
       for (std::size_t t = 0; t < T; ++t) {
@@ -149,6 +157,10 @@ void VulkanRenderer::Impl::uploadScene() {
     // The pixel-centre directions, as core fused builds them (double → float).
     const std::vector<glm::vec4> dirs = pixelCentreDirections(level);
     upload(directions, dirs.data(), dirs.size() * sizeof(glm::vec4), kTexelUsage);
+    upload(sliceEnergy, energies.data(), energies.size() * sizeof(glm::vec4));
+    upload(lobes, lobeData.data(), lobeData.size() * sizeof(shared::SliceLobe));
+    const std::span<const glm::vec4> prefiltered = prepared.lobeLight.texels();
+    upload(lobeLight, prefiltered.data(), prefiltered.size_bytes(), kTexelUsage);
   }
   submitUploads(context, uploads);
 
@@ -211,6 +223,7 @@ void VulkanRenderer::Impl::createFusedPipeline(std::uint32_t local) {
   lightTexels = TexelView(context, light, VK_FORMAT_R32G32B32A32_SFLOAT, sizeof(glm::vec4));
   directionTexels = TexelView(context, directions, VK_FORMAT_R32G32B32A32_SFLOAT, sizeof(glm::vec4));
   visibilityTexels = TexelView(context, visibility, VK_FORMAT_R32_UINT, sizeof(std::uint32_t));
+  lobeLightTexels = TexelView(context, lobeLight, VK_FORMAT_R32G32B32A32_SFLOAT, sizeof(glm::vec4));
   lightTexelData.resize(prepared.objects.size() * coefficients);
 
   // No scratch: a workgroup keeps only its reduction's vec3 per invocation,
@@ -228,7 +241,8 @@ void VulkanRenderer::Impl::createFusedPipeline(std::uint32_t local) {
       context, "fused.comp", fusedBindings(), 0,
       std::vector<SpecConstant>{{0, static_cast<std::uint32_t>(level)},
                                 {2, fusedLocal},
-                                {4, options.interpolateSlices ? 1u : 0u}});
+                                {4, options.interpolateSlices ? 1u : 0u},
+                                {5, static_cast<std::uint32_t>(prepared.lobeLight.finestLevel())}});
 }
 
 }  // namespace haarcast::gpu

@@ -85,9 +85,12 @@ struct VulkanRenderer::Impl {
   // frame the point lights (PointLight, kMaxPointLights per object).
   bool fused = false;
   Buffer directions, pointLights;
+  // `fused`: per global slice its ∫ρ (vec4) and its lobe (SliceLobe), and
+  // the prefiltered light (core/prefiltered_light.h) the lobe path reads.
+  Buffer sliceEnergy, lobes, lobeLight;
   BufferUpload pointLightUpload;
   // fused.comp reads these through texel views (BindingKind::Texels).
-  TexelView sliceTexels, lightTexels, directionTexels, visibilityTexels;
+  TexelView sliceTexels, lightTexels, directionTexels, visibilityTexels, lobeLightTexels;
   std::vector<glm::vec4> lightTexelData;  // this frame's light texels, before upload
   std::vector<PointLight> pointLightData;         // this frame's point lights, before upload
   std::uint32_t fusedGroups = 0;     // the most workgroups of the fused dispatch
@@ -199,7 +202,7 @@ struct VulkanRenderer::Impl {
   // The "shadow-rays" stage: the covered samples read back, each one's
   // point-light mask (render::pointLightMask against `rays`, posed for this
   // frame) written for the upload. Returns the covered count.
-  std::uint32_t computeShadowMasks(const render::ResolvedFrame& resolved);
+  std::uint32_t computeShadowMasks(const render::ResolvedFrame& resolved, const glm::vec3& eye);
 
   // rotating_frame.cpp
   render::Frame renderRotating(const render::FrameRequest& request);

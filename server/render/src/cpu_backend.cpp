@@ -458,6 +458,7 @@ std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const RayScen
     toWorld.emplace_back(o.objectToWorld);
     rotations.emplace_back(o.rotation);
   }
+  const glm::vec3 eye(camera.origin());
   // The ground's hidden sky on the coarse grid (point_lights.h), from the
   // interior pixels' centre samples, as the Vulkan backend takes them.
   GroundSkyGrid sky(frame.width, frame.height);
@@ -488,6 +489,7 @@ std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const RayScen
     const ShadingPoint point = shadingPoint(*p.mesh, triangle, b, toWorld[object], rotations[object],
                                             p.shadowShift * static_cast<float>(o.scale));
     std::uint32_t seen = pointLightMask(rays, point, resolved.pointLightDirections);
+    if (p.lobePath) seen |= lobeRayBit(rays, point, eye);
     if (p.ground) {
       // The word the Vulkan backend reads too: bits, then the sky's occlusion.
       seen = withGroundOcclusion(seen, sky.at(sample.pixel, [&] { return groundSkyOcclusion(rays, point, resolved.groundSky); }));
@@ -504,7 +506,9 @@ std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const RayScen
     const shared::SliceBlend blend = shared::sliceBlendAt(static_cast<float>(in.rotation.thetaOut),
                                                           static_cast<shared::uint>(slices.thetaSamples()),
                                                           options_.interpolateSlices ? 1u : 0u);
-    rgb = fusedShade(slices, blend, in.rotation.euler, o.fusedLight, vis, o.pointLights, seen, scratch);
+    const LobePath lobe{&prepared_.lobeLight, p.lobes, o.toLight, false};
+    rgb = fusedShade(slices, blend, in.rotation.euler, o.fusedLight, vis, o.pointLights, seen, scratch,
+                     p.lobePath ? &lobe : nullptr);
     return fusedPixelBytes(slices.level(), blend.weight != 0.0f, 3 * p.visibilityBits.wordsPerPoint() * sizeof(std::uint32_t));
   }, cancelPoint);
   frame.stages.push_back({"fused", since(t0)});

@@ -40,6 +40,16 @@ std::uint32_t pointLightMask(const RayScene& world, const ShadingPoint& p, std::
   return mask;
 }
 
+std::uint32_t lobeRayBit(const RayScene& world, const ShadingPoint& p, const glm::vec3& eye) {
+  const glm::vec3 toward = glm::normalize(eye - p.position);
+  const glm::vec3 mirror = 2.0f * glm::dot(p.normal, toward) * p.normal - toward;
+  if (!(glm::dot(p.normal, mirror) > 0.0f)) return 0u;  // a back-facing normal: no lobe above the horizon
+  Ray r;
+  r.origin = p.position + p.normal * p.shift;
+  r.direction = mirror;
+  return world.occluded(r) ? 0u : shared::kLobeSeenBit;
+}
+
 float groundSkyOcclusion(const RayScene& world, const ShadingPoint& p, const GroundSky& sky) {
   if (!(sky.total > 0.0) || sky.occluders.empty() || !sky.luminance) return 0.0f;
   const glm::vec3 origin = p.position + p.normal * p.shift;

@@ -8,6 +8,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "haarcast/core/lobe.h"
 #include "haarcast/io/slice_cache.h"
 #include "haarcast/render/shading.h"
 #include "haarcast/render/visibility_cache.h"
@@ -129,6 +130,16 @@ PreparedScene prepareScene(const Scene& scene, const RenderOptions& options, con
     prepared.pointLights = std::move(split.lights);
     prepared.restLight = std::move(split.rest);
     const std::array<SphereMap, 3>& rest = prepared.restLight;
+    prepared.lobeLight = PrefilteredLight::build(prepared.background);
+    for (std::size_t k = 0; k < prepared.objects.size(); ++k) {
+      PreparedObject& p = prepared.objects[k];
+      if (p.ground) continue;  // shaded in closed form
+      std::vector<double> thetaOut;
+      for (int t = 0; t < p.table.thetaSamples(); ++t) thetaOut.push_back(p.table.thetaOut(t));
+      p.lobes = measureLobes(*scene.objects[k].material.brdf, thetaOut);
+      for (const shared::SliceLobe& lobe : p.lobes)
+        p.lobePath = p.lobePath || shared::lobePathShare(lobe.median.x, static_cast<shared::uint>(options.level)) > 0.0f;
+    }
     prepared.restLuminance = SphereMap(rest[0].level());
     for (int r = 0; r < rest[0].size(); ++r)
       for (int c = 0; c < rest[0].size(); ++c)
@@ -289,6 +300,7 @@ ResolvedFrame resolveFrame(const PreparedScene& prepared, const RenderOptions& o
     o.rotation = pose.rotation();
     o.objectToWorld = pose.objectToWorld();
     o.scale = pose.scale;
+    o.toLight = glm::mat3(glm::transpose(request.lightRotation) * o.rotation);
   }
   std::optional<glm::dvec3> groundNormal;
   if (prepared.ground) groundNormal = out.objects[*prepared.ground].rotation * glm::dvec3(0.0, 1.0, 0.0);

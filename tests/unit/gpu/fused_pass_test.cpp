@@ -104,6 +104,38 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
     }
   }
   objects[kGround].flags = shared::kObjectGround;
+
+  // The lobe path: object 1 has random lobes whose median angle puts its
+  // samples all on the path, part on it or off it; a random prefiltered
+  // light (finest level 5) and a random turn into its frame.
+  constexpr std::size_t kLobeObject = 1;
+  constexpr int kPrefilterFinest = 5;
+  std::vector<shared::SliceLobe> lobes(kObjects * kThetaSamples);
+  std::vector<glm::vec4> energies;
+  for (std::size_t o = 0; o < kObjects; ++o) {
+    for (int t = 0; t < kThetaSamples; ++t) {
+      const std::array<float, 3>& e = slices[o].energy(t);
+      energies.emplace_back(e[0], e[1], e[2], 0.0f);
+    }
+  }
+  for (int t = 0; t < kThetaSamples; ++t) {
+    shared::SliceLobe& l = lobes[kLobeObject * kThetaSamples + static_cast<std::size_t>(t)];
+    l.energy = glm::vec4(u(rng), u(rng), u(rng), u(rng) * static_cast<float>(kPi / 2.0));
+    float angle = 0.0f;
+    for (int k = 0; k < 4; ++k) {
+      angle += 0.01f + 0.1f * u(rng);
+      l.angle[k] = angle;
+      l.level[k] = u(rng) * (kPrefilterFinest + 1.0f) - 0.5f;  // some outside [0, finest]: clamped
+    }
+    const float texel = static_cast<float>(kPi) / static_cast<float>(mapSize(level));
+    l.median = glm::vec4(texel * (0.3f + 0.9f * u(rng)), 0.0f, 0.0f, 0.0f);
+  }
+  objects[kLobeObject].flags = shared::kObjectLobePath;
+  const glm::mat3 toLight(rotationMatrix(randomRotations(1, 7)[0]));
+  for (int c = 0; c < 3; ++c) objects[kLobeObject].toLight[c] = glm::vec4(toLight[c], 0.0f);
+  std::array<SphereMap, 3> prefilterMaps;
+  for (auto& map : prefilterMaps) map = randomMap(kPrefilterFinest, 0.0, 1.0, rng);
+  const PrefilteredLight prefiltered = PrefilteredLight::build(prefilterMaps);
   objects[kGround].groundRadiance = glm::vec4(u(rng), u(rng), u(rng), 0.0f);
 
   // Samples: three vertices each (their random bits), a rotation, θₒ, a mask.
@@ -137,6 +169,7 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
     sh.pixel = static_cast<std::uint32_t>(kPixels - 1 - i);  // not the sample order
     // Every light seen, none, and random masks (with bits past kLights).
     masks[i] = i < 3 ? 0xFFu : i < 6 ? 0u : static_cast<std::uint32_t>(rng() & 0xFFu);
+    if (sh.object != kGround && i % 4 != 3) masks[i] |= shared::kLobeSeenBit;  // the lobe ray: mostly seen
   }
   const std::vector<glm::vec4> dirs = pixelCentreDirections(level);
   const CoverageCounter counter{static_cast<std::uint32_t>(kPixels), {kGroups, 1, 1}};
@@ -158,19 +191,25 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
   Buffer radiance(context, kPixels * sizeof(glm::vec4));
   Buffer counterBuf = upload(&counter, sizeof counter);
   Buffer maskBuf = upload(masks.data(), masks.size() * sizeof(std::uint32_t));
+  Buffer energyBuf = upload(energies.data(), energies.size() * sizeof(glm::vec4));
+  Buffer lobeBuf = upload(lobes.data(), lobes.size() * sizeof(shared::SliceLobe));
+  Buffer prefilterBuf = upload(prefiltered.texels().data(), prefiltered.texels().size_bytes());
+  const TexelView prefilterView(context, prefilterBuf, VK_FORMAT_R32G32B32A32_SFLOAT, sizeof(glm::vec4));
   const TexelView texelView(context, texelBuf, VK_FORMAT_R32G32B32A32_SFLOAT, sizeof(glm::vec4));
   const TexelView lightView(context, lightBuf, VK_FORMAT_R32G32B32A32_SFLOAT, sizeof(glm::vec4));
   const TexelView bitsView(context, bitsBuf, VK_FORMAT_R32_UINT, sizeof(std::uint32_t));
   const TexelView dirView(context, dirBuf, VK_FORMAT_R32G32B32A32_SFLOAT, sizeof(glm::vec4));
   ComputePipeline p(context, "fused.comp", fusedBindings(), 0,
-                    {{0, static_cast<std::uint32_t>(level)}, {2, 64u}, {4, pc.interpolate ? 1u : 0u}});
+                    {{0, static_cast<std::uint32_t>(level)}, {2, 64u}, {4, pc.interpolate ? 1u : 0u},
+                     {5, static_cast<std::uint32_t>(kPrefilterFinest)}});
   p.bind({&sampleBuf, &shadeBuf, &objectBuf, &texelView, &lightView, &bitsView, &dirView, &pointBuf, &radiance,
-          &counterBuf, &maskBuf});
+          &counterBuf, &maskBuf, &energyBuf, &lobeBuf, &prefilterView});
   context.submit([&](VkCommandBuffer cb) { p.dispatch(cb, {kGroups, 1, 1}); });
   std::vector<glm::vec4> got(kPixels);
   radiance.read(got.data(), got.size() * sizeof(glm::vec4));
 
   double worst = 0.0, scale = 0.0, lightShare = 0.0;
+  std::array<int, 3> lobeSamples{};  // the lobe object's samples all on the path, part on it, off it
   FusedScratch work;
   std::vector<std::array<float, 3>> expected(kPixels);
   for (std::size_t i = 0; i < kPixels; ++i) {
@@ -188,9 +227,18 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
                                              WeightedBits{bits.point(3 * i + 1).data(), shade[i].b[1]},
                                              WeightedBits{bits.point(3 * i + 2).data(), shade[i].b[2]}};
     const EulerYXY r{samples[i].alpha, samples[i].beta, samples[i].gamma};
-    expected[i] = fusedShade(slices[o], blend, r, lights[o], vis, pointLights[o], masks[i], work);
+    const LobePath path{&prefiltered,
+                        std::span<const shared::SliceLobe>(lobes).subspan(o * kThetaSamples, kThetaSamples), toLight,
+                        false};
+    const LobePath* lobe = o == kLobeObject ? &path : nullptr;
+    if (lobe) {
+      const float share = lobePathShareAt(path, blend, level);
+      (share >= 1.0f ? lobeSamples[0] : share > 0.0f ? lobeSamples[1] : lobeSamples[2])++;
+    }
+    expected[i] = fusedShade(slices[o], blend, r, lights[o], vis, pointLights[o], masks[i], work, lobe);
     // How much of the sample the point lights make (the test must see them).
-    const std::array<float, 3> mapOnly = fusedShade(slices[o], blend, r, lights[o], vis, pointLights[o], 0u, work);
+    const std::array<float, 3> mapOnly =
+        fusedShade(slices[o], blend, r, lights[o], vis, pointLights[o], masks[i] & shared::kLobeSeenBit, work, lobe);
     for (std::size_t c = 0; c < 3; ++c) {
       lightShare = std::max(lightShare, static_cast<double>(expected[i][c] - mapOnly[c]) / std::max(1e-30f, expected[i][c]));
     }
@@ -213,6 +261,7 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
     }
   }
   EXPECT_GT(groundSamples, 3u);
+  std::printf("lobe path: %d samples all on it, %d in part, %d off it\n", lobeSamples[0], lobeSamples[1], lobeSamples[2]);
   std::printf("fused pass, level %d, %s: max |gpu − cpu| / max|I| = %.3g (point lights up to %.0f%% of a sample)\n",
               level, pc.interpolate ? "blended slices" : "nearest slice", worst, 100.0 * lightShare);
   EXPECT_LT(worst, 1e-5);

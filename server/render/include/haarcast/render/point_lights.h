@@ -46,6 +46,11 @@ ShadingPoint shadingPoint(const Mesh& mesh, const glm::uvec3& triangle, const fl
 // and the ray from position + shift·n toward d_k escapes. At most 32 directions.
 std::uint32_t pointLightMask(const RayScene& world, const ShadingPoint& p, std::span<const glm::vec3> directions);
 
+// shared::kLobeSeenBit when the ray from the point along the mirror
+// direction of the eye escapes (the lobe path's visibility, fused.h: a lobe
+// narrower than the visibility's texels sees along one direction), else 0.
+std::uint32_t lobeRayBit(const RayScene& world, const ShadingPoint& p, const glm::vec3& eye);
+
 // What the objects hide of a ground's map light (the sky less its point
 // lights): the ground is shaded in closed form, the same at every point,
 // so without this an object standing on it casts no contact shadow from

@@ -126,6 +126,11 @@ struct PreparedObject {
   // toward an object's sphere, point_lights.h, hit it more often).
   glm::dvec3 sphereCentre{0.0};
   double sphereRadius = 0.0;
+  // `fused`: its slices' lobes measured from the BRDF (core/lobe.h), and
+  // whether any pixel of it can take the lobe path at the render's level
+  // (then its samples trace a ray along their mirror direction too).
+  std::vector<shared::SliceLobe> lobes;
+  bool lobePath = false;
 };
 
 struct PreparedScene {
@@ -138,6 +143,7 @@ struct PreparedScene {
   std::vector<DirectionalLight> pointLights;
   std::array<SphereMap, 3> restLight;
   SphereMap restLuminance;              // its Rec. 709 luminance (the ground's hidden sky, point_lights.h)
+  PrefilteredLight lobeLight;           // `fused`: the backdrop's maps at every level, for the lobe path
   std::optional<std::size_t> ground;    // index of the ground object, if any
 };
 
@@ -211,6 +217,7 @@ struct ResolvedObject {
   FusedLight fusedLight;           // empty unless the method is fused
   std::vector<FusedPointLight> pointLights;
   std::array<float, 3> groundFlat{};
+  glm::mat3 toLight{1.0f};         // fused: object frame → the environment's (lightRotationᵀ·rotation)
 };
 struct ResolvedFrame {
   std::size_t lightCoefficients = 0;  // k in effect (the Haar methods)
