@@ -22,16 +22,19 @@ int percentOf(const v1::BuildProgress& p) {
 
 }  // namespace
 
-std::string formatSeconds(double seconds) {
+std::string formatDuration(double seconds) {
   char b[48];
   if (!(seconds >= 0.0)) seconds = 0.0;
   if (seconds < 9.95) {
     std::snprintf(b, sizeof b, "%.1f s", seconds);
   } else if (seconds < 59.5) {
     std::snprintf(b, sizeof b, "%.0f s", seconds);
-  } else {
-    const long s = std::lround(std::min(seconds, 1e9));
+  } else if (seconds < 3599.5) {
+    const long s = std::lround(seconds);
     std::snprintf(b, sizeof b, "%ld min %02ld s", s / 60, s % 60);
+  } else {
+    const long m = std::lround(std::min(seconds, 1e9) / 60.0);
+    std::snprintf(b, sizeof b, "%ld h %02ld min", m / 60, m % 60);
   }
   return b;
 }
@@ -52,7 +55,7 @@ std::string buildProgressText(const v1::BuildProgress& p) {
   }
   const double left = p.estimated_stage_seconds_left();
   if (percent >= 0 && percent < 100 && std::isfinite(left) && left > 0.0) {
-    out += " (~" + formatSeconds(left) + " left in this stage)";
+    out += " (~" + formatDuration(left) + " left in this stage)";
   }
   return out;
 }
@@ -78,7 +81,7 @@ void BuildProgressDisplay::update(const v1::BuildProgress& p, double now) {
 
 void BuildProgressDisplay::ready(double now) {
   if (!shown_) return;
-  const std::string text = "building: ready after " + formatSeconds(lastElapsed_ + std::max(0.0, now - lastAt_));
+  const std::string text = "building: ready after " + formatDuration(lastElapsed_ + std::max(0.0, now - lastAt_));
   sink_(terminal_ ? "\r" + text + "\x1b[K\n" : text + "\n");
   lineOpen_ = false;
   shown_ = false;

@@ -26,8 +26,8 @@ namespace haarcast::client {
 // there is one. Control characters in the stage are shown as '?'.
 std::string buildProgressText(const v1::BuildProgress& progress);
 
-// "0.4 s", "12 s", "3 min 05 s".
-std::string formatSeconds(double seconds);
+// "0.4 s", "12 s", "3 min 05 s", "2 h 07 min".
+std::string formatDuration(double seconds);
 
 class BuildProgressDisplay {
  public:

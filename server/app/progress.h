@@ -22,6 +22,8 @@
 #include <utility>
 #include <vector>
 
+#include "build_progress.h"  // client: formatDuration
+
 namespace haarcast::app {
 
 // What long steps report: done of total items of a named stage. The same
@@ -37,23 +39,9 @@ struct ProgressOptions {
   std::string prefix;           // before every line, e.g. "[serve] "
 };
 
-// "0.4 s", "12 s", "3 min 05 s", "2 h 07 min".
-inline std::string formatDuration(double seconds) {
-  char b[48];
-  if (!(seconds >= 0.0)) seconds = 0.0;
-  if (seconds < 9.95) {
-    std::snprintf(b, sizeof b, "%.1f s", seconds);
-  } else if (seconds < 59.5) {
-    std::snprintf(b, sizeof b, "%.0f s", seconds);
-  } else if (seconds < 3599.5) {
-    const long s = std::lround(seconds);
-    std::snprintf(b, sizeof b, "%ld min %02ld s", s / 60, s % 60);
-  } else {
-    const long m = std::lround(seconds / 60.0);
-    std::snprintf(b, sizeof b, "%ld h %02ld min", m / 60, m % 60);
-  }
-  return b;
-}
+// "0.4 s", "12 s", "3 min 05 s", "2 h 07 min": the client's formatter, one
+// definition for every progress line of the project.
+using client::formatDuration;
 
 // Samples per pixel a Monte Carlo render will have when it stops: its
 // half-image difference falls as 1/√samples, so reaching `tolerance` from

@@ -7,6 +7,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "haarcast/core/light_split.h"
 #include "haarcast/core/parallel.h"
 #include "haarcast/core/sphere_map.h"
 
@@ -17,7 +18,7 @@ constexpr int kRings = 240;
 constexpr int kSectors = 96;
 constexpr double kInnerAngle = 1e-4;  // the central cap: one sample on the axis
 
-double luminance(const glm::dvec3& c) { return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b; }
+double luminance(const glm::dvec3& c) { return luminance709(c.r, c.g, c.b); }
 
 // f(ω)·ΔΩ over a polar grid about `centre`: the cap of half-angle
 // kInnerAngle, then kRings rings log-spaced out to π, kSectors cells each.

@@ -159,7 +159,10 @@ void VulkanRenderer::Impl::uploadScene() {
     upload(directions, dirs.data(), dirs.size() * sizeof(glm::vec4), kTexelUsage);
     upload(sliceEnergy, energies.data(), energies.size() * sizeof(glm::vec4));
     upload(lobes, lobeData.data(), lobeData.size() * sizeof(shared::SliceLobe));
-    const std::span<const glm::vec4> prefiltered = prepared.lobeLight.texels();
+    // No object with a lobe path: one zero texel, never read (a buffer may not be empty).
+    const glm::vec4 none(0.0f);
+    const std::span<const glm::vec4> prefiltered =
+        prepared.lobeLight.empty() ? std::span<const glm::vec4>(&none, 1) : prepared.lobeLight.texels();
     upload(lobeLight, prefiltered.data(), prefiltered.size_bytes(), kTexelUsage);
   }
   submitUploads(context, uploads);
@@ -242,7 +245,7 @@ void VulkanRenderer::Impl::createFusedPipeline(std::uint32_t local) {
       std::vector<SpecConstant>{{0, static_cast<std::uint32_t>(level)},
                                 {2, fusedLocal},
                                 {4, options.interpolateSlices ? 1u : 0u},
-                                {5, static_cast<std::uint32_t>(prepared.lobeLight.finestLevel())}});
+                                {5, static_cast<std::uint32_t>(std::max(prepared.lobeLight.finestLevel(), 0))}});
 }
 
 }  // namespace haarcast::gpu

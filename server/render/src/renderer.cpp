@@ -130,7 +130,6 @@ PreparedScene prepareScene(const Scene& scene, const RenderOptions& options, con
     prepared.pointLights = std::move(split.lights);
     prepared.restLight = std::move(split.rest);
     const std::array<SphereMap, 3>& rest = prepared.restLight;
-    prepared.lobeLight = PrefilteredLight::build(prepared.background);
     for (std::size_t k = 0; k < prepared.objects.size(); ++k) {
       PreparedObject& p = prepared.objects[k];
       if (p.ground) continue;  // shaded in closed form
@@ -139,6 +138,8 @@ PreparedScene prepareScene(const Scene& scene, const RenderOptions& options, con
       p.lobes = measureLobes(*scene.objects[k].material.brdf, thetaOut);
       for (const shared::SliceLobe& lobe : p.lobes)
         p.lobePath = p.lobePath || shared::lobePathShare(lobe.median.x, static_cast<shared::uint>(options.level)) > 0.0f;
+      // The prefiltered light (5.6 MB at level 9) only where a pixel can read it.
+      if (p.lobePath && prepared.lobeLight.empty()) prepared.lobeLight = PrefilteredLight::build(prepared.background);
     }
     prepared.restLuminance = SphereMap(rest[0].level());
     for (int r = 0; r < rest[0].size(); ++r)

@@ -143,7 +143,7 @@ struct PreparedScene {
   std::vector<DirectionalLight> pointLights;
   std::array<SphereMap, 3> restLight;
   SphereMap restLuminance;              // its Rec. 709 luminance (the ground's hidden sky, point_lights.h)
-  PrefilteredLight lobeLight;           // `fused`: the backdrop's maps at every level, for the lobe path
+  PrefilteredLight lobeLight;           // `fused`: the backdrop's maps at every level, for the lobe path (empty when no object has one)
   std::optional<std::size_t> ground;    // index of the ground object, if any
 };
 
