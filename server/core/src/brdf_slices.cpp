@@ -38,8 +38,9 @@ void checkSupersampling(int n, const char* what) {
 // on the whole (Mn)² sample grid times 2 sin(δ/2)/δ (δ the sample spacing in
 // θ), so it depends on the sample grid only, not on how it is cut into pixels.
 //
-// `sample(dir)` is called once per sample; `store(row, col, mean)` receives
-// the pixel's weighted mean.
+// `sample(dir)` is called once per sample, in one fixed order (pixels in
+// raster order, each pixel's n×n θ-major: what supersampledDirections lists);
+// `store(row, col, mean)` receives the pixel's weighted mean.
 template <typename T, typename Sample, typename Store>
 void forEachPixelMean(int level, int n, const Sample& sample, const Store& store) {
   const int m = mapSize(level);
@@ -104,6 +105,37 @@ SphereMap supersampledMap(int level, int supersampling, const std::function<doub
   checkSupersampling(supersampling, "supersampledMap");
   SphereMap map(level);
   forEachPixelMean<double>(level, supersampling, f,
+                           [&](int row, int col, double mean) { map.at(row, col) = static_cast<float>(mean); });
+  return map;
+}
+
+std::vector<glm::dvec3> supersampledDirections(int level, int supersampling) {
+  checkLevel(level, "supersampledDirections");
+  checkSupersampling(supersampling, "supersampledDirections");
+  const std::size_t side = static_cast<std::size_t>(mapSize(level)) * static_cast<std::size_t>(supersampling);
+  std::vector<glm::dvec3> directions;
+  directions.reserve(side * side);
+  // The builder's own directions, in the order it asks for them.
+  forEachPixelMean<double>(level, supersampling, [&](const glm::dvec3& d) {
+    directions.push_back(d);
+    return 0.0;
+  }, [](int, int, double) {});
+  return directions;
+}
+
+SphereMap supersampledMeans(int level, int supersampling, std::span<const double> values) {
+  checkLevel(level, "supersampledMeans");
+  checkSupersampling(supersampling, "supersampledMeans");
+  const std::size_t side = static_cast<std::size_t>(mapSize(level)) * static_cast<std::size_t>(supersampling);
+  if (values.size() != side * side) {
+    throw std::invalid_argument("supersampledMeans: " + std::to_string(values.size()) + " values for " +
+                                std::to_string(side * side) + " samples");
+  }
+  SphereMap map(level);
+  // forEachPixelMean asks for the samples in supersampledDirections' order,
+  // so the next value is always the one for the direction it passes.
+  std::size_t next = 0;
+  forEachPixelMean<double>(level, supersampling, [&](const glm::dvec3&) { return values[next++]; },
                            [&](int row, int col, double mean) { map.at(row, col) = static_cast<float>(mean); });
   return map;
 }

@@ -437,5 +437,30 @@ TEST(SupersampledMap, IntegralIsTheSolidAngleIntegral) {
   for (float v : constant.values()) EXPECT_FLOAT_EQ(v, 2.5f);
 }
 
+// The two-step form (directions out, values in) is supersampledMap to the
+// bit, for every supersampling, and refuses a wrong number of values.
+TEST(SupersampledMap, DirectionsThenMeansIsTheSameMap) {
+  const auto f = [](const glm::dvec3& d) { return std::exp(3.0 * d.y) * (1.0 + d.x * d.z) + (d.x > 0.2 ? 0.5 : 0.0); };
+  for (int n : {1, 2, 3, 4}) {
+    const std::vector<glm::dvec3> directions = supersampledDirections(3, n);
+    ASSERT_EQ(directions.size(), static_cast<std::size_t>(8 * n) * static_cast<std::size_t>(8 * n));
+    std::vector<double> values;
+    for (const glm::dvec3& d : directions) values.push_back(f(d));
+    const SphereMap twoSteps = supersampledMeans(3, n, values);
+    const SphereMap direct = supersampledMap(3, n, f);
+    for (std::size_t i = 0; i < direct.pixelCount(); ++i) {
+      ASSERT_EQ(twoSteps.values()[i], direct.values()[i]) << "n " << n << " pixel " << i;
+    }
+    // Pixel by pixel in raster order: pixel 9's n×n samples come after
+    // pixels 0…8's, and they lie in row 1, column 1.
+    const Spherical s = directionToSpherical(directions[9 * static_cast<std::size_t>(n * n)]);
+    EXPECT_EQ(static_cast<int>(s.theta / (kPi / 8.0)), 1) << "n " << n;
+    EXPECT_EQ(static_cast<int>(s.phi / (kTwoPi / 8.0)), 1) << "n " << n;
+    values.pop_back();
+    EXPECT_THROW(supersampledMeans(3, n, values), std::invalid_argument);
+  }
+  EXPECT_THROW(supersampledDirections(3, 0), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace haarcast

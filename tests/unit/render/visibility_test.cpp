@@ -173,7 +173,40 @@ TEST(RayScene, SetTransformMovesAnObject) {
   scene.setTransform(0, glm::translate(glm::mat4(1.0f), {0.0f, 10.0f, 0.0f}));
   EXPECT_FALSE(scene.occluded(ray));
   EXPECT_TRUE(scene.occluded(Ray{{0.0f, 10.0f, 5.0f}, {0.0f, 0.0f, -1.0f}}));
+  // Back at the identity (where occlusion skips the instance level).
+  scene.setTransform(0, glm::mat4(1.0f));
+  EXPECT_TRUE(scene.occluded(ray));
+  EXPECT_FALSE(scene.occluded(Ray{{0.0f, 10.0f, 5.0f}, {0.0f, 0.0f, -1.0f}}));
   EXPECT_THROW(scene.setTransform(1, glm::mat4(1.0f)), std::out_of_range);
+}
+
+// One origin's directions as packets of 16 give the single rays' answers:
+// for one object at the identity (traced without the instance level), the
+// same object moved, and a count that leaves the last packet part full.
+TEST(RayScene, OccludedFromAgreesWithSingleRays) {
+  const Mesh scene = merged(floorMesh(4.0f), icosphere(2, 0.5f, {0.0f, 1.0f, 0.0f}));
+  std::mt19937 rng(11);
+  std::normal_distribution<float> g(0.0f, 1.0f);
+  std::vector<glm::vec3> directions(1001);
+  for (glm::vec3& d : directions) d = glm::normalize(glm::vec3(g(rng), g(rng), g(rng)));
+  const glm::mat4 moved = glm::translate(glm::mat4(1.0f), {0.3f, 0.0f, -0.2f});
+  for (const glm::mat4& placed : {glm::mat4(1.0f), moved}) {
+    const RayScene rays({Instance{&scene, placed}});
+    const glm::vec3 origin(0.2f, 0.05f, 0.1f);
+    for (float tnear : {0.0f, 0.3f}) {
+      std::vector<std::uint8_t> out(directions.size(), 2);
+      rays.occludedFrom(origin, tnear, directions, out);
+      std::size_t blocked = 0;
+      for (std::size_t i = 0; i < directions.size(); ++i) {
+        ASSERT_EQ(out[i], rays.occluded(Ray{origin, directions[i], tnear}) ? 1 : 0) << "direction " << i;
+        blocked += out[i];
+      }
+      EXPECT_GT(blocked, directions.size() / 10);  // both answers are seen
+      EXPECT_LT(blocked, directions.size() - directions.size() / 10);
+    }
+  }
+  std::vector<std::uint8_t> wrongSize(3);
+  EXPECT_THROW(RayScene({Instance{&scene}}).occludedFrom({}, 0.0f, directions, wrongSize), std::invalid_argument);
 }
 
 TEST(RayScene, BatchAndThreadsAgreeWithSingleRays) {

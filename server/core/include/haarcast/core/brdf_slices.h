@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <functional>
+#include <span>
 #include <vector>
 
 #include "haarcast/core/brdf.h"
@@ -62,5 +63,15 @@ SphereMap sliceMap(const Brdf& brdf, double thetaOut, int channel, int level, in
 // pixel, from n×n stratified positions (uniform in θ and φ within the pixel,
 // each weighted by sin θ so that SphereMap::integral stays right).
 SphereMap supersampledMap(int level, int supersampling, const std::function<double(const glm::dvec3&)>& f);
+
+// supersampledMap in two steps, for a caller that evaluates f for many
+// directions at once (visibility traces them as ray packets). The
+// directions, pixel by pixel in raster order and each pixel's n×n θ-major,
+// are the order supersampledMeans reads its values in:
+//   supersampledMeans(level, n, f at each of supersampledDirections(level, n))
+// equals supersampledMap(level, n, f) to the bit. Values must number
+// (2^level·n)², else std::invalid_argument.
+std::vector<glm::dvec3> supersampledDirections(int level, int supersampling);
+SphereMap supersampledMeans(int level, int supersampling, std::span<const double> values);
 
 }  // namespace haarcast

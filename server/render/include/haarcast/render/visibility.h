@@ -79,8 +79,9 @@ std::vector<SparseHaar> computeVertexVisibility(
 // vertex's tangent plane are taken as occluded without a ray: the surface
 // itself lies there unless it is thinner than the offset, and only a pixel
 // whose interpolated normal leans that far from the vertex's could see them.
-// Rays go 8 at a time as Embree packets sharing the vertex's origin;
-// vertices are shared out over the threads as computeVertexVisibility does.
+// Rays go 16 at a time as Embree packets sharing the vertex's origin, each
+// a 4×4 block of neighbouring pixels; vertices are shared out over the
+// threads as computeVertexVisibility does.
 inline constexpr double kBitsSkipBelowDegrees = 15.0;
 VisibilityBits computeVisibilityBits(const RayScene& occluders, const Mesh& mesh, const VisibilityOptions& options,
                                      const std::function<void(std::size_t done, std::size_t total)>& progress = {});
