@@ -131,6 +131,7 @@ struct PreparedObject {
   // (then its samples trace a ray along their mirror direction too).
   std::vector<shared::SliceLobe> lobes;
   bool lobePath = false;
+  float lobeCore = 0.0f;  // the lobe path's core angle (fused.h LobePath::coreAngle); π: the path takes all
 };
 
 struct PreparedScene {
