@@ -181,24 +181,27 @@ std::vector<shared::SliceLobe> measureLobes(const Brdf& brdf, const std::vector<
 }
 
 LobeCore chooseLobeCore(const Brdf& brdf, const std::vector<double>& thetaOut, int level) {
-  const double coreAngle = kLobeCoreTexels * kPi / mapSize(level);
+  const double texel = kPi / mapSize(level);
   LobeCore out;
-  out.lobes = measureLobes(brdf, thetaOut, coreAngle);
-  double tail = 0.0, core = 0.0;  // the largest shares outside and inside the core
-  for (const shared::SliceLobe& lobe : out.lobes) {
+  out.lobes = measureLobes(brdf, thetaOut);
+  float sharpest = static_cast<float>(kPi);
+  for (const shared::SliceLobe& lobe : out.lobes) sharpest = std::min(sharpest, lobe.median.x);
+  if (out.lobes.empty() || sharpest > kLobeMedianTexels * texel) {
+    out.lobes.clear();
+    return out;
+  }
+  const double coreAngle = kLobeCoreTexels * texel;
+  std::vector<shared::SliceLobe> cores = measureLobes(brdf, thetaOut, coreAngle);
+  double tail = 0.0;  // the largest share outside the core
+  for (const shared::SliceLobe& lobe : cores) {
     const double e = luminance709(lobe.energy.r, lobe.energy.g, lobe.energy.b);
-    if (!(e > 0.0)) continue;
-    const double c = luminance709(lobe.core.r, lobe.core.g, lobe.core.b) / e;
-    tail = std::max(tail, 1.0 - c);
-    core = std::max(core, c);
+    if (e > 0.0) tail = std::max(tail, 1.0 - luminance709(lobe.core.r, lobe.core.g, lobe.core.b) / e);
   }
   if (tail < kLobeTailLeft) {
     out.angle = static_cast<float>(kPi);
-    out.lobes = measureLobes(brdf, thetaOut);
-  } else if (core >= kLobeCoreMin) {
-    out.angle = static_cast<float>(coreAngle);
   } else {
-    out.lobes.clear();
+    out.angle = static_cast<float>(coreAngle);
+    out.lobes = std::move(cores);
   }
   return out;
 }

@@ -118,7 +118,7 @@ TEST(PrefilteredLight, ACoarseTexelIsTheCapMeanAboutItsCentreEvenAtThePoles) {
 
 TEST(LobeCore, MirrorsTakeThePathHazyMirrorsTheirCoreRoughLobesNone) {
   const std::vector<double> thetaOut{0.2, 0.8, 1.3};
-  // A near-mirror: all of the lobe within two level-5 texels.
+  // A near-mirror: all of the lobe within four level-5 texels.
   const LobeCore mirror = chooseLobeCore(*makeGgx(glm::dvec3(0.0), glm::dvec3(0.9), 0.002), thetaOut, 5);
   EXPECT_FLOAT_EQ(mirror.angle, static_cast<float>(kPi));
   ASSERT_EQ(mirror.lobes.size(), thetaOut.size());
@@ -131,8 +131,12 @@ TEST(LobeCore, MirrorsTakeThePathHazyMirrorsTheirCoreRoughLobesNone) {
     EXPECT_LT(l.core.r, 0.95f * l.energy.r) << "the diffuse part is outside the core";
     EXPECT_GT(l.core.r, 0.3f * l.energy.r);
   }
-  // A rough lobe, and a Lambert one: the maps resolve them.
+  // Rough and glossy lobes, and a Lambert one: the maps resolve them.
   EXPECT_EQ(chooseLobeCore(*makeGgx(glm::dvec3(0.0), glm::dvec3(0.9), 0.3), thetaOut, 5).angle, 0.0f);
+  EXPECT_EQ(chooseLobeCore(*makePhong(glm::dvec3(0.5), glm::dvec3(0.5), 64.0), thetaOut, 5).angle, 0.0f);
+  const auto glossy = makeGgx(glm::dvec3(0.0), glm::dvec3(0.9), 0.05);
+  EXPECT_GT(chooseLobeCore(*glossy, thetaOut, 5).angle, 0.0f) << "its median is under a level-5 texel";
+  EXPECT_EQ(chooseLobeCore(*glossy, thetaOut, 6).angle, 0.0f) << "and over a level-6 one";
   const LobeCore lambert = chooseLobeCore(*makeLambert(glm::dvec3(0.8)), thetaOut, 5);
   EXPECT_EQ(lambert.angle, 0.0f);
   EXPECT_TRUE(lambert.lobes.empty());
