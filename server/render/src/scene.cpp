@@ -129,6 +129,9 @@ Material materialFromSpec(const std::string& spec, const std::string& baseDir) {
     }
     m.brdf = std::move(merl);
     m.cacheKey = io::fileCacheKey(path);
+    // Named by its file's stem, as `serve --materials-dir` names its files:
+    // the name reaches clients (SceneInfo), a path of the server must not.
+    m.name = "merl:" + fs::path(spec).stem().string();
   } else {
     throw std::invalid_argument("material \"" + spec +
                                 "\": expected lambert, phong:EXP, blinn-phong:EXP, ggx:ROUGHNESS or a MERL .binary file");

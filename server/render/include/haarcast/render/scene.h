@@ -60,7 +60,7 @@ Environment constantEnvironment(double radiance);
 Environment environmentFromFile(const std::string& path, const std::string& layout = "auto");
 
 struct Material {
-  std::string name;      // as written in the scene ("phong:64", a file path)
+  std::string name;      // as written in the scene ("phong:64"); a MERL file: "merl:" + its stem, never a path
   std::string cacheKey;  // identifies the BRDF for the slice-table cache
   std::shared_ptr<const Brdf> brdf;
   std::string warning;   // non-empty when the file needed a repair (shown to the user)
