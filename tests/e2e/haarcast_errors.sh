@@ -44,6 +44,8 @@ expect "material without a mesh" "--material applies to --mesh" -- "$bin" render
 expect "output folder missing" "--out $work/none/x.exr: the folder $work/none does not exist" -- \
   "$bin" render --out "$work/none/x.exr"
 expect "output extension" "--out must end in .exr or .png" -- "$bin" render --out "$work/x.jpg"
+expect "bad --up" "--up x is not an up axis (valid: y, z)" -- "$bin" render --mesh "$work/none.obj" --up x --out "$work/x.exr"
+expect "--up without --mesh" "--up applies to --mesh" -- "$bin" render --up z --out "$work/x.exr"
 expect "unknown scene file" "$work/none.json" -- "$bin" serve --scene "$work/none.json"
 
 # Checked before the work: no output was started for any of the above.
