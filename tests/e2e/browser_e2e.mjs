@@ -650,8 +650,8 @@ try {
     await page.setViewportSize({ width, height: 800 });
     await page.waitForTimeout(150);
     await panelFits(`${width}×800`);
+    if (opts.out && width === 320) await page.screenshot({ path: join(opts.out, 'panel-320x800.png'), fullPage: true });
   }
-  if (opts.out) await page.screenshot({ path: join(opts.out, 'panel-320x800.png'), fullPage: true });
   await switchScene('default');
 
   await page.setViewportSize({ width: 1200, height: 800 });
