@@ -3,7 +3,8 @@
 // (shaders include it with GL_GOOGLE_include_directive, -I server/core/include).
 // Write only what both languages read alike: plain structs of uint, float and
 // vec3/vec4, `const` numbers, and functions built from floor/min/max/clamp,
-// integer bit operations and findMSB. The GPU tests check the shaders'
+// log2, integer bit operations and findMSB (not sin, cos, atan or acos:
+// Vulkan lets a device compute those loosely, sphere.glsl has precise ones). The GPU tests check the shaders'
 // results against the C++ use of the same lines (SharedLayout.*).
 #ifndef HAARCAST_CORE_SHARED_LAYOUT_H
 #define HAARCAST_CORE_SHARED_LAYOUT_H
@@ -26,6 +27,7 @@ using vec4 = glm::vec4;
 using mat4 = glm::mat4;
 using std::clamp;
 using std::floor;
+using std::log2;
 using std::max;
 using std::min;
 // GLSL's findMSB: the index of the highest set bit, −1 for 0.
@@ -360,6 +362,22 @@ HC_FUNCTION LatLongTaps latLongTaps(uint level, float theta, float phi) {
   t.col0 = uint(int(fx) & int(m - 1u));
   t.col1 = (t.col0 + 1u) & (m - 1u);
   return t;
+}
+
+// ---- `splitsum` (core/splitsum.h): the image-based lighting of real-time
+// engines, one lookup of the prefiltered light per pixel instead of the lobe
+// path's K·J. I_c = E_c(θₒ)·L_c(λ, m)·V(m): m the mirror direction, V its
+// shadow ray (kLobeSeenBit), and λ the level whose texel has the solid
+// angle of the disc of the lobe's median angle a, π·a² = 2π²/M² (a level-n
+// texel at the equator is (π/M)·(2π/M), M = 2^n): M = √(2π)/a. A bilinear
+// lookup of box-filtered texels of side s spreads like a Gaussian of σ = s/2,
+// whose median radius 1.18σ then matches a with s² ≈ π·a² to 10 %: the
+// texel's footprint has the lobe's spread, not its support. λ is
+// fractional (trilinear) and clamped to the light's levels.
+HC_CONST float kSqrtTwoPi = 2.50662827463100050f;
+HC_CONST float kSplitsumMinAngle = 1e-6f;
+HC_FUNCTION float splitsumLevel(float medianAngle) {
+  return log2(kSqrtTwoPi / max(medianAngle, kSplitsumMinAngle));
 }
 
 // A sample's shadow word, for an object with a lobe path (not a ground):
