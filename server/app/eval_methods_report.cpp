@@ -49,7 +49,9 @@ std::string methodRankingMarkdown(const nlohmann::json& ranked) {
      << " θₒ samples; `splitsum` reads no map of that level). **Speed**: the median frame time of "
      << c["frames_timed"].get<int>()
      << " frames after a warm-up, the methods one after another on one machine (compare them as ratios). "
-        "**Storage**: the BRDF data kept per material (`loadtest`'s figure). **Truth**: against the Monte Carlo "
+        "**Storage**: the BRDF data kept per material (`loadtest`'s figure). **Prepare**: building the renderer "
+        "with eval's cache (a material's slice table and the sphere's visibility are computed once, by the first "
+        "method that needs them, and read back after). **Truth**: against the Monte Carlo "
         "reference converged to a half-image difference of "
      << fmt(c["tolerance"].get<double>(), 3) << " (at most " << c["max_samples"].get<int>()
      << " samples); its **floor** is a second seed with the same samples against the first. Ranks: 1 = fastest, "
@@ -89,7 +91,7 @@ std::string methodRankingMarkdown(const nlohmann::json& ranked) {
        << fmt(m["floor"]["psnr"].get<double>()) << " dB, relative L2 " << fmt(100.0 * m["floor"]["relative_l2"].get<double>())
        << " %, brightness " << fmt(m["floor"]["brightness"].get<double>(), 3) << ".\n\n"
        << "| truth rank | method | relative L2 | brightness | PSNR (dB) | frame (ms) | speed rank | stored | storage rank | "
-          "precompute (s) |\n|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+          "prepare (s) |\n|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
     std::vector<std::string> names;
     for (const auto& [n, v] : m["methods"].items()) names.push_back(n);
     std::stable_sort(names.begin(), names.end(), [&](const std::string& a, const std::string& b) {

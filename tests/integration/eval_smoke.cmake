@@ -92,8 +92,8 @@ if(brightness LESS 0.2 OR brightness GREATER 5)
   message(FATAL_ERROR "methods_ranked ggx:0.3 splitsum brightness ${brightness}: not a comparison")
 endif()
 file(READ "${OUT}/report.md" ranked_md)
-if(NOT ranked_md MATCHES "## Methods ranked: speed, storage, truth" OR NOT ranked_md MATCHES "\| splitsum \|"
-   OR NOT ranked_md MATCHES "### ggx:0.02 \(near-mirror\)")
+if(NOT ranked_md MATCHES "## Methods ranked: speed, storage, truth" OR NOT ranked_md MATCHES "\\| splitsum \\|"
+   OR NOT ranked_md MATCHES "### ggx:0.02 \\(near-mirror\\)")
   message(FATAL_ERROR "report.md has no ranking of the methods")
 endif()
 message(STATUS "methods ranked: splitsum keeps ${splitsum_bytes} bytes, fused ${fused_bytes}")
