@@ -24,10 +24,12 @@
 //      the lobe's energy back (× ∫ρ / Σ ΔΩ·ρ, the second sum of step 1:
 //      core fused.cpp energyKept), adds the point lights whose bit is set,
 //      in light order, each with the same rhoAt at the light's direction,
-//      and blends in the lobe path by its share; radiance[pixel] = Σ.
-// A sample whose lobe is narrower than the map's texels (shared_layout.h,
-// "The lobe path") skips steps 1–2: invocation 0 reads the prefiltered
-// light over the lobe's K·J stratified directions (lobeShade).
+//      and adds the lobe path's core; radiance[pixel] = Σ.
+// An object with a lobe path (shared_layout.h, "The lobe path") leaves the
+// directions within its core angle of the lobe's axis to it (rhoAt reads
+// ρ = 0 there, and the pass's energy is the lobe's less the core's); when
+// the path takes the whole lobe, steps 1–2 are skipped and invocation 0
+// reads the prefiltered light at the lobe's samples (lobeShade).
 //
 // The large read-only arrays of step 1 (slice texels, light, directions,
 // visibility words) are uniform texel buffers read with texelFetch: on a CPU
@@ -86,6 +88,8 @@ struct PixelSetup {
   float fraction;          // and the fraction
   float skipBelowY;
   uint firstRow, endRow;   // the rows that can reach the slice's non-zero cap
+  vec3 axis;               // the lobe's axis before R_y(−γ), and the lobe path's core (fused.cpp setCore)
+  float coreCos;
 };
 
 // Texel `index` of ρ: the slice's own, or the blend of the two slices.
@@ -107,6 +111,7 @@ vec3 rhoAt(const bool blended, PixelSetup p, vec3 w0) {
   const float y2 = p.cosB * w0.y + p.sinB * z1;    // R_x(−β)
   if (y2 < p.skipBelowY) return vec3(0.0);
   const float z2 = p.cosB * z1 - p.sinB * w0.y;
+  if (x1 * p.axis.x + y2 * p.axis.y + z2 * p.axis.z > p.coreCos) return vec3(0.0);  // the lobe path's core
   const float theta = atan2Fast(sqrt(x1 * x1 + z2 * z2), y2);
   const float phi = atan2Fast(x1, z2);
   const float rowPos = min(max(theta * rowScale - 0.5, 0.0), float(M - 1u));
@@ -175,8 +180,8 @@ vec3 prefilteredAt(float level, vec3 d) {
   return a + t * (prefilteredAt(l0 + 1u, d) - a);
 }
 
-// The lobe path (shared_layout.h, core fused.cpp lobeShade): E_c·the mean
-// of the prefiltered light over the lobe's K·J stratified directions.
+// The lobe path (shared_layout.h, core fused.cpp lobeShade): E_c of the
+// core times Σ_i w_i·L(ω_i) over the lobe's samples, each read at its level.
 vec3 lobeShade(ObjectInfo o, RotationSample rs, SliceBlend blend, uint seen) {
   if ((seen & kLobeSeenBit) == 0u) return vec3(0.0);
   const SliceLobe lobe = blendLobes(lobes[o.sliceBase + blend.first], lobes[o.sliceBase + blend.second], blend.weight);
@@ -185,16 +190,13 @@ vec3 lobeShade(ObjectInfo o, RotationSample rs, SliceBlend blend, uint seen) {
   const vec3 axis = toLight * vec3(0.0, sc.y, -sc.x);
   const vec3 u = toLight * vec3(1.0, 0.0, 0.0);
   const vec3 v = toLight * vec3(0.0, -sc.x, -sc.y);
-  const float sector = kTwoPi / float(kLobeSectors);
   vec3 sum = vec3(0.0);
-  for (uint k = 0u; k < kLobeRings; ++k) {
-    const vec2 ak = sinCosPrecise(lobe.angle[k]);
-    for (uint j = 0u; j < kLobeSectors; ++j) {
-      const vec2 bj = sinCosPrecise(lobeAzimuthSectors(k, j) * sector);
-      sum += prefilteredAt(lobe.level[k], ak.y * axis + ak.x * (bj.y * u + bj.x * v));
-    }
+  for (uint i = 0u; i < kLobeSamples; ++i) {
+    const vec4 s = lobe.samples[i];
+    const vec2 a = sinCosPrecise(s.x), b = sinCosPrecise(s.y);
+    sum += s.w * prefilteredAt(s.z, a.y * axis + a.x * (b.y * u + b.x * v));
   }
-  return lobe.energy.rgb * (sum / float(kLobeRings * kLobeSectors));
+  return lobe.core.rgb * sum;
 }
 
 // sum + Σ_k bit_k·power_k·ρ(Rᵀd_k) over the lights the sample sees, added
@@ -232,13 +234,10 @@ void shadePixel(uint s) {
   const SliceBlend blend = sliceBlendAt(rs.thetaOut, o.thetaSamples, INTERPOLATE);
   const bool blended = blend.weight != 0.0 && blend.second != blend.first;
 
-  // The lobe path's share (fused.h lobePathShareAt); all of it: no pass.
-  float share = 0.0;
-  if ((o.flags & kObjectLobePath) != 0u) {
-    const SliceLobe a = lobes[o.sliceBase + blend.first], b = lobes[o.sliceBase + blend.second];
-    share = lobePathShare(a.median.x + blend.weight * (b.median.x - a.median.x), LEVEL);
-  }
-  if (share >= 1.0) {
+  // The lobe path (fused.h LobePath): all of the lobe, with no pass, or
+  // its core, with the pass over the rest.
+  const bool lobePath = (o.flags & kObjectLobePath) != 0u;
+  if (lobePath && o.lobeCore.x <= -1.0) {
     if (lid == 0u) radiance[sh.pixel] = vec4(lobeShade(o, rs, blend, seen), 1.0);
     return;  // uniform over the workgroup
   }
@@ -261,6 +260,22 @@ void shadePixel(uint s) {
   p.shift = int(whole);
   p.fraction = offset - whole;
   p.skipBelowY = o.skipBelowY;
+  p.axis = vec3(0.0, 1.0, 0.0);
+  p.coreCos = 2.0;
+  vec3 energy;
+  if (lobePath) {
+    const SliceLobe a = lobes[o.sliceBase + blend.first], b = lobes[o.sliceBase + blend.second];
+    const float theta = a.energy.w + blend.weight * (b.energy.w - a.energy.w);
+    const vec2 st = sinCosPrecise(theta), sg = sinCosPrecise(rs.gamma);
+    p.axis = vec3(-st.x * sg.x, st.y, -st.x * sg.y);
+    p.coreCos = o.lobeCore.x;
+    const vec3 e = a.energy.rgb + blend.weight * (b.energy.rgb - a.energy.rgb);
+    const vec3 c = a.core.rgb + blend.weight * (b.core.rgb - a.core.rgb);
+    energy = max(e - c, vec3(0.0));
+  } else {
+    const vec3 e0 = sliceEnergy[o.sliceBase + blend.first].rgb, e1 = sliceEnergy[o.sliceBase + blend.second].rgb;
+    energy = e0 + blend.weight * (e1 - e0);
+  }
 
   // Only rows that can reach the slice's non-zero cap: y2 = ω·a with
   // a = (sin β sin α, cos β, sin β cos α) at angle β from +Y, so y2 ≥
@@ -292,8 +307,6 @@ void shadePixel(uint s) {
     vec3 sum = vec3(0.0), sampled = vec3(0.0);
     for (uint k = 0u; k < LOCAL; ++k) sum += partial[k];
     for (uint k = 0u; k < LOCAL; ++k) sampled += partialSum[k];
-    const vec3 e0 = sliceEnergy[o.sliceBase + blend.first].rgb, e1 = sliceEnergy[o.sliceBase + blend.second].rgb;
-    const vec3 energy = e0 + blend.weight * (e1 - e0);
     for (int c = 0; c < 3; ++c) {
       if (sampled[c] > 0.0) sum[c] *= energy[c] / sampled[c];
     }
@@ -301,7 +314,7 @@ void shadePixel(uint s) {
       sum = blended ? addPointLights(true, p, sh.object, o.pointLights, seen, sum)
                     : addPointLights(false, p, sh.object, o.pointLights, seen, sum);
     }
-    if (share > 0.0) sum += share * (lobeShade(o, rs, blend, seen) - sum);
+    if (lobePath) sum += lobeShade(o, rs, blend, seen);
     radiance[sh.pixel] = vec4(sum, 1.0);
   }
   sync();  // `partial` is reused by the next sample

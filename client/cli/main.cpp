@@ -17,6 +17,7 @@
 
 #include "build_progress.h"
 #include "client_options.h"
+#include "flag_suggest.h"
 #include "pose_path.h"
 #include "run_stats.h"
 #include "session.h"
@@ -232,6 +233,13 @@ int run(int argc, char** argv) {
 
   try {
     app.parse(argc, argv);
+  } catch (const CLI::ExtrasError& e) {
+    // A flag the client does not take: name it and the one meant.
+    const auto lines = haarcast::cli::unknownFlags(app, std::vector<std::string>(argv + 1, argv + argc));
+    if (lines.empty()) return app.exit(e) == 0 ? 0 : 2;
+    for (const auto& line : lines) std::fprintf(stderr, "haarcast-client: error: %s\n", line.c_str());
+    std::fprintf(stderr, "`haarcast-client --help` lists the flags.\n");
+    return 2;
   } catch (const CLI::ParseError& e) {
     // --help and --version exit 0; every flag error exits 2, as the checks
     // below do.

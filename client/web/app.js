@@ -9,13 +9,16 @@
 //   drag          the target chosen under "drag rotates" (the camera by default)
 //   shift-drag    the chosen object (the first one when none is chosen)
 //   alt-drag      the light (the environment) about +Y
-//   wheel         camera distance
+//   wheel, pinch  camera distance
 //   f / Esc       full window on / off
+//   h             the HUD's details folded / shown
 //
 // Page parameters (page_params.js; a bad one is shown and nothing connects):
-//   ?size=256x256&encoding=jpeg|png|raw|h264&quality=85&fps=30&token=T
+//   ?resolution=auto|360p|540p|720p|1080p (or ?size=WxH, fixed)
+//   &encoding=jpeg|png|raw|h264&quality=85&fps=30&token=T
 //   &method=fused&level=4&k=256&exposure=auto|STOPS&scene=NAME
-import './view_input.js';  // drags, the wheel and the reset button steer the view
+import './view_input.js';  // drags, pinches, the wheel and the reset button steer the view
+import { endBuild, expectBuild, showBuildProgress } from './build_view.js';
 import { onFrame, startH264View } from './frames.js';
 import { frameWindow, setServerStats, updateHud } from './hud.js';
 import { setFrameSize } from './layout.js';
@@ -26,6 +29,7 @@ import { onSceneInfo, showScenes, undoSceneChoice } from './scene_panel.js';
 import { Encoding, loadSchema, methodNames } from './schema.js';
 import { connect, onServerMessages, send, stop } from './session.js';
 import { chooseEncoding, flushExposure, showWelcomeSettings, undoSettingsChange } from './settings_panel.js';
+import { granted, refit, showResolutionChoice } from './resolution.js';
 import { setStatus, showBanner } from './status.js';
 import { flushPose, objectRotation, orbit, scenePoseOf, view } from './view.js';
 
@@ -35,6 +39,7 @@ const $ = (id) => document.getElementById(id);
 // starts the orbit at the scene's own camera).
 state.viewEye = () => (orbit.target ? orbitEye(orbit) : null);
 state.objectPose = (i) => objectRotation.get(i) || scenePoseOf(i);
+state.viewDistance = () => orbit.distance;
 
 // ---- messages from the server -----------------------------------------------------
 
@@ -48,6 +53,7 @@ function onWelcome(w) {
   frameWindow.clear();
   $('reconnect').hidden = true;
   $('banner').hidden = true;  // what it said was about the previous session
+  endBuild();
   setFrameSize(w.width, w.height);
   startH264View(w.encoding === Encoding.values.ENCODING_H264);
   showWelcomeSettings(w);
@@ -57,12 +63,19 @@ function onWelcome(w) {
   }
   view.pendingScene = null;
   onSceneInfo(w.sceneInfo || { name: w.scenes[0] || '', objects: [] }, true);
-  setStatus(`connected: ${w.device || 'renderer'}, ${w.width}×${w.height}, session ${w.sessionId}`);
+  // The frame size is the HUD's to say: it follows the view.
+  setStatus(`connected: ${w.device || 'renderer'}, session ${w.sessionId}`);
   view.poseDirty = true;  // the first pose: the view kept across a reconnect, or none
+  // The Hello's size was a guess made before the server's limits were known
+  // (or the view changed meanwhile): ask for the one that fits now.
+  granted(w.width, w.height);
+  refit();
 }
 
 // A change the server refused; the session goes on as before.
 function onRefused(code) {
+  // A build that failed (RENDER_FAILED) or a change refused: nothing is built.
+  endBuild();
   if (code === 'ERROR_CODE_UNKNOWN_SCENE' || code === 'ERROR_CODE_UNKNOWN_MATERIAL') undoSceneChoice();
   else if (code === 'ERROR_CODE_BAD_SETTINGS') undoSettingsChange();
 }
@@ -73,6 +86,7 @@ onServerMessages({
   sceneInfo: (info) => onSceneInfo(info, false),
   stats: setServerStats,
   refused: onRefused,
+  buildProgress: showBuildProgress,
 });
 
 // At most one pose and one exposure change per display frame: pointer and
@@ -100,7 +114,10 @@ async function main() {
     return;
   }
   Object.assign(choices, { scene: page.scene, method: page.method, level: page.level, k: page.k,
-                           exposure: page.exposure });
+                           exposure: page.exposure, resolution: page.resolution });
+  showResolutionChoice();
+  // The first build: the scene the Hello asks for.
+  expectBuild(`scene ${page.scene || 'default'}`);
   if (!page.exposure.auto) {
     $('exposure-auto').checked = false;
     $('exposure').value = String(page.exposure.stops);

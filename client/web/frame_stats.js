@@ -63,7 +63,8 @@ export class FrameWindow {
   }
 
   // Everything the HUD shows. `idle`: no frame for longer than a gap, so the
-  // stream is paused (the numbers are those of the last stretch of frames).
+  // stream is paused (the numbers are those of the last stretch of frames);
+  // `sinceLastMs`: how long ago the newest frame came (null: none yet).
   summary(now) {
     const w = this.window();
     const mean = (values) => {
@@ -93,6 +94,7 @@ export class FrameWindow {
       serverMs: mean(w.map((x) => x.serverMs)),
       stages,
       idle: last !== null && now - last > this.gapLimitMs(),
+      sinceLastMs: last === null ? null : now - last,
     };
   }
 }

@@ -2,15 +2,18 @@
 // has: JPEG and PNG through the browser's image decoder, raw RGBA as is, and
 // H.264 through WebCodecs (h264_view.js). Only a frame newer than the one on
 // the canvas is drawn, and each is counted for the HUD.
+import { buildShown, endBuild } from './build_view.js';
 import { H264View } from './h264_view.js';
 import { frameWindow } from './hud.js';
 import { ctx, setFrameSize } from './layout.js';
 import { state } from './page_state.js';
+import { frameTiming } from './resolution.js';
+import { sceneShown } from './scene_panel.js';
 import { Encoding, ExposureMode, methodName } from './schema.js';
 import { generation } from './session.js';
 import { setEffective, showFrameExposure } from './settings_panel.js';
 import { showBanner } from './status.js';
-import { requestKeyframe } from './view.js';
+import { requestKeyframe, view } from './view.js';
 
 // Frames are decoded asynchronously and may finish out of order; only a
 // frame newer than the one on the canvas is drawn.
@@ -18,13 +21,16 @@ export async function onFrame(f, gen) {
   state.framesReceived++;
   const received = performance.now();
   const bytes = f.data.byteLength;
-  frameWindow.add(received, {
-    bytes,
-    latencyMs: f.clientTimeMs > 0 ? received - f.clientTimeMs : NaN,
-    // The first frame (pose 0) waited for the renderer to be prepared: not a frame time.
-    serverMs: f.serverMs > 0 && f.poseSequence > 0 ? f.serverMs : NaN,
-    stages: f.timings.map((t) => ({ name: t.name, ms: t.ms })),
-  });
+  // A frame that answers a change (settings, scene, size) rather than a
+  // pose, or that ends a build, has no pose-to-frame latency: its pose was
+  // sent before what it waited for.
+  const answersChange = f.poseSequence < view.changeFromPose;
+  const endsBuild = buildShown() && !answersChange;
+  // The first frame (pose 0) waited for the renderer to be prepared: not a frame time.
+  const serverMs = f.serverMs > 0 && f.poseSequence > 0 ? f.serverMs : NaN;
+  const latencyMs = f.clientTimeMs > 0 && !answersChange && !endsBuild ? received - f.clientTimeMs : NaN;
+  frameWindow.add(received, { bytes, latencyMs, serverMs, stages: f.timings.map((t) => ({ name: t.name, ms: t.ms })) });
+  frameTiming(f.width, f.height, serverMs);
   if (f.poseSequence < state.scene.firstPose) return;  // the previous scene, rendered before the switch
   if (f.settings) setEffective(f.settings);
   const method = f.settings && f.settings.method ? methodName(f.settings.method) : null;
@@ -33,9 +39,15 @@ export async function onFrame(f, gen) {
   const shown = () => {
     state.lastShownSequence = f.sequence;
     state.framesShown++;
+    // serverMs, latencyMs: what the HUD counted of this frame (NaN: not counted).
     state.lastFrame = { sequence: f.sequence, poseSequence: f.poseSequence, width: f.width, height: f.height,
-                        encoding: f.encoding, method, bytes, exposureStops: f.exposureStops, exposureMode };
+                        encoding: f.encoding, method, bytes, exposureStops: f.exposureStops, exposureMode,
+                        serverMs, latencyMs };
     showFrameExposure(f.exposureStops, exposureMode);
+    // The first frame of a change ends its build on the page, and the first
+    // of a new scene lists its objects.
+    if (f.poseSequence >= view.changeFromPose) endBuild();
+    sceneShown();
   };
   if (f.encoding === Encoding.values.ENCODING_RAW_RGBA8) {
     if (bytes !== f.width * f.height * 4) throw new Error(`raw frame of ${bytes} bytes for ${f.width}×${f.height}`);

@@ -1,34 +1,65 @@
 // The HUD over the view: how the session is doing (frame rate, latency,
-// bandwidth, the server's frame time and its stages), so that a slow frame
-// can be told from a slow network. Its numbers come from frame_stats.js.
+// bandwidth, the server's frame time and its stages, the frame size), so
+// that a slow frame can be told from a slow network; and, when no frame
+// has come for a while, that the stream is idle and up to date (the server
+// sends a frame only when something changes) with the last frame's age.
+// Its details fold away (the button, or h) to one line; folded is the
+// default on a window under 600 px wide, where the view is small. Its
+// numbers come from frame_stats.js.
+import { idleText } from './build_status.js';
 import { FrameWindow, formatNumber, formatStops } from './frame_stats.js';
 import { state } from './page_state.js';
+import { resolutionLabel } from './resolution.js';
 import { showReconnectCountdown } from './session.js';
 
 const $ = (id) => document.getElementById(id);
 
 export const frameWindow = new FrameWindow();
 
+// Narrower than this, the HUD starts folded.
+export const HUD_FOLDED_BELOW_PX = 600;
+
 let serverStats = null;
 export function setServerStats(stats) {
   serverStats = stats;
 }
 
+export function setHudFolded(folded) {
+  $('hud').classList.toggle('collapsed', folded);
+  $('hud-toggle').setAttribute('aria-expanded', String(!folded));
+  $('hud-toggle').textContent = folded ? '▸' : '▾';
+  $('hud-toggle').title = folded ? 'more details (h)' : 'fewer details (h)';
+  state.hudFolded = folded;
+}
+setHudFolded(window.innerWidth < HUD_FOLDED_BELOW_PX);
+$('hud-toggle').addEventListener('click', () => setHudFolded(!state.hudFolded));
+document.addEventListener('keydown', (e) => {
+  if (e.target instanceof HTMLInputElement || e.target instanceof HTMLSelectElement) return;
+  if (e.key === 'h' && !e.ctrlKey && !e.metaKey && !e.altKey) setHudFolded(!state.hudFolded);
+});
+
 export function updateHud() {
   const s = frameWindow.summary(performance.now());
+  // Idle: the last stretch's rates would be stale; say how old the frame is.
+  const idle = s.idle && s.sinceLastMs !== null;
+  $('hud-rates').hidden = idle;
+  $('hud-idle').hidden = !idle;
+  if (idle) $('hud-idle').textContent = idleText(s.sinceLastMs);
   $('hud-fps').textContent = formatNumber(s.fps);
   $('hud-latency').textContent = formatNumber(s.latencyMs);
   $('hud-kbps').textContent = formatNumber(s.kbps);
   $('hud-frame-ms').textContent = formatNumber(s.serverMs);
-  $('hud-method').textContent = (state.lastFrame && state.lastFrame.method) || '—';
-  $('hud-exposure').textContent = state.lastFrame
-    ? `${formatStops(state.lastFrame.exposureStops)} stops ${state.lastFrame.exposureMode}` : '—';
+  const f = state.lastFrame;
+  $('hud-size').textContent = f ? `${f.width}×${f.height} ${resolutionLabel()}` : '—';
+  $('hud-method').textContent = (f && f.method) || '—';
+  $('hud-exposure').textContent = f ? `${formatStops(f.exposureStops)} stops ${f.exposureMode}` : '—';
   $('hud-stages').textContent = s.stages.length
     ? s.stages.map((x) => `${x.name} ${formatNumber(x.ms)}`).join(' · ') + ' ms' : '—';
   $('hud').classList.toggle('idle', s.idle);
   $('hud').title = [
     `over the last ${s.frames} frame(s)${s.idle ? '; no frames lately (the server sends one when something changes)' : ''}`,
-    'frame: the server\'s time from pose to frame queued; stages: the renderer\'s and the encoder\'s',
+    'frame: the server\'s time from the request (a pose, a change) to the frame queued, never a renderer build; ' +
+      'stages: the renderer\'s and the encoder\'s',
     serverStats ? `server: ${serverStats.fps.toFixed(1)} fps, ${serverStats.sessions} session(s)` : '',
   ].filter(Boolean).join('\n');
   state.hudUpdates++;

@@ -69,3 +69,12 @@ export function zoomOrbit(orbit, deltaY) {
   const d = orbit.startDistance;
   return Math.max(0.2 * d, Math.min(10 * d, orbit.distance * Math.exp(deltaY * 0.001)));
 }
+
+// The distance after a pinch whose fingers moved from `fromPx` apart to
+// `toPx` apart: spreading them brings the eye closer by the same ratio, as
+// a map does; within the wheel's range.
+export function pinchOrbit(orbit, fromPx, toPx) {
+  if (!(fromPx > 0) || !(toPx > 0)) return orbit.distance;
+  const d = orbit.startDistance;
+  return Math.max(0.2 * d, Math.min(10 * d, orbit.distance * fromPx / toPx));
+}

@@ -10,9 +10,12 @@
 // H.264 is drawn through WebCodecs where the browser has it, else the page
 // asks for JPEG and says why (h264_view.js).
 export const ENCODINGS = ['jpeg', 'png', 'raw', 'h264'];
+// The resolution control (stream_size.js): the view's own size, or lines.
+export const RESOLUTION_CHOICES = ['auto', '360p', '540p', '720p', '1080p'];
 
 export const PARAMETERS = {
-  size: 'WIDTHxHEIGHT, e.g. 256x256',
+  size: 'WIDTHxHEIGHT, e.g. 256x256 (a fixed size instead of one that fits the view)',
+  resolution: RESOLUTION_CHOICES.join(', '),
   encoding: ENCODINGS.join(', '),
   quality: 'a JPEG quality 1..100',
   fps: 'frames per second at most, a number > 0',
@@ -34,7 +37,7 @@ function wholeNumber(text) {
 export function parsePageParameters(search, { methods }) {
   const params = search instanceof URLSearchParams ? search : new URLSearchParams(search);
   const out = {
-    width: 256, height: 256, encoding: 'jpeg', quality: 0, fps: 0, token: '',
+    width: 0, height: 0, resolution: 'auto', encoding: 'jpeg', quality: 0, fps: 0, token: '',
     method: '', level: 0, k: 0, exposure: { auto: true, stops: 0 }, scene: '',
     errors: [],
   };
@@ -57,6 +60,12 @@ export function parsePageParameters(search, { methods }) {
     const m = /^(\d+)x(\d+)$/.exec(size);
     if (!m || Number(m[1]) < 1 || Number(m[2]) < 1) bad('size', size, 'use WIDTHxHEIGHT, e.g. 256x256');
     else { out.width = Number(m[1]); out.height = Number(m[2]); }
+  }
+  const resolution = get('resolution');
+  if (resolution !== null) {
+    if (!RESOLUTION_CHOICES.includes(resolution)) bad('resolution', resolution, `use one of ${valid.resolution}`);
+    else if (size !== null) bad('resolution', resolution, 'give ?size= (a fixed size) or ?resolution=, not both');
+    else out.resolution = resolution;
   }
   const encoding = get('encoding');
   if (encoding !== null) {

@@ -10,7 +10,8 @@ export const state = {
   framesReceived: 0,
   framesShown: 0,
   lastShownSequence: 0,
-  lastFrame: null,     // {sequence, poseSequence, width, height, encoding, method, bytes, exposureStops, exposureMode}
+  lastFrame: null,     // {sequence, poseSequence, width, height, encoding, method, bytes, exposureStops, exposureMode,
+                       //  serverMs, latencyMs}
   posesSent: 0,
   errors: [],          // {code, message, fatal}; page-parameter errors have code "PAGE_PARAMETER"
   closed: null,        // {code, reason} of the last socket close
@@ -24,6 +25,16 @@ export const state = {
   h264: null,          // h264Support()'s answer, once H.264 was chosen
   helloEncoding: '',   // what the last Hello asked for (jpeg when H.264 falls back)
   keyframeRequests: 0, // poses sent with PoseUpdate.keyframe
+  requestedSize: null, // {width, height} last asked for (Hello or RenderSettings)
+  resizes: 0,          // sizes asked for after the Hello (a resized view, auto's steps)
+  autoSteps: 0,        // sizes auto's rule changed
+  sizeFallback: false, // the server refused the size that fits the view: the Hello asks for its default
+  build: null,         // the build on the page: {what, stage, percent, fraction, detail}; null: none
+  buildProgressMessages: 0,
+  buildsEnded: 0,      // builds shown and over
+  hudFolded: false,    // the HUD shows its first line only
+  pinches: 0,          // pointer moves with two fingers down (pinch zoom)
+  sceneReady: true,    // false while a new scene's renderer is prepared: its objects are not listed yet
 };
 window.haarcast = state;
 
@@ -34,7 +45,7 @@ export function setPage(p) {
 }
 
 // What the user asked for: the next Hello, after a reconnect, says it again.
-export const choices = { scene: '', method: '', level: 0, k: 0, exposure: { auto: true, stops: 0 } };
+export const choices = { scene: '', method: '', level: 0, k: 0, exposure: { auto: true, stops: 0 }, resolution: 'auto' };
 
 // The exposure the user chose, as RenderSettings fields.
 export function exposureSettings() {

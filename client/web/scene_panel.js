@@ -1,10 +1,13 @@
 // The scene controls: which of the server's scenes is shown, each object's
 // material, and the objects a drag can turn. They show the scene the server
-// says is in effect (SceneInfo), so a refused choice leaves them truthful.
+// says is in effect (SceneInfo), so a refused choice leaves them truthful;
+// a new scene's objects are listed once its first frame is on the canvas
+// (its renderer may take a while to build), not over the old scene's frame.
+import { expectBuild } from './build_view.js';
 import { choices, state } from './page_state.js';
 import { send } from './session.js';
 import { fillSelect, selectValue } from './settings_panel.js';
-import { resetView, touched, view } from './view.js';
+import { noteChange, resetView, touched, view } from './view.js';
 
 const $ = (id) => document.getElementById(id);
 
@@ -32,7 +35,38 @@ export function onSceneInfo(info, fromWelcome) {
   if (view.pendingScene === info.name) view.pendingScene = null;
   view.poseDirty = true;
   selectValue($('scene'), info.name);
-  showObjects(info);
+  if (newScene && !fromWelcome) {
+    state.sceneReady = false;
+    showPreparing(info.name);
+  } else {
+    state.sceneReady = true;
+    showObjects(info);
+  }
+}
+
+// A frame of the scene in effect is on the canvas: its objects are listed
+// if they were held back.
+export function sceneShown() {
+  if (state.sceneReady || !state.sceneInfo) return;
+  state.sceneReady = true;
+  showObjects(state.sceneInfo);
+}
+
+function removeObjectTargets() {
+  for (const r of document.querySelectorAll('#drag-target input')) {
+    if (r.value.startsWith('object:')) {
+      if (r.checked) document.querySelector('#drag-target input[value="camera"]').checked = true;
+      r.closest('label').remove();
+    }
+  }
+}
+
+function showPreparing(name) {
+  const note = document.createElement('li');
+  note.className = 'note';
+  note.textContent = `preparing ${name}: its objects are listed with its first frame`;
+  $('objects').replaceChildren(note);
+  removeObjectTargets();
 }
 
 function showObjects(info) {
@@ -56,8 +90,14 @@ function showObjects(info) {
     select.setAttribute('aria-label', `material of ${o.name || `object ${o.index}`}`);
     const options = offered.map((m) => [m, m]);
     // A scene file's own material (say, a MERL file) is in effect but not
-    // offered: shown, and not choosable again once changed.
-    if (!offered.includes(o.material)) options.unshift([o.material, `${o.material} (the scene's own)`]);
+    // offered: shown by its name, and not choosable again once changed.
+    if (!offered.includes(o.material)) {
+      options.unshift([o.material, o.material]);
+      const own = document.createElement('span');
+      own.className = 'own';
+      own.textContent = ' · the scene\'s own material';
+      name.append(own);
+    }
     fillSelect(select, options, o.material);
     select.addEventListener('change', () => chooseMaterial(o.index, select.value));
     li.append(name, select);
@@ -92,12 +132,15 @@ function chooseScene(name) {
   touched.camera = false;
   touched.light = false;
   touched.objects.clear();
-  send({ scene: { scene: name } });
+  expectBuild(`scene ${name}`);
+  if (send({ scene: { scene: name } })) noteChange();
 }
 
 function chooseMaterial(index, spec) {
   if (!state.sceneInfo) return;
-  send({ scene: { scene: state.sceneInfo.name, objectMaterials: { [index]: spec } } });
+  const o = state.sceneInfo.objects.find((x) => x.index === index);
+  expectBuild(`${spec} on ${(o && o.name) || `object ${index}`}`);
+  if (send({ scene: { scene: state.sceneInfo.name, objectMaterials: { [index]: spec } } })) noteChange();
 }
 
 $('scene').addEventListener('change', () => chooseScene($('scene').value));

@@ -6,6 +6,7 @@
 import { backoffMs } from './frame_stats.js';
 import { helloEncoding } from './h264_view.js';
 import { choices, exposureSettings, page, state } from './page_state.js';
+import { helloSize } from './resolution.js';
 import { ClientMessage, Encoding, ErrorCode, ServerMessage, methodValue } from './schema.js';
 import { setStatus, showBanner } from './status.js';
 
@@ -20,8 +21,8 @@ let reconnectAt = 0;
 let reconnectWhy = '';
 
 // What the page does with the server's messages:
-// {welcome(w), frame(f, generation) → Promise, sceneInfo(info), stats(s), refused(code)};
-// refused: a non-fatal Error, the change it answers was not made.
+// {welcome(w), frame(f, generation) → Promise, sceneInfo(info), stats(s), refused(code),
+//  buildProgress(p)}; refused: a non-fatal Error, the change it answers was not made.
 let handlers = null;
 export function onServerMessages(h) {
   handlers = h;
@@ -46,8 +47,9 @@ function hello() {
   state.helloEncoding = helloEncoding(page.encoding, state.h264).encoding;
   const encoding = { jpeg: 'ENCODING_JPEG', png: 'ENCODING_PNG', raw: 'ENCODING_RAW_RGBA8', h264: 'ENCODING_H264' }[
     state.helloEncoding];
+  const size = helloSize();
   const h = {
-    protocolVersion: 1, authToken: page.token, width: page.width, height: page.height,
+    protocolVersion: 1, authToken: page.token, width: size.width, height: size.height,
     encoding: Encoding.values[encoding], fpsCap: page.fps, jpegQuality: page.quality, clientName: 'browser',
     settings: { method: methodValue(choices.method), level: choices.level, lightCoefficients: choices.k,
                 ...exposureSettings() },
@@ -100,10 +102,10 @@ export function connect() {
     else if (m.sceneInfo) handlers.sceneInfo(m.sceneInfo);
     else if (m.stats) handlers.stats(m.stats);
     else if (m.error) onError(m.error);
-    // BuildProgress (the renderer is being built) is not shown by the page
-    // yet; Pong needs no answer. Any other message type a newer server adds
+    else if (m.buildProgress) handlers.buildProgress(m.buildProgress);
+    // Pong needs no answer. Any other message type a newer server adds
     // decodes to none of the above and is ignored too.
-    else if (m.buildProgress || m.pong) { /* nothing to do */ }
+    else if (m.pong) { /* nothing to do */ }
   };
   socket.onclose = (event) => {
     if (gen !== generation) return;
@@ -176,6 +178,13 @@ function onError(e) {
   state.errors.push({ code, message: e.message, fatal: e.fatal });
   if (e.fatal) {
     lastFatal = { code, retry: RETRYABLE.has(code) };
+    if (code === 'ERROR_CODE_BAD_RESOLUTION' && !(page.width > 0) && !state.sizeFallback) {
+      // The size that fits the view is over this server's limits, which the
+      // page learns only from a Welcome: once more at the server's default
+      // size, then within the limits its Welcome gives.
+      state.sizeFallback = true;
+      lastFatal.retry = true;
+    }
     const next = lastFatal.retry ? 'The session was closed; the page reconnects.' : `The session was closed. ${advice(code)}`;
     showBanner(`server error ${code}: ${e.message}\n${next}`);
     return;

@@ -8,7 +8,8 @@ import { formatStops } from './frame_stats.js';
 import { choices, exposureSettings, page, state } from './page_state.js';
 import { ExposureMode, methodName, methodNames, methodValue } from './schema.js';
 import { restartSession, send } from './session.js';
-import { view } from './view.js';
+import { expectBuild } from './build_view.js';
+import { noteChange } from './view.js';
 
 const $ = (id) => document.getElementById(id);
 
@@ -95,6 +96,7 @@ function sendSettings(fields) {
   if (send({ settings: fields })) {
     settingsBeforeChange = settingsAfterChange;
     settingsAfterChange = currentSettings();
+    noteChange();
   }
 }
 
@@ -103,8 +105,9 @@ function onSettingsControl() {
   choices.level = Number($('level').value);
   choices.k = Number($('coefficients').value);
   const { method, level, lightCoefficients } = currentSettings();
+  // What a build, if one comes, is for: the method and the level.
+  expectBuild(`${choices.method} at level ${choices.level} (${2 ** choices.level}×${2 ** choices.level} maps)`);
   sendSettings({ method, level, lightCoefficients });
-  view.poseDirty = true;
 }
 
 // The exposure change due, if one is: called once per display frame, as the

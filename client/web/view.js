@@ -1,7 +1,7 @@
 // The view the user steers — the camera's orbit, each object's turn and the
 // light's — and the poses that tell the server about it. A pose carries only
 // what the user touched, so the server keeps the scene's own pose for the rest.
-import { DRAG_DEGREES_PER_PIXEL, dragOrbit, orbitEye, orbitFromCamera, zoomOrbit } from './orbit.js';
+import { DRAG_DEGREES_PER_PIXEL, dragOrbit, orbitEye, orbitFromCamera, pinchOrbit, zoomOrbit } from './orbit.js';
 import { state } from './page_state.js';
 import { send } from './session.js';
 
@@ -17,7 +17,18 @@ export const view = {
   poseSequence: 0,
   poseDirty: false,    // a pose is due at the next display frame
   pendingScene: null,  // a SceneChoice for another scene, not answered yet
+  // The first pose sent after the last change (settings, scene, size):
+  // frames answering older poses were made before it or answer the change
+  // itself, not a pose, so they carry no pose-to-frame latency.
+  changeFromPose: 0,
 };
+
+// A change was sent: a pose follows it at once, so that the frame made with
+// the change answers a pose of its own.
+export function noteChange() {
+  view.changeFromPose = view.poseSequence + 1;
+  view.poseDirty = true;
+}
 
 // The scene's own pose of an object (SceneInfo), where its turns start from,
 // so the first drag does not snap it back to no rotation.
@@ -66,6 +77,14 @@ export function steer(target, dx, dy) {
 export function zoom(deltaY) {
   if (!steerable()) return;
   orbit.distance = zoomOrbit(orbit, deltaY);
+  touched.camera = true;
+  view.poseDirty = true;
+}
+
+// Fingers that moved from `fromPx` apart to `toPx` apart (a pinch).
+export function pinch(fromPx, toPx) {
+  if (!steerable()) return;
+  orbit.distance = pinchOrbit(orbit, fromPx, toPx);
   touched.camera = true;
   view.poseDirty = true;
 }

@@ -5,6 +5,7 @@
 #include "bench_frame_command.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -21,6 +22,7 @@
 
 #include "haarcast/gpu/backend.h"
 #include "list_flags.h"
+#include "progress.h"
 #include "haarcast/render/renderer.h"
 #include "haarcast/render/scene.h"
 
@@ -122,14 +124,29 @@ int run(const BenchArgs& a) {
     }
     out["vulkan_devices"] = devices;
   }
-  std::string table;
+  // The table goes out a row at a time, as each is measured (a run of
+  // every method and level takes many minutes); with --json only the JSON,
+  // at the end. stderr says how many rows are done and left either way.
   auto line = [&](const std::string& s) {
-    table += s;
-    table += '\n';
+    if (a.json) return;
+    std::fputs((s + "\n").c_str(), stdout);
+    std::fflush(stdout);
   };
   // "fused / splitsum": the one pass of either, in place of rotation and triple product.
   line("| level | method | size | backend | light | gbuffer | rotation-input | rotation | triple-product | fused / splitsum | tonemap | frame (s) | fps | coeff. bytes/frame | vs cpu |");
   line("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+  const std::size_t rows = levels.size() * methods.size() * sizes.size() * ((cpu ? 1 : 0) + (vulkan ? 1 : 0));
+  std::size_t rowsDone = 0;
+  const auto started = std::chrono::steady_clock::now();
+  StderrProgress progress("[bench-frame] ");
+  auto rowDone = [&](const std::string& what, double fps) {
+    ++rowsDone;
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    char text[256];
+    std::snprintf(text, sizeof text, "row %zu of %zu (%s: %.2f fps); %zu left, %s so far", rowsDone, rows, what.c_str(),
+                  fps, rows - rowsDone, formatDuration(elapsed).c_str());
+    progress.message(text);
+  };
 
   for (const int level : levels) {
     for (const RotationMethod method : methods) {
@@ -139,14 +156,15 @@ int run(const BenchArgs& a) {
       options.interpolateSlices = a.slices == "blend";
       options.antialias = antialias;
       options.cacheDir = a.cacheDir == "none" ? "" : a.cacheDir;
-      std::fprintf(stderr, "[bench-frame] level %d, %s: preparing\n", level, std::string(methodName(method)).c_str());
+      progress.message("level " + std::to_string(level) + ", " + std::string(methodName(method)) + ": preparing");
       std::unique_ptr<render::Renderer> cpuRenderer, gpuRenderer;
-      if (cpu) cpuRenderer = gpu::makeRenderer("cpu", scene, options);
+      // Slice tables, visibility, rotators: the same progress lines as `render`.
+      if (cpu) cpuRenderer = gpu::makeRenderer("cpu", scene, options, {}, progress.callback());
       if (vulkan) {
         gpu::VulkanOptions v;
         v.device = a.device;
         v.validation = false;  // timing: validation layers would dominate
-        gpuRenderer = gpu::makeRenderer("vulkan", scene, options, v);
+        gpuRenderer = gpu::makeRenderer("vulkan", scene, options, v, progress.callback());
         out["vulkan_device"] = gpuRenderer->deviceName();
       }
       if (cpuRenderer) out["cpu_device"] = cpuRenderer->deviceName();
@@ -158,8 +176,9 @@ int run(const BenchArgs& a) {
         std::map<std::string, Measured> results;
         for (render::Renderer* r : {cpuRenderer.get(), gpuRenderer.get()}) {
           if (!r) continue;
-          std::fprintf(stderr, "[bench-frame] level %d, %s, %d×%d, %s: %d frames + %d warm-up\n", level,
-                       std::string(methodName(method)).c_str(), width, height, r->backend().c_str(), a.frames, a.warmup);
+          progress.message("level " + std::to_string(level) + ", " + std::string(methodName(method)) + ", " +
+                           std::to_string(width) + "×" + std::to_string(height) + ", " + r->backend() + ": " +
+                           std::to_string(a.frames) + " frames + " + std::to_string(a.warmup) + " warm-up");
           results[r->backend()] = measure(*r, request, a.frames, a.warmup);
         }
         std::optional<std::pair<double, std::size_t>> agree;
@@ -211,15 +230,14 @@ int run(const BenchArgs& a) {
           std::snprintf(buf, sizeof buf, " %.4f | %.2f | %zu | %s |", m.frameSeconds,
                         m.frameSeconds > 0.0 ? 1.0 / m.frameSeconds : 0.0, m.coefficientBytes, ratio.c_str());
           line(row + buf);
+          rowDone("level " + std::to_string(level) + ", " + std::string(methodName(method)) + ", " +
+                      std::to_string(width) + "×" + std::to_string(height) + ", " + backend,
+                  m.frameSeconds > 0.0 ? 1.0 / m.frameSeconds : 0.0);
         }
       }
     }
   }
-  if (a.json) {
-    std::cout << out.dump(2) << '\n';
-  } else {
-    std::cout << table;
-  }
+  if (a.json) std::cout << out.dump(2) << '\n';
   return 0;
 }
 

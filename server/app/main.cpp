@@ -11,6 +11,7 @@
 #include "bench_frame_command.h"
 #include "compare_command.h"
 #include "eval.h"
+#include "flag_suggest.h"
 #include "loadtest_command.h"
 #include "progress.h"
 #include "reference_command.h"
@@ -20,40 +21,36 @@
 
 namespace {
 
-// Edit distance (insertions, deletions, substitutions), for "did you mean".
-std::size_t editDistance(const std::string& a, const std::string& b) {
-  std::vector<std::size_t> row(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    std::size_t diagonal = row[0];
-    row[0] = i;
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      const std::size_t up = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      diagonal = up;
-    }
-  }
-  return row[b.size()];
-}
-
 // A first argument that is not an option and names no command: CLI11 would
 // only say "A subcommand is required". Name the word, the nearest command
 // and every command.
 std::optional<std::string> unknownCommand(const CLI::App& app, int argc, char** argv) {
   if (argc < 2 || argv[1][0] == '-') return std::nullopt;
   const std::string word = argv[1];
-  std::string all, nearest;
-  std::size_t best = std::string::npos;
+  std::string all;
+  std::vector<std::string> names;
   for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) {
     const std::string& name = sub->get_name();
     if (name == word) return std::nullopt;
     all += (all.empty() ? "" : ", ") + name;
-    const std::size_t d = editDistance(word, name);
-    if (d < best) best = d, nearest = name;
+    names.push_back(name);
   }
   std::string message = "unknown command \"" + word + "\"";
-  if (best <= 2) message += "; did you mean " + nearest + "?";
+  if (const auto near = haarcast::cli::nearestName(word, names)) message += "; did you mean " + *near + "?";
   return message + " (commands: " + all + "; --help explains each)";
+}
+
+// CLI11 refused the arguments of `command` (named by argv[1]): the flags it
+// does not know, each with the one most likely meant. Empty when none of the
+// words is an unknown flag (CLI11's own message says what is wrong then).
+std::vector<std::string> unknownFlagLines(CLI::App& app, int argc, char** argv) {
+  if (argc < 2 || argv[1][0] == '-') return {};
+  CLI::App* command = nullptr;
+  for (CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) {
+    if (sub->get_name() == argv[1]) command = sub;
+  }
+  if (!command) return {};
+  return haarcast::cli::unknownFlags(*command, std::vector<std::string>(argv + 2, argv + argc));
 }
 
 int runReport(const haarcast::app::RotationReportOptions& options, bool json) {
@@ -98,6 +95,13 @@ int main(int argc, char** argv) {
   const auto runLoadtest = haarcast::app::addLoadtestCommand(app);
   const auto runCompare = haarcast::app::addCompareCommand(app);
 
+  if (argc < 2) {
+    // A bare `haarcast`: what it can do, not only that it needs a command.
+    std::fprintf(stderr, "haarcast: a command is required. The commands:\n%s"
+                         "`haarcast COMMAND --help` lists a command's flags.\n",
+                 haarcast::cli::commandList(app).c_str());
+    return 2;
+  }
   if (const auto unknown = unknownCommand(app, argc, argv)) {
     std::fprintf(stderr, "haarcast: error: %s\n", unknown->c_str());
     return 2;
@@ -117,6 +121,13 @@ int main(int argc, char** argv) {
       report.rotator.haarVariant = *v;
       return runReport(report, json);
     }
+  } catch (const CLI::ExtrasError& e) {
+    // A flag the command does not take: name it and the one meant.
+    const auto lines = unknownFlagLines(app, argc, argv);
+    if (lines.empty()) return app.exit(e) == 0 ? 0 : 2;
+    for (const auto& line : lines) std::fprintf(stderr, "haarcast %s: error: %s\n", argv[1], line.c_str());
+    std::fprintf(stderr, "`haarcast %s --help` lists its flags.\n", argv[1]);
+    return 2;
   } catch (const CLI::ParseError& e) {
     // --help exits 0; every flag error exits 2, as the checks below do.
     return app.exit(e) == 0 ? 0 : 2;

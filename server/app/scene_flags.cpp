@@ -23,6 +23,8 @@ void addSceneFlags(CLI::App& c, SceneFlags& f) {
   c.add_option("--material", f.material,
                std::string("With --mesh: lambert, phong:EXP, blinn-phong:EXP, ggx:ROUGHNESS or a MERL .binary (default ") +
                    kMeshMaterial + ")");
+  c.add_option("--up", f.up, "With --mesh: its up axis as the file has it, y|z (z: turned to stand along +Y; "
+                             "scene files: \"up\" per object)");
   c.add_option("--rotate", f.rotate, "Object rotation X,Y,Z in degrees")->delimiter(',')->expected(3);
   c.add_option("--width", f.width, "Image width")->capture_default_str();
   c.add_option("--height", f.height, "Image height")->capture_default_str();
@@ -44,10 +46,21 @@ void addSceneLimitFlags(CLI::App& c, render::SceneLimits& limits) {
       ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 24));
 }
 
+namespace {
+render::UpAxis parseUp(const std::string& text) {
+  try {
+    return render::parseUpAxis(text);
+  } catch (const std::invalid_argument&) {
+    throw std::invalid_argument("--up " + text + " is not an up axis (valid: y, z)");
+  }
+}
+}  // namespace
+
 render::Scene sceneFromFlags(const SceneFlags& f) {
   if (!f.scene.empty()) {
     if (!f.mesh.empty() || !f.env.empty()) throw std::invalid_argument("give either --scene or --env/--mesh, not both");
     if (f.ground) throw std::invalid_argument("--ground applies to --mesh (a scene file says \"ground\": true)");
+    if (!f.up.empty()) throw std::invalid_argument("--up applies to --mesh (a scene file says \"up\": \"z\" per object)");
     return render::loadScene(f.scene, f.limits);
   }
   if (f.mesh.empty()) {
@@ -56,12 +69,16 @@ render::Scene sceneFromFlags(const SceneFlags& f) {
     if (f.ground) throw std::invalid_argument("--ground applies to --mesh (the default scene has its own ground)");
     if (!f.material.empty()) throw std::invalid_argument("--material applies to --mesh (the default scene's objects have their own)");
     if (!f.rotate.empty()) throw std::invalid_argument("--rotate applies to --mesh (the default scene's objects have their own poses)");
+    if (!f.up.empty()) throw std::invalid_argument("--up applies to --mesh (the default scene's objects stand along +Y)");
     return render::defaultScene();
   }
+  // Before any file is read: a bad --up fails at once.
+  const render::UpAxis up = f.up.empty() ? render::UpAxis::Y : parseUp(f.up);
   render::Scene scene = render::defaultScene();
   scene.objects.clear();
   if (!f.env.empty()) scene.environment = render::environmentFromFile(f.env, f.layout);
   auto mesh = std::make_shared<Mesh>(io::loadMesh(f.mesh));
+  render::makeYUp(*mesh, up);
   render::fitToUnitSphere(*mesh);
   render::SceneObject object{fs::path(f.mesh).stem().string(), mesh, render::materialFromSpec(f.material.empty() ? kMeshMaterial : f.material), {}};
   if (!f.rotate.empty()) {

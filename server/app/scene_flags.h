@@ -20,6 +20,7 @@ inline constexpr const char* kMeshMaterial = "phong:64";
 struct SceneFlags {
   std::string scene, env, layout = "auto", mesh, material;
   std::vector<double> rotate;
+  std::string up;  // with --mesh: y (empty: the same) or z
   int width = 128, height = 128;
   std::string background = "env";
   std::string out;
@@ -31,7 +32,7 @@ struct SceneFlags {
 // --max-scene-objects --max-scene-triangles --max-visibility-mb into `limits`.
 void addSceneLimitFlags(CLI::App& command, render::SceneLimits& limits);
 
-// --scene --env --env-layout --mesh --material --rotate --width --height
+// --scene --env --env-layout --mesh --material --up --rotate --width --height
 // --background --out --exposure, and the scene limits
 void addSceneFlags(CLI::App& command, SceneFlags& flags);
 

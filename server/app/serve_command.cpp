@@ -23,6 +23,7 @@
 #include "app_paths.h"
 #include "progress.h"
 #include "scene_flags.h"
+#include "serve_catalog.h"
 
 namespace haarcast::app {
 namespace {
@@ -47,13 +48,7 @@ struct ServeArgs {
   long long serverPixelBudget = -1;  // -1: 2 × --max-session-pixels
 };
 
-// The analytic materials every server offers (MERL files come from --materials-dir).
-const std::vector<std::string> kBuiltinMaterials = {"lambert", "phong:16", "phong:64", "phong:256", "ggx:0.1", "ggx:0.3"};
-
-struct SceneSource {
-  std::string name;
-  render::Scene scene;
-};
+using SceneSource = ServedScene;
 
 int run(ServeArgs& a) {
   // Flags → the catalogue: scenes by name, offered materials, backends.
@@ -66,34 +61,9 @@ int run(ServeArgs& a) {
     }
     scenes.push_back({name, render::loadScene(file, a.sceneLimits)});
   }
-  auto materialFiles = std::make_shared<std::map<std::string, std::string>>();  // offered name → MERL path
-  net::Catalog catalog;
-  catalog.materials = kBuiltinMaterials;
-  if (!a.materialsDir.empty()) {
-    std::error_code ec;
-    if (!fs::is_directory(a.materialsDir, ec)) throw std::invalid_argument("--materials-dir " + a.materialsDir + " is not a folder");
-    std::vector<fs::path> files;
-    for (const auto& entry : fs::directory_iterator(a.materialsDir)) {
-      if (entry.is_regular_file() && entry.path().extension() == ".binary") files.push_back(entry.path());
-    }
-    std::sort(files.begin(), files.end());
-    for (const auto& f : files) {
-      const std::string name = "merl:" + f.stem().string();
-      (*materialFiles)[name] = f.string();
-      catalog.materials.push_back(name);
-    }
-  }
-  for (const auto& s : scenes) {
-    net::Catalog::SceneEntry entry;
-    entry.name = s.name;
-    entry.camera = s.scene.camera;
-    for (const auto& o : s.scene.objects) {
-      entry.defaultMaterials.push_back(o.material.name);
-      entry.objectNames.push_back(o.name);
-      entry.poses.push_back(o.pose);
-    }
-    catalog.scenes.push_back(std::move(entry));
-  }
+  ServeCatalog served = buildServeCatalog(scenes, a.materialsDir);
+  net::Catalog catalog = std::move(served.catalog);
+  auto materialFiles = std::make_shared<std::map<std::string, std::string>>(std::move(served.materialFiles));
   // Backends: those built into this binary; clients may use only the ones
   // the operator enabled (--backends, else just --backend).
   const std::vector<std::string> built = gpu::availableBackends();

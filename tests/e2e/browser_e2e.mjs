@@ -24,12 +24,27 @@
 //      ratio (also for a 128×96 frame) and goes full window and back;
 //  10. a dropped connection (a proxy between page and server cuts it) shows
 //      the countdown to the next attempt and reconnects;
-//  11. no page errors and no request outside the server; SIGTERM → exit 0.
+//  11. no page errors and no request outside the server; SIGTERM → exit 0;
+//  12. a renderer build (the server's cache starts empty): switching to a
+//      scene not built yet dims the frame and shows the stage and a progress
+//      bar, the new scene's objects are not listed until its first frame,
+//      and that frame's time in the HUD does not count the build;
+//  13. no server path on the page: the box scene names a MERL file by its
+//      absolute path, and the panel shows it as merl:STEM;
+//  14. the panel fits its column at every width from 320 px up (no name,
+//      select or control cut off or past the window);
+//  15. the stream fits the window: without ?size= the frames are the view's
+//      size in device pixels, asked again after a resize (once, debounced),
+//      and a fixed 360p gives 360 lines with the view's aspect;
+//  16. the HUD says "idle — last frame N s ago" when no frame comes, folds
+//      to one line (the button, h; folded by default under 600 px), and
+//      folded it covers little of a 400×300 view;
+//  17. a pinch on a touch screen moves the camera closer.
 //
 // usage: node browser_e2e.mjs --haarcast BUILD/bin/haarcast [--chromium /usr/bin/chromium]
 //        [--out DIR] [--page-query 'size=96x96&encoding=jpeg'] [-- extra `serve` args]
 import { spawn } from 'node:child_process';
-import { mkdirSync, mkdtempSync, rmSync, writeFileSync } from 'node:fs';
+import { mkdirSync, mkdtempSync, rmSync, symlinkSync, writeFileSync } from 'node:fs';
 import { createRequire } from 'node:module';
 import net from 'node:net';
 import { tmpdir } from 'node:os';
@@ -203,16 +218,41 @@ async function startProxy(target) {
 
 // ---- the test ---------------------------------------------------------------------
 
-// The second scene: a box with its own camera (docs/scenes.md).
+// A MERL file (int32 dims 90, 90, 180, then three channels of doubles),
+// one value everywhere: a measured material the box scene names by its
+// absolute path, which must never reach the page.
+function constantMerl(value) {
+  const cells = 90 * 90 * 180;
+  const bytes = Buffer.alloc(12 + 3 * cells * 8);
+  bytes.writeInt32LE(90, 0);
+  bytes.writeInt32LE(90, 4);
+  bytes.writeInt32LE(180, 8);
+  for (let i = 0; i < 3 * cells; i++) bytes.writeDoubleLE(value, 12 + 8 * i);
+  return bytes;
+}
+
+// The second scene: a box with its own camera (docs/scenes.md), and a ball
+// in a MERL material named by its absolute path. --materials-dir offers
+// another name for the same file (merl:e2e-chrome). The cache starts empty,
+// so that a scene's first use is a build the page shows.
 const sceneDir = mkdtempSync(join(tmpdir(), 'haarcast-e2e-'));
 const boxScene = join(sceneDir, 'e2e-box.json');
 const boxCamera = [1.6, 1.2, 2.6];
+mkdirSync(join(sceneDir, 'brdfs'));
+const gilt = join(sceneDir, 'brdfs', 'e2e-gilt.binary');
+writeFileSync(gilt, constantMerl(0.02));
+const offered = join(sceneDir, 'offered');
+mkdirSync(offered);
+symlinkSync(gilt, join(offered, 'e2e-chrome.binary'));
 writeFileSync(boxScene, JSON.stringify({
   camera: { eye: boxCamera, target: [0, 0, 0], up: [0, 1, 0], fov_y: 40 },
-  objects: [{ name: 'box', mesh: { builtin: 'box' }, material: 'lambert', rotate: [0, 30, 0], scale: 0.8 }],
+  objects: [{ name: 'box', mesh: { builtin: 'box' }, material: 'lambert', rotate: [0, 30, 0], scale: 0.8 },
+            { name: 'gilded ball with a name longer than the panel is wide', mesh: { builtin: 'sphere' },
+              material: gilt, translate: [1.1, 0, 0], scale: 0.3 }],
 }));
 
-const server = startServer(['--scene', boxScene, ...opts.serveArgs]);
+const server = startServer(['--scene', boxScene, '--materials-dir', offered, '--cache-dir', join(sceneDir, 'cache'),
+                            ...opts.serveArgs]);
 let browser = null;
 let proxy = null;
 try {
@@ -256,6 +296,33 @@ try {
     const e = document.querySelector(s);
     return e && !e.closest('[hidden]') ? e.textContent : null;
   }, selector);
+  // Nothing in the panel is cut or past its column: names wrap, each select
+  // is wide enough for its chosen option's text, no control sticks out.
+  const panelProblems = (page) => page.evaluate(() => {
+    const problems = [];
+    const panel = document.getElementById('panel').getBoundingClientRect();
+    const measure = document.createElement('canvas').getContext('2d');
+    for (const e of document.querySelectorAll('#panel select, #panel input, #panel button, #panel label, #objects .name')) {
+      if (e.closest('[hidden]')) continue;
+      const r = e.getBoundingClientRect();
+      if (r.width === 0) continue;
+      const id = e.id || e.getAttribute('aria-label') || e.textContent.trim().slice(0, 24);
+      if (r.left < panel.left - 0.5 || r.right > panel.right + 0.5) problems.push(`${id} is outside the panel (${r.left.toFixed(0)}..${r.right.toFixed(0)} of ${panel.left.toFixed(0)}..${panel.right.toFixed(0)})`);
+      if (e.scrollWidth > e.clientWidth + 1 && e.tagName !== 'SELECT' && e.tagName !== 'INPUT') problems.push(`${id} is cut (${e.scrollWidth} > ${e.clientWidth})`);
+      if (e.tagName === 'SELECT' && e.selectedIndex >= 0) {
+        const cs = getComputedStyle(e);
+        measure.font = `${cs.fontSize} ${cs.fontFamily}`;
+        const need = measure.measureText(e.options[e.selectedIndex].text).width + parseFloat(cs.paddingLeft) + 18;
+        if (need > e.clientWidth + 0.5) problems.push(`select ${id} cuts "${e.options[e.selectedIndex].text}" (${need.toFixed(0)} > ${e.clientWidth})`);
+      }
+    }
+    if (document.documentElement.scrollWidth > window.innerWidth) problems.push(`the page is ${document.documentElement.scrollWidth} px wide`);
+    return problems;
+  });
+  const panelFits = async (what) => {
+    const problems = await panelProblems(page);
+    check(problems.length === 0, `${what}: the panel fits its column (${problems.slice(0, 4).join('; ')})`);
+  };
   const waitFrames = (page, n, timeout = 120000) =>
     page.waitForFunction((k) => window.haarcast && window.haarcast.framesShown >= k, n, { timeout });
 
@@ -445,8 +512,58 @@ try {
     await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => r())));
   };
   const beforeSwitch = await shot();
+  // 12. The box scene was never built: record what the page shows meanwhile
+  // (every change of the build overlay and the objects list) and each frame.
+  await page.evaluate(() => {
+    window.buildLog = [];
+    window.frameLog = [];
+    const snap = () => {
+      const b = document.getElementById('build');
+      window.buildLog.push({
+        t: performance.now(), shown: !b.hidden, dimmed: document.getElementById('view').classList.contains('building'),
+        stage: document.getElementById('build-stage').textContent, title: document.getElementById('build-title').textContent,
+        bar: document.getElementById('build-bar').value, objects: document.getElementById('objects').textContent,
+      });
+    };
+    new MutationObserver(snap).observe(document.getElementById('build'), { attributes: true, subtree: true, childList: true, characterData: true });
+    new MutationObserver(snap).observe(document.getElementById('objects'), { childList: true, subtree: true });
+    const h = window.haarcast;
+    let last = h.lastFrame;
+    Object.defineProperty(h, 'lastFrame', { configurable: true, get: () => last,
+      set: (v) => { last = v; window.frameLog.push({ t: performance.now(), ...v }); } });
+  });
   await switchScene('e2e-box');
   const afterSwitch = await shot();
+  {
+    const { buildLog, frameLog, ended } = await page.evaluate(() => ({ buildLog: window.buildLog, frameLog: window.frameLog,
+                                                                       ended: window.haarcast.buildsEnded }));
+    const during = buildLog.filter((r) => r.shown);
+    console.log(`build: ${during.length} overlay states, e.g. ${JSON.stringify(during.at(-1))}`);
+    check(during.length > 0 && during.every((r) => r.dimmed) &&
+          during.some((r) => /preparing scene e2e-box/.test(r.title) && /(BRDF slice table|visibility) of /.test(r.stage)),
+          'a build: the frame is dimmed and the stage of the scene being prepared is shown');
+    check(during.some((r) => r.bar >= 0 && r.bar <= 1 && /\d+ %/.test(r.stage)), 'a build: a progress bar and a percentage');
+    // Listed objects read "box #0", "gilded ball … #1".
+    check(during.every((r) => !/#\d|gilded/.test(r.objects)) && during.some((r) => /preparing e2e-box/.test(r.objects)),
+          `while it builds the new scene's objects are not listed (${JSON.stringify(during.map((r) => r.objects).slice(-1))})`);
+    const startedAt = during.length ? during[0].t : Infinity;
+    const endedAt = buildLog.filter((r) => !r.shown).map((r) => r.t).find((t) => t > startedAt);
+    const buildMs = endedAt - startedAt;
+    const first = endedAt === undefined ? null : frameLog.find((f) => f.t >= endedAt - 1);
+    check(ended >= 1 && first && Number.isNaN(first.latencyMs) && first.serverMs < buildMs,
+          `the frame that ends the build counts no build: its frame time ${first && first.serverMs.toFixed(1)} ms ` +
+          `(the build showed for ${buildMs.toFixed(0)} ms), no latency (${first && first.latencyMs})`);
+  }
+  // 13. No server path on the page: the scene's own MERL file by its name.
+  {
+    const panel = await page.evaluate(() => {
+      const p = document.getElementById('panel');
+      return [p.innerText, ...[...p.querySelectorAll('option')].map((o) => `${o.value} ${o.textContent}`),
+              ...[...p.querySelectorAll('[title],[aria-label]')].map((e) => `${e.title} ${e.getAttribute('aria-label')}`)].join('\n');
+    });
+    check(!panel.includes(sceneDir) && !/\.binary|\/tmp\//.test(panel),
+          `no server path in the panel (${JSON.stringify(panel.split('\n').filter((l) => /\//.test(l)).slice(0, 3))})`);
+  }
   const diffScene = meanAbsDiff(luma(beforeSwitch), luma(afterSwitch));
   check(diffScene > 3, `switching to e2e-box changes the frame (mean |Δluma| ${diffScene.toFixed(2)} > 3)`);
   if (opts.out) writeFileSync(join(opts.out, 'scene-e2e-box.png'), await canvas.screenshot(shotOptions));
@@ -454,8 +571,12 @@ try {
   const eyeError = Math.hypot(s.viewEye.x - boxCamera[0], s.viewEye.y - boxCamera[1], s.viewEye.z - boxCamera[2]);
   check(eyeError < 1e-6, `the orbit starts at the new scene's camera (eye ${JSON.stringify(s.viewEye)}, want ${boxCamera})`);
   objs = await objects();
-  check(JSON.stringify(objs.map((o) => [o.name, o.material])) === JSON.stringify([['box', 'lambert']]),
-        `e2e-box's objects are listed (${JSON.stringify(objs.map((o) => [o.name, o.material]))})`);
+  check(JSON.stringify(objs.map((o) => [o.name, o.material])) ===
+        JSON.stringify([['box', 'lambert'], ['gilded ball with a name longer than the panel is wide', 'merl:e2e-gilt']]),
+        `e2e-box's objects are listed, the MERL file by its name (${JSON.stringify(objs.map((o) => [o.name, o.material]))})`);
+  const offeredMerl = await page.evaluate(() => [...document.querySelectorAll('#objects select option')].map((o) => o.value));
+  check(offeredMerl.includes('merl:e2e-chrome'), `--materials-dir's file is offered as merl:e2e-chrome (${[...new Set(offeredMerl)]})`);
+  await panelFits('e2e-box at 900 px');
   await switchScene('default');
   objs = await objects();
   check(objs.length === 3 && objs[0].material === 'phong:64', `back on default, sphere is phong:64 again (${objs[0] && objs[0].material})`);
@@ -522,6 +643,16 @@ try {
   check(aspectOk(l) && l.canvas.w >= 360 && l.canvas.y + l.canvas.h <= 800,
         `400×800: the canvas is ${l.canvas.w.toFixed(0)}×${l.canvas.h.toFixed(0)}, in view at the top`);
   if (opts.out) await page.screenshot({ path: join(opts.out, 'layout-400x800.png'), fullPage: true });
+
+  // 14. Every width from 320 px up (the box scene, with its long names).
+  await switchScene('e2e-box');
+  for (const width of [320, 360, 400, 480, 600, 720, 721, 800, 1024, 1280, 1600]) {
+    await page.setViewportSize({ width, height: 800 });
+    await page.waitForTimeout(150);
+    await panelFits(`${width}×800`);
+    if (opts.out && width === 320) await page.screenshot({ path: join(opts.out, 'panel-320x800.png'), fullPage: true });
+  }
+  await switchScene('default');
 
   await page.setViewportSize({ width: 1200, height: 800 });
   await page.click('#fullwindow');
@@ -616,6 +747,118 @@ try {
           `at 0.8 fps the HUD shows ${[...new Set(seen)].join(' ')} (never 0; settles on ${seen.at(-1)})`);
     check(problems.length === 0, `slow page: no page errors (${problems.join('; ')})`);
     await p.close();
+  }
+
+  // 15. The stream fits the window (no ?size=): the view's size in device
+  // pixels, asked again once after a resize; a fixed 360p. And 16. the HUD
+  // on a small view: folded by default, idle when nothing changes.
+  section('stream size and HUD');
+  {
+    const { page: p, problems } = await openPage('level=4', { viewport: { width: 400, height: 300 } });
+    await waitFrames(p, 1);
+    // The view's content box × devicePixelRatio, even, as the page should ask.
+    const fits = () => p.evaluate(() => {
+      const stage = document.getElementById('stage');
+      const cs = getComputedStyle(stage);
+      const dpr = window.devicePixelRatio;
+      const w = (stage.clientWidth - parseFloat(cs.paddingLeft) - parseFloat(cs.paddingRight)) * dpr;
+      const h = (stage.clientHeight - parseFloat(cs.paddingTop) - parseFloat(cs.paddingBottom)) * dpr;
+      const f = window.haarcast.lastFrame;
+      return { want: [2 * Math.floor(w / 2), 2 * Math.floor(h / 2)], frame: [f.width, f.height],
+               resizes: window.haarcast.resizes };
+    });
+    const waitSize = (want) => p.waitForFunction((w) => window.haarcast.lastFrame.width === w[0] &&
+                                                       window.haarcast.lastFrame.height === w[1], want, { timeout: 30000 })
+      .catch(() => {});
+    let f = await fits();
+    await waitSize(f.want);
+    f = await fits();
+    check(JSON.stringify(f.frame) === JSON.stringify(f.want), `400×300: the frames are the view's size (${f.frame} for a ${f.want} view)`);
+    // Five resizes in quick succession (each well inside the 300 ms
+    // debounce, though a loaded machine may stretch one): one or two sizes
+    // asked for, the last the last view's.
+    const resizesBefore = f.resizes;
+    for (const [w, h] of [[500, 360], [560, 400], [600, 420], [620, 450], [640, 480]]) {
+      await p.setViewportSize({ width: w, height: h });
+      await p.waitForTimeout(20);
+    }
+    await p.waitForTimeout(600);
+    f = await fits();
+    await waitSize(f.want);
+    f = await fits();
+    check(JSON.stringify(f.frame) === JSON.stringify(f.want) && f.resizes >= resizesBefore + 1 && f.resizes <= resizesBefore + 2,
+          `after resizing to 640×480 the frames are the new view's size (${f.frame} for ${f.want}; ` +
+          `${f.resizes - resizesBefore} size(s) asked for five resizes)`);
+    await p.selectOption('#resolution', '360p');
+    await p.waitForFunction(() => window.haarcast.lastFrame.height === 360, null, { timeout: 30000 }).catch(() => {});
+    f = await fits();
+    const address = await p.evaluate(() => location.search);
+    check(f.frame[1] === 360 && Math.abs(f.frame[0] / 360 - f.want[0] / f.want[1]) < 0.02 && /resolution=360p/.test(address),
+          `360p: ${f.frame[0]}×${f.frame[1]} frames with the view's aspect (${(f.want[0] / f.want[1]).toFixed(3)}), address ${address}`);
+    await p.selectOption('#resolution', 'auto');
+    await p.setViewportSize({ width: 400, height: 300 });
+    await p.waitForTimeout(600);
+    f = await fits();
+    await waitSize(f.want);
+
+    // The HUD at 400×300: folded to its first line, which covers little of the view.
+    const hudBox = () => p.evaluate(() => {
+      const a = document.getElementById('hud').getBoundingClientRect();
+      const c = document.getElementById('frame').getBoundingClientRect();
+      return { share: (a.width * a.height) / (c.width * c.height), folded: window.haarcast.hudFolded,
+               more: getComputedStyle(document.getElementById('hud-more')).display };
+    });
+    let hb = await hudBox();
+    check(hb.folded && hb.more === 'none' && hb.share < 0.15,
+          `400×300: the HUD starts folded and covers ${(100 * hb.share).toFixed(1)} % of the view (< 15 %)`);
+    await p.click('#hud-toggle');
+    hb = await hudBox();
+    check(!hb.folded && hb.more !== 'none', `the HUD's button shows its details (${(100 * hb.share).toFixed(1)} % of the view)`);
+    await p.keyboard.press('h');
+    hb = await hudBox();
+    check(hb.folded, 'h folds it again');
+    // Nothing changes for a while: idle, with the last frame's age.
+    await p.waitForTimeout(3500);
+    const idle = await text(p, '#hud-idle');
+    check(/^idle — last frame \d+(\.\d)? s ago, up to date$/.test(idle || ''), `a still view: the HUD says "${idle}"`);
+    if (opts.out) await p.screenshot({ path: join(opts.out, 'idle-400x300.png') });
+    check(problems.length === 0, `stream size page: no page errors (${problems.join('; ')})`);
+    await p.close();
+  }
+
+  // 17. Pinch on a touch screen: two fingers spreading bring the camera closer.
+  section('pinch');
+  {
+    const context = await browser.newContext({ viewport: { width: 390, height: 844 }, hasTouch: true, isMobile: true });
+    const p = await context.newPage();
+    const problems = [];
+    p.on('pageerror', (e) => problems.push(e.message));
+    await p.goto(`${base}?size=64x64`);
+    await waitFrames(p, 1);
+    const before = await p.evaluate(() => ({ d: window.haarcast.viewDistance(), poses: window.haarcast.posesSent }));
+    const c = await p.locator('#frame').boundingBox();
+    const cx = c.x + c.width / 2, cy = c.y + c.height / 2;
+    const cdp = await context.newCDPSession(p);
+    const touch = (type, spread) => cdp.send('Input.dispatchTouchEvent', {
+      type, touchPoints: spread === null ? [] : [{ x: cx - spread, y: cy, id: 1 }, { x: cx + spread, y: cy, id: 2 }],
+    });
+    await touch('touchStart', 20);
+    for (let k = 1; k <= 8; k++) {
+      await touch('touchMove', 20 + 5 * k);
+      await p.waitForTimeout(20);
+    }
+    await touch('touchEnd', null);
+    await p.waitForTimeout(300);
+    const after = await p.evaluate(() => ({ d: window.haarcast.viewDistance(), poses: window.haarcast.posesSent,
+                                            pinches: window.haarcast.pinches }));
+    // Fingers 40 → 120 px apart: the distance ×1/3.
+    check(after.pinches > 0 && Math.abs(after.d / before.d - 1 / 3) < 0.03 && after.poses > before.poses,
+          `a pinch from 40 to 120 px apart takes the camera from ${before.d.toFixed(2)} to ${after.d.toFixed(2)} ` +
+          `(${after.pinches} pinch moves, ${after.poses - before.poses} poses)`);
+    await p.waitForFunction((n) => window.haarcast.lastFrame.poseSequence >= n, after.poses, { timeout: 30000 }).catch(() => {});
+    check((await p.evaluate(() => window.haarcast.lastFrame.poseSequence)) >= after.poses, 'the pinch is answered with a frame');
+    check(problems.length === 0, `pinch page: no page errors (${problems.join('; ')})`);
+    await context.close();
   }
 
   // 10. A dropped connection: the page counts down and reconnects.

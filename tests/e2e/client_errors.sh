@@ -39,6 +39,7 @@ expect "h264 at an odd size" 2 "even width and height" -- "$client_bin" ws://127
 expect "wss:// refused" 2 "wss://" -- "$client_bin" wss://127.0.0.1:1
 expect "bad --level" 2 "--level: Value 12 not in range 0 to 7" -- "$client_bin" ws://127.0.0.1:1 --level 12
 expect "bad --exposure" 2 "--exposure must be auto or a number of stops" -- "$client_bin" ws://127.0.0.1:1 --exposure bright
+expect "misspelt flag" 2 "unknown flag --frmes; did you mean --frames?" -- "$client_bin" ws://127.0.0.1:1 --frmes 3
 expect "connection refused" 1 "Connection refused" -- "$client_bin" ws://127.0.0.1:1 --frames 1 --quiet
 
 source "$(dirname "${BASH_SOURCE[0]}")/start_server.sh"

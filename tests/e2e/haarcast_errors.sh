@@ -26,6 +26,13 @@ expect() {
 
 expect "misspelt command" 'unknown command "rendr"; did you mean render?' -- "$bin" rendr
 expect "commands listed" "commands: rotation-report, render, reference, eval, bench-frame, serve" -- "$bin" rendr
+expect "a bare haarcast lists its commands" "bench-frame      Per-pass and frame times" -- "$bin"
+expect "a bare haarcast says how to see flags" "\`haarcast COMMAND --help\` lists a command's flags" -- "$bin"
+expect "misspelt flag" "haarcast render: error: unknown flag --widht; did you mean --width?" -- \
+  "$bin" render --widht 64 --out "$work/x.exr"
+expect "misspelt flag with =" "unknown flag --levle; did you mean --levels?" -- "$bin" bench-frame --levle=4
+expect "two misspelt flags" "unknown flag --heigth; did you mean --height?" -- \
+  "$bin" render --widht 64 --heigth 32 --out "$work/x.exr"
 expect "port out of range" "--port: Value 99999 not in range 0 to 65535" -- "$bin" serve --port 99999
 expect "backend not offered" "--backend gpu is not one this server offers (valid: cpu" -- "$bin" serve --backend gpu
 expect "missing web root" "--web-root $work/none: no such folder" -- "$bin" serve --web-root "$work/none"
@@ -37,6 +44,8 @@ expect "material without a mesh" "--material applies to --mesh" -- "$bin" render
 expect "output folder missing" "--out $work/none/x.exr: the folder $work/none does not exist" -- \
   "$bin" render --out "$work/none/x.exr"
 expect "output extension" "--out must end in .exr or .png" -- "$bin" render --out "$work/x.jpg"
+expect "bad --up" "--up x is not an up axis (valid: y, z)" -- "$bin" render --mesh "$work/none.obj" --up x --out "$work/x.exr"
+expect "--up without --mesh" "--up applies to --mesh" -- "$bin" render --up z --out "$work/x.exr"
 expect "unknown scene file" "$work/none.json" -- "$bin" serve --scene "$work/none.json"
 
 # Checked before the work: no output was started for any of the above.

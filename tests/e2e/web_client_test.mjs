@@ -1,7 +1,9 @@
 // Unit tests of the browser client's pure parts, in node (no browser): the
 // HUD's frame window (client/web/frame_stats.js) with made-up arrival times,
 // the page-parameter checks (client/web/page_params.js), the view's orbit
-// maths (client/web/orbit.js), and the page's H.264 view
+// maths and pinch (client/web/orbit.js), the stream's size and auto's rule
+// (client/web/stream_size.js), the words of a build and of an idle stream
+// (client/web/build_status.js), and the page's H.264 view
 // (client/web/h264_view.js) over a stand-in WebCodecs VideoDecoder.
 //
 // usage: node web_client_test.mjs
@@ -13,8 +15,11 @@ const web = join(resolve(dirname(fileURLToPath(import.meta.url)), '..', '..'), '
 const { FrameWindow, backoffMs, formatNumber, formatStops } = await import(pathToFileURL(join(web, 'frame_stats.js')));
 const { parsePageParameters } = await import(pathToFileURL(join(web, 'page_params.js')));
 const { H264View, helloEncoding } = await import(pathToFileURL(join(web, 'h264_view.js')));
-const { DRAG_DEGREES_PER_PIXEL, dragOrbit, orbitEye, orbitFromCamera, v3, zoomOrbit } =
+const { DRAG_DEGREES_PER_PIXEL, dragOrbit, orbitEye, orbitFromCamera, pinchOrbit, v3, zoomOrbit } =
   await import(pathToFileURL(join(web, 'orbit.js')));
+const { AutoResolution, FIRST_LIMITS, FPS_FLOOR, autoSteps, fpsFloor, frameSize, sizeWithin } =
+  await import(pathToFileURL(join(web, 'stream_size.js')));
+const { describeBuild, formatSeconds, idleText } = await import(pathToFileURL(join(web, 'build_status.js')));
 
 const tests = [];
 const test = (name, fn) => tests.push({ name, fn });
@@ -139,8 +144,10 @@ test('page parameters: good ones', () => {
   assert.deepEqual(p.exposure, { auto: false, stops: -1.5 });
   const defaults = parsePageParameters('', { methods });
   assert.deepEqual(defaults.errors, []);
-  assert.deepEqual([defaults.width, defaults.height, defaults.encoding, defaults.method, defaults.level],
-                   [256, 256, 'jpeg', '', 0]);
+  // No size: the stream fits the view (resolution auto).
+  assert.deepEqual([defaults.width, defaults.height, defaults.resolution, defaults.encoding, defaults.method, defaults.level],
+                   [0, 0, 'auto', 'jpeg', '', 0]);
+  assert.equal(parsePageParameters('?resolution=720p', { methods }).resolution, '720p');
   assert.deepEqual(defaults.exposure, { auto: true, stops: 0 });
   assert.deepEqual(parsePageParameters('?exposure=auto', { methods }).exposure, { auto: true, stops: 0 });
 });
@@ -170,6 +177,8 @@ test('page parameters: each bad one is named with its valid values', () => {
   assert.match(one('?scene=').message, /\?scene=/);
   assert.match(one('?methd=haar').message, /\?methd is not a parameter.*method/);
   assert.match(one('?level=3&level=4').message, /more than once/);
+  assert.match(one('?resolution=4k').message, /\?resolution=4k.*auto, 360p, 540p, 720p, 1080p/);
+  assert.match(one('?resolution=720p&size=64x64').message, /\?size=.*or \?resolution=, not both/);
   assert.equal(parsePageParameters('?method=fast&encoding=exr', { methods }).errors.length, 2);
 });
 
@@ -282,6 +291,169 @@ test('orbit: the wheel keeps the distance within a fifth and ten times the scene
   assert.equal(zoomOrbit({ ...o, distance: 10 * d }, 1e5), 10 * d);
   const far = { ...o, distance: zoomOrbit(o, 500) };
   assert.ok(Math.abs(v3.norm(v3.sub(orbitEye(far), o.target)) - far.distance) < 1e-9, 'the eye is that far');
+});
+
+test('pinch: fingers spreading bring the eye closer by their ratio, within the wheel\'s range', () => {
+  const o = orbitFromCamera(cameras['off axis, above']);
+  const d = o.startDistance;
+  assert.ok(Math.abs(pinchOrbit(o, 100, 200) - d / 2) < 1e-12, 'twice as far apart: half the distance');
+  assert.ok(Math.abs(pinchOrbit(o, 200, 100) - 2 * d) < 1e-12, 'pinched together: twice the distance');
+  assert.equal(pinchOrbit(o, 100, 100), d);
+  assert.equal(pinchOrbit(o, 1, 1000), 0.2 * d);
+  assert.equal(pinchOrbit(o, 1000, 1), 10 * d);
+  assert.equal(pinchOrbit(o, 0, 100), d, 'no distance yet: no change');
+});
+
+// ---- the stream's size (stream_size.js) ------------------------------------------------
+
+const LIMITS = { maxWidth: 2048, maxHeight: 2048, maxPixels: 4194304 };
+
+test('size: auto asks for the view in device pixels, even, within the limits', () => {
+  assert.deepEqual(frameSize('auto', { cssWidth: 964, cssHeight: 784, dpr: 1 }, LIMITS), { width: 964, height: 784 });
+  assert.deepEqual(frameSize('auto', { cssWidth: 377, cssHeight: 301, dpr: 2 }, LIMITS), { width: 754, height: 602 });
+  // Even sides (H.264 takes only those): an odd view gives up its last pixel.
+  assert.deepEqual(frameSize('auto', { cssWidth: 377, cssHeight: 301, dpr: 1 }, LIMITS), { width: 376, height: 300 });
+  // A phone at 3 device pixels per CSS pixel.
+  const phone = frameSize('auto', { cssWidth: 378, cssHeight: 382, dpr: 3 }, LIMITS);
+  assert.deepEqual(phone, { width: 1134, height: 1146 });
+  // Over the pixel budget: the largest size with the view's aspect under it.
+  const big = frameSize('auto', { cssWidth: 1900, cssHeight: 1000, dpr: 2 }, LIMITS);
+  assert.ok(big.width * big.height <= LIMITS.maxPixels && big.width <= 2048, JSON.stringify(big));
+  assert.ok(Math.abs(big.width / big.height - 1.9) < 0.01, JSON.stringify(big));
+  assert.ok(big.width % 2 === 0 && big.height % 2 === 0);
+  // The budget the first Hello assumes, before Welcome says the server's.
+  const first = frameSize('auto', { cssWidth: 1900, cssHeight: 1000, dpr: 2 }, FIRST_LIMITS);
+  assert.ok(first.width * first.height <= 1280 * 720, JSON.stringify(first));
+  // Protobuf's uint64 arrives as a Long: its number is used.
+  const long = { maxWidth: 4096, maxHeight: 4096, maxPixels: { toNumber: () => 10000 } };
+  const small = sizeWithin(1, 1000, long);
+  assert.ok(small.width * small.height <= 10000 && small.width === small.height, JSON.stringify(small));
+});
+
+test('size: a fixed resolution is that many lines with the view\'s aspect; auto\'s steps lie below the view', () => {
+  const view = { cssWidth: 1280, cssHeight: 720, dpr: 1 };
+  assert.deepEqual(frameSize('360p', view, LIMITS), { width: 640, height: 360 });
+  assert.deepEqual(frameSize('1080p', view, LIMITS), { width: 1920, height: 1080 });
+  assert.deepEqual(frameSize('auto', view, LIMITS, 540), { width: 960, height: 540 });
+  assert.deepEqual(frameSize('auto', { cssWidth: 400, cssHeight: 186, dpr: 1 }, LIMITS, 540), { width: 400, height: 186 },
+                   'a step above the view changes nothing');
+  assert.deepEqual(autoSteps(784), [Infinity, 720, 540, 360, 270, 180]);
+  assert.deepEqual(autoSteps(2160), [Infinity, 1080, 720, 540, 360, 270, 180]);
+  assert.deepEqual(autoSteps(150), [Infinity]);
+  assert.equal(fpsFloor(30), FPS_FLOOR);
+  assert.equal(fpsFloor(10), 8);
+});
+
+// Auto's rule against a server whose frame time is `msPerMegapixel` per
+// million pixels (and 5 ms besides): frames every `interval` ms.
+function runAuto(auto, { msPerMegapixel, frames, start = 0, interval = 100, view = { cssWidth: 1280, cssHeight: 720, dpr: 1 } }) {
+  const steps = autoSteps(view.cssHeight * view.dpr).map((lines) => {
+    const s = frameSize('auto', view, LIMITS, lines);
+    return { lines, pixels: s.width * s.height };
+  });
+  let t = start;
+  const sizes = [];
+  let size = frameSize('auto', view, LIMITS, auto.capLines);
+  auto.asked(size.width * size.height, t);
+  for (let i = 0; i < frames; i++, t += interval) {
+    const pixels = size.width * size.height;
+    const changed = auto.frame(t, { pixels, serverMs: 5 + msPerMegapixel * pixels / 1e6 }, steps, FPS_FLOOR);
+    if (changed !== null) {
+      size = frameSize('auto', view, LIMITS, changed);
+      auto.asked(size.width * size.height, t);
+    }
+    sizes.push(size.height);
+  }
+  return { sizes, t };
+}
+
+test('auto: a server too slow for the floor at the view\'s size steps down to the largest size that holds it', () => {
+  const auto = new AutoResolution();
+  // 1280×720 = 0.92 Mpx at 200 ms/Mpx: 189 ms, 5 fps. 360p (0.23 Mpx): 51 ms,
+  // 19.6 fps, the largest that holds 15 fps (540p: 108 ms).
+  const { sizes } = runAuto(auto, { msPerMegapixel: 200, frames: 20 });
+  assert.equal(sizes[0], 720);
+  assert.equal(sizes.at(-1), 360, sizes.join(' '));
+  assert.equal(auto.label(), 'auto ≤360p');
+  assert.ok(sizes.indexOf(360) <= 4, `it steps after a few frames: ${sizes.join(' ')}`);
+  // It stays there: 360p holds the floor and 540p would not.
+  assert.equal(new Set(sizes.slice(sizes.indexOf(360))).size, 1);
+});
+
+test('auto: a fast server keeps the view\'s own size; one that gets faster is stepped back up, one step at a time', () => {
+  const fast = new AutoResolution();
+  const kept = runAuto(fast, { msPerMegapixel: 20, frames: 30 }).sizes;
+  assert.ok(kept.every((h) => h === 720), kept.join(' '));
+  assert.equal(fast.label(), 'auto');
+
+  const auto = new AutoResolution();
+  const slow = runAuto(auto, { msPerMegapixel: 500, frames: 20 });
+  assert.equal(slow.sizes.at(-1), 180, slow.sizes.join(' '));
+  const downAt = auto.changedAt;
+  // The server frees up (another session ended): 270p, then 360p, … back to the view's size.
+  const start = slow.t + 100;
+  const up = runAuto(auto, { msPerMegapixel: 20, frames: 200, start }).sizes;
+  const steps = up.filter((h, i) => i === 0 || h !== up[i - 1]);
+  assert.deepEqual(steps, [180, 270, 360, 540, 720], up.join(' '));
+  // Each step only after the size has held for holdMs (3 s).
+  let last = downAt;
+  for (const h of steps.slice(1)) {
+    const at = start + 100 * up.indexOf(h);
+    assert.ok(at - last >= auto.holdMs, `${h}p ${at - last} ms after the step before`);
+    last = at;
+  }
+});
+
+test('auto: frames of another size, and frames with no time, are not counted', () => {
+  const auto = new AutoResolution();
+  auto.asked(1000, 0);
+  const steps = [{ lines: Infinity, pixels: 1000 }, { lines: 180, pixels: 250 }];
+  for (let i = 0; i < 10; i++) {
+    assert.equal(auto.frame(i, { pixels: 4000, serverMs: 500 }, steps, 15), null);  // an old size's
+    assert.equal(auto.frame(i, { pixels: 1000, serverMs: NaN }, steps, 15), null);  // the first frame
+  }
+  assert.equal(auto.samples.length, 0);
+  // A median, so one slow frame among quick ones does not step.
+  for (const ms of [20, 20, 900, 20]) assert.equal(auto.frame(20, { pixels: 1000, serverMs: ms }, steps, 15), null);
+});
+
+// ---- what the page says of a build and of an idle stream (build_status.js) -------------
+
+test('build: the stage in words, its share, the time left, never 100 % before the end', () => {
+  const d = describeBuild({ stage: 'visibility bunny', stageIndex: 1, done: 14379, total: 35947, fraction: 0.4,
+                            elapsedSeconds: 12.3, estimatedStageSecondsLeft: 80 }, 'level 6');
+  assert.equal(d.title, 'preparing level 6');
+  assert.equal(d.stage, 'visibility of bunny');
+  assert.equal(d.fraction, 0.4);
+  assert.equal(d.percent, 40);
+  assert.equal(d.detail, 'step 2 · 14379 of 35947 · about 1 min 20 s left in this step · 12 s so far');
+  assert.equal(describeBuild({ stage: 'slices ball', total: 10, done: 10, fraction: 1 }).percent, 99);
+  assert.equal(describeBuild({ stage: 'slices ball' }).stage, 'BRDF slice table of ball');
+  assert.equal(describeBuild({ stage: 'rotators torus' }).stage, 'rotation tables of torus');
+  // Unknown total: no share (an indeterminate bar); an unknown step is said as the server said it.
+  const u = describeBuild({ stage: 'lights sky', total: 0, fraction: 0 });
+  assert.equal(u.fraction, null);
+  assert.equal(u.percent, null);
+  assert.equal(u.stage, 'lights sky');
+  assert.equal(u.title, 'preparing the renderer');
+  // A Long (uint64) total and done.
+  assert.equal(describeBuild({ stage: 'x', done: { toString: () => '5' }, total: { toString: () => '20' }, fraction: 0.25 }).percent, 25);
+});
+
+test('idle: the HUD says the stream is up to date and how old the last frame is', () => {
+  assert.equal(idleText(3400), 'idle — last frame 3.4 s ago, up to date');
+  assert.equal(idleText(75000), 'idle — last frame 1 min 15 s ago, up to date');
+  assert.equal(formatSeconds(0.04), '0.0 s');
+  assert.equal(formatSeconds(12.4), '12 s');
+  assert.equal(formatSeconds(3 * 3600 + 7 * 60), '3 h 07 min');
+  // The frame window says how long ago the newest frame came.
+  const w = new FrameWindow();
+  assert.equal(w.summary(0).sinceLastMs, null);
+  for (let t = 0; t <= 1000; t += 100) w.add(t, { bytes: 100 });
+  const s = w.summary(6000);
+  assert.equal(s.idle, true);
+  assert.equal(s.sinceLastMs, 5000);
+  assert.equal(w.summary(1050).idle, false);
 });
 
 // A stand-in for WebCodecs: every chunk decodes at once into a "frame" that

@@ -198,6 +198,7 @@ std::array<float, 3> sliceAt(const detail::FusedPass& p, const glm::vec3& w) {
   const float y2 = p.cosBeta * w.y + p.sinBeta * z1;     // R_x(−β)
   const float z2 = p.cosBeta * z1 - p.sinBeta * w.y;
   if (y2 < p.skipBelowY) return {0.0f, 0.0f, 0.0f};
+  if (x1 * p.axisX + y2 * p.axisY + z2 * p.axisZ > p.coreCos) return {0.0f, 0.0f, 0.0f};  // the lobe path's core
   const float theta = std::atan2(std::sqrt(x1 * x1 + z2 * z2), y2);
   const float phi = std::atan2(x1, z2);
   const float rowPos = std::min(std::max(theta * (static_cast<float>(m) / shared::kPiF) - 0.5f, 0.0f), static_cast<float>(m - 1));
@@ -239,18 +240,31 @@ detail::FusedPass makePass(const PixelSlices& slices, const float* slice, const 
 // under-counted depending on where it falls between them — rings as R turns
 // across a surface. Σ ΔΩ·ρ(Rᵀω) measures that count in the same pass, and
 // ∫ρ of the slice is what it should be.
-std::array<float, 3> energyKept(const detail::FusedPass& pass, const PixelSlices& slices,
-                                const shared::SliceBlend& blend) {
+std::array<float, 3> energyKept(const detail::FusedPass& pass, const std::array<float, 3>& energy) {
   float sums[6] = {};
   detail::fusedSample(pass, sums);
+  std::array<float, 3> out{};
+  for (std::size_t c = 0; c < 3; ++c) out[c] = sums[3 + c] > 0.0f ? sums[c] * (energy[c] / sums[3 + c]) : sums[c];
+  return out;
+}
+
+// ∫ρ_c of the slice between the blend's two slices.
+std::array<float, 3> sliceEnergy(const PixelSlices& slices, const shared::SliceBlend& blend) {
   const std::array<float, 3>& e0 = slices.energy(static_cast<int>(blend.first));
   const std::array<float, 3>& e1 = slices.energy(static_cast<int>(blend.second));
   std::array<float, 3> out{};
-  for (std::size_t c = 0; c < 3; ++c) {
-    const float energy = e0[c] + blend.weight * (e1[c] - e0[c]);
-    out[c] = sums[3 + c] > 0.0f ? sums[c] * (energy / sums[3 + c]) : sums[c];
-  }
+  for (std::size_t c = 0; c < 3; ++c) out[c] = e0[c] + blend.weight * (e1[c] - e0[c]);
   return out;
+}
+
+// The core of the lobe path in the pass's frame: the lobe's axis, local
+// (0, cos θ, −sin θ) at φ' = π, is at φ = π + γ before R_y(−γ).
+void setCore(detail::FusedPass& pass, const EulerYXY& r, float axisTheta, float coreAngle) {
+  const float s = std::sin(axisTheta);
+  pass.axisX = -s * static_cast<float>(std::sin(r.gamma));
+  pass.axisY = std::cos(axisTheta);
+  pass.axisZ = -s * static_cast<float>(std::cos(r.gamma));
+  pass.coreCos = std::cos(coreAngle);
 }
 
 }  // namespace
@@ -260,8 +274,7 @@ std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBl
                                 std::span<const FusedPointLight> lights, std::uint32_t visibleLights,
                                 FusedScratch& scratch, const LobePath* lobe) {
   const int level = slices.level();
-  const float share = lobe ? lobePathShareAt(*lobe, blend, level) : 0.0f;
-  if (share >= 1.0f) return lobeShade(*lobe, blend, r, visibleLights);
+  if (lobe && (lobe->everyLobe || lobe->coreAngle >= static_cast<float>(kPi))) return lobeShade(*lobe, blend, r, visibleLights);
   checkSameLevel(light.level, level, "the light");
   const std::size_t n = static_cast<std::size_t>(mapSize(level)) * static_cast<std::size_t>(mapSize(level));
   scratch.visibility.resize(n);
@@ -270,15 +283,23 @@ std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBl
   detail::FusedPass pass = makePass(slices, blendedSlice(slices, blend, scratch), r);
   pass.light = light.planes.data();
   pass.visibility = scratch.visibility.data();
-  std::array<float, 3> out = energyKept(pass, slices, blend);
+  std::array<float, 3> energy = sliceEnergy(slices, blend);
+  shared::SliceLobe core{};
+  if (lobe) {
+    // The pass takes the lobe outside the core, and its energy, E − E_core.
+    core = shared::blendLobes(lobe->lobes[blend.first], lobe->lobes[blend.second], blend.weight);
+    setCore(pass, r, core.energy.w, lobe->coreAngle);
+    for (std::size_t c = 0; c < 3; ++c) energy[c] = std::max(0.0f, core.energy[static_cast<int>(c)] - core.core[static_cast<int>(c)]);
+  }
+  std::array<float, 3> out = energyKept(pass, energy);
   for (std::size_t k = 0; k < lights.size(); ++k) {
     if (((visibleLights >> k) & 1u) == 0) continue;
     const std::array<float, 3> rho = sliceAt(pass, lights[k].direction);
     for (std::size_t c = 0; c < 3; ++c) out[c] += lights[k].power[c] * rho[c];
   }
-  if (share > 0.0f) {
-    const std::array<float, 3> mirror = lobeShade(*lobe, blend, r, visibleLights);
-    for (std::size_t c = 0; c < 3; ++c) out[c] += share * (mirror[c] - out[c]);
+  if (lobe) {
+    const std::array<float, 3> inCore = lobeShade(*lobe, blend, r, visibleLights);
+    for (std::size_t c = 0; c < 3; ++c) out[c] += inCore[c];
   }
   return out;
 }
@@ -302,15 +323,7 @@ std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBl
   detail::FusedPass pass = makePass(slices, blendedSlice(slices, blend, scratch), r);
   pass.light = light.planes.data();
   pass.visibility = scratch.visibility.data();
-  return energyKept(pass, slices, blend);
-}
-
-float lobePathShareAt(const LobePath& path, const shared::SliceBlend& blend, int level) {
-  if (path.everyLobe) return 1.0f;
-  const shared::SliceLobe& a = path.lobes[blend.first];
-  const shared::SliceLobe& b = path.lobes[blend.second];
-  const float median = a.median.x + blend.weight * (b.median.x - a.median.x);
-  return shared::lobePathShare(median, static_cast<shared::uint>(level));
+  return energyKept(pass, sliceEnergy(slices, blend));
 }
 
 std::array<float, 3> lobeShade(const LobePath& path, const shared::SliceBlend& blend, const EulerYXY& r,
@@ -325,7 +338,7 @@ std::array<float, 3> lobeShade(const LobePath& path, const shared::SliceBlend& b
   const glm::vec3 u = toLight * glm::vec3(1.0f, 0.0f, 0.0f);
   const glm::vec3 v = toLight * glm::vec3(0.0f, -s, -c);
   const glm::vec3 light = path.light->lobe(lobe, axis, u, v);
-  return {lobe.energy.r * light.r, lobe.energy.g * light.g, lobe.energy.b * light.b};
+  return {lobe.core.r * light.r, lobe.core.g * light.g, lobe.core.b * light.b};
 }
 
 std::string fusedTargetName() { return detail::fusedTarget(); }

@@ -5,7 +5,8 @@
 // Per direction ω (the unit vector of a pixel centre):
 //   Rᵀω = R_y(−γ) R_x(−β) R_y(−α) ω        (core/rotation.h; seed eq. for p)
 //   θ' = atan2(|(x, z)|, y),  φ' = atan2(x, z) − γ
-//   ρ_c = bilinear lookup of the slice at (θ', φ')   (sphere_map.h bilinearTaps)
+//   ρ_c = bilinear lookup of the slice at (θ', φ')   (sphere_map.h bilinearTaps),
+//         0 inside the lobe path's core (FusedPass::coreCos)
 //   acc_c += (L_c·ΔΩ)(ω) · V(ω) · ρ_c
 // γ never needs trigonometry: it only offsets the source column.
 #undef HWY_TARGET_INCLUDE
@@ -49,6 +50,8 @@ void FusedSample(const FusedPass& p, float* HWY_RESTRICT out) {
   const VF cosA = hn::Set(d, p.cosAlpha), sinA = hn::Set(d, p.sinAlpha);
   const VF cosB = hn::Set(d, p.cosBeta), sinB = hn::Set(d, p.sinBeta);
   const VF skipBelow = hn::Set(d, p.skipBelowY);
+  const VF axisX = hn::Set(d, p.axisX), axisY = hn::Set(d, p.axisY), axisZ = hn::Set(d, p.axisZ);
+  const VF coreCos = hn::Set(d, p.coreCos);
   // Continuous pixel coordinates with centres at integer + ½ (bilinearTaps).
   const VF rowScale = hn::Set(d, static_cast<float>(m) / 3.14159265358979324f);
   const VF colScale = hn::Set(d, static_cast<float>(m) / 6.28318530717958648f);
@@ -113,7 +116,11 @@ void FusedSample(const FusedPass& p, float* HWY_RESTRICT out) {
     // W_c = (L_c·ΔΩ)·V, formed only for the directions that are not skipped.
     const VF v = hn::LoadU(d, vis + i);
     const VF dOmega = hn::LoadU(d, omega + i);
-    const VF rhoR = lookup(red), rhoG = lookup(green), rhoB = lookup(blue);
+    // Outside the lobe path's core (ρ·0 there: the core is the path's).
+    const auto outside = hn::Le(hn::MulAdd(x1, axisX, hn::MulAdd(y2, axisY, hn::Mul(z2, axisZ))), coreCos);
+    const VF rhoR = hn::IfThenElseZero(outside, lookup(red));
+    const VF rhoG = hn::IfThenElseZero(outside, lookup(green));
+    const VF rhoB = hn::IfThenElseZero(outside, lookup(blue));
     accR = hn::MulAdd(hn::Mul(hn::LoadU(d, l0 + i), v), rhoR, accR);
     accG = hn::MulAdd(hn::Mul(hn::LoadU(d, l1 + i), v), rhoG, accG);
     accB = hn::MulAdd(hn::Mul(hn::LoadU(d, l2 + i), v), rhoB, accB);

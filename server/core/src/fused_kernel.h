@@ -28,6 +28,11 @@ struct FusedPass {
   int columnShift = 0;        // whole columns of γ·M/2π + ½
   float columnFraction = 0.0f;
   float skipBelowY = -2.0f;   // directions with cos θ' below this read only zero texels
+  // The lobe path's core (fused.h LobePath): directions whose R_x(−β)R_y(−α)ω
+  // is within it of `axis` (the lobe's axis turned by R_y(γ)), cos > coreCos,
+  // read ρ = 0; they are the lobe path's. coreCos > 1: no core.
+  float axisX = 0.0f, axisY = 1.0f, axisZ = 0.0f;
+  float coreCos = 2.0f;
 };
 
 // out[0..2]: Σ W_c·ρ_c; out[3..5]: Σ ΔΩ·ρ_c, the lobe's energy as the map's

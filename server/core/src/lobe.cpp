@@ -20,15 +20,12 @@ constexpr double kInnerAngle = 1e-4;  // the central cap: one sample on the axis
 
 double luminance(const glm::dvec3& c) { return luminance709(c.r, c.g, c.b); }
 
-// f(ω)·ΔΩ over a polar grid about `centre`: the cap of half-angle
-// kInnerAngle, then kRings rings log-spaced out to π, kSectors cells each.
+// f(ω)·ΔΩ over a polar grid about `centre`, azimuth b from u toward v: the
+// cap of half-angle kInnerAngle (ring 0, sector 0), then kRings rings
+// log-spaced out to π, kSectors cells each.
 template <typename Visit>
-void forEachCell(const glm::dvec3& centre, const Visit& visit) {
-  // An orthonormal frame about the centre.
-  const glm::dvec3 helper = std::abs(centre.y) < 0.9 ? glm::dvec3(0, 1, 0) : glm::dvec3(1, 0, 0);
-  const glm::dvec3 u = glm::normalize(glm::cross(helper, centre));
-  const glm::dvec3 v = glm::cross(centre, u);
-  visit(centre, kTwoPi * (1.0 - std::cos(kInnerAngle)), 0, kInnerAngle);
+void forEachCell(const glm::dvec3& centre, const glm::dvec3& u, const glm::dvec3& v, const Visit& visit) {
+  visit(centre, kTwoPi * (1.0 - std::cos(kInnerAngle)), 0, 0);
   const double ratio = std::pow(kPi / kInnerAngle, 1.0 / kRings);
   double a0 = kInnerAngle;
   for (int ring = 0; ring < kRings; ++ring) {
@@ -38,65 +35,174 @@ void forEachCell(const glm::dvec3& centre, const Visit& visit) {
     const double sa = std::sin(a), ca = std::cos(a);
     for (int s = 0; s < kSectors; ++s) {
       const double b = (s + 0.5) * kTwoPi / kSectors;
-      visit(ca * centre + sa * (std::cos(b) * u + std::sin(b) * v), dOmega, ring + 1, a1);
+      visit(ca * centre + sa * (std::cos(b) * u + std::sin(b) * v), dOmega, ring + 1, s);
     }
     a0 = a1;
   }
 }
 
+// The ring boundaries of forEachCell: ring r spans [outer(r − 1), outer(r)].
+std::vector<double> ringOuterAngles() {
+  std::vector<double> outer(kRings + 1, kInnerAngle);
+  const double ratio = std::pow(kPi / kInnerAngle, 1.0 / kRings);
+  for (int r = 1; r <= kRings; ++r) outer[static_cast<std::size_t>(r)] = r == kRings ? kPi : outer[static_cast<std::size_t>(r) - 1] * ratio;
+  return outer;
+}
+
+// The point below which the share q of a piecewise-uniform density lies:
+// mass[i] spread evenly over [edge[i], edge[i + 1]].
+double quantileOf(const std::vector<double>& mass, const std::vector<double>& edge, double q) {
+  double total = 0.0;
+  for (const double m : mass) total += m;
+  if (!(total > 0.0)) return edge.front() + q * (edge.back() - edge.front());
+  double below = 0.0;
+  for (std::size_t i = 0; i < mass.size(); ++i) {
+    const double e = mass[i] / total;
+    if (below + e >= q && e > 0.0) return edge[i] + (q - below) / e * (edge[i + 1] - edge[i]);
+    below += e;
+  }
+  return edge.back();
+}
+
+// A prefiltered level whose equatorial texels, (π/M)·(2π/M), have the solid angle Ω.
+float levelOfSolidAngle(double omega) { return static_cast<float>(0.5 * std::log2(2.0 * kPi * kPi / std::max(omega, 1e-12))); }
+
 }  // namespace
 
-shared::SliceLobe measureLobe(const Brdf& brdf, double thetaOut) {
+shared::SliceLobe measureLobe(const Brdf& brdf, double thetaOut, double coreAngle) {
   const glm::dvec3 wo(0.0, std::cos(thetaOut), std::sin(thetaOut));
   // The axis is the mirror direction: a microfacet lobe peaks there, while
   // its mean is pulled toward the normal by its tail and the horizon's cut
   // (by 2° at 87° for GGX 0.02), which shows as a shifted highlight.
   const glm::dvec3 axis(0.0, wo.y, -wo.z);
+  const glm::dvec3 u(1.0, 0.0, 0.0), v = glm::cross(axis, u);  // lobeShade's frame
   auto f = [&](const glm::dvec3& wi) { return wi.y > 0.0 ? brdf.evaluate(wi, wo) * wi.y : glm::dvec3(0.0); };
-
-  // The energy, and its luminance per ring of the polar grid (ring 0: the cap).
-  glm::dvec3 energy(0.0);
-  std::vector<double> ringEnergy(kRings + 1, 0.0), ringOuter(kRings + 1, kInnerAngle);
-  forEachCell(axis, [&](const glm::dvec3& w, double dOmega, int ring, double outer) {
+  // The energy, and its luminance per cell of the polar grid.
+  glm::dvec3 energy(0.0), core(0.0);
+  std::vector<double> cell(static_cast<std::size_t>(kRings + 1) * kSectors, 0.0), ringEnergy(kRings + 1, 0.0);
+  forEachCell(axis, u, v, [&](const glm::dvec3& w, double dOmega, int ring, int sector) {
     const glm::dvec3 e = f(w) * dOmega;
     energy += e;
-    ringEnergy[static_cast<std::size_t>(ring)] += luminance(e);
-    ringOuter[static_cast<std::size_t>(ring)] = outer;
+    if (glm::dot(w, axis) >= std::cos(coreAngle)) core += e;
+    const double y = luminance(e);
+    cell[static_cast<std::size_t>(ring) * kSectors + static_cast<std::size_t>(sector)] = y;
+    ringEnergy[static_cast<std::size_t>(ring)] += y;
   });
-  double total = 0.0;
-  for (const double e : ringEnergy) total += e;
+  std::vector<double> ringEdge(kRings + 2, 0.0);
+  const std::vector<double> outer = ringOuterAngles();
+  for (int r = 0; r <= kRings; ++r) ringEdge[static_cast<std::size_t>(r) + 1] = outer[static_cast<std::size_t>(r)];
+  auto quantile = [&](double q) { return quantileOf(ringEnergy, ringEdge, q); };
 
-  // The angle within which the share q of the energy lies, linear inside a ring.
-  auto quantile = [&](double q) {
-    if (!(total > 0.0)) return kPi / 2.0;
-    double below = 0.0, inner = 0.0;
-    for (std::size_t r = 0; r < ringEnergy.size(); ++r) {
-      const double e = ringEnergy[r] / total;
-      if (below + e >= q && e > 0.0) return inner + (q - below) / e * (ringOuter[r] - inner);
-      below += e;
-      inner = ringOuter[r];
-    }
-    return kPi;
-  };
   shared::SliceLobe lobe{};
   lobe.energy = glm::vec4(glm::vec3(energy), static_cast<float>(thetaOut));
-  constexpr int kK = static_cast<int>(shared::kLobeRings);
+  lobe.median = glm::vec4(static_cast<float>(quantile(0.5)), 0.0f, 0.0f, 0.0f);
+  lobe.core = glm::vec4(glm::vec3(coreAngle >= kPi ? energy : core), 0.0f);
+  constexpr int kK = static_cast<int>(shared::kLobeRings), kJ = static_cast<int>(shared::kLobeSectors);
   for (int k = 0; k < kK; ++k) {
+    // The ring summary: K equal shares of the energy.
     const double lo = k == 0 ? 0.0 : quantile(static_cast<double>(k) / kK);
     const double hi = quantile(static_cast<double>(k + 1) / kK);
     lobe.angle[k] = static_cast<float>(quantile((k + 0.5) / kK));
-    // A sample stands for its share of the ring: that solid angle is a
-    // texel of the level whose equatorial texels (π/M)·(2π/M) match it.
-    const double perSample = std::max(kTwoPi * (std::cos(lo) - std::cos(hi)) / shared::kLobeSectors, 1e-12);
-    lobe.level[k] = static_cast<float>(0.5 * std::log2(2.0 * kPi * kPi / perSample));
+    lobe.level[k] = levelOfSolidAngle(kTwoPi * (std::cos(lo) - std::cos(hi)) / kJ);
   }
-  lobe.median = glm::vec4(static_cast<float>(quantile(0.5)), 0.0f, 0.0f, 0.0f);
+  // The lobe path's samples. Equal shares of the energy would leave the last
+  // share of a heavy-tailed lobe (GGX's falls as θ⁻⁴) one band from a few
+  // degrees out to the horizon, read at that band's solid angle: a quarter
+  // of the energy smeared over a hemisphere. Bands whose edges double
+  // instead (½m, m, 2m, … from the median angle m, the last out to π) keep
+  // every band's width near its distance from the axis, each weighted by
+  // its share of the energy.
+  std::vector<double> bandEdge(shared::kLobeBands + 1);
+  bandEdge[0] = 0.0;
+  for (int i = 1; i < static_cast<int>(shared::kLobeBands); ++i) {
+    bandEdge[static_cast<std::size_t>(i)] = std::min(coreAngle, lobe.median.x * std::ldexp(1.0, i - 2));
+  }
+  bandEdge[shared::kLobeBands] = std::min(coreAngle, kPi);
+  std::vector<double> sectorEdge(kSectors + 1);
+  for (int s = 0; s <= kSectors; ++s) sectorEdge[static_cast<std::size_t>(s)] = s * kTwoPi / kSectors;
+  double weightSum = 0.0;
+  for (int k = 0; k < static_cast<int>(shared::kLobeBands); ++k) {
+    const double lo = bandEdge[static_cast<std::size_t>(k)], hi = bandEdge[static_cast<std::size_t>(k) + 1];
+    // The band's cells, each ring weighted by the part of it inside [lo, hi].
+    auto inBand = [&](int r) {
+      const double r0 = ringEdge[static_cast<std::size_t>(r)], r1 = ringEdge[static_cast<std::size_t>(r) + 1];
+      return std::max(0.0, std::min(r1, hi) - std::max(r0, lo)) / std::max(r1 - r0, 1e-300);
+    };
+    std::vector<double> azimuth(kSectors, 0.0);
+    double bandEnergy = 0.0;
+    for (int r = 0; r <= kRings; ++r) {
+      const double w = inBand(r);
+      if (w == 0.0) continue;
+      for (int s = 0; s < kSectors; ++s) azimuth[static_cast<std::size_t>(s)] += w * cell[static_cast<std::size_t>(r) * kSectors + static_cast<std::size_t>(s)];
+    }
+    for (const double e : azimuth) bandEnergy += e;
+    // J equal shares of the band's energy in azimuth, from b = 0 (u, across
+    // the plane of incidence); each sample at its share's median azimuth
+    // and at the median angle of the cells in its share, reading the light
+    // at the share's solid angle. A lobe is symmetric about the plane of
+    // incidence and, stretched at grazing views, thin across it: b = 0 and
+    // b = π are where it is thinnest, and with J even they are shares'
+    // edges, never a share's median (which would sit where there is no
+    // energy).
+    for (int j = 0; j < kJ; ++j) {
+      const double q = (j + 0.5) / kJ;
+      const double qLo = q - 0.5 / kJ, qHi = q + 0.5 / kJ;
+      // Azimuths of a share that wraps past 2π stay continuous (b may exceed 2π or go below 0).
+      auto az = [&](double x) { return x < 0.0 ? quantileOf(azimuth, sectorEdge, x + 1.0) - kTwoPi
+                                        : x > 1.0 ? quantileOf(azimuth, sectorEdge, x - 1.0) + kTwoPi
+                                                  : quantileOf(azimuth, sectorEdge, x); };
+      const double b = az(q), bLo = az(qLo), bHi = az(qHi);
+      std::vector<double> radial(kRings + 1, 0.0);
+      for (int s = 0; s < kSectors; ++s) {
+        const double c0 = sectorEdge[static_cast<std::size_t>(s)], c1 = sectorEdge[static_cast<std::size_t>(s) + 1];
+        // The sector's overlap with [bLo, bHi], trying the share's wraps.
+        double overlap = 0.0;
+        for (const double shift : {-kTwoPi, 0.0, kTwoPi}) overlap += std::max(0.0, std::min(c1 + shift, bHi) - std::max(c0 + shift, bLo));
+        if (overlap <= 0.0) continue;
+        for (int r = 0; r <= kRings; ++r) radial[static_cast<std::size_t>(r)] += inBand(r) * overlap * cell[static_cast<std::size_t>(r) * kSectors + static_cast<std::size_t>(s)];
+      }
+      std::vector<double> edges = ringEdge;
+      for (double& e : edges) e = std::clamp(e, lo, hi);
+      const double a = quantileOf(radial, edges, 0.5);
+      const double omega = (std::cos(lo) - std::cos(hi)) * std::max(bHi - bLo, 1e-9);
+      const double w = bandEnergy / kJ;
+      weightSum += w;
+      lobe.samples[k * kJ + j] = glm::vec4(static_cast<float>(a), static_cast<float>(b), levelOfSolidAngle(omega), static_cast<float>(w));
+    }
+  }
+  for (glm::vec4& s : lobe.samples) s.w = weightSum > 0.0 ? static_cast<float>(s.w / weightSum) : 1.0f / shared::kLobeSamples;
   return lobe;
 }
 
-std::vector<shared::SliceLobe> measureLobes(const Brdf& brdf, const std::vector<double>& thetaOut) {
+std::vector<shared::SliceLobe> measureLobes(const Brdf& brdf, const std::vector<double>& thetaOut, double coreAngle) {
   std::vector<shared::SliceLobe> out(thetaOut.size());
-  parallelFor(thetaOut.size(), [&](std::size_t t) { out[t] = measureLobe(brdf, thetaOut[t]); });
+  parallelFor(thetaOut.size(), [&](std::size_t t) { out[t] = measureLobe(brdf, thetaOut[t], coreAngle); });
+  return out;
+}
+
+LobeCore chooseLobeCore(const Brdf& brdf, const std::vector<double>& thetaOut, int level) {
+  const double texel = kPi / mapSize(level);
+  LobeCore out;
+  out.lobes = measureLobes(brdf, thetaOut);
+  float sharpest = static_cast<float>(kPi);
+  for (const shared::SliceLobe& lobe : out.lobes) sharpest = std::min(sharpest, lobe.median.x);
+  if (out.lobes.empty() || sharpest > kLobeMedianTexels * texel) {
+    out.lobes.clear();
+    return out;
+  }
+  const double coreAngle = kLobeCoreTexels * texel;
+  std::vector<shared::SliceLobe> cores = measureLobes(brdf, thetaOut, coreAngle);
+  double tail = 0.0;  // the largest share outside the core
+  for (const shared::SliceLobe& lobe : cores) {
+    const double e = luminance709(lobe.energy.r, lobe.energy.g, lobe.energy.b);
+    if (e > 0.0) tail = std::max(tail, 1.0 - luminance709(lobe.core.r, lobe.core.g, lobe.core.b) / e);
+  }
+  if (tail < kLobeTailLeft) {
+    out.angle = static_cast<float>(kPi);
+  } else {
+    out.angle = static_cast<float>(coreAngle);
+    out.lobes = std::move(cores);
+  }
   return out;
 }
 

@@ -2,6 +2,7 @@
 // visibility, backdrop), the compute pipelines that read it and, for
 // `fused`, the ray scene of the point lights' shadow rays.
 
+#include <cmath>
 #include <algorithm>
 #include <stdexcept>
 #include <string>
@@ -55,7 +56,10 @@ void VulkanRenderer::Impl::uploadScene() {
         energies.emplace_back(e[0], e[1], e[2], 0.0f);
         lobeData.push_back(p.lobes.empty() ? shared::SliceLobe{} : p.lobes[t]);
       }
-      if (p.lobePath) info.flags |= shared::kObjectLobePath;
+      if (p.lobePath) {
+        info.flags |= shared::kObjectLobePath;
+        info.lobeCore = glm::vec4(std::cos(p.lobeCore), 0.0f, 0.0f, 0.0f);  // fused.cpp setCore's cos, in float
+      }
     } else {
       info.sliceBase = static_cast<std::uint32_t>(sliceData.size() / (3 * n));
       for (std::size_t t = 0; t < T; ++t) {

@@ -1,5 +1,6 @@
 #include "haarcast/net/h264_encoder.h"
 
+#include <algorithm>
 #include <cmath>
 #include <mutex>
 #include <sstream>
@@ -56,6 +57,14 @@ void quietLibav() {
 }
 
 }  // namespace
+
+int defaultH264BitrateKbps(int width, int height, double fps) {
+  const double pixels = static_cast<double>(std::max(width, 0)) * static_cast<double>(std::max(height, 0));
+  const double rate = std::isfinite(fps) && fps > 0.0 ? fps : 30.0;
+  const double kbps = std::round(kH264DefaultBitsPerPixel * pixels * rate / 1000.0);
+  return static_cast<int>(std::clamp(kbps, static_cast<double>(kMinDefaultH264BitrateKbps),
+                                     static_cast<double>(kMaxDefaultH264BitrateKbps)));
+}
 
 void validateH264Settings(const H264Settings& s) {
   checkRange("width", s.width, 2, io::kMaxImageDimension);

@@ -56,6 +56,35 @@ std::optional<RotationMethod> methodFromWire(v1::RotationMethod m) {
   }
 }
 
+// A frame size within the limits (and even for H.264 when `encoding` says
+// so): Hello's and RenderSettings' alike.
+std::optional<ProtocolError> checkSize(std::uint32_t w, std::uint32_t h, const Limits& limits,
+                                       std::optional<FrameEncoding> encoding, bool fatal) {
+  if (w == 0 || h == 0 || w > static_cast<std::uint32_t>(limits.maxWidth) ||
+      h > static_cast<std::uint32_t>(limits.maxHeight)) {
+    return error(v1::ERROR_CODE_BAD_RESOLUTION,
+                 "resolution " + std::to_string(w) + "x" + std::to_string(h) + " is outside 1x1.." +
+                     std::to_string(limits.maxWidth) + "x" + std::to_string(limits.maxHeight),
+                 fatal);
+  }
+  if (static_cast<std::size_t>(w) * h > limits.maxPixels) {
+    return error(v1::ERROR_CODE_BAD_RESOLUTION,
+                 "resolution " + std::to_string(w) + "x" + std::to_string(h) + " is " +
+                     std::to_string(static_cast<std::size_t>(w) * h) + " pixels, over the server's " +
+                     std::to_string(limits.maxPixels) + " per session (max-session-pixels)",
+                 fatal);
+  }
+  if (encoding == FrameEncoding::H264 && (w % 2 != 0 || h % 2 != 0)) {
+    // 4:2:0 halves both dimensions: a size the encoder cannot take is
+    // refused here, before any frame is rendered.
+    return error(v1::ERROR_CODE_BAD_RESOLUTION,
+                 "resolution " + std::to_string(w) + "x" + std::to_string(h) +
+                     " is odd: ENCODING_H264 needs an even width and height",
+                 fatal);
+  }
+  return std::nullopt;
+}
+
 // Validates settings into a copy; only a fully valid change is applied.
 std::optional<ProtocolError> mergeSettings(SessionConfig& config, const v1::RenderSettings& s, const Limits& limits,
                                            const Catalog& catalog, bool fatal) {
@@ -126,6 +155,17 @@ std::optional<ProtocolError> mergeSettings(SessionConfig& config, const v1::Rend
                    fatal);
     }
     next.h264KeyframeInterval = static_cast<int>(s.h264_keyframe_interval());
+  }
+  if (s.width() != 0 || s.height() != 0) {
+    if (s.width() == 0 || s.height() == 0) {
+      return error(v1::ERROR_CODE_BAD_RESOLUTION,
+                   "resolution " + std::to_string(s.width()) + "x" + std::to_string(s.height()) +
+                       ": set both width and height, or neither (0 = unchanged)",
+                   fatal);
+    }
+    if (auto e = checkSize(s.width(), s.height(), limits, config.encoding, fatal)) return e;
+    next.width = static_cast<int>(s.width());
+    next.height = static_cast<int>(s.height());
   }
   switch (s.exposure_mode()) {
     case v1::EXPOSURE_MODE_UNSPECIFIED: break;  // unchanged (a Hello starts with auto)
@@ -268,20 +308,13 @@ std::variant<SessionConfig, ProtocolError> configFromHello(const v1::Hello& hell
   const std::uint32_t w = hello.width() ? hello.width() : static_cast<std::uint32_t>(defaults.width);
   const std::uint32_t h = hello.height() ? hello.height() : static_cast<std::uint32_t>(defaults.height);
   // 0 × 0 is a mistake, not "default": both or neither must be given.
-  if ((hello.width() == 0) != (hello.height() == 0) || w > static_cast<std::uint32_t>(limits.maxWidth) ||
-      h > static_cast<std::uint32_t>(limits.maxHeight)) {
+  if ((hello.width() == 0) != (hello.height() == 0)) {
     return error(v1::ERROR_CODE_BAD_RESOLUTION,
                  "resolution " + std::to_string(hello.width()) + "x" + std::to_string(hello.height()) +
                      " is outside 1x1.." + std::to_string(limits.maxWidth) + "x" + std::to_string(limits.maxHeight),
                  true);
   }
-  if (static_cast<std::size_t>(w) * h > limits.maxPixels) {
-    return error(v1::ERROR_CODE_BAD_RESOLUTION,
-                 "resolution " + std::to_string(w) + "x" + std::to_string(h) + " is " +
-                     std::to_string(static_cast<std::size_t>(w) * h) + " pixels, over the server's " +
-                     std::to_string(limits.maxPixels) + " per session (max-session-pixels)",
-                 true);
-  }
+  if (auto e = checkSize(w, h, limits, std::nullopt, true)) return *e;
   c.width = static_cast<int>(w);
   c.height = static_cast<int>(h);
   if (hello.encoding() == v1::ENCODING_UNSPECIFIED) {
@@ -476,8 +509,10 @@ v1::RenderSettings settingsToWire(const SessionConfig& config) {
   s.set_backend(toWire(config.backend));
   s.set_exposure_mode(config.autoExposure ? v1::EXPOSURE_MODE_AUTO : v1::EXPOSURE_MODE_FIXED);
   s.set_exposure_stops(config.exposureStops);
+  s.set_width(static_cast<std::uint32_t>(config.width));
+  s.set_height(static_cast<std::uint32_t>(config.height));
   if (config.encoding == FrameEncoding::H264) {
-    s.set_h264_bitrate_kbps(static_cast<std::uint32_t>(config.h264BitrateKbps));
+    s.set_h264_bitrate_kbps(static_cast<std::uint32_t>(h264Settings(config).bitrateKbps));
     s.set_h264_keyframe_interval(static_cast<std::uint32_t>(config.h264KeyframeInterval));
   }
   return s;
@@ -487,7 +522,8 @@ H264Settings h264Settings(const SessionConfig& config) {
   H264Settings s;
   s.width = config.width;
   s.height = config.height;
-  s.bitrateKbps = config.h264BitrateKbps;
+  s.bitrateKbps = config.h264BitrateKbps > 0 ? config.h264BitrateKbps
+                                             : defaultH264BitrateKbps(config.width, config.height, config.fps);
   s.keyframeInterval = config.h264KeyframeInterval;
   s.fps = config.fps;
   return s;

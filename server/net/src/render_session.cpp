@@ -130,7 +130,7 @@ void RenderSession::onHello(const v1::Hello& hello, Clock::time_point now) {
     std::lock_guard lock(mutex_);
     config_ = std::get<SessionConfig>(std::move(config));
     pose_ = initialPose(scene->camera, scene->poses);
-    poseReceived_ = now;
+    requested_ = now;
   }
   log(format("hello from \"%s\": %dx%d %s, %.1f fps, level %d, %s, %s, scene \"%s\"", clientName_.c_str(),
              config_.width, config_.height, std::string(encodingName(config_.encoding)).c_str(), config_.fps,
@@ -147,7 +147,7 @@ void RenderSession::onPose(const v1::PoseUpdate& update, Clock::time_point now) 
     const auto before = pose_.sequence;
     e = applyPose(pose_, update);
     applied = pose_.sequence != before;
-    if (applied) poseReceived_ = now;
+    if (applied) requested_ = now;
   }
   if (e) {
     badMessage(std::move(*e));
@@ -175,6 +175,7 @@ void RenderSession::adopt(SessionConfig next, bool announceScene, Clock::time_po
     // Auto exposure starts afresh for another scene or after a fixed spell.
     if (newScene || !next.autoExposure) lastExposure_.reset();
     config_ = std::move(next);
+    requested_ = now;  // the next frame answers this change, whatever pose it shows
     if (newScene) {
       const auto* scene = catalog_.findScene(config_.scene);
       const auto sequence = pose_.sequence;
@@ -229,6 +230,10 @@ void RenderSession::onPrepared(const std::string& key, std::shared_ptr<PreparedR
     return;
   }
   renderer_ = std::move(renderer);
+  {
+    std::lock_guard lock(mutex_);
+    requested_ = std::max(requested_, now);  // the build was no frame's time
+  }
   if (!welcomed_) {
     welcomed_ = true;
     lastStats_ = now;
@@ -309,7 +314,7 @@ std::optional<render::FrameRequest> RenderSession::takeRequest(FrameContext& con
   if (ended_.load()) return std::nullopt;
   context.poseSequence = pose_.sequence;
   context.clientTimeMs = pose_.clientTimeMs;
-  context.poseReceived = poseReceived_;
+  context.requested = requested_;
   context.config = config_;
   render::FrameRequest request = frameRequest(pose_, config_);
   if (request.exposure.automatic && lastExposure_) {
@@ -346,7 +351,7 @@ void RenderSession::onRendered(const FrameContext& context, std::optional<Render
   facts.sequence = ++frameSequence_;
   facts.poseSequence = context.poseSequence;
   facts.clientTimeMs = context.clientTimeMs;
-  facts.serverMs = secondsBetween(context.poseReceived, now) * 1e3;
+  facts.serverMs = secondsBetween(context.requested, now) * 1e3;
   const std::size_t payload = rendered->encoded.size();
   if (port_.sendFrame(frameMessage(context.config, rendered->frame, std::move(rendered->encoded), facts), payload)) {
     // The client had not taken the last one yet: latest wins.

@@ -514,7 +514,7 @@ std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const RayScen
     const shared::SliceBlend blend = shared::sliceBlendAt(static_cast<float>(in.rotation.thetaOut),
                                                           static_cast<shared::uint>(slices.thetaSamples()),
                                                           options_.interpolateSlices ? 1u : 0u);
-    const LobePath lobe{&prepared_.lobeLight, p.lobes, o.toLight, false};
+    const LobePath lobe{&prepared_.lobeLight, p.lobes, o.toLight, false, p.lobeCore};
     rgb = fusedShade(slices, blend, in.rotation.euler, o.fusedLight, vis, o.pointLights, seen, scratch,
                      p.lobePath ? &lobe : nullptr);
     return fusedPixelBytes(slices.level(), blend.weight != 0.0f, 3 * p.visibilityBits.wordsPerPoint() * sizeof(std::uint32_t));

@@ -146,9 +146,10 @@ PreparedScene prepareScene(const Scene& scene, const RenderOptions& options, con
       if (p.ground) continue;  // shaded in closed form
       std::vector<double> thetaOut;
       for (int t = 0; t < p.table.thetaSamples(); ++t) thetaOut.push_back(p.table.thetaOut(t));
-      p.lobes = measureLobes(*scene.objects[k].material.brdf, thetaOut);
-      for (const shared::SliceLobe& lobe : p.lobes)
-        p.lobePath = p.lobePath || shared::lobePathShare(lobe.median.x, static_cast<shared::uint>(options.level)) > 0.0f;
+      LobeCore core = chooseLobeCore(*scene.objects[k].material.brdf, thetaOut, options.level);
+      p.lobes = std::move(core.lobes);
+      p.lobeCore = core.angle;
+      p.lobePath = p.lobeCore > 0.0f;
       // The prefiltered light (5.6 MB at level 9) only where a pixel can read it.
       if (p.lobePath && prepared.lobeLight.empty()) prepared.lobeLight = PrefilteredLight::build(prepared.background);
     }

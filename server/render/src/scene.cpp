@@ -129,11 +129,27 @@ Material materialFromSpec(const std::string& spec, const std::string& baseDir) {
     }
     m.brdf = std::move(merl);
     m.cacheKey = io::fileCacheKey(path);
+    // Named by its file's stem, as `serve --materials-dir` names its files:
+    // the name reaches clients (SceneInfo), a path of the server must not.
+    m.name = "merl:" + fs::path(spec).stem().string();
   } else {
     throw std::invalid_argument("material \"" + spec +
                                 "\": expected lambert, phong:EXP, blinn-phong:EXP, ggx:ROUGHNESS or a MERL .binary file");
   }
   return m;
+}
+
+UpAxis parseUpAxis(const std::string& text) {
+  if (text == "y" || text == "Y") return UpAxis::Y;
+  if (text == "z" || text == "Z") return UpAxis::Z;
+  throw std::invalid_argument("up axis \"" + text + "\" is not one of y, z");
+}
+
+void makeYUp(Mesh& mesh, UpAxis up) {
+  if (up == UpAxis::Y) return;
+  const auto turn = [](const glm::vec3& v) { return glm::vec3(v.x, v.z, -v.y); };
+  for (glm::vec3& p : mesh.positions) p = turn(p);
+  for (glm::vec3& n : mesh.normals) n = turn(n);
 }
 
 void fitToUnitSphere(Mesh& mesh) {
@@ -219,7 +235,7 @@ glm::dvec3 vec3At(const nlohmann::json& j, const std::string& file, const std::s
 }
 
 std::shared_ptr<Mesh> meshAt(const nlohmann::json& j, const std::string& file, const std::string& where,
-                             const fs::path& base, bool fit) {
+                             const fs::path& base, bool fit, UpAxis up) {
   Mesh mesh;
   if (j.is_string()) {
     mesh = io::loadMesh((base / j.get<std::string>()).string());
@@ -234,6 +250,7 @@ std::shared_ptr<Mesh> meshAt(const nlohmann::json& j, const std::string& file, c
   } else {
     fail(file, where, "expected a file name or {\"builtin\": …}");
   }
+  makeYUp(mesh, up);
   if (fit) fitToUnitSphere(mesh);
   return std::make_shared<Mesh>(std::move(mesh));
 }
@@ -309,8 +326,17 @@ Scene sceneFromJson(const nlohmann::json& j, const std::string& path, const Scen
     if (!o.contains("material") || !o["material"].is_string()) fail(path, where, "missing \"material\" string");
     SceneObject obj;
     obj.name = o.value("name", "object" + std::to_string(k));
+    UpAxis up = UpAxis::Y;
+    if (o.contains("up")) {
+      if (!o["up"].is_string()) fail(path, where + ".up", "expected \"y\" or \"z\"");
+      try {
+        up = parseUpAxis(o["up"].get<std::string>());
+      } catch (const std::invalid_argument& e) {
+        fail(path, where + ".up", e.what());
+      }
+    }
     try {
-      obj.mesh = meshAt(o["mesh"], path, where + ".mesh", base, o.value("fit", true));
+      obj.mesh = meshAt(o["mesh"], path, where + ".mesh", base, o.value("fit", true), up);
       obj.material = materialFromSpec(o["material"].get<std::string>(), base.string());
     } catch (const std::invalid_argument& e) {
       fail(path, where, e.what());

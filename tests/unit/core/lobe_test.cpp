@@ -71,9 +71,9 @@ TEST(PrefilteredLight, EveryLevelKeepsTheIntegralAndAConstantLobeReadsTheConstan
   }
   // Level 0 is one texel, the mean: any lobe that reads only it gets it.
   shared::SliceLobe wide{};
-  for (int k = 0; k < 4; ++k) {
-    wide.angle[k] = 0.3f * static_cast<float>(k + 1);
-    wide.level[k] = -1.0f;  // clamped to 0
+  for (shared::uint i = 0; i < shared::kLobeSamples; ++i) {
+    wide.samples[i] = glm::vec4(0.02f * static_cast<float>(i), 0.1f * static_cast<float>(i), -1.0f,  // level clamped to 0
+                                1.0f / shared::kLobeSamples);
   }
   const glm::vec3 mean = light.lobe(wide, {0, 1, 0}, {1, 0, 0}, {0, 0, 1});
   EXPECT_NEAR(mean.g, maps[1].integral() / (4.0 * kPi), 1e-4);
@@ -81,21 +81,93 @@ TEST(PrefilteredLight, EveryLevelKeepsTheIntegralAndAConstantLobeReadsTheConstan
   std::array<SphereMap, 3> flat{SphereMap(5, 1.5f), SphereMap(5, 1.5f), SphereMap(5, 1.5f)};
   const PrefilteredLight constant = PrefilteredLight::build(flat);
   shared::SliceLobe narrow{};
-  for (int k = 0; k < 4; ++k) {
-    narrow.angle[k] = 0.01f * static_cast<float>(k + 1);
-    narrow.level[k] = 4.3f - static_cast<float>(k);
+  for (shared::uint i = 0; i < shared::kLobeSamples; ++i) {
+    narrow.samples[i] = glm::vec4(0.01f * static_cast<float>(i % 4 + 1), 0.7f * static_cast<float>(i), 4.3f - static_cast<float>(i % 4),
+                                  1.0f / shared::kLobeSamples);
   }
   const glm::vec3 d = glm::normalize(glm::vec3(0.3f, 0.5f, -0.8f));
   const glm::vec3 u = glm::normalize(glm::cross(d, glm::vec3(0, 1, 0)));
   EXPECT_NEAR(constant.lobe(narrow, d, u, glm::cross(d, u)).b, 1.5f, 1e-5f);
 }
 
-TEST(LobePath, ShareIsOneForNarrowLobesZeroForWideAndLinearBetween) {
-  const float texel5 = shared::kPiF / 32.0f;
-  EXPECT_EQ(shared::lobePathShare(0.4f * texel5, 5u), 1.0f);
-  EXPECT_EQ(shared::lobePathShare(1.2f * texel5, 5u), 0.0f);
-  EXPECT_NEAR(shared::lobePathShare(0.75f * texel5, 5u), 0.5f, 1e-6f);
-  EXPECT_EQ(shared::lobePathShare(0.75f * texel5, 6u), 0.0f) << "a level finer resolves it";
+TEST(PrefilteredLight, ACoarseTexelIsTheCapMeanAboutItsCentreEvenAtThePoles) {
+  // A box-filtered lat-long texel next to a pole is a thin wedge from the
+  // pole out, holding that wedge's mean rather than a mean about its
+  // centre; the wedges around the pole then differ like a pinwheel on a
+  // mirror's reflection of the zenith. Cap means are the same filter in
+  // every direction: under L = 1 + x the mean over a cap of half-angle r
+  // about d is 1 + d.x·(1 + cos r)/2, on every row.
+  const std::array<SphereMap, 3> maps{SphereMap::fromFunction(8, [](const glm::dvec3& w) { return 1.0 + w.x; }),
+                                      SphereMap(8, 1.0f), SphereMap(8, 1.0f)};
+  const PrefilteredLight light = PrefilteredLight::build(maps);
+  for (const int level : {3, 4, 5}) {
+    const int m = mapSize(level);
+    const double capCos = 1.0 - kPi / (static_cast<double>(m) * m);
+    const std::span<const glm::vec4> t = light.texels().subspan(shared::prefilterOffset(static_cast<shared::uint>(level)));
+    double worst = 0.0;
+    for (int r = 0; r < m; ++r) {
+      for (int c = 0; c < m; ++c) {
+        const glm::dvec3 d = sphericalToDirection(rowTheta(level, r), colPhi(level, c));
+        const double expected = 1.0 + d.x * (1.0 + capCos) / 2.0;
+        worst = std::max(worst, std::abs(t[static_cast<std::size_t>(r * m + c)].r - expected));
+      }
+    }
+    EXPECT_LT(worst, 0.01) << "level " << level;
+  }
+}
+
+TEST(LobeCore, MirrorsTakeThePathHazyMirrorsTheirCoreRoughLobesNone) {
+  const std::vector<double> thetaOut{0.2, 0.8, 1.3};
+  // A near-mirror: all of the lobe within four level-5 texels.
+  const LobeCore mirror = chooseLobeCore(*makeGgx(glm::dvec3(0.0), glm::dvec3(0.9), 0.002), thetaOut, 5);
+  EXPECT_FLOAT_EQ(mirror.angle, static_cast<float>(kPi));
+  ASSERT_EQ(mirror.lobes.size(), thetaOut.size());
+  EXPECT_FLOAT_EQ(mirror.lobes[1].core.g, mirror.lobes[1].energy.g) << "the path carries all of the energy";
+  // A mirror over a diffuse base (as measured chrome): the core by the path, the rest by the pass.
+  const auto hazy = makeGgx(glm::dvec3(0.3), glm::dvec3(0.9), 0.005);
+  const LobeCore split = chooseLobeCore(*hazy, thetaOut, 5);
+  EXPECT_FLOAT_EQ(split.angle, static_cast<float>(kLobeCoreTexels * kPi / 32.0));
+  for (const shared::SliceLobe& l : split.lobes) {
+    EXPECT_LT(l.core.r, 0.95f * l.energy.r) << "the diffuse part is outside the core";
+    EXPECT_GT(l.core.r, 0.3f * l.energy.r);
+  }
+  // Rough and glossy lobes, and a Lambert one: the maps resolve them.
+  EXPECT_EQ(chooseLobeCore(*makeGgx(glm::dvec3(0.0), glm::dvec3(0.9), 0.3), thetaOut, 5).angle, 0.0f);
+  EXPECT_EQ(chooseLobeCore(*makePhong(glm::dvec3(0.5), glm::dvec3(0.5), 64.0), thetaOut, 5).angle, 0.0f);
+  const auto glossy = makeGgx(glm::dvec3(0.0), glm::dvec3(0.9), 0.05);
+  EXPECT_GT(chooseLobeCore(*glossy, thetaOut, 5).angle, 0.0f) << "its median is under a level-5 texel";
+  EXPECT_EQ(chooseLobeCore(*glossy, thetaOut, 6).angle, 0.0f) << "and over a level-6 one";
+  const LobeCore lambert = chooseLobeCore(*makeLambert(glm::dvec3(0.8)), thetaOut, 5);
+  EXPECT_EQ(lambert.angle, 0.0f);
+  EXPECT_TRUE(lambert.lobes.empty());
+}
+
+TEST(LobePath, SamplesFollowTheLobeWhereTheHorizonCutsIt) {
+  // At a grazing view a GGX lobe is cut by the horizon and stretched along
+  // the plane of incidence. Under a light that changes linearly, L = 1 + y
+  // (y the normal), the lobe path's weighted samples must give the lobe's
+  // own mean of L: Σ ρ·cos·L·ΔΩ / Σ ρ·cos·ΔΩ on a fine slice map. Samples
+  // spread evenly about the mirror direction would read light below the
+  // horizon and miss the mean.
+  const auto ggx = makeGgx(glm::dvec3(0.0), glm::dvec3(0.9), 0.08);
+  std::array<SphereMap, 3> maps;
+  for (auto& m : maps) m = SphereMap::fromFunction(9, [](const glm::dvec3& w) { return 1.0 + w.y; });
+  const PrefilteredLight light = PrefilteredLight::build(maps);
+  for (const double thetaOut : {0.5, 1.35}) {
+    const shared::SliceLobe lobe = measureLobe(*ggx, thetaOut);
+    const SphereMap slice = sliceMap(*ggx, thetaOut, 0, 8, 4);
+    double num = 0.0, den = 0.0;
+    for (int r = 0; r < slice.size(); ++r) {
+      for (int c = 0; c < slice.size(); ++c) {
+        const double w = slice.at(r, c) * pixelSolidAngle(8, r);
+        num += w * (1.0 + std::cos(rowTheta(8, r)));
+        den += w;
+      }
+    }
+    const float s = static_cast<float>(std::sin(thetaOut)), co = static_cast<float>(std::cos(thetaOut));
+    const glm::vec3 got = light.lobe(lobe, {0.0f, co, -s}, {1.0f, 0.0f, 0.0f}, {0.0f, -s, -co});
+    EXPECT_NEAR(got.r, num / den, 0.003 * num / den) << "θₒ " << thetaOut;
+  }
 }
 
 TEST(LobePath, ShadesEnergyTimesTheLightWhereTheRaySeesAndNothingWhereNot) {
@@ -103,7 +175,7 @@ TEST(LobePath, ShadesEnergyTimesTheLightWhereTheRaySeesAndNothingWhereNot) {
   const PrefilteredLight light = PrefilteredLight::build(flat);
   const auto ggx = makeGgx(glm::dvec3(0.0), glm::dvec3(0.9, 0.7, 0.5), 0.02);
   const std::vector<shared::SliceLobe> lobes = measureLobes(*ggx, {0.3, 0.9});
-  const LobePath path{&light, lobes, glm::mat3(1.0f), false};
+  const LobePath path{&light, lobes, glm::mat3(1.0f), false};  // the path takes all: E_core = E
   const shared::SliceBlend blend{0u, 1u, 0.25f};
   const EulerYXY r{0.4, 1.1, -0.7};
   const std::array<float, 3> seen = lobeShade(path, blend, r, shared::kLobeSeenBit);
@@ -145,6 +217,42 @@ TEST(Fused, KeepsTheSlicesEnergyWhereTheMapsDirectionsMissPartOfANarrowLobe) {
     worstRaw = std::max(worstRaw, std::abs(raw / energy - 1.0));
   }
   EXPECT_GT(worstRaw, 0.01) << "the lobe must be narrow enough for the map's directions to miss part of it";
+}
+
+TEST(Fused, ASplitLobeIsThePassOutsideTheCoreAndThePathInsideIt) {
+  // A mirror over a diffuse base, split at two level-4 texels. Under a
+  // uniform unit light with V = 1 the pixel is the lobe's energy: E − E_core
+  // from the pass, E_core from the path; with the path's ray blocked, the
+  // pass's part alone.
+  const auto hazy = makeGgx(glm::dvec3(0.3), glm::dvec3(0.9), 0.005);
+  SliceTableOptions options;
+  options.level = 4;
+  options.thetaSamples = 4;
+  const BrdfSliceTable table = BrdfSliceTable::build(*hazy, options);
+  const PixelSlices slices = PixelSlices::synthesize(table);
+  std::vector<double> thetaOut;
+  for (int t = 0; t < table.thetaSamples(); ++t) thetaOut.push_back(table.thetaOut(t));
+  const LobeCore core = chooseLobeCore(*hazy, thetaOut, 4);
+  ASSERT_GT(core.angle, 0.0f);
+  ASSERT_LT(core.angle, static_cast<float>(kPi));
+  std::array<SphereMap, 3> unit{SphereMap(4, 1.0f), SphereMap(4, 1.0f), SphereMap(4, 1.0f)};
+  const PrefilteredLight prefiltered = PrefilteredLight::build(unit);
+  for (auto& m : unit) m = m.weightedBySolidAngle();
+  const FusedLight light = FusedLight::fromWeightedMaps(unit);
+  VisibilityBits bits(4, 1);
+  std::vector<std::uint32_t> ones(bits.wordsPerPoint(), ~0u);
+  bits.assign(ones);
+  const std::array<WeightedBits, 1> vis{WeightedBits{bits.point(0).data(), 1.0f}};
+  const LobePath path{&prefiltered, core.lobes, glm::mat3(1.0f), false, core.angle};
+  FusedScratch scratch;
+  for (const EulerYXY& r : randomRotations(6, 4)) {
+    const shared::SliceBlend blend{1u, 2u, 0.3f};
+    const std::array<float, 3> got = fusedShade(slices, blend, r, light, vis, {}, shared::kLobeSeenBit, scratch, &path);
+    const shared::SliceLobe l = shared::blendLobes(core.lobes[1], core.lobes[2], 0.3f);
+    EXPECT_NEAR(got[0], l.energy.r, 1e-4f * l.energy.r);
+    const std::array<float, 3> hidden = fusedShade(slices, blend, r, light, vis, {}, 0u, scratch, &path);
+    EXPECT_NEAR(hidden[0], l.energy.r - l.core.r, 1e-4f * l.energy.r) << "the ray blocked: only the pass's part";
+  }
 }
 
 }  // namespace

@@ -63,8 +63,8 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
   const int level = pc.level;
   constexpr int kThetaSamples = 4;
   constexpr std::size_t kPixels = 17;
-  constexpr std::size_t kObjects = 3;           // two shaded by the loop, the ground last
-  constexpr std::size_t kGround = 2;
+  constexpr std::size_t kObjects = 4;           // three shaded by the loop (0, 1 with a lobe path), the ground last
+  constexpr std::size_t kGround = 3;
   constexpr std::size_t kLights = 5;            // of kMaxPointLights; mask bits 5–7 must be ignored
   constexpr std::uint32_t kGroups = 5;          // fewer than the samples: groups loop
   std::mt19937 rng(static_cast<unsigned>(100 + level));
@@ -105,11 +105,13 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
   }
   objects[kGround].flags = shared::kObjectGround;
 
-  // The lobe path: object 1 has random lobes whose median angle puts its
-  // samples all on the path, part on it or off it; a random prefiltered
-  // light (finest level 5) and a random turn into its frame.
-  constexpr std::size_t kLobeObject = 1;
+  // The lobe path: object 1 takes all of its lobes by the path, object 0
+  // their core (two texels about the axis) and the pass the rest; random
+  // lobes (energies, cores, samples with levels some outside [0, finest]),
+  // a random prefiltered light (finest level 5) and a random turn into its frame.
+  constexpr std::size_t kLobeAll = 1, kLobeSplit = 0;
   constexpr int kPrefilterFinest = 5;
+  const float coreAngle = 2.0f * static_cast<float>(kPi) / static_cast<float>(mapSize(level));
   std::vector<shared::SliceLobe> lobes(kObjects * kThetaSamples);
   std::vector<glm::vec4> energies;
   for (std::size_t o = 0; o < kObjects; ++o) {
@@ -118,21 +120,25 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
       energies.emplace_back(e[0], e[1], e[2], 0.0f);
     }
   }
-  for (int t = 0; t < kThetaSamples; ++t) {
-    shared::SliceLobe& l = lobes[kLobeObject * kThetaSamples + static_cast<std::size_t>(t)];
-    l.energy = glm::vec4(u(rng), u(rng), u(rng), u(rng) * static_cast<float>(kPi / 2.0));
-    float angle = 0.0f;
-    for (int k = 0; k < 4; ++k) {
-      angle += 0.01f + 0.1f * u(rng);
-      l.angle[k] = angle;
-      l.level[k] = u(rng) * (kPrefilterFinest + 1.0f) - 0.5f;  // some outside [0, finest]: clamped
+  for (const std::size_t o : {kLobeAll, kLobeSplit}) {
+    for (int t = 0; t < kThetaSamples; ++t) {
+      shared::SliceLobe& l = lobes[o * kThetaSamples + static_cast<std::size_t>(t)];
+      l.energy = glm::vec4(u(rng), u(rng), u(rng), u(rng) * static_cast<float>(kPi / 2.0));
+      l.core = glm::vec4(glm::vec3(l.energy) * u(rng), 0.0f);
+      float total = 0.0f;
+      for (glm::vec4& sample : l.samples) {
+        sample = glm::vec4(0.3f * u(rng), 6.3f * u(rng), u(rng) * (kPrefilterFinest + 1.0f) - 0.5f, u(rng));
+        total += sample.w;
+      }
+      for (glm::vec4& sample : l.samples) sample.w /= total;
     }
-    const float texel = static_cast<float>(kPi) / static_cast<float>(mapSize(level));
-    l.median = glm::vec4(texel * (0.3f + 0.9f * u(rng)), 0.0f, 0.0f, 0.0f);
+    objects[o].flags = shared::kObjectLobePath;
   }
-  objects[kLobeObject].flags = shared::kObjectLobePath;
+  objects[kLobeAll].lobeCore = glm::vec4(-1.0f, 0.0f, 0.0f, 0.0f);
+  objects[kLobeSplit].lobeCore = glm::vec4(std::cos(coreAngle), 0.0f, 0.0f, 0.0f);
   const glm::mat3 toLight(rotationMatrix(randomRotations(1, 7)[0]));
-  for (int c = 0; c < 3; ++c) objects[kLobeObject].toLight[c] = glm::vec4(toLight[c], 0.0f);
+  for (const std::size_t o : {kLobeAll, kLobeSplit})
+    for (int c = 0; c < 3; ++c) objects[o].toLight[c] = glm::vec4(toLight[c], 0.0f);
   std::array<SphereMap, 3> prefilterMaps;
   for (auto& map : prefilterMaps) map = randomMap(kPrefilterFinest, 0.0, 1.0, rng);
   const PrefilteredLight prefiltered = PrefilteredLight::build(prefilterMaps);
@@ -209,7 +215,7 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
   radiance.read(got.data(), got.size() * sizeof(glm::vec4));
 
   double worst = 0.0, scale = 0.0, lightShare = 0.0;
-  std::array<int, 3> lobeSamples{};  // the lobe object's samples all on the path, part on it, off it
+  std::array<int, 2> lobeSamples{};  // samples all on the path, in part
   FusedScratch work;
   std::vector<std::array<float, 3>> expected(kPixels);
   for (std::size_t i = 0; i < kPixels; ++i) {
@@ -229,12 +235,9 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
     const EulerYXY r{samples[i].alpha, samples[i].beta, samples[i].gamma};
     const LobePath path{&prefiltered,
                         std::span<const shared::SliceLobe>(lobes).subspan(o * kThetaSamples, kThetaSamples), toLight,
-                        false};
-    const LobePath* lobe = o == kLobeObject ? &path : nullptr;
-    if (lobe) {
-      const float share = lobePathShareAt(path, blend, level);
-      (share >= 1.0f ? lobeSamples[0] : share > 0.0f ? lobeSamples[1] : lobeSamples[2])++;
-    }
+                        false, o == kLobeAll ? static_cast<float>(kPi) : coreAngle};
+    const LobePath* lobe = o == kLobeAll || o == kLobeSplit ? &path : nullptr;
+    if (lobe) lobeSamples[o == kLobeAll ? 0 : 1]++;
     expected[i] = fusedShade(slices[o], blend, r, lights[o], vis, pointLights[o], masks[i], work, lobe);
     // How much of the sample the point lights make (the test must see them).
     const std::array<float, 3> mapOnly =
@@ -261,7 +264,9 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
     }
   }
   EXPECT_GT(groundSamples, 3u);
-  std::printf("lobe path: %d samples all on it, %d in part, %d off it\n", lobeSamples[0], lobeSamples[1], lobeSamples[2]);
+  std::printf("lobe path: %d samples all on it, %d in part\n", lobeSamples[0], lobeSamples[1]);
+  EXPECT_GT(lobeSamples[0], 3);
+  EXPECT_GT(lobeSamples[1], 3);
   std::printf("fused pass, level %d, %s: max |gpu − cpu| / max|I| = %.3g (point lights up to %.0f%% of a sample)\n",
               level, pc.interpolate ? "blended slices" : "nearest slice", worst, 100.0 * lightShare);
   EXPECT_LT(worst, 1e-5);

@@ -129,6 +129,38 @@ TEST_P(FusedFrame, VulkanMatchesTheCpuBackend) {
 
 INSTANTIATE_TEST_SUITE_P(Levels, FusedFrame, ::testing::Values(4, 5, 6, 7));
 
+// The same with the lobe path (core/lobe.h chooseLobeCore): the sphere a
+// near-mirror the path takes whole, the torus a mirror over a diffuse base
+// it takes the core of, the pass the rest.
+class FusedMirrorFrame : public ::testing::TestWithParam<int> {};
+
+TEST_P(FusedMirrorFrame, VulkanMatchesTheCpuBackend) {
+  HAARCAST_REQUIRE_VULKAN();
+  render::Scene scene = render::defaultScene();
+  ASSERT_GE(scene.objects.size(), 2u);
+  scene.objects[0].material = {"ggx:0.002", "test-mirror", makeGgx(glm::dvec3(0.0), glm::dvec3(0.9), 0.002), ""};
+  scene.objects[1].material = {"hazy mirror", "test-hazy", makeGgx(glm::dvec3(0.3), glm::dvec3(0.9), 0.005), ""};
+  render::RenderOptions o = frameOptions(RotationMethod::Fused, true);
+  o.level = GetParam();
+  const auto cpu = render::makeCpuRenderer(scene, o);
+  VulkanRenderer gpu(scene, o, testing::testOptions());
+  render::FrameRequest request = requestFor(scene, o.width, o.height);
+  request.poses = scenePoses(scene);
+  request.poses[1].rotateDegrees += glm::dvec3(10.0, 25.0, -5.0);
+  request.lightRotation = rotationMatrix({0.3, -0.4, 0.1});
+  const render::Frame a = cpu->render(request);
+  const render::Frame b = gpu.render(request);
+  const Comparison c = compare(a, b);
+  std::printf("fused with the lobe path, level %d: PSNR %.1f dB (MSE %.3g) over %zu pixels; %zu of %zu object pixels mismatched\n",
+              o.level, c.psnr, c.mse, c.compared, c.mismatched, c.objectPixels);
+  EXPECT_GE(c.psnr, kFusedPsnrFloor);
+  EXPECT_EQ(c.mismatched, 0u);
+  EXPECT_GT(c.objectPixels, 500u);
+  testing::expectNoValidationMessages(gpu.context());
+}
+
+INSTANTIATE_TEST_SUITE_P(Levels, FusedMirrorFrame, ::testing::Values(4, 5));
+
 // Auto exposure: the device's frame is measured and exposed as the CPU's
 // (the lit object pixels' log-average, the same transform), and eases from
 // a previous exposure by the fraction asked for.

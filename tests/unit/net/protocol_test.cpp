@@ -237,6 +237,86 @@ TEST(Protocol, SettingsChangeAllOrNothing) {
   EXPECT_EQ(c.lightCoefficients, 32u);
 }
 
+// A resized client window: RenderSettings.width and height change the frame
+// size mid-session under Hello's rules (the limits, the pixel budget, even
+// for H.264), all or nothing, never fatal; the renderer stays the same.
+TEST(Protocol, SettingsResizeTheFramesWithinTheLimits) {
+  Limits limits;
+  limits.maxWidth = 800;
+  limits.maxHeight = 600;
+  limits.maxPixels = 400 * 300;
+  auto c = std::get<SessionConfig>(configFromHello(goodHello(), limits, Defaults{}, testCatalog()));
+  const std::string key = c.rendererKey();
+  v1::RenderSettings s;
+  s.set_width(400);
+  s.set_height(300);
+  EXPECT_FALSE(applySettings(c, s, limits, testCatalog()));
+  EXPECT_EQ(c.width, 400);
+  EXPECT_EQ(c.height, 300);
+  EXPECT_EQ(c.rendererKey(), key) << "a new size needs no new renderer";
+  EXPECT_EQ(settingsToWire(c).width(), 400u);
+  EXPECT_EQ(settingsToWire(c).height(), 300u);
+
+  const auto refused = [&](std::uint32_t w, std::uint32_t h, const std::string& words) {
+    v1::RenderSettings bad;
+    bad.set_width(w);
+    bad.set_height(h);
+    bad.set_level(3);  // all or nothing: not applied either
+    const SessionConfig before = c;
+    const auto e = applySettings(c, bad, limits, testCatalog());
+    ASSERT_TRUE(e) << w << "x" << h << " accepted";
+    EXPECT_EQ(e->code, v1::ERROR_CODE_BAD_RESOLUTION);
+    EXPECT_FALSE(e->fatal);
+    EXPECT_NE(e->message.find(words), std::string::npos) << e->message;
+    EXPECT_EQ(c.width, before.width);
+    EXPECT_EQ(c.height, before.height);
+    EXPECT_EQ(c.level, before.level);
+  };
+  refused(801, 100, "801x100 is outside 1x1..800x600");
+  refused(500, 300, "150000 pixels, over the server's 120000 per session");
+  refused(320, 0, "set both width and height, or neither");
+  refused(0, 200, "set both width and height, or neither");
+
+  auto h264 = goodHello();
+  h264.set_encoding(v1::ENCODING_H264);
+  c = std::get<SessionConfig>(configFromHello(h264, limits, Defaults{}, testCatalog()));
+  EXPECT_NE(c.level, 3);
+  refused(321, 200, "321x200 is odd: ENCODING_H264 needs an even width and height");
+}
+
+// A session that sets no H.264 bitrate gets one that follows its frame size
+// and rate; one it set stays through a resize.
+TEST(Protocol, TheDefaultH264BitrateFollowsTheSize) {
+  EXPECT_EQ(defaultH264BitrateKbps(1280, 720, 30), 2765);
+  EXPECT_EQ(defaultH264BitrateKbps(1920, 1080, 30), 6221);
+  EXPECT_EQ(defaultH264BitrateKbps(1920, 1080, 60), 12442);
+  EXPECT_EQ(defaultH264BitrateKbps(256, 256, 30), kMinDefaultH264BitrateKbps);
+  EXPECT_EQ(defaultH264BitrateKbps(2048, 2048, 60), kMaxDefaultH264BitrateKbps);
+
+  Limits limits;
+  auto h = goodHello();
+  h.set_encoding(v1::ENCODING_H264);
+  h.set_width(640);
+  h.set_height(360);
+  h.set_fps_cap(30);
+  auto c = std::get<SessionConfig>(configFromHello(h, limits, Defaults{}, testCatalog()));
+  EXPECT_EQ(h264Settings(c).bitrateKbps, kMinDefaultH264BitrateKbps);
+  v1::RenderSettings s;
+  s.set_width(1920);
+  s.set_height(1080);
+  ASSERT_FALSE(applySettings(c, s, limits, testCatalog()));
+  EXPECT_EQ(h264Settings(c).bitrateKbps, 6221);
+  EXPECT_EQ(settingsToWire(c).h264_bitrate_kbps(), 6221u) << "Frame.settings says the cap in effect";
+  s.Clear();
+  s.set_h264_bitrate_kbps(1500);
+  ASSERT_FALSE(applySettings(c, s, limits, testCatalog()));
+  s.Clear();
+  s.set_width(1280);
+  s.set_height(720);
+  ASSERT_FALSE(applySettings(c, s, limits, testCatalog()));
+  EXPECT_EQ(h264Settings(c).bitrateKbps, 1500) << "a bitrate the client set is kept";
+}
+
 TEST(Protocol, LatestPoseWinsAndBadPosesChangeNothing) {
   PoseState state = initialPose(render::Camera{}, {render::Pose{}, render::Pose{}});
   v1::PoseUpdate u;

@@ -226,6 +226,59 @@ TEST(RenderSession, SceneSwitchAnnouncesSceneInfoAndBuildsItsRenderer) {
   EXPECT_EQ(f.port.sent.back().scene_info().objects(1).material(), "phong:16");
 }
 
+// A resize (RenderSettings.width/height) keeps the renderer: no build, and
+// the next frame comes at the new size.
+TEST(RenderSession, AResizeKeepsTheRendererAndTheNextFrameHasTheNewSize) {
+  Fixture f;
+  f.welcome();
+  f.finishRender(f.t0 + 5ms);
+  ASSERT_EQ(f.port.frames.back().frame().width(), 16u);
+  v1::ClientMessage m;
+  m.mutable_settings()->set_width(64);
+  m.mutable_settings()->set_height(48);
+  f.receive(m, f.t0 + 200ms);
+  EXPECT_EQ(f.port.prepared.size(), 1u) << "a new size builds nothing";
+  ASSERT_EQ(f.port.orders.size(), 2u);
+  EXPECT_EQ(f.port.orders.back().pixels, 64u * 48u);
+  f.finishRender(f.t0 + 210ms);
+  EXPECT_EQ(f.port.frames.back().frame().width(), 64u);
+  EXPECT_EQ(f.port.frames.back().frame().height(), 48u);
+  // A size past the limits is refused, not fatal, and nothing changes.
+  m.mutable_settings()->set_width(100000);
+  f.receive(m, f.t0 + 400ms);
+  EXPECT_EQ(f.port.sent.back().error().code(), v1::ERROR_CODE_BAD_RESOLUTION);
+  EXPECT_FALSE(f.port.sent.back().error().fatal());
+  EXPECT_EQ(f.session.config().width, 64);
+  EXPECT_FALSE(f.port.closeCode);
+}
+
+// Frame.server_ms is the server's time for the frame: a renderer build that
+// the frame waited for, or the time a still view sat before a settings
+// change, is not in it.
+TEST(RenderSession, ServerMsNeverCountsABuildOrAnIdleSpell) {
+  Fixture f;
+  f.welcome();
+  f.finishRender(f.t0 + 5ms);
+  f.receive(pose(1), f.t0 + 200ms);
+  f.finishRender(f.t0 + 230ms);
+  EXPECT_NEAR(f.port.frames.back().frame().server_ms(), 30.0, 1e-6);
+  // Another level: a build of 20 s; the frame after it took 40 ms.
+  v1::ClientMessage m;
+  m.mutable_settings()->set_level(3);
+  f.receive(m, f.t0 + 1s);
+  ASSERT_EQ(f.port.prepared.size(), 2u);
+  f.session.onPrepared(f.port.prepared.back().rendererKey(), Fixture::prepared(), "", f.t0 + 21s);
+  f.finishRender(f.t0 + 21s + 40ms);
+  EXPECT_NEAR(f.port.frames.back().frame().server_ms(), 40.0, 1e-6);
+  // A still view for a minute, then an exposure change (no pose): 25 ms.
+  m.Clear();
+  m.mutable_settings()->set_exposure_mode(v1::EXPOSURE_MODE_FIXED);
+  m.mutable_settings()->set_exposure_stops(1.0);
+  f.receive(m, f.t0 + 81s);
+  f.finishRender(f.t0 + 81s + 25ms);
+  EXPECT_NEAR(f.port.frames.back().frame().server_ms(), 25.0, 1e-6);
+}
+
 TEST(RenderSession, PosesArePacedToTheFpsCapAndTheLatestWins) {
   Fixture f;
   f.welcome();

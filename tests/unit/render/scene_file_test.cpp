@@ -144,3 +144,57 @@ TEST(SceneFile, AFifoOrADirectoryIsRefusedBeforeItIsOpened) {
 
 }  // namespace
 }  // namespace haarcast::render
+
+namespace haarcast::render {
+namespace {
+
+// A Z-up mesh (a post 4 tall along +Z, 1 × 1 across, with a tip leaning to
+// +X at its top, as Lucy and many scans are stored): "up": "z" stands it
+// along +Y, its top still leaning to +X; without it, it lies along Z.
+TEST(SceneFile, AZUpMeshStandsAlongYWithUpZ) {
+  const auto dir = std::filesystem::temp_directory_path() / "haarcast_scene_up";
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "post.obj") << "v -0.5 -0.5 0\nv 0.5 -0.5 0\nv 0.5 0.5 0\nv -0.5 0.5 0\n"
+                                     "v -0.5 -0.5 4\nv 0.5 -0.5 4\nv 0.5 0.5 4\nv -0.5 0.5 4\nv 1.5 0 4\n"
+                                     "f 1 2 6\nf 1 6 5\nf 2 3 7\nf 2 7 6\nf 3 4 8\nf 3 8 7\nf 4 1 5\nf 4 5 8\n"
+                                     "f 5 6 9\nf 6 7 9\nf 7 8 9\nf 8 5 9\nf 1 3 2\nf 1 4 3\n";
+  const auto load = [&](const std::string& up) {
+    std::ofstream(dir / "scene.json") << R"({"objects": [{"mesh": "post.obj", "material": "lambert", "fit": false)"
+                                      << (up.empty() ? "" : R"(, "up": ")" + up + "\"") << "}]}";
+    return loadScene((dir / "scene.json").string());
+  };
+  const auto extent = [](const Scene& s) {
+    const Bounds b = s.objects[0].mesh->bounds();
+    return b.hi - b.lo;
+  };
+  const Scene lying = load("");
+  EXPECT_NEAR(extent(lying).z, 4.0, 1e-6);
+  EXPECT_NEAR(extent(lying).y, 1.0, 1e-6);
+  const Scene standing = load("z");
+  EXPECT_NEAR(extent(standing).y, 4.0, 1e-6) << "stands along +Y";
+  EXPECT_NEAR(extent(standing).z, 1.0, 1e-6);
+  const Mesh& m = *standing.objects[0].mesh;
+  // The tip (vertex 9, (1.5, 0, 4)) is at the top, still to +X: a turn, not a mirror.
+  EXPECT_NEAR(m.positions[8].x, 1.5f, 1e-6);
+  EXPECT_NEAR(m.positions[8].y, 4.0f, 1e-6);
+  EXPECT_NEAR(m.positions[8].z, 0.0f, 1e-6);
+  // Normals turn with it: the file's +Z-facing top faces now face up.
+  const Mesh& flat = *lying.objects[0].mesh;
+  for (std::size_t v = 0; v < m.normals.size(); ++v) {
+    EXPECT_NEAR(m.normals[v].y, flat.normals[v].z, 1e-6) << v;
+    EXPECT_NEAR(m.normals[v].z, -flat.normals[v].y, 1e-6) << v;
+  }
+  EXPECT_EQ(load("Z").objects[0].mesh->bounds().hi.y, standing.objects[0].mesh->bounds().hi.y);
+  // A bad value names the key and the choices.
+  std::ofstream(dir / "bad.json") << R"({"objects": [{"mesh": "post.obj", "material": "lambert", "up": "x"}]})";
+  try {
+    (void)loadScene((dir / "bad.json").string());
+    ADD_FAILURE() << "\"up\": \"x\" was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("objects[0].up: up axis \"x\" is not one of y, z"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace haarcast::render

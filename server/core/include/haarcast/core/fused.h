@@ -107,28 +107,32 @@ struct FusedScratch {
 
 // One object's lobe path (shared_layout.h, "The lobe path"): its slices'
 // lobes, the scene's prefiltered light and the turn from the object's frame
-// into the light's. `everyLobe`: every pixel takes it (`splitsum`), not
-// only those whose lobe the maps cannot resolve (shared::lobePathShare).
+// into the light's (core/lobe.h chooseLobeCore decides which objects have
+// one). `everyLobe`: it takes all of every lobe (`splitsum`), as with
+// coreAngle π.
 struct LobePath {
   const PrefilteredLight* light = nullptr;
   std::span<const shared::SliceLobe> lobes;  // one per θₒ slice
   glm::mat3 toLight{1.0f};                   // object frame → the prefiltered light's frame
   bool everyLobe = false;
+  // The lobes' core, measured with it (measureLobe): the path takes the
+  // directions within it of the lobe's axis, the pass the rest. π: the
+  // path takes all, and there is no pass.
+  float coreAngle = static_cast<float>(kPi);
 };
 
-// The share s of a pixel that takes the lobe path, at the slices' level.
-float lobePathShareAt(const LobePath& path, const shared::SliceBlend& blend, int level);
-
-// The lobe path's radiance: E_c·Σ_l w_l·L_l,c(R·axis), times the ray bit
-// (shared::kLobeSeenBit) of the pixel's word.
+// The lobe path's radiance: E_c of the core·Σ_i w_i·L_c(R·ω_i), times the
+// ray bit (shared::kLobeSeenBit) of the pixel's word.
 std::array<float, 3> lobeShade(const LobePath& path, const shared::SliceBlend& blend, const EulerYXY& r,
                                std::uint32_t word);
 
 // One pixel of `fused` with exact visibility: V(ω) = Σ_v b_v·bit_v(ω) blended
 // from the hit triangle's vertices (visibility_bits.h), then the pass below;
 // plus Σ_k power_k·ρ(Rᵀd_k) over the point lights whose bit k is set in
-// `visibleLights` (each pixel's own shadow rays). With a lobe path, the
-// result is (1 − s)·that + s·lobeShade, and the pass is skipped when s = 1.
+// `visibleLights` (each pixel's own shadow rays). With a lobe path, the pass
+// leaves the directions within the path's core angle of the lobe's axis to
+// lobeShade (and sums the lobe's energy less the core's), or is skipped
+// when the path takes all.
 std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBlend& blend, const EulerYXY& r,
                                 const FusedLight& light, std::span<const WeightedBits> visibility,
                                 std::span<const FusedPointLight> lights, std::uint32_t visibleLights,

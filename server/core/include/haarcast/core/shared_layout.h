@@ -255,6 +255,7 @@ struct ObjectInfo {
   uint flags;          // kObjectGround, …
   vec4 groundRadiance; // a ground object: the radiance of its unshadowed map light (rgb)
   vec4 toLight[3];     // `fused`'s lobe path: object frame → the environment's, this frame (columns)
+  vec4 lobeCore;       // x: cos of the lobe path's core angle (core fused.h LobePath::coreAngle), −1: the path takes all; yzw: 0
 };
 
 // ObjectInfo::flags: the object is the scene's ground, a Lambert plane that
@@ -291,15 +292,20 @@ struct PointLight {
 // ---- The lobe path of `fused` and the `splitsum` method (core/lobe.h,
 // core/prefiltered_light.h). A lobe narrower than the map's texels is not
 // summed over the map's directions but integrated over its own: I_c =
-// E_c·(1/KJ)·Σ_k,j L_c(ω_kj)·V(a), E_c = ∫ρ_c dω of the slice, a the lobe's
-// axis, and ω_kj at the angle a_k from the axis that splits off the k-th
-// of K equal shares of the lobe's energy, J azimuths each: stratified by
-// the lobe's own radial distribution. Each reads the light prefiltered to
-// its stratum's solid angle (its Haar scaling coefficients, level λ_k,
-// trilinear), so the K·J lookups see all of the light, not K·J points of it
-// (filtered importance sampling).
+// E_c·Σ_i w_i·L_c(ω_i)·V(a), E_c = ∫ρ_c dω of the lobe (or of its core),
+// a the lobe's axis (the mirror direction), and the samples ω_i stratified
+// by the lobe's own distribution, measured from the BRDF: kLobeBands radial
+// bands whose edges double outward from half the median angle, each cut
+// into kLobeSectors equal shares of its energy in azimuth, one sample at
+// each share's median, weighted by the share's energy w_i. Each reads the
+// light prefiltered to its share's solid angle (level λ_i, trilinear), so
+// the samples see all of the light, not points of it (filtered importance
+// sampling). The ring summary (angle, level) is K equal-energy rings about
+// the axis, for a single lookup's level.
 HC_CONST uint kLobeRings = 4u;      // K
 HC_CONST uint kLobeSectors = 8u;    // J
+HC_CONST uint kLobeBands = 8u;      // the lobe path's radial bands (samples)
+HC_CONST uint kLobeSamples = kLobeBands * kLobeSectors;
 
 // One slice's lobe, measured from the BRDF itself (core/lobe.h).
 struct SliceLobe {
@@ -307,18 +313,13 @@ struct SliceLobe {
   vec4 angle;    // a_k: the angle from the axis of ring k's median share (radians)
   vec4 level;    // λ_k: the prefiltered level whose texels have ring k's per-sample solid angle
   vec4 median;   // x: the angle holding half the energy; yzw: 0
+  vec4 core;     // rgb: ∫ρ_c dω within the core angle (the lobe path's part of the energy); a: 0
+  // Sample kJ + j of the lobe path: (a, b, λ, w), the angle a from the
+  // axis, the azimuth b from u = (1, 0, 0) toward v = axis × u = (0, −sin θ,
+  // −cos θ), the prefiltered level λ of its stratum's solid angle, and its
+  // share w of the energy (Σ w = 1).
+  vec4 samples[kLobeSamples];
 };
-
-// The share of a pixel that takes the lobe path at map level n: 1 while
-// the lobe's median angle is at most kLobeTexelsLow of a level-n texel (π/2^n),
-// 0 from kLobeTexelsHigh, linear between, so no seam shows where a
-// surface's θₒ crosses over.
-HC_CONST float kLobeTexelsLow = 0.5f;
-HC_CONST float kLobeTexelsHigh = 1.0f;
-HC_FUNCTION float lobePathShare(float medianAngle, uint level) {
-  const float texels = medianAngle * float(1u << level) / kPiF;
-  return clamp((kLobeTexelsHigh - texels) / (kLobeTexelsHigh - kLobeTexelsLow), 0.0f, 1.0f);
-}
 
 // The lobe of θₒ between two slices: each field linear in the blend weight.
 HC_FUNCTION SliceLobe blendLobes(SliceLobe a, SliceLobe b, float t) {
@@ -327,6 +328,8 @@ HC_FUNCTION SliceLobe blendLobes(SliceLobe a, SliceLobe b, float t) {
   l.angle = a.angle + t * (b.angle - a.angle);
   l.level = a.level + t * (b.level - a.level);
   l.median = a.median + t * (b.median - a.median);
+  l.core = a.core + t * (b.core - a.core);
+  for (uint i = 0u; i < kLobeSamples; ++i) l.samples[i] = a.samples[i] + t * (b.samples[i] - a.samples[i]);
   return l;
 }
 
@@ -462,10 +465,11 @@ struct GBufferPush {
 #ifdef __cplusplus
 static_assert(sizeof(FrameParams) == 128 && offsetof(FrameParams, tanHalf) == 96 &&
               offsetof(FrameParams, fusedGroups) == 124);
-static_assert(sizeof(ObjectInfo) == 144 && offsetof(ObjectInfo, toLight) == 96 && offsetof(ObjectInfo, sliceBase) == 48 &&
+static_assert(sizeof(ObjectInfo) == 160 && offsetof(ObjectInfo, toLight) == 96 && offsetof(ObjectInfo, sliceBase) == 48 &&
               offsetof(ObjectInfo, skipBelowY) == 68 && offsetof(ObjectInfo, groundRadiance) == 80);
 static_assert(sizeof(PointLight) == 32);
-static_assert(sizeof(SliceLobe) == 64 && offsetof(SliceLobe, angle) == 16 && offsetof(SliceLobe, median) == 48);
+static_assert(sizeof(SliceLobe) == 80 + 16 * kLobeSamples && offsetof(SliceLobe, angle) == 16 &&
+              offsetof(SliceLobe, median) == 48 && offsetof(SliceLobe, samples) == 80);
 static_assert(kLobeSeenBit >= (1u << kMaxPointLights), "the lobe's bit lies above the light bits");
 static_assert(kMaxPointLights <= kGroundOcclusionShift, "the light bits and the ground's occlusion share one word");
 static_assert(sizeof(RotationSample) == 32 && offsetof(RotationSample, alpha) == 8 &&

@@ -30,7 +30,7 @@
 
 namespace haarcast::net {
 
-inline constexpr int kDefaultH264BitrateKbps = 4000;   // the cap when a session sets none
+inline constexpr int kDefaultH264BitrateKbps = 4000;   // the encoder's own default (a session's follows its size)
 inline constexpr int kMinH264BitrateKbps = 100;
 inline constexpr int kMaxH264BitrateKbps = 50000;      // Welcome.limits.max_h264_bitrate_kbps
 inline constexpr int kDefaultH264KeyframeInterval = 120;  // frames; 4 s at 30 fps
@@ -43,6 +43,17 @@ inline constexpr int kH264Crf = 23;  // x264's default quality; the cap above bo
 // inside a 30 fps budget; bandwidth is what a session is charged for, so
 // veryfast (CABAC, 8×8 transform: High profile).
 inline constexpr const char* kH264Preset = "veryfast";
+
+// The bitrate cap of a session that sets none: it follows the frame size
+// and rate, kH264DefaultBitsPerPixel bits per pixel per frame (a still view
+// costs far less: constant quality under the cap), within
+// kMinDefaultH264BitrateKbps..kMaxDefaultH264BitrateKbps. 0.1 bit per pixel
+// gives 2.8 Mbit/s at 1280×720 and 6.2 Mbit/s at 1920×1080, 30 fps: the
+// rates streaming services ask for at those sizes.
+inline constexpr double kH264DefaultBitsPerPixel = 0.1;
+inline constexpr int kMinDefaultH264BitrateKbps = 1000;
+inline constexpr int kMaxDefaultH264BitrateKbps = 20000;
+int defaultH264BitrateKbps(int width, int height, double fps);
 
 struct H264Settings {
   int width = 0;   // even, 2..io::kMaxImageDimension

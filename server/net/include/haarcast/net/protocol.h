@@ -106,8 +106,9 @@ struct SessionConfig {
   Backend backend = Backend::Cpu;
   bool autoExposure = true;   // else exposureStops
   double exposureStops = 0.0;
-  // ENCODING_H264 only (h264_encoder.h has the ranges).
-  int h264BitrateKbps = kDefaultH264BitrateKbps;
+  // ENCODING_H264 only (h264_encoder.h has the ranges). A bitrate of 0:
+  // none set, the cap follows the size (defaultH264BitrateKbps).
+  int h264BitrateKbps = 0;
   int h264KeyframeInterval = kDefaultH264KeyframeInterval;
 
   // Identifies the prepared renderer this config needs; equal keys share one.
@@ -162,7 +163,8 @@ v1::Backend toWire(Backend backend);
 v1::RenderSettings settingsToWire(const SessionConfig& config);
 v1::ServerLimits limitsToWire(const Limits& limits);
 // The H.264 encoder settings of a config (size, bitrate, keyframe interval,
-// fps); meaningful for ENCODING_H264.
+// fps); meaningful for ENCODING_H264. A config that set no bitrate gets
+// defaultH264BitrateKbps of its size and fps.
 H264Settings h264Settings(const SessionConfig& config);
 // The config's scene, its objects (named by the catalog) and their materials.
 v1::SceneInfo sceneInfo(const SessionConfig& config, const Catalog& catalog);

@@ -44,7 +44,10 @@ struct FrameContext {
   std::atomic<bool> cancelled{false};
   std::uint64_t poseSequence = 0;
   double clientTimeMs = 0.0;
-  Clock::time_point poseReceived;
+  // The request this frame answers: its pose received, or a later settings
+  // or scene change, or the renderer ready after a build (Frame.server_ms
+  // counts from here: a build is not frame time).
+  Clock::time_point requested;
   SessionConfig config;
 };
 
@@ -194,7 +197,7 @@ class RenderSession {
   std::mutex mutex_;
   SessionConfig config_;
   PoseState pose_;
-  Clock::time_point poseReceived_;
+  Clock::time_point requested_;  // the latest pose, change or renderer ready (FrameContext::requested)
   std::optional<double> lastExposure_;  // auto exposure: the last frame's, eased from (tonemap.h)
   Clock::time_point lastExposureAt_;
   std::atomic<bool> ended_{false};

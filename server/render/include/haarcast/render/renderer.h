@@ -136,6 +136,7 @@ struct PreparedObject {
   // for every object, and lobePath always; its `table` is empty.
   std::vector<shared::SliceLobe> lobes;
   bool lobePath = false;
+  float lobeCore = 0.0f;  // the lobe path's core angle (fused.h LobePath::coreAngle); π: the path takes all
 };
 
 struct PreparedScene {

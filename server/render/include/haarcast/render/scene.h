@@ -60,7 +60,7 @@ Environment constantEnvironment(double radiance);
 Environment environmentFromFile(const std::string& path, const std::string& layout = "auto");
 
 struct Material {
-  std::string name;      // as written in the scene ("phong:64", a file path)
+  std::string name;      // as written in the scene ("phong:64"); a MERL file: "merl:" + its stem, never a path
   std::string cacheKey;  // identifies the BRDF for the slice-table cache
   std::shared_ptr<const Brdf> brdf;
   std::string warning;   // non-empty when the file needed a repair (shown to the user)
@@ -135,5 +135,17 @@ Scene loadScene(const std::string& path, const SceneLimits& limits = {});
 
 // Centre a mesh on the origin and scale it to unit bounding radius.
 void fitToUnitSphere(Mesh& mesh);
+
+// A mesh's up axis as its file has it: +Y (haarcast's, and most OBJ files)
+// or +Z (Lucy, many scans and CAD exports, which otherwise lie on their
+// side). Scene files say it per object ("up": "y"|"z"), `render` and
+// `reference` with --up.
+enum class UpAxis { Y, Z };
+// "y" or "z" (either case); throws std::invalid_argument naming the choices.
+UpAxis parseUpAxis(const std::string& text);
+// Turns a mesh whose up is `up` to stand along +Y: for Z, a rotation of −90°
+// about X, (x, y, z) → (x, z, −y), positions and normals alike (a rotation,
+// so the winding and the normals' sides are kept). Y changes nothing.
+void makeYUp(Mesh& mesh, UpAxis up);
 
 }  // namespace haarcast::render
