@@ -3,8 +3,7 @@
 // includer declares, before this file:
 //   uniform samplerBuffer lobeLight;     the texels
 //   const uint PREFILTER_FINEST;         the light's finest level (a spec constant)
-// splitsum.comp reads it through these; fused.comp has its own copy of the
-// same two functions (the lobe path), to be replaced by this include.
+// splitsum.comp and fused.comp's lobe path read it through these.
 #ifndef HAARCAST_PREFILTERED_GLSL
 #define HAARCAST_PREFILTERED_GLSL
 

@@ -300,9 +300,7 @@ struct PointLight {
 // each share's median, weighted by the share's energy w_i. Each reads the
 // light prefiltered to its share's solid angle (level λ_i, trilinear), so
 // the samples see all of the light, not points of it (filtered importance
-// sampling). The ring summary (angle, level) is K equal-energy rings about
-// the axis, for a single lookup's level.
-HC_CONST uint kLobeRings = 4u;      // K
+// sampling).
 HC_CONST uint kLobeSectors = 8u;    // J
 HC_CONST uint kLobeBands = 8u;      // the lobe path's radial bands (samples)
 HC_CONST uint kLobeSamples = kLobeBands * kLobeSectors;
@@ -310,8 +308,6 @@ HC_CONST uint kLobeSamples = kLobeBands * kLobeSectors;
 // One slice's lobe, measured from the BRDF itself (core/lobe.h).
 struct SliceLobe {
   vec4 energy;   // rgb: ∫ρ_c dω (cos θᵢ included); a: the axis' θ, local direction (0, cos θ, −sin θ)
-  vec4 angle;    // a_k: the angle from the axis of ring k's median share (radians)
-  vec4 level;    // λ_k: the prefiltered level whose texels have ring k's per-sample solid angle
   vec4 median;   // x: the angle holding half the energy; yzw: 0
   vec4 core;     // rgb: ∫ρ_c dω within the core angle (the lobe path's part of the energy); a: 0
   // Sample kJ + j of the lobe path: (a, b, λ, w), the angle a from the
@@ -325,8 +321,6 @@ struct SliceLobe {
 HC_FUNCTION SliceLobe blendLobes(SliceLobe a, SliceLobe b, float t) {
   SliceLobe l;
   l.energy = a.energy + t * (b.energy - a.energy);
-  l.angle = a.angle + t * (b.angle - a.angle);
-  l.level = a.level + t * (b.level - a.level);
   l.median = a.median + t * (b.median - a.median);
   l.core = a.core + t * (b.core - a.core);
   for (uint i = 0u; i < kLobeSamples; ++i) l.samples[i] = a.samples[i] + t * (b.samples[i] - a.samples[i]);
@@ -468,8 +462,8 @@ static_assert(sizeof(FrameParams) == 128 && offsetof(FrameParams, tanHalf) == 96
 static_assert(sizeof(ObjectInfo) == 160 && offsetof(ObjectInfo, toLight) == 96 && offsetof(ObjectInfo, sliceBase) == 48 &&
               offsetof(ObjectInfo, skipBelowY) == 68 && offsetof(ObjectInfo, groundRadiance) == 80);
 static_assert(sizeof(PointLight) == 32);
-static_assert(sizeof(SliceLobe) == 80 + 16 * kLobeSamples && offsetof(SliceLobe, angle) == 16 &&
-              offsetof(SliceLobe, median) == 48 && offsetof(SliceLobe, samples) == 80);
+static_assert(sizeof(SliceLobe) == 48 + 16 * kLobeSamples && offsetof(SliceLobe, median) == 16 &&
+              offsetof(SliceLobe, core) == 32 && offsetof(SliceLobe, samples) == 48);
 static_assert(kLobeSeenBit >= (1u << kMaxPointLights), "the lobe's bit lies above the light bits");
 static_assert(kMaxPointLights <= kGroundOcclusionShift, "the light bits and the ground's occlusion share one word");
 static_assert(sizeof(RotationSample) == 32 && offsetof(RotationSample, alpha) == 8 &&
