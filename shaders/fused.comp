@@ -156,29 +156,7 @@ vec3 sumDirections(const bool blended, PixelSetup p, out vec3 norm) {
   return acc;
 }
 
-// Level `level` of the prefiltered light, bilinear at direction d (core
-// PrefilteredLight::sampleLevel).
-vec3 prefilteredAt(uint level, vec3 d) {
-  const LatLongTaps t = latLongTaps(level, atan2Fast(sqrt(d.x * d.x + d.z * d.z), d.y), atan2Fast(d.x, d.z));
-  const int base = int(prefilterOffset(level)), m = int(1u << level);
-  const vec3 a = texelFetch(lobeLight, base + int(t.row0) * m + int(t.col0)).rgb;
-  const vec3 b = texelFetch(lobeLight, base + int(t.row0) * m + int(t.col1)).rgb;
-  const vec3 c = texelFetch(lobeLight, base + int(t.row1) * m + int(t.col0)).rgb;
-  const vec3 e = texelFetch(lobeLight, base + int(t.row1) * m + int(t.col1)).rgb;
-  const vec3 top = t.tCol * (b - a) + a;
-  const vec3 bottom = t.tCol * (e - c) + c;
-  return t.tRow * (bottom - top) + top;
-}
-
-// Trilinear: ⌊λ⌋ and ⌊λ⌋ + 1 blended by λ's fraction (PrefilteredLight::sample).
-vec3 prefilteredAt(float level, vec3 d) {
-  const float lambda = clamp(level, 0.0, float(PREFILTER_FINEST));
-  const uint l0 = uint(lambda);
-  const float t = lambda - float(l0);
-  const vec3 a = prefilteredAt(l0, d);
-  if (t == 0.0 || l0 == PREFILTER_FINEST) return a;
-  return a + t * (prefilteredAt(l0 + 1u, d) - a);
-}
+#include "common/prefiltered.glsl"
 
 // The lobe path (shared_layout.h, core fused.cpp lobeShade): E_c of the
 // core times Σ_i w_i·L(ω_i) over the lobe's samples, each read at its level.

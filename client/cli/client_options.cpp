@@ -166,7 +166,8 @@ v1::RotationMethod parseMethod(const std::string& name) {
   if (name == "matrix") return v1::ROTATION_METHOD_MATRIX;
   if (name == "table") return v1::ROTATION_METHOD_TABLE;
   if (name == "fused") return v1::ROTATION_METHOD_FUSED;
-  throw std::invalid_argument("--method must be fused, haar, spatial, matrix or table (got \"" + name + "\")");
+  if (name == "splitsum") return v1::ROTATION_METHOD_SPLITSUM;
+  throw std::invalid_argument("--method must be fused, haar, spatial, matrix, table or splitsum (got \"" + name + "\")");
 }
 
 std::string methodName(v1::RotationMethod method) {
@@ -176,6 +177,7 @@ std::string methodName(v1::RotationMethod method) {
     case v1::ROTATION_METHOD_MATRIX: return "matrix";
     case v1::ROTATION_METHOD_TABLE: return "table";
     case v1::ROTATION_METHOD_FUSED: return "fused";
+    case v1::ROTATION_METHOD_SPLITSUM: return "splitsum";
     default: return "default";
   }
 }

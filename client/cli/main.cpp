@@ -192,7 +192,7 @@ int run(int argc, char** argv) {
   app.add_option("--keyframe-interval", h264.keyframeInterval,
                  "H.264 frames from one keyframe to the next (0 = the server's default)")
       ->check(CLI::Range(0u, 100000u));
-  app.add_option("--method", method, "Per-pixel method: fused | haar | spatial | matrix | table (default: the server's)");
+  app.add_option("--method", method, "Per-pixel method: fused | haar | spatial | matrix | table | splitsum (default: the server's)");
   app.add_option("--level", level,
                  "Map level n, 2^n x 2^n: " + std::to_string(minLevel()) + ".." + std::to_string(maxLevel()) +
                      " as far as the server allows (its Welcome says; 0 = the server's default)")

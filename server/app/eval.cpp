@@ -21,6 +21,7 @@
 #include "haarcast/render/renderer.h"
 #include "haarcast/render/scene.h"
 #include "haarcast/render/tonemap.h"
+#include "eval_methods.h"
 #include "eval_truth.h"
 #include "progress.h"
 #include "report_figures.h"
@@ -185,7 +186,8 @@ std::string timingsTable(const nlohmann::json& timings) {
       {"tables_s", "Tables 1–4 and the MSE data"},
       {"glossiness_s", "glossiness grid"},
       {"truth_s", "truth PSNR (Monte Carlo and every method)"},
-      {"shadow_truth_s", "shadow truth (three Monte Carlo renders per scene, fused and haar)"}};
+      {"shadow_truth_s", "shadow truth (three Monte Carlo renders per scene, fused and haar)"},
+      {"methods_ranked_s", "methods ranked (two Monte Carlo renders per material, five methods)"}};
   const double total = timings.value("total_s", 0.0);
   std::ostringstream md;
   auto row = [&](const std::string& name, double s) {
@@ -208,7 +210,16 @@ std::string timingsTable(const nlohmann::json& timings) {
 
 EvalResult runEval(const EvalOptions& options, ProgressReporter& progress) {
   EvalOptions o = options;
+  if (o.methodsOnly && (o.truthOnly || o.shadowsOnly)) {
+    throw std::invalid_argument("eval: --methods-only runs one section; it cannot go with --truth-only or --shadows-only");
+  }
   o.truthOnly = o.truthOnly || o.shadowsOnly;
+  // The sections: the seed's (tables, glossiness), the truth, the shadows,
+  // the ranking of the methods; each flag keeps some of them.
+  const bool seedSections = !o.truthOnly && !o.methodsOnly;
+  const bool truthSection = !o.shadowsOnly && !o.methodsOnly;
+  const bool shadowSection = !o.methodsOnly;
+  const bool rankingSection = !o.shadowsOnly;
   const auto tStart = Clock::now();
   fs::create_directories(o.outDir);
   auto log = [&](const std::string& line) { progress.message("[eval] " + line); };
@@ -238,7 +249,7 @@ EvalResult runEval(const EvalOptions& options, ProgressReporter& progress) {
 
   // ---- Tables 1–4 and the MSE data ----------------------------------------
   const auto tTables = Clock::now();
-  if (!o.truthOnly) {
+  if (seedSections) {
   const std::vector<glm::dvec3> poses = [&] {
     std::vector<glm::dvec3> p;
     for (const EulerYXY& r : randomRotations(rotations * static_cast<int>(a.models.size()), 2026u)) {
@@ -292,7 +303,7 @@ EvalResult runEval(const EvalOptions& options, ProgressReporter& progress) {
   }
   progress.update(stage, renders, renders);
   }
-  report["timings"]["tables_s"] = since(tTables);
+  if (seedSections) report["timings"]["tables_s"] = since(tTables);
 
   // ---- Glossiness grid: materials × light coefficients -------------------
   // Each tile is a PNG of its own (glossiness/); the script lays them out
@@ -300,7 +311,7 @@ EvalResult runEval(const EvalOptions& options, ProgressReporter& progress) {
   // object (the union of the renders' object masks), so that the object,
   // not the background, fills the sheet and the tiles still line up.
   const auto tGloss = Clock::now();
-  if (!o.truthOnly) {
+  if (seedSections) {
     const int glossLevel = o.quick ? 4 : 6;
     const int frameSize = o.quick ? 32 : 256;
     const std::vector<std::size_t> ks = {4, 16, 64, 256};
@@ -346,12 +357,12 @@ EvalResult runEval(const EvalOptions& options, ProgressReporter& progress) {
                             {"frame_size", frameSize}, {"tile_size", crop.size}, {"tiles", tiles}};
     for (const auto& [name, m] : a.glossMaterials) report["glossiness"]["materials"].push_back(name);
   }
-  report["timings"]["glossiness_s"] = since(tGloss);
+  if (seedSections) report["timings"]["glossiness_s"] = since(tGloss);
 
   // ---- Truth: the methods against converged Monte Carlo renders -------------
   const TruthRun truthRun{o, base, progress, log};
   const auto tTruth = Clock::now();
-  if (!o.shadowsOnly) {
+  if (truthSection) {
     const auto& model = a.models.front();
     const render::Scene scene = singleObjectScene(a.environments.front().second, model.first, model.second,
                                                   a.tableMaterials.back().second, {0.0, 20.0, 0.0});
@@ -359,23 +370,26 @@ EvalResult runEval(const EvalOptions& options, ProgressReporter& progress) {
                                      {{"model", model.first}, {"environment", a.environments.front().first},
                                       {"material", a.tableMaterials.back().first}});
   }
-  report["timings"]["truth_s"] = since(tTruth);
+  if (truthSection) report["timings"]["truth_s"] = since(tTruth);
   const auto tShadow = Clock::now();
   std::vector<std::string> shadowNotes;
-  report["shadow_truth"] = runShadowTruth(truthRun, shadowNotes);
+  if (shadowSection) report["shadow_truth"] = runShadowTruth(truthRun, shadowNotes);
+  if (shadowSection) report["timings"]["shadow_truth_s"] = since(tShadow);
+  const auto tRanked = Clock::now();
+  if (rankingSection) report["methods_ranked"] = runMethodRanking(truthRun, shadowNotes);
+  if (rankingSection) report["timings"]["methods_ranked_s"] = since(tRanked);
   for (const auto& n : shadowNotes) {
     log("note: " + n);
     report["notes"].push_back(n);
   }
-  report["timings"]["shadow_truth_s"] = since(tShadow);
   report["timings"]["total_s"] = since(tStart);
 
   // ---- report.json, then the figures from it, then report.md ---------------
   EvalResult result;
   const fs::path jsonPath = fs::path(o.outDir) / "report.json";
   std::ofstream(jsonPath) << report.dump(2) << '\n';
-  if (o.truthOnly) {
-    result.figures.problem = "--truth-only has no figures";
+  if (!seedSections) {
+    result.figures.problem = o.methodsOnly ? "--methods-only has no figures" : "--truth-only has no figures";
   } else if (o.figures) {
     // Unavailable is said by the command, last, where it is seen.
     result.figures = drawReportFigures(jsonPath);
@@ -392,13 +406,16 @@ EvalResult runEval(const EvalOptions& options, ProgressReporter& progress) {
 
   std::ostringstream md;
   md << "# haarcast evaluation\n\nGenerated by `haarcast eval --data " << o.dataDir << " --out " << o.outDir
-     << (o.quick ? " --quick" : "") << (o.shadowsOnly ? " --shadows-only" : o.truthOnly ? " --truth-only" : "") << "` in "
+     << (o.quick ? " --quick" : "")
+     << (o.shadowsOnly ? " --shadows-only" : o.truthOnly ? " --truth-only" : o.methodsOnly ? " --methods-only" : "")
+     << (o.methodsFrame > 0 ? " --methods-frame " + std::to_string(o.methodsFrame) : std::string())
+     << (o.methodsLevel > 0 ? " --methods-level " + std::to_string(o.methodsLevel) : std::string()) << "` in "
      << formatDuration(report["timings"]["total_s"].get<double>())
      << ". Every number is also in report.json; the figures are drawn from it by `tools/plot_report.py` "
         "(matplotlib).\n\n";
   for (const auto& n : report["notes"]) md << "- Note: " << n.get<std::string>() << "\n";
-  if (!drawn && !o.truthOnly) md << "- **Figures not drawn:** " << result.figures.problem << ".\n";
-  if (!o.truthOnly) {
+  if (!drawn && seedSections) md << "- **Figures not drawn:** " << result.figures.problem << ".\n";
+  if (seedSections) {
   md << "\n## Tables 1–4: average seed PSNR (dB)\n\nSeed PSNR = PSNR of the `haar` render against the same render with "
         "`spatial` rotation, over the object's pixels (DESIGN.md), averaged over the models ("
      << listed(report["config"]["models"]) << ") × " << rotations << " random rotations each; frames " << frame << "², "
@@ -442,7 +459,8 @@ EvalResult runEval(const EvalOptions& options, ProgressReporter& progress) {
      << g["tile_size"].get<int>() << "² square around the object (glossiness/).\n";
   }
   if (report.contains("truth")) md << methodTruthMarkdown(report["truth"]);
-  md << shadowTruthMarkdown(report["shadow_truth"]);
+  if (report.contains("shadow_truth")) md << shadowTruthMarkdown(report["shadow_truth"]);
+  if (report.contains("methods_ranked")) md << methodRankingMarkdown(report["methods_ranked"]);
   md << "\n## Timings\n\n" << timingsTable(report["timings"]);
   std::ofstream(fs::path(o.outDir) / "report.md") << md.str();
   result.report = std::move(report);
@@ -462,6 +480,13 @@ std::function<int()> addEvalCommand(CLI::App& app) {
               "Only the shadow truth (the shadow scenes against the reference with every object occluding)");
   c->add_option("--truth-frame", options->truthFrame,
                 "Frame size of the shadow truth (0 = 16 with --quick, else 64)")->capture_default_str();
+  c->add_flag("--methods-only", options->methodsOnly,
+              "Only the ranking of fused, haar, splitsum, table and matrix on speed, storage and truth "
+              "(a rough, a glossy and a near-mirror sphere under a real probe)");
+  c->add_option("--methods-frame", options->methodsFrame,
+                "Frame size of the methods' ranking (0 = 16 with --quick, else 64)")->capture_default_str();
+  c->add_option("--methods-level", options->methodsLevel,
+                "Map level of the methods' ranking (0 = 4 with --quick, else 5)")->capture_default_str();
   c->add_flag("!--no-figures", options->figures,
               "Do not run tools/plot_report.py (matplotlib) on report.json");
   c->add_flag("--json", *json, "Print report.json to stdout");
@@ -473,7 +498,8 @@ std::function<int()> addEvalCommand(CLI::App& app) {
     if (*json) std::cout << result.report.dump(2) << '\n';
     std::fprintf(stderr, "wrote %s/report.md and report.json%s\n", options->outDir.c_str(),
                  result.figures.status == FigureRun::Status::Drawn ? " and the figures" : "");
-    if (result.figures.status == FigureRun::Status::Unavailable && options->figures && !options->truthOnly && !options->shadowsOnly) {
+    if (result.figures.status == FigureRun::Status::Unavailable && options->figures && !options->truthOnly &&
+        !options->shadowsOnly && !options->methodsOnly) {
       std::fprintf(stderr, "figures not drawn: %s\n", result.figures.problem.c_str());
     }
     return result.figures.status == FigureRun::Status::Failed ? 1 : 0;

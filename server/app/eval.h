@@ -13,6 +13,9 @@
 //   shadow truth shadow-heavy scenes (objects shadowing themselves, each
 //                other and a ground) against the reference with every object
 //                occluding: whole, shadowed and lit pixels (eval_truth.h)
+//   methods ranked  fused, haar, splitsum, table and matrix on speed, storage
+//                and truth for a rough, a glossy and a near-mirror sphere
+//                under a real probe (eval_methods.h)
 //
 // The figures (MSE plots, the labelled glossiness sheet) are drawn from
 // report.json by tools/plot_report.py with matplotlib (report_figures.h).
@@ -36,12 +39,16 @@ struct EvalOptions {
   bool truthOnly = false;  // only the truth sections (Monte Carlo and every method, shadow scenes)
   bool shadowsOnly = false;  // only the shadow truth (implies truthOnly)
   int truthFrame = 0;      // shadow truth frame size; 0 = 16 (quick) or 64
+  bool methodsOnly = false;  // only the ranking of the methods (eval_methods.h)
+  int methodsFrame = 0;      // its frame size; 0 = 16 (quick) or 64
+  int methodsLevel = 0;      // its map level; 0 = 4 (quick) or 5
   bool figures = true;     // run tools/plot_report.py on report.json
   unsigned threads = 0;
 };
 
 struct EvalResult {
-  nlohmann::json report;  // keys "config", "tables", "mse", "figures", "glossiness", "truth", "shadow_truth", "timings"
+  nlohmann::json report;  // keys "config", "tables", "mse", "figures", "glossiness", "truth", "shadow_truth",
+                          // "methods_ranked", "timings"
   FigureRun figures;      // whether the figures were drawn, and why not
 };
 

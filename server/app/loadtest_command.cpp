@@ -165,11 +165,12 @@ int run(const LoadtestArgs& a) {
 
   // Storage first, in this process and before any run: the server then finds
   // the slice tables and visibility in the shared cache.
+  // splitsum too, always: its lobes are the floor of what a method can keep.
   std::vector<RotationMethod> sized = p.methods;
-  for (RotationMethod m : {RotationMethod::Haar, RotationMethod::Table}) {
+  for (RotationMethod m : {RotationMethod::Haar, RotationMethod::Table, RotationMethod::Splitsum}) {
     if (std::find(sized.begin(), sized.end(), m) == sized.end()) sized.push_back(m);
   }
-  // At the runs' level: every run's method, haar and table (the storage
+  // At the runs' level: every run's method, haar, table and splitsum (the storage
   // figure reuses these when the levels agree) and the PRT baselines.
   std::vector<RotationMethod> atRunLevel = sized;
   for (RotationMethod m : kPrtBaselines) {

@@ -205,7 +205,8 @@ std::string toMarkdown(const LoadtestReport& r, const std::string& figuresNote) 
   md += "## Storage and the PRT download baseline\n\n";
   md += "stored bytes = the BRDF coefficient data a method holds for this scene (all objects, all channels): "
         "`makeRotator(method, slices)->storedBytes()`, with what rotators share (matrix's elevation matrices) "
-        "counted once, or for fused the slices in pixel form.\n\n";
+        "counted once, or for fused the slices in pixel form, for splitsum its lobes alone (64 bytes per θₒ "
+        "sample: no slices).\n\n";
   md += "| method | stored bytes, level " + std::to_string(r.runStorage.level) + " | stored bytes, level " +
         std::to_string(r.storage.level) + " |\n|---|---|---|\n";
   for (const auto& [m, bytes] : r.storage.storedBytes) {

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "haarcast/core/fused.h"
+#include "haarcast/core/splitsum.h"
 
 namespace haarcast::app {
 namespace {
@@ -27,6 +28,11 @@ std::size_t methodStoredBytes(RotationMethod method, const std::vector<BrdfSlice
                               const RotatorOptions& rotator) {
   std::size_t bytes = 0, shared = 0;  // every table has the same level: one shared part
   for (const BrdfSliceTable& table : tables) {
+    if (method == RotationMethod::Splitsum) {
+      // splitsum keeps its lobes alone (core/splitsum.h): 64 bytes per θₒ sample.
+      bytes += splitsumStoredBytes(table.thetaSamples());
+      continue;
+    }
     if (method == RotationMethod::Fused) {
       // fused reads the unrotated slices in pixel form (cpu_backend.cpp keeps
       // exactly this per object), every channel.

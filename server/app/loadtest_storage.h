@@ -9,7 +9,8 @@
 // data from makeRotator(...)->storedBytes() (rotation.h: the unrotated slices
 // plus whatever the method precomputed, or for `table` the copies that replace
 // them) and, for `fused`, PixelSlices::storedBytes() (the slices in pixel form,
-// the only BRDF data fused reads). Visibility, light and meshes are the same
+// the only BRDF data fused reads); for `splitsum`, splitsumStoredBytes (its
+// lobes, one per θₒ sample: it keeps no slices). Visibility, light and meshes are the same
 // for every method and counted apart.
 #pragma once
 

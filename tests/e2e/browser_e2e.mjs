@@ -455,7 +455,7 @@ try {
   check(Number(h1.frameMs) > 0, `HUD frame time is a positive number of ms ("${h1.frameMs}")`);
   check(/encode \d/.test(h1.stages) && /(fused|triple-product) \d/.test(h1.stages),
         `HUD shows the server's stage times ("${h1.stages}")`);
-  check(['fused', 'haar', 'spatial', 'matrix', 'table'].includes(h1.method), `HUD method names a method ("${h1.method}")`);
+  check(['fused', 'haar', 'spatial', 'matrix', 'table', 'splitsum'].includes(h1.method), `HUD method names a method ("${h1.method}")`);
   check(/stops (auto|fixed)$/.test(h1.exposure), `HUD shows the frame's exposure ("${h1.exposure}")`);
   await page.waitForTimeout(600);
   const h2 = await hud();

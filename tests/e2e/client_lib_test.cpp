@@ -76,9 +76,10 @@ TEST(Flags, SizeEncodingAndMethod) {
   EXPECT_EQ(encodingFileExtension(v1::ENCODING_H264), ".png");
   EXPECT_EQ(parseMethod(""), v1::ROTATION_METHOD_UNSPECIFIED);
   for (auto m : {v1::ROTATION_METHOD_HAAR, v1::ROTATION_METHOD_SPATIAL, v1::ROTATION_METHOD_MATRIX,
-                 v1::ROTATION_METHOD_TABLE}) {
+                 v1::ROTATION_METHOD_TABLE, v1::ROTATION_METHOD_FUSED, v1::ROTATION_METHOD_SPLITSUM}) {
     EXPECT_EQ(parseMethod(methodName(m)), m);
   }
+  EXPECT_EQ(methodName(v1::ROTATION_METHOD_SPLITSUM), "splitsum");
   EXPECT_THROW(parseMethod("Haar"), std::invalid_argument);
 }
 

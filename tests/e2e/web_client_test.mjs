@@ -133,7 +133,7 @@ test('reconnect back-off: 1, 2, 4, … 30 s with ±20 % jitter', () => {
   assert.equal(backoffMs(1, 0.999999), 1200);
 });
 
-const methods = ['haar', 'spatial', 'matrix', 'table', 'fused'];
+const methods = ['haar', 'spatial', 'matrix', 'table', 'fused', 'splitsum'];
 
 test('page parameters: good ones', () => {
   const p = parsePageParameters('?size=320x200&encoding=raw&quality=90&fps=0.5&token=a%20b&method=haar&level=5&k=64' +

@@ -97,14 +97,7 @@ shared::SliceLobe measureLobe(const Brdf& brdf, double thetaOut, double coreAngl
   lobe.energy = glm::vec4(glm::vec3(energy), static_cast<float>(thetaOut));
   lobe.median = glm::vec4(static_cast<float>(quantile(0.5)), 0.0f, 0.0f, 0.0f);
   lobe.core = glm::vec4(glm::vec3(coreAngle >= kPi ? energy : core), 0.0f);
-  constexpr int kK = static_cast<int>(shared::kLobeRings), kJ = static_cast<int>(shared::kLobeSectors);
-  for (int k = 0; k < kK; ++k) {
-    // The ring summary: K equal shares of the energy.
-    const double lo = k == 0 ? 0.0 : quantile(static_cast<double>(k) / kK);
-    const double hi = quantile(static_cast<double>(k + 1) / kK);
-    lobe.angle[k] = static_cast<float>(quantile((k + 0.5) / kK));
-    lobe.level[k] = levelOfSolidAngle(kTwoPi * (std::cos(lo) - std::cos(hi)) / kJ);
-  }
+  constexpr int kJ = static_cast<int>(shared::kLobeSectors);
   // The lobe path's samples. Equal shares of the energy would leave the last
   // share of a heavy-tailed lobe (GGX's falls as θ⁻⁴) one band from a few
   // degrees out to the horizon, read at that band's solid angle: a quarter

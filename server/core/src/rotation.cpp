@@ -66,6 +66,7 @@ std::string_view methodName(RotationMethod m) {
     case RotationMethod::Matrix: return "matrix";
     case RotationMethod::Table: return "table";
     case RotationMethod::Fused: return "fused";
+    case RotationMethod::Splitsum: return "splitsum";
   }
   return "?";
 }
@@ -120,6 +121,8 @@ std::unique_ptr<SliceRotator> makeRotator(RotationMethod method, std::vector<Haa
     case RotationMethod::Table: return detail::makeTableRotator(std::move(slices), options);
     case RotationMethod::Fused:
       throw std::invalid_argument("makeRotator: fused rotates no coefficients (it samples the slice per pixel, core/fused.h)");
+    case RotationMethod::Splitsum:
+      throw std::invalid_argument("makeRotator: splitsum keeps no slices (it reads the prefiltered light, core/splitsum.h)");
   }
   throw std::invalid_argument("makeRotator: unknown method");
 }

@@ -133,11 +133,15 @@ void VulkanRenderer::Impl::ensureResolution(int w, int h) {
   resolve->bind({&frameParams, &gbufIds, &radiance, &background, &edges});
   exposure->bind({&frameParams, &gbufIds, &radiance, &exposureResult});
   tonemap->bind({&frameParams, &radiance, &rgba8, &thresholds, &exposureResult});
-  if (fused) {
+  if (fused || splitsum) {
     // Each sample's point-light mask, written by the host every frame (the
     // frame's "shadow-rays" stage) and read by the fused pass.
     masks = Buffer(context, sampleCapacity * sizeof(std::uint32_t), kStorageUsage, MemoryUse::DeviceInput);
     maskUpload = BufferUpload(context, masks);
+    if (splitsum) {
+      fusedPass->bind({&samples, &shade, &objects, &counter, &masks, &lobes, &lobeLightTexels, &radiance});
+      return;
+    }
     fusedPass->bind({&samples, &shade, &objects, &sliceTexels, &lightTexels, &visibilityTexels, &directionTexels,
                      &pointLights, &radiance, &counter, &masks, &sliceEnergy, &lobes, &lobeLightTexels});
     return;

@@ -1,6 +1,7 @@
 // A `fused` frame: [G-buffer → rotation input (compaction, indirect
 // arguments)] → the host's shadow rays for the covered samples read back →
-// [fused (vkCmdDispatchIndirect) → tonemap]. Two submissions (each one
+// [fused (vkCmdDispatchIndirect) → tonemap]. A `splitsum` frame is the same
+// with splitsum.comp as the pass, its rays the mirror rays alone. Two submissions (each one
 // command buffer on devices with timestamps), because each sample's
 // point-light bits come from Embree on the host (render/point_lights.h),
 // the same rays as the CPU backend's for the same hit.
@@ -14,6 +15,7 @@
 #include "haarcast/core/check.h"
 #include "haarcast/core/fused.h"
 #include "haarcast/core/parallel.h"
+#include "haarcast/core/splitsum.h"
 #include "haarcast/render/point_lights.h"
 #include "haarcast/render/shading.h"
 
@@ -57,7 +59,9 @@ std::uint32_t VulkanRenderer::Impl::computeShadowMasks(const render::ResolvedFra
   // from the interior pixels' centre samples (slot < pixels), as the CPU.
   const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
   render::GroundSkyGrid sky(static_cast<int>(width), static_cast<int>(height));
-  if (prepared.ground) {
+  // splitsum shades its ground as any object (core/splitsum.h): no hidden sky.
+  const bool groundSky = fused && prepared.ground;
+  if (groundSky) {
     std::vector<std::uint32_t> centreOf(pixels, ~0u);
     for (std::size_t s = 0; s < count.covered; ++s)
       if (sh[s].pixel < pixels && sh[s].object < objectCount) centreOf[sh[s].pixel] = static_cast<std::uint32_t>(s);
@@ -85,7 +89,7 @@ std::uint32_t VulkanRenderer::Impl::computeShadowMasks(const render::ResolvedFra
       const render::ShadingPoint point = pointOf(sample);
       out[s] = render::pointLightMask(*rays, point, lightDirections);
       if (prepared.objects[sample.object].lobePath) out[s] |= render::lobeRayBit(*rays, point, eye);
-      if (prepared.objects[sample.object].ground) {
+      if (groundSky && prepared.objects[sample.object].ground) {
         // Its pixel: the slot itself, or the edge pixel a sub-sample's slot belongs to.
         const std::size_t pixel = sample.pixel < pixels ? sample.pixel : (sample.pixel - pixels) / shared::kSubsamples;
         out[s] = render::withGroundOcclusion(
@@ -113,7 +117,7 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
   HC_CHECK_LE(lightCount, std::size_t{shared::kMaxPointLights});
   for (std::size_t i = 0; i < objectCount; ++i) {
     const render::ResolvedObject& o = resolved.objects[i];
-    fusedLightTexels(o.fusedLight.planes, std::span<glm::vec4>(lightTexelData).subspan(i * coefficients, coefficients));
+    if (fused) fusedLightTexels(o.fusedLight.planes, std::span<glm::vec4>(lightTexelData).subspan(i * coefficients, coefficients));
     ObjectInfo& info = objectInfo[i];
     for (int c = 0; c < 3; ++c) info.rotation[c] = glm::vec4(glm::vec3(o.rotation[c]), 0.0f);
     for (int c = 0; c < 3; ++c) info.toLight[c] = glm::vec4(o.toLight[c], 0.0f);
@@ -127,8 +131,10 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
       out.power = glm::vec4(l.power[0], l.power[1], l.power[2], 0.0f);
     }
   }
-  lightUpload.write(lightTexelData.data(), lightTexelData.size() * sizeof(glm::vec4));
-  pointLightUpload.write(pointLightData.data(), pointLightData.size() * sizeof(PointLight));
+  if (fused) {
+    lightUpload.write(lightTexelData.data(), lightTexelData.size() * sizeof(glm::vec4));
+    pointLightUpload.write(pointLightData.data(), pointLightData.size() * sizeof(PointLight));
+  }
   objects.write(objectInfo.data(), objectInfo.size() * sizeof(ObjectInfo));
   uploadFrameUniforms(request);
   frame.stages.push_back({"light", secondsSince(t0)});
@@ -154,11 +160,13 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
   frame.stages.push_back({"shadow-rays", secondsSince(t0)});
 
   // ---- the device's second part: the pass over the samples, the image
-  runStages({{"fused",
+  runStages({{splitsum ? "splitsum" : "fused",
               [&](VkCommandBuffer cb) {
                 // Where the inputs are staged: their copies into device memory.
-                lightUpload.record(cb);
-                pointLightUpload.record(cb);
+                if (fused) {
+                  lightUpload.record(cb);
+                  pointLightUpload.record(cb);
+                }
                 maskUpload.record(cb);
                 computeBarrier(cb);
                 fusedPass->dispatchIndirect(cb, counter, offsetof(CoverageCounter, groups));
@@ -185,7 +193,13 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
   // Coefficient bytes read, counted as the CPU backend counts them: the
   // light, and per shaded sample core fusedPixelBytes (one slice or two, the
   // light planes, the three vertices' visibility words); the ground reads none.
+  // splitsum: core splitsumPixelBytes per sample, the ground's too.
   std::size_t bytes = resolved.lightBytes;
+  if (splitsum) {
+    frame.coefficientBytes = bytes + covered * splitsumPixelBytes();
+    frame.seconds = secondsSince(start);
+    return frame;
+  }
   const auto* rs = static_cast<const RotationSample*>(samples.mapped());
   const auto* sh = static_cast<const ShadeSample*>(shade.mapped());
   const std::size_t visibilityBytes = 3 * visibilityWords * sizeof(std::uint32_t);

@@ -41,6 +41,11 @@ std::vector<BindingKind> fusedBindings() {
   return {Storage, Storage, Storage, Texels, Texels, Texels, Texels, Storage, Storage, Storage, Storage, Storage, Storage, Texels};
 }
 
+std::vector<BindingKind> splitsumBindings() {
+  using enum BindingKind;
+  return {Storage, Storage, Storage, Storage, Storage, Storage, Texels, Storage};
+}
+
 void fusedLightTexels(std::span<const float> planes, std::span<glm::vec4> out) {
   const std::size_t n = out.size();
   if (planes.size() != 3 * n) {

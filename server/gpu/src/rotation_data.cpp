@@ -181,6 +181,8 @@ std::uint32_t appendRotationData(RotationMethod method, const BrdfSliceTable& ta
     case RotationMethod::Fused:
       // fused keeps no rotation data: it samples the slices' pixel form.
       throw std::invalid_argument("appendRotationData: fused rotates nothing ahead (it samples the slices' pixel form)");
+    case RotationMethod::Splitsum:
+      throw std::invalid_argument("appendRotationData: splitsum keeps no slices (it reads the prefiltered light)");
   }
   throw std::invalid_argument("appendRotationData: unknown rotation method");
 }

@@ -35,12 +35,17 @@ void VulkanRenderer::Impl::uploadScene() {
   for (std::size_t k = 0; k < objectCount; ++k) {
     const render::PreparedObject& p = prepared.objects[k];
     ObjectInfo& info = objectInfo[k];
-    if (static_cast<std::size_t>(p.table.thetaSamples()) != T || p.table.level() != level) {
+    if (splitsum ? p.lobes.size() != T
+                 : static_cast<std::size_t>(p.table.thetaSamples()) != T || p.table.level() != level) {
       throw std::logic_error("Vulkan backend: object " + p.name + " has a slice table unlike the options");
     }
     info.thetaSamples = static_cast<std::uint32_t>(T);
     info.flags = p.ground ? shared::kObjectGround : 0u;
-    if (fused) {
+    if (splitsum) {
+      // Its lobes are all it keeps: lobe t of the object at sliceBase + t.
+      info.sliceBase = static_cast<std::uint32_t>(lobeData.size());
+      lobeData.insert(lobeData.end(), p.lobes.begin(), p.lobes.end());
+    } else if (fused) {
       // The slices in pixel form, RGB0 texels (core PixelSlices), slice s at s·N texels.
       const PixelSlices pixelSlices = PixelSlices::synthesize(p.table);
       info.sliceBase = static_cast<std::uint32_t>(sliceData.size() / (shared::kTexelFloats * n));
@@ -65,7 +70,7 @@ void VulkanRenderer::Impl::uploadScene() {
       }
     }
     const std::size_t before = method.size();
-    info.methodBase = options.method == RotationMethod::Spatial || fused
+    info.methodBase = options.method == RotationMethod::Spatial || fused || splitsum
                           ? static_cast<std::uint32_t>(method.size())
                           : appendRotationData(options.method, p.table, info.sliceBase, method, options.rotator);
     const std::size_t blockWords = method.size() - before;
@@ -83,7 +88,8 @@ void VulkanRenderer::Impl::uploadScene() {
         break;
       }
       case RotationMethod::Spatial:
-      case RotationMethod::Fused: break;
+      case RotationMethod::Fused:
+      case RotationMethod::Splitsum: break;
     }
     methodBytesPerChannel.push_back(methodBytes);
 
@@ -100,6 +106,7 @@ void VulkanRenderer::Impl::uploadScene() {
       tri.push_back(info.vertexBase + t.z);
     }
     triangleCount.push_back(static_cast<std::uint32_t>(mesh.triangles.size()));
+    if (splitsum) continue;  // its visibility is the host's one ray per sample
     if (fused) {
       // fused reads the bits (core VisibilityBits), never the lists.
       const VisibilityBits& b = p.visibilityBits;
@@ -135,7 +142,10 @@ void VulkanRenderer::Impl::uploadScene() {
   auto upload = [&](Buffer& b, const void* data, std::size_t bytes, VkBufferUsageFlags usage = kStorageUsage) {
     input(b, bytes, usage).write(data, bytes);
   };
-  if (fused) {
+  if (splitsum) {
+    upload(lobes, lobeData.data(), lobeData.size() * sizeof(shared::SliceLobe));
+    upload(lobeLight, prepared.lobeLight.texels().data(), prepared.lobeLight.texels().size_bytes(), kTexelUsage);
+  } else if (fused) {
     // The bits as they are (W words per vertex, vertex v of object o at
     // global vertex o's vertexBase + v): fused.comp blends three vertices'
     // bits per direction.
@@ -146,7 +156,7 @@ void VulkanRenderer::Impl::uploadScene() {
     for (std::size_t v = 0; v < vis.size(); ++v) visibilityBlocks[v] = visPacked[v].y;
     upload(visibility, visPacked.data(), visPacked.size() * sizeof(glm::uvec4));
   }
-  upload(slices, sliceData.data(), sliceData.size() * sizeof(float), fusedUsage);
+  if (!splitsum) upload(slices, sliceData.data(), sliceData.size() * sizeof(float), fusedUsage);
   if (method.empty()) method.push_back(0u);  // spatial: a 4-byte dummy (the contract)
   upload(methodData, method.data(), method.size() * sizeof(std::uint32_t));
   upload(positions, pos.data(), pos.size() * sizeof(glm::vec4));
@@ -172,14 +182,23 @@ void VulkanRenderer::Impl::uploadScene() {
   submitUploads(context, uploads);
 
   objects = Buffer(context, objectCount * sizeof(ObjectInfo));
+  if (splitsum) {
+    // No light per frame: the pass turns its lookup (ObjectInfo::toLight).
+    // The mirror rays' scene, as fused's shadow rays' (below).
+    std::vector<Instance> instances;
+    for (const render::PreparedObject& p : prepared.objects) instances.push_back({p.mesh.get(), glm::mat4(p.pose.objectToWorld())});
+    rays = std::make_unique<RayScene>(std::move(instances));
+  }
   // The light: per object and channel a header and at most (N − 1)/3 blocks;
   // for `fused` its pixel form, N RGB0 texels per object (fusedLightTexels).
   // Written every frame, device-local like the other inputs: its upload (and
   // staging buffer, where there is one) lives as long as the renderer.
-  light = Buffer(context,
-                 fused ? objectCount * n * sizeof(glm::vec4) : objectCount * 3 * (1 + (n - 1) / 3) * sizeof(glm::uvec4),
-                 fusedUsage, MemoryUse::DeviceInput);
-  lightUpload = BufferUpload(context, light);
+  if (!splitsum) {
+    light = Buffer(context,
+                   fused ? objectCount * n * sizeof(glm::vec4) : objectCount * 3 * (1 + (n - 1) / 3) * sizeof(glm::uvec4),
+                   fusedUsage, MemoryUse::DeviceInput);
+    lightUpload = BufferUpload(context, light);
+  }
   if (fused) {
     // The point lights, written every frame like the light.
     pointLightData.assign(objectCount * shared::kMaxPointLights, PointLight{});
@@ -207,6 +226,10 @@ void VulkanRenderer::Impl::uploadScene() {
   resolve = std::make_unique<ComputePipeline>(context, "resolve.comp", 5, 0);
   exposure = std::make_unique<ComputePipeline>(context, "exposure.comp", 4, sizeof(ExposurePush));
   tonemap = std::make_unique<ComputePipeline>(context, "tonemap.comp", 5, 0);
+  if (splitsum) {
+    createSplitsumPipeline();
+    return;
+  }
   if (fused) {
     // One SIMD group per workgroup on a CPU device: the workgroup's only
     // barriers (the reduction's) then switch no coroutines (docs/gpu.md).
@@ -250,6 +273,28 @@ void VulkanRenderer::Impl::createFusedPipeline(std::uint32_t local) {
                                 {2, fusedLocal},
                                 {4, options.interpolateSlices ? 1u : 0u},
                                 {5, static_cast<std::uint32_t>(std::max(prepared.lobeLight.finestLevel(), 0))}});
+}
+
+}  // namespace haarcast::gpu
+
+namespace haarcast::gpu {
+
+void VulkanRenderer::Impl::createSplitsumPipeline() {
+  lobeLightTexels = TexelView(context, lobeLight, VK_FORMAT_R32G32B32A32_SFLOAT, sizeof(glm::vec4));
+  // One invocation per sample (splitsum.comp); the rotation-input pass sizes
+  // the indirect dispatch as min(covered, fusedGroups) workgroups, and the
+  // invocations stride over the samples beyond. A CPU device runs a
+  // workgroup per thread: a few per core are enough.
+  fusedLocal = limits.fusedLocalSize ? limits.fusedLocalSize : 64u;
+  const std::size_t maxGroups = context.properties().limits.maxComputeWorkGroupCount[0];
+  const std::size_t groups = context.info().type == "cpu" ? 64u : 4096u;
+  fusedGroups = static_cast<std::uint32_t>(std::min<std::size_t>(maxGroups, groups));
+  if (limits.fusedGroups) fusedGroups = std::min(fusedGroups, limits.fusedGroups);
+  fusedPass = std::make_unique<ComputePipeline>(
+      context, "splitsum.comp", splitsumBindings(), 0,
+      std::vector<SpecConstant>{{2, fusedLocal},
+                                {4, options.interpolateSlices ? 1u : 0u},
+                                {5, static_cast<std::uint32_t>(prepared.lobeLight.finestLevel())}});
 }
 
 }  // namespace haarcast::gpu

@@ -19,8 +19,9 @@ VulkanRenderer::Impl::Impl(const render::Scene& scene, const render::RenderOptio
     : options(o), limits(l), prepared(), context(vulkan) {
   render::checkRenderOptions(options);
   fused = options.method == RotationMethod::Fused;
-  if (fused) {
-    checkFusedLevel(options.level);  // 2–7: its scratch need not fit in shared memory
+  splitsum = options.method == RotationMethod::Splitsum;
+  if (fused || splitsum) {
+    checkFusedLevel(options.level);  // 2–7: its scratch need not fit in shared memory (splitsum reads no maps of it)
   } else if (options.level < kMinGpuLevel || options.level > kMaxGpuLevel) {
     throw std::invalid_argument("the Vulkan backend takes map levels " + std::to_string(kMinGpuLevel) + " to " +
                                 std::to_string(kMaxGpuLevel) + " (got " + std::to_string(options.level) +
@@ -28,7 +29,7 @@ VulkanRenderer::Impl::Impl(const render::Scene& scene, const render::RenderOptio
                                 "16 KiB every Vulkan device guarantees");
   }
   methodName = std::string(haarcast::methodName(options.method));
-  const std::string shader = fused ? "fused.comp" : "rotate_" + methodName + ".comp";
+  const std::string shader = fused || splitsum ? methodName + ".comp" : "rotate_" + methodName + ".comp";
   if (embeddedShader(shader).empty()) {
     throw std::invalid_argument("rotation method \"" + methodName + "\" has no Vulkan shader in this build (shaders/" +
                                 shader + " is missing)");
@@ -60,7 +61,7 @@ render::Frame VulkanRenderer::Impl::render(const render::FrameRequest& request) 
     ~Polled() { impl.cancelled = nullptr; }
   } polled{*this};
   cancelled = &request.cancelled;
-  return fused ? renderFused(request) : renderRotating(request);
+  return fused || splitsum ? renderFused(request) : renderRotating(request);
 }
 
 // ------------------------------------------------------------------ facade

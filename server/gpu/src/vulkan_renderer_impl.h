@@ -5,7 +5,7 @@
 //   gbuffer_pass.cpp      the G-buffer's render pass, pipeline, projection, recording
 //   frame_buffers.cpp     the per-resolution images and buffers
 //   frame_stages.cpp      a frame's uniforms, its stages recorded, submitted and timed
-//   fused_frame.cpp       a `fused` frame: two submissions around the host's shadow rays, indirect dispatch
+//   fused_frame.cpp       a `fused` or `splitsum` frame: two submissions around the host's shadow rays, indirect dispatch
 //   rotating_frame.cpp    a frame of the rotating methods: rotation and triple product in batches
 #pragma once
 
@@ -84,6 +84,10 @@ struct VulkanRenderer::Impl {
   // pixel form per frame (in `light`), the pixel-centre directions; per
   // frame the point lights (PointLight, kMaxPointLights per object).
   bool fused = false;
+  // `splitsum`: no slices, light or visibility; per global lobe (`lobes`,
+  // ObjectInfo::sliceBase + t) its SliceLobe, and the prefiltered light.
+  // Its frame is fused's (renderFused) with shaders/splitsum.comp as the pass.
+  bool splitsum = false;
   Buffer directions, pointLights;
   // `fused`: per global slice its ∫ρ (vec4) and its lobe (SliceLobe), and
   // the prefiltered light (core/prefiltered_light.h) the lobe path reads.
@@ -158,6 +162,7 @@ struct VulkanRenderer::Impl {
   // scene_upload.cpp
   void uploadScene();
   void createFusedPipeline(std::uint32_t local);
+  void createSplitsumPipeline();
 
   // gbuffer_pass.cpp
   void createGraphicsPipeline();
@@ -198,6 +203,8 @@ struct VulkanRenderer::Impl {
   void ensureQueries(std::uint32_t count);
 
   // fused_frame.cpp
+  // A `fused` frame, or a `splitsum` one: the same stages with splitsum.comp
+  // as the pass ("splitsum") and no light or point lights to upload.
   render::Frame renderFused(const render::FrameRequest& request);
   // The "shadow-rays" stage: the covered samples read back, each one's
   // point-light mask (render::pointLightMask against `rays`, posed for this

@@ -51,6 +51,7 @@ std::optional<RotationMethod> methodFromWire(v1::RotationMethod m) {
     case v1::ROTATION_METHOD_MATRIX: return RotationMethod::Matrix;
     case v1::ROTATION_METHOD_TABLE: return RotationMethod::Table;
     case v1::ROTATION_METHOD_FUSED: return RotationMethod::Fused;
+    case v1::ROTATION_METHOD_SPLITSUM: return RotationMethod::Splitsum;
     default: return std::nullopt;
   }
 }
@@ -487,6 +488,7 @@ v1::RotationMethod toWire(RotationMethod method) {
     case RotationMethod::Matrix: return v1::ROTATION_METHOD_MATRIX;
     case RotationMethod::Table: return v1::ROTATION_METHOD_TABLE;
     case RotationMethod::Fused: return v1::ROTATION_METHOD_FUSED;
+    case RotationMethod::Splitsum: return v1::ROTATION_METHOD_SPLITSUM;
   }
   return v1::ROTATION_METHOD_UNSPECIFIED;
 }

@@ -18,6 +18,7 @@
 
 #include "haarcast/core/parallel.h"
 #include "haarcast/core/rotate_haar.h"
+#include "haarcast/core/splitsum.h"
 #include "haarcast/core/triple_product.h"
 #include "haarcast/render/embree_scene.h"
 #include "haarcast/render/point_lights.h"
@@ -52,6 +53,7 @@ class CpuRenderer final : public Renderer {
   CpuRenderer(const Scene& scene, const RenderOptions& options, const RenderProgress& progress)
       : options_(options), prepared_(prepareScene(scene, options, progress)) {
     for (const PreparedObject& p : prepared_.objects) {
+      if (options.method == RotationMethod::Splitsum) continue;  // its lobes are all it keeps (prepareScene)
       if (options.method == RotationMethod::Fused) {
         // The only per-object data fused keeps: the unrotated slices in pixel form.
         pixelSlices_.push_back(PixelSlices::synthesize(p.table));
@@ -176,6 +178,9 @@ class CpuRenderer final : public Renderer {
   std::size_t shadeFused(const ResolvedFrame& resolved, const RayScene& rays, const GBuffer& g,
                          const FrameRequest& request, const CameraRays& camera, Frame& frame,
                          const CancelPoint& cancelPoint) const;
+  std::size_t shadeSplitsum(const ResolvedFrame& resolved, const RayScene& rays, const GBuffer& g,
+                            const FrameRequest& request, const CameraRays& camera, Frame& frame,
+                            const CancelPoint& cancelPoint) const;
 
   RenderOptions options_;
   PreparedScene prepared_;
@@ -276,7 +281,7 @@ void CpuRenderer::fillInputs(const ResolvedFrame& resolved, GBuffer& g, const Ca
     const glm::dvec3 n = glm::normalize(in.b[0] * glm::dvec3(mesh.normals[tri.x]) + in.b[1] * glm::dvec3(mesh.normals[tri.y]) +
                                         in.b[2] * glm::dvec3(mesh.normals[tri.z]));
     const glm::dvec3 wo = glm::transpose(resolved.objects[s.hit.object].rotation) * -s.direction;
-    in.rotation = rotationInput(n, wo, p.table);
+    in.rotation = options_.method == RotationMethod::Splitsum ? rotationInput(n, wo) : rotationInput(n, wo, p.table);
   };
   // In rows (and runs of 64 edge pixels): one task per pixel would cost
   // more in scheduling than the work.
@@ -371,8 +376,11 @@ Frame CpuRenderer::renderFrame(const FrameRequest& request, const CancelPoint& c
 
   frame.image = io::makeImage(w, h);
   frame.objectMask.assign(pixels, 0);
-  bytes += options_.method == RotationMethod::Fused ? shadeFused(resolved, *rays, g, request, camera, frame, cancelPoint)
-                                                    : shadeRotating(resolved, g, request, camera, frame, cancelPoint);
+  switch (options_.method) {
+    case RotationMethod::Fused: bytes += shadeFused(resolved, *rays, g, request, camera, frame, cancelPoint); break;
+    case RotationMethod::Splitsum: bytes += shadeSplitsum(resolved, *rays, g, request, camera, frame, cancelPoint); break;
+    default: bytes += shadeRotating(resolved, g, request, camera, frame, cancelPoint); break;
+  }
 
   // ---- tonemap: backdrop, RGBA8 --------------------------------------------
   t0 = Clock::now();
@@ -512,6 +520,39 @@ std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const RayScen
     return fusedPixelBytes(slices.level(), blend.weight != 0.0f, 3 * p.visibilityBits.wordsPerPoint() * sizeof(std::uint32_t));
   }, cancelPoint);
   frame.stages.push_back({"fused", since(t0)});
+  return bytes;
+}
+
+std::size_t CpuRenderer::shadeSplitsum(const ResolvedFrame& resolved, const RayScene& rays, const GBuffer& g,
+                                       const FrameRequest& request, const CameraRays& camera, Frame& frame,
+                                       const CancelPoint& cancelPoint) const {
+  const auto t0 = Clock::now();
+  std::vector<glm::mat4> toWorld;
+  std::vector<glm::mat3> rotations;
+  for (const ResolvedObject& o : resolved.objects) {
+    toWorld.emplace_back(o.objectToWorld);
+    rotations.emplace_back(o.rotation);
+  }
+  const glm::vec3 eye(camera.origin());
+  const std::size_t bytes = shadePixels(g, request, camera, frame, [&](const Sample& sample, std::array<float, 3>& rgb) {
+    const std::size_t object = sample.hit.object;
+    const PreparedObject& p = prepared_.objects[object];
+    const ResolvedObject& o = resolved.objects[object];
+    const PixelInput& in = sample.input;
+    const float b[3] = {static_cast<float>(in.b[0]), static_cast<float>(in.b[1]), static_cast<float>(in.b[2])};
+    // The one shadow ray along the mirror direction, against the whole posed
+    // scene, as `fused`'s lobe path casts it (point_lights.h lobeRayBit).
+    const ShadingPoint point = shadingPoint(*p.mesh, glm::uvec3(in.vertex[0], in.vertex[1], in.vertex[2]), b,
+                                            toWorld[object], rotations[object], p.shadowShift * static_cast<float>(o.scale));
+    const std::uint32_t seen = lobeRayBit(rays, point, eye);
+    const shared::SliceBlend blend = shared::sliceBlendAt(static_cast<float>(in.rotation.thetaOut),
+                                                          static_cast<shared::uint>(p.lobes.size()),
+                                                          options_.interpolateSlices ? 1u : 0u);
+    const LobePath path{&prepared_.lobeLight, p.lobes, o.toLight, true};
+    rgb = splitsumShade(path, blend, in.rotation.euler, in.rotation.thetaOut, seen);
+    return splitsumPixelBytes();
+  }, cancelPoint);
+  frame.stages.push_back({"splitsum", since(t0)});
   return bytes;
 }
 

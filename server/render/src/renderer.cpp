@@ -9,6 +9,7 @@
 #include <glm/geometric.hpp>
 
 #include "haarcast/core/lobe.h"
+#include "haarcast/core/splitsum.h"
 #include "haarcast/io/slice_cache.h"
 #include "haarcast/render/shading.h"
 #include "haarcast/render/visibility_cache.h"
@@ -55,8 +56,11 @@ PreparedScene prepareScene(const Scene& scene, const RenderOptions& options, con
   // computed: triangles, and what the visibility will hold (fused: bits per
   // vertex; the Haar methods: `keep` entries of 8 bytes per vertex).
   checkObjectCount(scene.objects.size(), options.sceneLimits);
+  // splitsum keeps none: its visibility is one ray per pixel.
+  const bool splitsum = options.method == RotationMethod::Splitsum;
   std::size_t triangles = 0, visibilityBytes = 0;
-  const std::size_t perVertex = options.method == RotationMethod::Fused
+  const std::size_t perVertex = splitsum ? 0
+                                : options.method == RotationMethod::Fused
                                     ? 4 * visibilityWordsPerPoint(options.level)
                                     : 8 * std::min<std::size_t>(options.visibility.keep, std::size_t{1} << (2 * options.level));
   for (const SceneObject& object : scene.objects) {
@@ -94,7 +98,8 @@ PreparedScene prepareScene(const Scene& scene, const RenderOptions& options, con
     p.pose = object.pose;
     object.mesh->validate();
     p.mesh = withNormals(object.mesh);  // a mesh built in code may come without them
-    p.table = objectSliceTable(object, options, progress);
+    // splitsum's only precompute is its lobes (below): no slice table.
+    if (!splitsum) p.table = objectSliceTable(object, options, progress);
     p.ground = object.ground;
     p.groundAlbedo = object.groundAlbedo;
     p.sphereCentre = p.mesh->bounds().centre();
@@ -109,7 +114,12 @@ PreparedScene prepareScene(const Scene& scene, const RenderOptions& options, con
     auto visibilityProgress = [&](std::size_t done, std::size_t total) {
       if (progress) progress("visibility " + object.name, done, total);
     };
-    if (options.method == RotationMethod::Fused) {
+    if (splitsum) {
+      // The lobe of every θₒ sample, the ground's too: every pixel reads the
+      // prefiltered light along its mirror direction (core/splitsum.h).
+      p.lobes = measureLobes(*object.material.brdf, lobeThetaOut(options.thetaSamples));
+      p.lobePath = true;
+    } else if (options.method == RotationMethod::Fused) {
       if (p.ground || refine.rounds == 0) {
         p.visibilityBits = loadOrComputeVisibilityBits(*p.mesh, vis, options.cacheDir, visibilityProgress);
       } else {
@@ -123,6 +133,7 @@ PreparedScene prepareScene(const Scene& scene, const RenderOptions& options, con
   }
   prepared.light = scene.environment.maps(options.level);
   prepared.background = scene.environment.maps(kBackgroundLevel);
+  if (splitsum) prepared.lobeLight = PrefilteredLight::build(prepared.background);
   if (options.method == RotationMethod::Fused) {
     // Lights found on the backdrop's fine map (light_split.h: their
     // directions to a tenth of a degree), the rest at the render's level.
@@ -163,12 +174,17 @@ std::array<SparseHaar, 3> lightInObjectFrame(const std::array<SphereMap, 3>& wor
   return light;
 }
 
-RotationInput rotationInput(const glm::dvec3& normal, const glm::dvec3& towardEye, const BrdfSliceTable& table) {
+RotationInput rotationInput(const glm::dvec3& normal, const glm::dvec3& towardEye) {
   double thetaOut = 0.0;
   RotationInput in;
   in.euler = eulerFromMatrix(shadingFrame(normal, towardEye, thetaOut));
-  in.slice = table.nearestSlice(thetaOut);
   in.thetaOut = thetaOut;
+  return in;
+}
+
+RotationInput rotationInput(const glm::dvec3& normal, const glm::dvec3& towardEye, const BrdfSliceTable& table) {
+  RotationInput in = rotationInput(normal, towardEye);
+  in.slice = table.nearestSlice(in.thetaOut);
   return in;
 }
 
@@ -335,6 +351,7 @@ ResolvedFrame resolveFrame(const PreparedScene& prepared, const RenderOptions& o
       out.lightBytes += o.fusedLight.planes.size() * sizeof(float);
       continue;
     }
+    if (options.method == RotationMethod::Splitsum) continue;  // it turns the lookup (toLight), not the light
     o.light = lightInObjectFrame(prepared.light, o.rotation, request.lightRotation, out.lightCoefficients);
     for (const SparseHaar& l : o.light) out.lightBytes += l.size() * (sizeof(std::uint32_t) + sizeof(float));
   }

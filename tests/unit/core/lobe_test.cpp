@@ -38,7 +38,7 @@ TEST(Lobe, LambertKeepsItsAlbedoAndIsWide) {
   EXPECT_GT(lobe.median.x, 0.5) << "half of a cosine lobe lies beyond 29° of the mirror direction";
 }
 
-TEST(Lobe, GgxMedianIsTwiceItsRoughnessAndTheRingsSplitItEvenly) {
+TEST(Lobe, GgxMedianIsTwiceItsRoughnessAndTheSamplesBandsWidenOutward) {
   // GGX's D puts half the microfacet normals within atan α of the normal
   // (P(θₕ < t) = tan²t/(α² + tan²t)); at normal incidence the reflected
   // direction turns by 2θₕ, so half the energy lies within ≈ 2α.
@@ -47,12 +47,18 @@ TEST(Lobe, GgxMedianIsTwiceItsRoughnessAndTheRingsSplitItEvenly) {
     const shared::SliceLobe lobe = measureLobe(*ggx, 0.02);
     EXPECT_NEAR(lobe.median.x, 2.0 * std::atan(alpha), 0.1 * 2.0 * alpha) << "α " << alpha;
     EXPECT_NEAR(lobe.energy.r, 0.95, 0.05);
-    for (int k = 1; k < 4; ++k) {
-      EXPECT_GT(lobe.angle[k], lobe.angle[k - 1]) << "ring " << k;
-      EXPECT_LT(lobe.level[k], lobe.level[k - 1]) << "a wider ring reads a coarser level";
+    // Band k's samples lie beyond band k − 1's and read a coarser level;
+    // the weights are the energy's shares.
+    constexpr shared::uint kJ = shared::kLobeSectors;
+    float total = 0.0f;
+    for (const glm::vec4& s : lobe.samples) total += s.w;
+    EXPECT_NEAR(total, 1.0f, 1e-5f);
+    for (shared::uint k = 1; k + 1 < shared::kLobeBands; ++k) {
+      EXPECT_GT(lobe.samples[k * kJ].x, lobe.samples[(k - 1) * kJ].x) << "band " << k;
+      EXPECT_LT(lobe.samples[k * kJ].z, lobe.samples[(k - 1) * kJ].z) << "band " << k;
     }
-    EXPECT_LT(lobe.angle[1], lobe.median.x);
-    EXPECT_GT(lobe.angle[2], lobe.median.x);
+    EXPECT_LT(lobe.samples[kJ].x, lobe.median.x) << "band 1 ends at the median";
+    EXPECT_GT(lobe.samples[2 * kJ].x, lobe.median.x) << "band 2 starts there";
   }
 }
 

@@ -57,12 +57,15 @@ TEST(Rotation, EulerRoundTrip) {
 }
 
 TEST(Rotation, MethodNamesAreTheDesignNames) {
-  const char* names[] = {"haar", "spatial", "matrix", "table"};
+  const char* names[] = {"fused", "haar", "spatial", "matrix", "table", "splitsum"};
   for (const char* n : names) {
     const auto m = parseRotationMethod(n);
     ASSERT_TRUE(m.has_value()) << n;
     EXPECT_EQ(methodName(*m), n);
   }
+  // Every method a renderer takes has its name, and the list says them all.
+  for (const RotationMethod m : kAllPixelMethods) EXPECT_EQ(parseRotationMethod(methodName(m)), m) << methodName(m);
+  EXPECT_EQ(pixelMethodNames(), "fused, haar, spatial, matrix, table, splitsum");
   EXPECT_FALSE(parseRotationMethod("Haar").has_value());
   EXPECT_FALSE(parseRotationMethod("").has_value());
   EXPECT_EQ(parseHaarVariant("faithful"), HaarVariant::Faithful);

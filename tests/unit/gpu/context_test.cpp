@@ -30,7 +30,7 @@ TEST(VulkanContext, ErrorsNameTheCallAndTheCode) {
 
 TEST(VulkanContext, EveryShaderIsEmbedded) {
   for (const char* name : {"rotate_spatial.comp", "rotation_input.comp", "triple_product.comp", "resolve.comp",
-                           "exposure.comp", "tonemap.comp",
+                           "exposure.comp", "tonemap.comp", "fused.comp", "splitsum.comp",
                            "gbuffer.vert", "gbuffer.frag"}) {
     const auto words = embeddedShader(name);
     ASSERT_GT(words.size(), 5u) << name;

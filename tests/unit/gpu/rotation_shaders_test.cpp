@@ -54,6 +54,7 @@ const char* shaderOf(RotationMethod m) {
     case RotationMethod::Matrix: return "rotate_matrix.comp";
     case RotationMethod::Spatial: return "rotate_spatial.comp";
     case RotationMethod::Fused: return "";  // no rotated coefficients: fused.comp (fused_pass_test.cpp)
+    case RotationMethod::Splitsum: return "";  // no slices: splitsum.comp (splitsum_frame_test.cpp)
   }
   return "";
 }

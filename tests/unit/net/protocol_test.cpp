@@ -91,6 +91,24 @@ TEST(Protocol, HelloGivesTheConfig) {
   EXPECT_NE(other.rendererKey(), c.rendererKey());
 }
 
+TEST(Protocol, EveryMethodCrossesTheWireAndBack) {
+  // Each per-pixel method a renderer takes has its wire value, and a Hello
+  // asking for it gets it; the error for an unknown one lists them all.
+  for (const RotationMethod m : kAllPixelMethods) {
+    const v1::RotationMethod wire = toWire(m);
+    EXPECT_NE(wire, v1::ROTATION_METHOD_UNSPECIFIED) << methodName(m);
+    auto h = goodHello();
+    h.mutable_settings()->set_method(wire);
+    const auto r = configFromHello(h, Limits{}, Defaults{}, testCatalog());
+    ASSERT_TRUE(std::holds_alternative<SessionConfig>(r)) << std::get<ProtocolError>(r).message;
+    EXPECT_EQ(std::get<SessionConfig>(r).method, m) << methodName(m);
+  }
+  EXPECT_EQ(toWire(RotationMethod::Splitsum), v1::ROTATION_METHOD_SPLITSUM);
+  auto h = goodHello();
+  h.mutable_settings()->set_method(static_cast<v1::RotationMethod>(42));
+  EXPECT_NE(helloError(h).message.find("ROTATION_METHOD_SPLITSUM = 6"), std::string::npos) << helloError(h).message;
+}
+
 TEST(Protocol, BadHellosNameWhatIsWrong) {
   auto h = goodHello();
   h.set_protocol_version(2);

@@ -16,8 +16,8 @@ namespace haarcast {
 // The lobe of ρ(·, ωₒ)·cos θᵢ with ωₒ = (0, cos θₒ, sin θₒ) (the slice's
 // frame, BrdfSliceTable). Measured on a polar grid about the mirror
 // direction (rings log-spaced in angle from 10⁻⁴ rad to π, so a lobe of a
-// hundredth of a degree is still resolved): its energy, and the angles
-// that split it into shared::kLobeRings equal shares.
+// hundredth of a degree is still resolved): its energy, its median angle,
+// and the lobe path's samples (shared_layout.h, "The lobe path").
 //
 // coreAngle: the lobe path's part of it. Its samples and `core` cover the
 // angles up to coreAngle from the axis; the rest is left to the pass over

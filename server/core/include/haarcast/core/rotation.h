@@ -40,7 +40,10 @@ EulerYXY eulerFromMatrix(const glm::dmat3& m);
 // a slice's coefficients (a SliceRotator each); `fused` never forms rotated
 // coefficients: it sums the rotated slice against light × visibility in the
 // pixel basis (fused.h), the same integral as `spatial` + the triple product.
-enum class RotationMethod { Haar, Spatial, Matrix, Table, Fused };
+// `splitsum` rotates nothing and keeps no slices: the image-based lighting of
+// real-time engines, the lobe's energy times the prefiltered light along the
+// mirror direction (splitsum.h), a baseline for speed and truth.
+enum class RotationMethod { Haar, Spatial, Matrix, Table, Fused, Splitsum };
 
 // The methods that make rotated coefficients (makeRotator accepts these).
 inline constexpr RotationMethod kAllRotationMethods[] = {RotationMethod::Haar, RotationMethod::Spatial,
@@ -48,13 +51,14 @@ inline constexpr RotationMethod kAllRotationMethods[] = {RotationMethod::Haar, R
 // Every per-pixel method a renderer accepts, the default first.
 inline constexpr RotationMethod kAllPixelMethods[] = {RotationMethod::Fused, RotationMethod::Haar,
                                                       RotationMethod::Spatial, RotationMethod::Matrix,
-                                                      RotationMethod::Table};
+                                                      RotationMethod::Table, RotationMethod::Splitsum};
 inline constexpr RotationMethod kDefaultPixelMethod = RotationMethod::Fused;
 
 std::string_view methodName(RotationMethod m);
-// Accepts exactly the DESIGN.md names: "fused", "haar", "spatial", "matrix", "table".
+// Accepts exactly the DESIGN.md names: "fused", "haar", "spatial", "matrix", "table",
+// and "splitsum".
 std::optional<RotationMethod> parseRotationMethod(std::string_view name);
-// "fused, haar, spatial, matrix, table": for error messages that list the choices.
+// "fused, haar, spatial, matrix, table, splitsum": for error messages that list the choices.
 std::string pixelMethodNames();
 
 // Variants of the seed's method (see rotate_haar.h for what each does).
@@ -103,7 +107,7 @@ class SliceRotator {
 };
 
 // Throws std::invalid_argument if slices is empty or mixes levels, or for
-// `fused`, which rotates no coefficients.
+// `fused` and `splitsum`, which rotate no coefficients.
 std::unique_ptr<SliceRotator> makeRotator(RotationMethod method, std::vector<HaarMap> slices,
                                           const RotatorOptions& options = {});
 

@@ -3,7 +3,8 @@
 // (shaders include it with GL_GOOGLE_include_directive, -I server/core/include).
 // Write only what both languages read alike: plain structs of uint, float and
 // vec3/vec4, `const` numbers, and functions built from floor/min/max/clamp,
-// integer bit operations and findMSB. The GPU tests check the shaders'
+// log2, integer bit operations and findMSB (not sin, cos, atan or acos:
+// Vulkan lets a device compute those loosely, sphere.glsl has precise ones). The GPU tests check the shaders'
 // results against the C++ use of the same lines (SharedLayout.*).
 #ifndef HAARCAST_CORE_SHARED_LAYOUT_H
 #define HAARCAST_CORE_SHARED_LAYOUT_H
@@ -26,6 +27,7 @@ using vec4 = glm::vec4;
 using mat4 = glm::mat4;
 using std::clamp;
 using std::floor;
+using std::log2;
 using std::max;
 using std::min;
 // GLSL's findMSB: the index of the highest set bit, −1 for 0.
@@ -298,9 +300,7 @@ struct PointLight {
 // each share's median, weighted by the share's energy w_i. Each reads the
 // light prefiltered to its share's solid angle (level λ_i, trilinear), so
 // the samples see all of the light, not points of it (filtered importance
-// sampling). The ring summary (angle, level) is K equal-energy rings about
-// the axis, for a single lookup's level.
-HC_CONST uint kLobeRings = 4u;      // K
+// sampling).
 HC_CONST uint kLobeSectors = 8u;    // J
 HC_CONST uint kLobeBands = 8u;      // the lobe path's radial bands (samples)
 HC_CONST uint kLobeSamples = kLobeBands * kLobeSectors;
@@ -308,8 +308,6 @@ HC_CONST uint kLobeSamples = kLobeBands * kLobeSectors;
 // One slice's lobe, measured from the BRDF itself (core/lobe.h).
 struct SliceLobe {
   vec4 energy;   // rgb: ∫ρ_c dω (cos θᵢ included); a: the axis' θ, local direction (0, cos θ, −sin θ)
-  vec4 angle;    // a_k: the angle from the axis of ring k's median share (radians)
-  vec4 level;    // λ_k: the prefiltered level whose texels have ring k's per-sample solid angle
   vec4 median;   // x: the angle holding half the energy; yzw: 0
   vec4 core;     // rgb: ∫ρ_c dω within the core angle (the lobe path's part of the energy); a: 0
   // Sample kJ + j of the lobe path: (a, b, λ, w), the angle a from the
@@ -323,8 +321,6 @@ struct SliceLobe {
 HC_FUNCTION SliceLobe blendLobes(SliceLobe a, SliceLobe b, float t) {
   SliceLobe l;
   l.energy = a.energy + t * (b.energy - a.energy);
-  l.angle = a.angle + t * (b.angle - a.angle);
-  l.level = a.level + t * (b.level - a.level);
   l.median = a.median + t * (b.median - a.median);
   l.core = a.core + t * (b.core - a.core);
   for (uint i = 0u; i < kLobeSamples; ++i) l.samples[i] = a.samples[i] + t * (b.samples[i] - a.samples[i]);
@@ -363,6 +359,22 @@ HC_FUNCTION LatLongTaps latLongTaps(uint level, float theta, float phi) {
   t.col0 = uint(int(fx) & int(m - 1u));
   t.col1 = (t.col0 + 1u) & (m - 1u);
   return t;
+}
+
+// ---- `splitsum` (core/splitsum.h): the image-based lighting of real-time
+// engines, one lookup of the prefiltered light per pixel instead of the lobe
+// path's K·J. I_c = E_c(θₒ)·L_c(λ, m)·V(m): m the mirror direction, V its
+// shadow ray (kLobeSeenBit), and λ the level whose texel has the solid
+// angle of the disc of the lobe's median angle a, π·a² = 2π²/M² (a level-n
+// texel at the equator is (π/M)·(2π/M), M = 2^n): M = √(2π)/a. A bilinear
+// lookup of box-filtered texels of side s spreads like a Gaussian of σ = s/2,
+// whose median radius 1.18σ then matches a with s² ≈ π·a² to 10 %: the
+// texel's footprint has the lobe's spread, not its support. λ is
+// fractional (trilinear) and clamped to the light's levels.
+HC_CONST float kSqrtTwoPi = 2.50662827463100050f;
+HC_CONST float kSplitsumMinAngle = 1e-6f;
+HC_FUNCTION float splitsumLevel(float medianAngle) {
+  return log2(kSqrtTwoPi / max(medianAngle, kSplitsumMinAngle));
 }
 
 // A sample's shadow word, for an object with a lobe path (not a ground):
@@ -450,8 +462,8 @@ static_assert(sizeof(FrameParams) == 128 && offsetof(FrameParams, tanHalf) == 96
 static_assert(sizeof(ObjectInfo) == 160 && offsetof(ObjectInfo, toLight) == 96 && offsetof(ObjectInfo, sliceBase) == 48 &&
               offsetof(ObjectInfo, skipBelowY) == 68 && offsetof(ObjectInfo, groundRadiance) == 80);
 static_assert(sizeof(PointLight) == 32);
-static_assert(sizeof(SliceLobe) == 80 + 16 * kLobeSamples && offsetof(SliceLobe, angle) == 16 &&
-              offsetof(SliceLobe, median) == 48 && offsetof(SliceLobe, samples) == 80);
+static_assert(sizeof(SliceLobe) == 48 + 16 * kLobeSamples && offsetof(SliceLobe, median) == 16 &&
+              offsetof(SliceLobe, core) == 32 && offsetof(SliceLobe, samples) == 48);
 static_assert(kLobeSeenBit >= (1u << kMaxPointLights), "the lobe's bit lies above the light bits");
 static_assert(kMaxPointLights <= kGroundOcclusionShift, "the light bits and the ground's occlusion share one word");
 static_assert(sizeof(RotationSample) == 32 && offsetof(RotationSample, alpha) == 8 &&

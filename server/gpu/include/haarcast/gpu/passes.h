@@ -63,6 +63,11 @@ std::vector<glm::vec4> pixelCentreDirections(int level);
 // samples' point-light masks (a uint per sample) (storage).
 std::vector<BindingKind> fusedBindings();
 
+// splitsum.comp's bindings: 0 samples, 1 shade, 2 objects, 3 counter, 4 the
+// samples' masks (kLobeSeenBit), 5 lobes (SliceLobe per global lobe)
+// (storage); 6 the prefiltered light (RGBA32F texels); 7 radiance (storage).
+std::vector<BindingKind> splitsumBindings();
+
 // The light of one object as fused.comp reads it: texel k = (L_r, L_g, L_b, 0)
 // at direction k, from the three planes of core FusedLight (ΔΩ folded in),
 // written to out[0 … N).

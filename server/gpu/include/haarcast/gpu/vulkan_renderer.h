@@ -7,11 +7,13 @@
 //                   then every batch's indirect arguments (batch_args.comp)
 //   rotation        compute: shaders/rotate_<method>.comp, in batches of covered pixels
 //   triple-product  compute: light × rotated slice × interpolated visibility
-//   shadow-rays     `fused` only, host: the covered samples read back, one
+//   shadow-rays     `fused` and `splitsum`, host: the covered samples read back, one
 //                   Embree shadow ray per sample and point light
-//                   (render::pointLightMask), the masks uploaded
+//                   (render::pointLightMask; splitsum: its mirror ray alone), the masks uploaded
 //   fused           `fused` only, in place of rotation and triple-product:
 //                   shaders/fused.comp, one indirect dispatch sized by rotation-input
+//   splitsum        `splitsum` only, in its place: shaders/splitsum.comp, one
+//                   invocation per sample, the same indirect dispatch
 //   tonemap         compute: backdrop and antialiased edge pixels (resolve.comp),
 //                   auto exposure measured and chosen (exposure.comp), RGBA8;
 //                   the linear image kept
@@ -23,8 +25,8 @@
 // The rotating methods record their frame as one command buffer (timestamps
 // per stage on GPUs; one submission per stage, host-timed, on CPU devices)
 // and read the covered count back only when the frame is done. `fused`
-// submits twice: [gbuffer, rotation-input], then, after the host's shadow
-// rays for the samples read back, [fused, tonemap].
+// (and `splitsum`) submits twice: [gbuffer, rotation-input], then, after the
+// host's shadow rays for the samples read back, [fused (splitsum), tonemap].
 // Scene data (slices, method data, meshes, visibility, backdrop) is uploaded
 // once, into device-local memory (staged where the host cannot map it);
 // frame buffers are allocated once per resolution and reused, so a frame at

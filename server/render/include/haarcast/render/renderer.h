@@ -10,10 +10,13 @@
 //   "rotation-input"  per pixel: BRDF slice index (θₒ) and Y-X-Y Euler angles
 //   "rotation"        the rotated slice's coefficients, per pixel and channel
 //   "triple-product"  light × rotated BRDF × interpolated vertex visibility
-//   "shadow-rays"     `fused` on Vulkan only: the host's point-light shadow rays for the
+//   "shadow-rays"     `fused` and `splitsum` on Vulkan only: the host's point-light shadow rays for the
 //                     device's samples, between its two submissions (the CPU's are in "fused")
 //   "fused"           `fused` only: rotation and triple product in one pass
 //                     over the map directions (core/fused.h), in place of the two above
+//   "splitsum"        `splitsum` only: the lobe's energy times the prefiltered light
+//                     along the mirror direction (core/splitsum.h), in place of the two
+//                     above (the CPU's shadow rays are in it, as in "fused")
 //   "tonemap"         exposure, sRGB, RGBA8 (and the linear image kept for EXR)
 #pragma once
 
@@ -129,6 +132,8 @@ struct PreparedObject {
   // `fused`: its slices' lobes measured from the BRDF (core/lobe.h), and
   // whether any pixel of it can take the lobe path at the render's level
   // (then its samples trace a ray along their mirror direction too).
+  // `splitsum`: the lobe of every θₒ sample (core/splitsum.h lobeThetaOut),
+  // for every object, and lobePath always; its `table` is empty.
   std::vector<shared::SliceLobe> lobes;
   bool lobePath = false;
   float lobeCore = 0.0f;  // the lobe path's core angle (fused.h LobePath::coreAngle); π: the path takes all
@@ -144,7 +149,7 @@ struct PreparedScene {
   std::vector<DirectionalLight> pointLights;
   std::array<SphereMap, 3> restLight;
   SphereMap restLuminance;              // its Rec. 709 luminance (the ground's hidden sky, point_lights.h)
-  PrefilteredLight lobeLight;           // `fused`: the backdrop's maps at every level, for the lobe path (empty when no object has one)
+  PrefilteredLight lobeLight;           // `fused`, `splitsum`: the backdrop's maps at every level, for the lobe path (empty when no object has one)
   std::optional<std::size_t> ground;    // index of the ground object, if any
 };
 
@@ -176,6 +181,8 @@ struct RotationInput {
   double thetaOut = 0.0;
 };
 RotationInput rotationInput(const glm::dvec3& normal, const glm::dvec3& towardEye, const BrdfSliceTable& table);
+// The same without a table (slice 0), for `splitsum`, which keeps none.
+RotationInput rotationInput(const glm::dvec3& normal, const glm::dvec3& towardEye);
 
 // The backdrop seen along a world direction when the environment is turned
 // by lightRotation: bilinear (sphere_map.h's bilinearTaps) in the maps.
@@ -209,7 +216,8 @@ inline constexpr double kMaxEyeDistance = 1e4;
 // its plane for every other object, which the ground hides), and per object
 // the point lights in its frame. A ground object's point-light powers are
 // the radiance each adds where seen, and groundFlat the radiance of the map
-// part (both in closed form for its Lambert plane).
+// part (both in closed form for its Lambert plane). `splitsum` gets only the
+// poses and toLight: it turns its lookup direction, not the light.
 struct ResolvedObject {
   glm::dmat3 rotation{1.0};        // object → world
   glm::dmat4 objectToWorld{1.0};
@@ -218,7 +226,7 @@ struct ResolvedObject {
   FusedLight fusedLight;           // empty unless the method is fused
   std::vector<FusedPointLight> pointLights;
   std::array<float, 3> groundFlat{};
-  glm::mat3 toLight{1.0f};         // fused: object frame → the environment's (lightRotationᵀ·rotation)
+  glm::mat3 toLight{1.0f};         // fused, splitsum: object frame → the environment's (lightRotationᵀ·rotation)
 };
 struct ResolvedFrame {
   std::size_t lightCoefficients = 0;  // k in effect (the Haar methods)

@@ -1,0 +1,55 @@
+#version 450
+// The "splitsum" pass (core/splitsum.h splitsumShade): per covered sample,
+//   I_c = E_c(θₒ)·L_c(λ, m)·V,
+// the image-based lighting of real-time engines: the lobes of the two
+// nearest θₒ samples blended (shared::sliceBlendAt, blendLobes), m the
+// mirror direction (0, cos θₒ, −sin θₒ) of the slice's frame turned by the
+// sample's Y-X-Y rotation and the object's toLight into the light's frame,
+// the prefiltered light read there trilinearly at λ = splitsumLevel(the
+// lobe's median angle), and V the host's shadow ray along m (the mask's
+// kLobeSeenBit, render/point_lights.h lobeRayBit).
+//
+// One invocation per sample, no shared memory and no barrier: a sample is
+// two lobe reads and eight texel fetches. The invocations stride over the
+// compacted samples (s = global id, + every invocation of the dispatch), so
+// the dispatch is the rotation-input pass's indirect arguments, as fused's
+// (FrameParams::fusedGroups caps its workgroups).
+#extension GL_GOOGLE_include_directive : require
+#include "haarcast/core/shared_layout.h"
+#include "common/frame.glsl"
+#include "common/sphere.glsl"
+
+layout(local_size_x_id = 2) in;
+layout(constant_id = 4) const uint INTERPOLATE = 1u;       // RenderOptions::interpolateSlices
+layout(constant_id = 5) const uint PREFILTER_FINEST = 9u;  // the prefiltered light's finest level
+
+layout(std430, set = 0, binding = 0) readonly buffer Samples { RotationSample samples[]; };
+layout(std430, set = 0, binding = 1) readonly buffer Shade { ShadeSample shade[]; };
+layout(std430, set = 0, binding = 2) readonly buffer Objects { ObjectInfo objects[]; };
+layout(std430, set = 0, binding = 3) readonly buffer Counter { CoverageCounter counter; };
+layout(std430, set = 0, binding = 4) readonly buffer Masks { uint masks[]; };  // sample s: kLobeSeenBit = its mirror ray escapes
+// Object o's lobe t at ObjectInfo::sliceBase + t (core SliceLobe).
+layout(std430, set = 0, binding = 5) readonly buffer Lobes { SliceLobe lobes[]; };
+// Level l of the prefiltered light at prefilterOffset(l), RGB0 (core PrefilteredLight).
+layout(set = 0, binding = 6) uniform samplerBuffer lobeLight;
+layout(std430, set = 0, binding = 7) writeonly buffer Radiance { vec4 radiance[]; };
+
+#include "common/prefiltered.glsl"
+
+vec3 splitsumShade(uint s) {
+  if ((masks[s] & kLobeSeenBit) == 0u) return vec3(0.0);
+  const RotationSample rs = samples[s];
+  const ObjectInfo o = objects[shade[s].object];
+  const SliceBlend blend = sliceBlendAt(rs.thetaOut, o.thetaSamples, INTERPOLATE);
+  const SliceLobe lobe = blendLobes(lobes[o.sliceBase + blend.first], lobes[o.sliceBase + blend.second], blend.weight);
+  const vec2 sc = sinCosPrecise(rs.thetaOut);
+  const mat3 toLight = mat3(o.toLight[0].xyz, o.toLight[1].xyz, o.toLight[2].xyz);
+  const vec3 mirror = toLight * (rotationYXY(rs.alpha, rs.beta, rs.gamma) * vec3(0.0, sc.y, -sc.x));
+  return lobe.energy.rgb * prefilteredAt(splitsumLevel(lobe.median.x), mirror);
+}
+
+void main() {
+  const uint count = counter.covered;
+  const uint stride = gl_NumWorkGroups.x * gl_WorkGroupSize.x;
+  for (uint s = gl_GlobalInvocationID.x; s < count; s += stride) radiance[shade[s].pixel] = vec4(splitsumShade(s), 1.0);
+}
