@@ -274,7 +274,7 @@ std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBl
                                 std::span<const FusedPointLight> lights, std::uint32_t visibleLights,
                                 FusedScratch& scratch, const LobePath* lobe) {
   const int level = slices.level();
-  if (lobe && (lobe->everyLobe || lobe->coreAngle >= static_cast<float>(kPi))) return lobeShade(*lobe, blend, r, visibleLights);
+  if (lobe && lobe->coreAngle >= static_cast<float>(kPi)) return lobeShade(*lobe, blend, r, visibleLights);
   checkSameLevel(light.level, level, "the light");
   const std::size_t n = static_cast<std::size_t>(mapSize(level)) * static_cast<std::size_t>(mapSize(level));
   scratch.visibility.resize(n);

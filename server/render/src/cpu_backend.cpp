@@ -175,6 +175,16 @@ class CpuRenderer final : public Renderer {
   // or one fused pass. Each adds its stages and returns the bytes read.
   std::size_t shadeRotating(const ResolvedFrame& resolved, const GBuffer& g, const FrameRequest& request,
                             const CameraRays& camera, Frame& frame, const CancelPoint& cancelPoint) const;
+  // Each object's placement and turn this frame, as shadingPoint takes them.
+  struct ObjectFrames {
+    std::vector<glm::mat4> toWorld;
+    std::vector<glm::mat3> rotations;
+    explicit ObjectFrames(const ResolvedFrame& resolved);
+  };
+  // The world point, normal and shadow-ray offset of a sample on `object`
+  // (point_lights.h), for the shadow rays `fused` and `splitsum` cast.
+  ShadingPoint samplePoint(const ObjectFrames& frames, const ResolvedFrame& resolved, std::size_t object,
+                           const PixelInput& in) const;
   std::size_t shadeFused(const ResolvedFrame& resolved, const RayScene& rays, const GBuffer& g,
                          const FrameRequest& request, const CameraRays& camera, Frame& frame,
                          const CancelPoint& cancelPoint) const;
@@ -456,16 +466,26 @@ std::size_t CpuRenderer::shadeRotating(const ResolvedFrame& resolved, const GBuf
   return bytes;
 }
 
-std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const RayScene& rays, const GBuffer& g,
-                                    const FrameRequest& request, const CameraRays& camera, Frame& frame,
-                                    const CancelPoint& cancelPoint) const {
-  const auto t0 = Clock::now();
-  std::vector<glm::mat4> toWorld;
-  std::vector<glm::mat3> rotations;
+CpuRenderer::ObjectFrames::ObjectFrames(const ResolvedFrame& resolved) {
   for (const ResolvedObject& o : resolved.objects) {
     toWorld.emplace_back(o.objectToWorld);
     rotations.emplace_back(o.rotation);
   }
+}
+
+ShadingPoint CpuRenderer::samplePoint(const ObjectFrames& frames, const ResolvedFrame& resolved, std::size_t object,
+                                      const PixelInput& in) const {
+  const PreparedObject& p = prepared_.objects[object];
+  const float b[3] = {static_cast<float>(in.b[0]), static_cast<float>(in.b[1]), static_cast<float>(in.b[2])};
+  return shadingPoint(*p.mesh, glm::uvec3(in.vertex[0], in.vertex[1], in.vertex[2]), b, frames.toWorld[object],
+                      frames.rotations[object], p.shadowShift * static_cast<float>(resolved.objects[object].scale));
+}
+
+std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const RayScene& rays, const GBuffer& g,
+                                    const FrameRequest& request, const CameraRays& camera, Frame& frame,
+                                    const CancelPoint& cancelPoint) const {
+  const auto t0 = Clock::now();
+  const ObjectFrames frames(resolved);
   const glm::vec3 eye(camera.origin());
   // The ground's hidden sky on the coarse grid (point_lights.h), from the
   // interior pixels' centre samples, as the Vulkan backend takes them.
@@ -477,11 +497,7 @@ std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const RayScen
       // antialiasing or without, as the Vulkan backend.
       if (!ground(pixel) || !interiorPixel(pixel, g.width, g.height, ground)) return std::nullopt;
       const std::optional<Sample>& c = g.centre[pixel];
-      const std::size_t object = c->hit.object;
-      const float b[3] = {static_cast<float>(c->input.b[0]), static_cast<float>(c->input.b[1]), static_cast<float>(c->input.b[2])};
-      return shadingPoint(*prepared_.objects[object].mesh, glm::uvec3(c->input.vertex[0], c->input.vertex[1], c->input.vertex[2]),
-                          b, toWorld[object], rotations[object],
-                          prepared_.objects[object].shadowShift * static_cast<float>(resolved.objects[object].scale));
+      return samplePoint(frames, resolved, c->hit.object, c->input);
     }, options_.threads);
   }
   const std::size_t bytes = shadePixels(g, request, camera, frame, [&](const Sample& sample, std::array<float, 3>& rgb) {
@@ -491,11 +507,8 @@ std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const RayScen
     const PreparedObject& p = prepared_.objects[object];
     const ResolvedObject& o = resolved.objects[object];
     const PixelInput& in = sample.input;
-    const glm::uvec3 triangle(in.vertex[0], in.vertex[1], in.vertex[2]);
-    const float b[3] = {static_cast<float>(in.b[0]), static_cast<float>(in.b[1]), static_cast<float>(in.b[2])};
     // The point lights this sample sees: one shadow ray each (point_lights.h).
-    const ShadingPoint point = shadingPoint(*p.mesh, triangle, b, toWorld[object], rotations[object],
-                                            p.shadowShift * static_cast<float>(o.scale));
+    const ShadingPoint point = samplePoint(frames, resolved, object, in);
     std::uint32_t seen = pointLightMask(rays, point, resolved.pointLightDirections);
     if (p.lobePath) seen |= lobeRayBit(rays, point, eye);
     if (p.ground) {
@@ -509,12 +522,12 @@ std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const RayScen
       return std::size_t{0};
     }
     std::array<WeightedBits, 3> vis;
-    for (std::size_t v = 0; v < 3; ++v) vis[v] = {p.visibilityBits.point(in.vertex[v]).data(), b[v]};
+    for (std::size_t v = 0; v < 3; ++v) vis[v] = {p.visibilityBits.point(in.vertex[v]).data(), static_cast<float>(in.b[v])};
     const PixelSlices& slices = pixelSlices_[object];
     const shared::SliceBlend blend = shared::sliceBlendAt(static_cast<float>(in.rotation.thetaOut),
                                                           static_cast<shared::uint>(slices.thetaSamples()),
                                                           options_.interpolateSlices ? 1u : 0u);
-    const LobePath lobe{&prepared_.lobeLight, p.lobes, o.toLight, false, p.lobeCore};
+    const LobePath lobe{&prepared_.lobeLight, p.lobes, o.toLight, p.lobeCore};
     rgb = fusedShade(slices, blend, in.rotation.euler, o.fusedLight, vis, o.pointLights, seen, scratch,
                      p.lobePath ? &lobe : nullptr);
     return fusedPixelBytes(slices.level(), blend.weight != 0.0f, 3 * p.visibilityBits.wordsPerPoint() * sizeof(std::uint32_t));
@@ -527,28 +540,21 @@ std::size_t CpuRenderer::shadeSplitsum(const ResolvedFrame& resolved, const RayS
                                        const FrameRequest& request, const CameraRays& camera, Frame& frame,
                                        const CancelPoint& cancelPoint) const {
   const auto t0 = Clock::now();
-  std::vector<glm::mat4> toWorld;
-  std::vector<glm::mat3> rotations;
-  for (const ResolvedObject& o : resolved.objects) {
-    toWorld.emplace_back(o.objectToWorld);
-    rotations.emplace_back(o.rotation);
-  }
+  const ObjectFrames frames(resolved);
   const glm::vec3 eye(camera.origin());
   const std::size_t bytes = shadePixels(g, request, camera, frame, [&](const Sample& sample, std::array<float, 3>& rgb) {
     const std::size_t object = sample.hit.object;
     const PreparedObject& p = prepared_.objects[object];
     const ResolvedObject& o = resolved.objects[object];
     const PixelInput& in = sample.input;
-    const float b[3] = {static_cast<float>(in.b[0]), static_cast<float>(in.b[1]), static_cast<float>(in.b[2])};
     // The one shadow ray along the mirror direction, against the whole posed
     // scene, as `fused`'s lobe path casts it (point_lights.h lobeRayBit).
-    const ShadingPoint point = shadingPoint(*p.mesh, glm::uvec3(in.vertex[0], in.vertex[1], in.vertex[2]), b,
-                                            toWorld[object], rotations[object], p.shadowShift * static_cast<float>(o.scale));
+    const ShadingPoint point = samplePoint(frames, resolved, object, in);
     const std::uint32_t seen = lobeRayBit(rays, point, eye);
     const shared::SliceBlend blend = shared::sliceBlendAt(static_cast<float>(in.rotation.thetaOut),
                                                           static_cast<shared::uint>(p.lobes.size()),
                                                           options_.interpolateSlices ? 1u : 0u);
-    const LobePath path{&prepared_.lobeLight, p.lobes, o.toLight, true};
+    const LobePath path{&prepared_.lobeLight, p.lobes, o.toLight};
     rgb = splitsumShade(path, blend, in.rotation.euler, in.rotation.thetaOut, seen);
     return splitsumPixelBytes();
   }, cancelPoint);

@@ -7,7 +7,6 @@
 #include <array>
 #include <cmath>
 #include <limits>
-#include <memory>
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
@@ -316,16 +315,8 @@ void RayScene::occludedFrom(const glm::vec3& origin, float tnear, std::span<cons
   // against packets of 8 along a pixel row (AVX-512; about the same either
   // way where Embree runs a packet of 16 as two of 8).
   constexpr std::size_t kWidth = 16;
-  // On the heap, where `new` honours the 64-byte alignment Embree's 16-wide
-  // packets need; a sanitizer's stack frames need not (rtcOccluded16 never
-  // returned under ASan with these on the stack).
-  struct alignas(64) Packet {
-    RTCRay16 ray;
-    alignas(64) int valid[kWidth];
-  };
-  const auto storage = std::make_unique<Packet>();
-  RTCRay16& packet = storage->ray;
-  int* valid = storage->valid;
+  alignas(64) RTCRay16 packet;
+  alignas(64) int valid[kWidth];
   // What every ray of every packet shares, set once.
   for (std::size_t k = 0; k < kWidth; ++k) {
     packet.org_x[k] = origin.x;

@@ -181,7 +181,7 @@ TEST(LobePath, ShadesEnergyTimesTheLightWhereTheRaySeesAndNothingWhereNot) {
   const PrefilteredLight light = PrefilteredLight::build(flat);
   const auto ggx = makeGgx(glm::dvec3(0.0), glm::dvec3(0.9, 0.7, 0.5), 0.02);
   const std::vector<shared::SliceLobe> lobes = measureLobes(*ggx, {0.3, 0.9});
-  const LobePath path{&light, lobes, glm::mat3(1.0f), false};  // the path takes all: E_core = E
+  const LobePath path{&light, lobes, glm::mat3(1.0f)};  // the path takes all: E_core = E
   const shared::SliceBlend blend{0u, 1u, 0.25f};
   const EulerYXY r{0.4, 1.1, -0.7};
   const std::array<float, 3> seen = lobeShade(path, blend, r, shared::kLobeSeenBit);
@@ -194,24 +194,39 @@ TEST(LobePath, ShadesEnergyTimesTheLightWhereTheRaySeesAndNothingWhereNot) {
   }
 }
 
+// A uniform unit light at level 4, and one point that sees every direction:
+// under them a `fused` pixel is the energy its slice (or lobe) keeps.
+struct UniformOpenSky {
+  FusedLight light;
+  VisibilityBits bits{4, 1};
+  UniformOpenSky() {
+    std::array<SphereMap, 3> unit{SphereMap(4, 1.0f), SphereMap(4, 1.0f), SphereMap(4, 1.0f)};
+    for (auto& m : unit) m = m.weightedBySolidAngle();
+    light = FusedLight::fromWeightedMaps(unit);
+    bits.assign(std::vector<std::uint32_t>(bits.wordsPerPoint(), ~0u));
+  }
+  std::array<WeightedBits, 1> visibility() const { return {WeightedBits{bits.point(0).data(), 1.0f}}; }
+};
+
+// A level-4 slice table of four θₒ samples.
+BrdfSliceTable level4Table(const Brdf& brdf) {
+  SliceTableOptions options;
+  options.level = 4;
+  options.thetaSamples = 4;
+  return BrdfSliceTable::build(brdf, options);
+}
+
 TEST(Fused, KeepsTheSlicesEnergyWhereTheMapsDirectionsMissPartOfANarrowLobe) {
   // Under a uniform unit light with V = 1, a pixel is ∫ρ: exactly the
   // slice's energy, whatever the rotation. The map's directions alone
   // count a lobe about a texel wide as they happen to fall on it (the
   // rotated map's integral below: off by percents), which showed as rings.
   const auto ggx = makeGgx(glm::dvec3(0.0), glm::dvec3(0.9), 0.06);
-  SliceTableOptions options;
-  options.level = 4;
-  options.thetaSamples = 4;
-  const BrdfSliceTable table = BrdfSliceTable::build(*ggx, options);
+  const BrdfSliceTable table = level4Table(*ggx);
   const PixelSlices slices = PixelSlices::synthesize(table);
-  std::array<SphereMap, 3> unit{SphereMap(4, 1.0f), SphereMap(4, 1.0f), SphereMap(4, 1.0f)};
-  for (auto& m : unit) m = m.weightedBySolidAngle();
-  const FusedLight light = FusedLight::fromWeightedMaps(unit);
-  VisibilityBits bits(4, 1);
-  std::vector<std::uint32_t> ones(bits.wordsPerPoint(), ~0u);
-  bits.assign(ones);
-  const std::array<WeightedBits, 1> vis{WeightedBits{bits.point(0).data(), 1.0f}};
+  const UniformOpenSky sky;
+  const FusedLight& light = sky.light;
+  const std::array<WeightedBits, 1> vis = sky.visibility();
   FusedScratch scratch;
   double worstRaw = 0.0;
   for (const EulerYXY& r : randomRotations(12, 3)) {
@@ -231,25 +246,19 @@ TEST(Fused, ASplitLobeIsThePassOutsideTheCoreAndThePathInsideIt) {
   // from the pass, E_core from the path; with the path's ray blocked, the
   // pass's part alone.
   const auto hazy = makeGgx(glm::dvec3(0.3), glm::dvec3(0.9), 0.005);
-  SliceTableOptions options;
-  options.level = 4;
-  options.thetaSamples = 4;
-  const BrdfSliceTable table = BrdfSliceTable::build(*hazy, options);
+  const BrdfSliceTable table = level4Table(*hazy);
   const PixelSlices slices = PixelSlices::synthesize(table);
   std::vector<double> thetaOut;
   for (int t = 0; t < table.thetaSamples(); ++t) thetaOut.push_back(table.thetaOut(t));
   const LobeCore core = chooseLobeCore(*hazy, thetaOut, 4);
   ASSERT_GT(core.angle, 0.0f);
   ASSERT_LT(core.angle, static_cast<float>(kPi));
-  std::array<SphereMap, 3> unit{SphereMap(4, 1.0f), SphereMap(4, 1.0f), SphereMap(4, 1.0f)};
-  const PrefilteredLight prefiltered = PrefilteredLight::build(unit);
-  for (auto& m : unit) m = m.weightedBySolidAngle();
-  const FusedLight light = FusedLight::fromWeightedMaps(unit);
-  VisibilityBits bits(4, 1);
-  std::vector<std::uint32_t> ones(bits.wordsPerPoint(), ~0u);
-  bits.assign(ones);
-  const std::array<WeightedBits, 1> vis{WeightedBits{bits.point(0).data(), 1.0f}};
-  const LobePath path{&prefiltered, core.lobes, glm::mat3(1.0f), false, core.angle};
+  const PrefilteredLight prefiltered =
+      PrefilteredLight::build({SphereMap(4, 1.0f), SphereMap(4, 1.0f), SphereMap(4, 1.0f)});
+  const UniformOpenSky sky;
+  const FusedLight& light = sky.light;
+  const std::array<WeightedBits, 1> vis = sky.visibility();
+  const LobePath path{&prefiltered, core.lobes, glm::mat3(1.0f), core.angle};
   FusedScratch scratch;
   for (const EulerYXY& r : randomRotations(6, 4)) {
     const shared::SliceBlend blend{1u, 2u, 0.3f};

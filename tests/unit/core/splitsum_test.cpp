@@ -29,7 +29,7 @@ TEST(Splitsum, UnderAUniformWhiteLightAPixelIsTheLobesEnergy) {
                            makeGgx(glm::dvec3(0.1), glm::dvec3(0.9, 0.6, 0.5), 0.3), makeLambert(glm::dvec3(0.8, 0.5, 0.2))}) {
     const std::vector<shared::SliceLobe> lobes = measureLobes(*brdf, lobeThetaOut(8));
     const glm::mat3 toLight = glm::mat3(rotationMatrix({0.3, 1.2, -0.4}));
-    const LobePath path{&light, lobes, toLight, true};
+    const LobePath path{&light, lobes, toLight};
     for (const EulerYXY& r : randomRotations(6, 11)) {
       for (const double thetaOut : {0.0, 0.4, 1.0, 1.5}) {
         const shared::SliceBlend blend = shared::sliceBlendAt(static_cast<float>(thetaOut), 8u, 1u);
@@ -79,7 +79,7 @@ TEST(Splitsum, UnderOneBrightTexelItIsTheEnergyTimesThePrefilteredLightAtTheMirr
         std::array<SphereMap, 3> maps{SphereMap(n), SphereMap(n), SphereMap(n)};
         for (int c = 0; c < 3; ++c) maps[static_cast<std::size_t>(c)].at(row, (col + dc) % m) = 1000.0f * static_cast<float>(c + 1);
         const PrefilteredLight light = PrefilteredLight::build(maps);
-        const LobePath path{&light, lobes, toLight, true};
+        const LobePath path{&light, lobes, toLight};
         const shared::SliceBlend blend = shared::sliceBlendAt(static_cast<float>(thetaOut), 4u, 1u);
         const shared::SliceLobe lobe = shared::blendLobes(lobes[blend.first], lobes[blend.second], blend.weight);
         const double lambda = shared::splitsumLevel(lobe.median.x);

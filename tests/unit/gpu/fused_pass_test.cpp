@@ -235,7 +235,7 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
     const EulerYXY r{samples[i].alpha, samples[i].beta, samples[i].gamma};
     const LobePath path{&prefiltered,
                         std::span<const shared::SliceLobe>(lobes).subspan(o * kThetaSamples, kThetaSamples), toLight,
-                        false, o == kLobeAll ? static_cast<float>(kPi) : coreAngle};
+                        o == kLobeAll ? static_cast<float>(kPi) : coreAngle};
     const LobePath* lobe = o == kLobeAll || o == kLobeSplit ? &path : nullptr;
     if (lobe) lobeSamples[o == kLobeAll ? 0 : 1]++;
     expected[i] = fusedShade(slices[o], blend, r, lights[o], vis, pointLights[o], masks[i], work, lobe);

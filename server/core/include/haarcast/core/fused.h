@@ -108,13 +108,11 @@ struct FusedScratch {
 // One object's lobe path (shared_layout.h, "The lobe path"): its slices'
 // lobes, the scene's prefiltered light and the turn from the object's frame
 // into the light's (core/lobe.h chooseLobeCore decides which objects have
-// one). `everyLobe`: it takes all of every lobe (`splitsum`), as with
-// coreAngle π.
+// one; `splitsum` reads its lobes and light whole).
 struct LobePath {
   const PrefilteredLight* light = nullptr;
   std::span<const shared::SliceLobe> lobes;  // one per θₒ slice
   glm::mat3 toLight{1.0f};                   // object frame → the prefiltered light's frame
-  bool everyLobe = false;
   // The lobes' core, measured with it (measureLobe): the path takes the
   // directions within it of the lobe's axis, the pass the rest. π: the
   // path takes all, and there is no pass.
