@@ -23,7 +23,8 @@
 //   2. the partial sums are reduced in invocation order; invocation 0 puts
 //      the lobe's energy back (× ∫ρ / Σ ΔΩ·ρ, the second sum of step 1:
 //      core fused.cpp energyKept), adds the point lights whose bit is set,
-//      in light order, each with the same rhoAt at the light's direction,
+//      in light order, each with ρ read at the light's direction from the
+//      point slices by Catmull-Rom (pointRhoAt: core fused.cpp pointRhoAt),
 //      and adds the lobe path's core; radiance[pixel] = Σ.
 // An object with a lobe path (shared_layout.h, "The lobe path") leaves the
 // directions within its core angle of the lobe's axis to it (rhoAt reads
@@ -68,6 +69,8 @@ layout(std430, set = 0, binding = 11) readonly buffer SliceEnergies { vec4 slice
 layout(std430, set = 0, binding = 12) readonly buffer Lobes { SliceLobe lobes[]; };          // global slice: its lobe
 // Level l of the prefiltered light at prefilterOffset(l), RGB0 (core PrefilteredLight).
 layout(set = 0, binding = 13) uniform samplerBuffer lobeLight;
+// The slices as point values at the texel centres (core PixelSlices::pointSlice), laid out as `texels`.
+layout(set = 0, binding = 14) uniform samplerBuffer pointTexels;
 
 shared vec3 partial[LOCAL];
 shared vec3 partialSum[LOCAL];  // Σ ΔΩ·ρ_c: the lobe's energy as the directions sample it
@@ -131,6 +134,43 @@ vec3 rhoAt(const bool blended, PixelSetup p, vec3 w0) {
   return tRow * (bottom - top) + top;
 }
 
+// ρ_c at the object-frame direction w0 for a point light: Rᵀw0, θ', φ' as
+// rhoAt, then Catmull-Rom over 4 × 4 taps of the point slices (rows
+// clamped, columns wrapped), each tap blended between the two slices
+// (core fused.cpp pointRhoAt; shared_layout.h catmullRomWeights).
+vec3 pointRhoAt(PixelSetup p, vec3 w0) {
+  const float rowScale = float(M) / kPi, colScale = float(M) / kTwoPi;
+  const int mask = int(M) - 1;
+  const float x1 = p.cosA * w0.x - p.sinA * w0.z;  // R_y(−α)
+  const float z1 = p.sinA * w0.x + p.cosA * w0.z;
+  const float y2 = p.cosB * w0.y + p.sinB * z1;    // R_x(−β)
+  if (y2 < p.skipBelowY) return vec3(0.0);
+  const float z2 = p.cosB * z1 - p.sinB * w0.y;
+  if (x1 * p.axis.x + y2 * p.axis.y + z2 * p.axis.z > p.coreCos) return vec3(0.0);  // the lobe path's core
+  const float theta = atan2Fast(sqrt(x1 * x1 + z2 * z2), y2);
+  const float phi = atan2Fast(x1, z2);
+  const float rowPos = min(max(theta * rowScale - 0.5, 0.0), float(M - 1u));
+  const float colPos = phi * colScale - p.fraction;
+  const float rowFloor = floor(rowPos), colFloor = floor(colPos);
+  const vec4 wr = catmullRomWeights(rowPos - rowFloor);
+  const vec4 wc = catmullRomWeights(colPos - colFloor);
+  const int r0 = int(rowFloor);
+  const int c0 = (int(colFloor) - p.shift) & mask;
+  vec3 sum = vec3(0.0);
+  for (int i = 0; i < 4; ++i) {
+    const uint row = uint(clamp(r0 - 1 + i, 0, int(M) - 1));
+    vec3 across = vec3(0.0);
+    for (int j = 0; j < 4; ++j) {
+      const uint k = row * M + uint((c0 - 1 + j) & mask);
+      const vec3 a = texelFetch(pointTexels, int(p.base0 + k)).rgb;
+      const vec3 b = texelFetch(pointTexels, int(p.base1 + k)).rgb;
+      across += wc[j] * (a + p.weight * (b - a));
+    }
+    sum += wr[i] * across;
+  }
+  return max(sum, vec3(0.0));  // the cubic overshoots below zero beside a steep lobe
+}
+
 // Bit i of global vertex v's visibility, as 0.0 or 1.0.
 float bitOf(uint v, uint i) {
   return float((texelFetch(visibilityBits, int(v * WORDS + i / 32u)).r >> (i & 31u)) & 1u);
@@ -179,11 +219,11 @@ vec3 lobeShade(ObjectInfo o, RotationSample rs, SliceBlend blend, uint seen) {
 
 // sum + Σ_k bit_k·power_k·ρ(Rᵀd_k) over the lights the sample sees, added
 // one by one in light order (fusedShade's order).
-vec3 addPointLights(const bool blended, PixelSetup p, uint object, uint count, uint seen, vec3 sum) {
+vec3 addPointLights(PixelSetup p, uint object, uint count, uint seen, vec3 sum) {
   for (uint k = 0u; k < count; ++k) {
     if (((seen >> k) & 1u) == 0u) continue;
     const PointLight l = pointLights[object * kMaxPointLights + k];
-    sum += l.power.rgb * rhoAt(blended, p, l.direction.xyz);
+    sum += l.power.rgb * pointRhoAt(p, l.direction.xyz);
   }
   return sum;
 }
@@ -289,8 +329,7 @@ void shadePixel(uint s) {
       if (sampled[c] > 0.0) sum[c] *= energy[c] / sampled[c];
     }
     if ((seen & 0xFFFFu) != 0u) {
-      sum = blended ? addPointLights(true, p, sh.object, o.pointLights, seen, sum)
-                    : addPointLights(false, p, sh.object, o.pointLights, seen, sum);
+      sum = addPointLights(p, sh.object, o.pointLights, seen, sum);
     }
     if (lobePath) sum += lobeShade(o, rs, blend, seen);
     radiance[sh.pixel] = vec4(sum, 1.0);

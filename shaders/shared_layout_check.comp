@@ -1,14 +1,17 @@
 #version 450
-// The shared header's Haar functions (core/shared_layout.h) evaluated by the
+// The shared header's Haar and lookup functions (core/shared_layout.h) evaluated by the
 // device, for the test that compares their GLSL reading with the C++ one
 // (tests/unit/gpu/shared_layout_test.cpp). Not part of any frame.
 //
 // Case k = (map level n, band, detail level l, block (i, j)) packed as
-// (n, band·256 + l, i, j); three results per case:
+// (n, band·256 + l, i, j); five results per case:
 //   [3k]     haarPreorderKey(n − 1, l, i, j) and the block haarPreorderBlock decodes
 //   [3k + 1] haarChildSign(haarChildQuadrant(i, j)) as float bits, the quadrant
 //   [3k + 2] haarDetailIndex(2^n, band, l, i, j) and its haarDetailPosition
 //            (band, level, i·65536 + j)
+//   [5k + 3] catmullRomWeights(t), t = (k mod 101)/101, as float bits
+//   [5k + 4] pointFromMean(mean, up, down, left, right) with the five from
+//            lookupInputs(k), and t, as float bits
 #extension GL_GOOGLE_include_directive : require
 #include "haarcast/core/shared_layout.h"
 
@@ -16,6 +19,9 @@ layout(local_size_x = 64) in;
 layout(push_constant) uniform Push { uint count; } pc;
 layout(std430, set = 0, binding = 0) readonly buffer Cases { uvec4 cases[]; };
 layout(std430, set = 0, binding = 1) writeonly buffer Results { uvec4 results[]; };
+
+// Five lookup inputs from a case index, the same in the C++ test.
+float lookupInput(uint k, uint s) { return float((k * (7u + 2u * s) + 3u * s) % 53u) / 13.0; }
 
 void main() {
   const uint k = gl_GlobalInvocationID.x;
@@ -25,12 +31,18 @@ void main() {
 
   const uint key = haarPreorderKey(n - 1u, l, i, j);
   const HaarBlock block = haarPreorderBlock(n - 1u, key);
-  results[3u * k] = uvec4(key, block.level, block.i, block.j);
+  results[5u * k] = uvec4(key, block.level, block.i, block.j);
 
   const uint quadrant = haarChildQuadrant(i, j);
-  results[3u * k + 1u] = uvec4(floatBitsToUint(haarChildSign(quadrant)), quadrant);
+  results[5u * k + 1u] = uvec4(floatBitsToUint(haarChildSign(quadrant)), quadrant);
 
   const uint index = haarDetailIndex(1u << n, band, l, i, j);
   const HaarDetailPosition p = haarDetailPosition(n, index);
-  results[3u * k + 2u] = uvec4(index, p.band, p.level, (p.i << 16u) | p.j);
+  results[5u * k + 2u] = uvec4(index, p.band, p.level, (p.i << 16u) | p.j);
+
+  const float t = float(k % 101u) / 101.0;
+  results[5u * k + 3u] = floatBitsToUint(catmullRomWeights(t));
+  const float point = pointFromMean(lookupInput(k, 0u), lookupInput(k, 1u), lookupInput(k, 2u), lookupInput(k, 3u),
+                                    lookupInput(k, 4u));
+  results[5u * k + 4u] = uvec4(floatBitsToUint(point), floatBitsToUint(t), 0u, 0u);
 }

@@ -104,7 +104,33 @@ PixelSlices PixelSlices::synthesize(const BrdfSliceTable& table) {
       out.energy_[static_cast<std::size_t>(t)][static_cast<std::size_t>(c)] = static_cast<float>(pixels.integral());
     }
   }
+  // The point table: each texel's mean turned into its centre's value.
+  out.pointTexels_.assign(out.texels_.size(), 0.0f);
+  for (int t = 0; t < out.thetaSamples_; ++t) {
+    const float* mean = out.texels_.data() + static_cast<std::size_t>(t) * n * shared::kTexelFloats;
+    float* point = out.pointTexels_.data() + static_cast<std::size_t>(t) * n * shared::kTexelFloats;
+    auto at = [&](int row, int col, int c) {
+      return mean[static_cast<std::size_t>(row * m + (col & (m - 1))) * shared::kTexelFloats + static_cast<std::size_t>(c)];
+    };
+    for (int row = 0; row < m; ++row) {
+      const int up = std::max(row - 1, 0), down = std::min(row + 1, m - 1);
+      for (int col = 0; col < m; ++col) {
+        for (int c = 0; c < BrdfSliceTable::kChannels; ++c) {
+          point[static_cast<std::size_t>(row * m + col) * shared::kTexelFloats + static_cast<std::size_t>(c)] =
+              shared::pointFromMean(at(row, col, c), at(up, col, c), at(down, col, c), at(row, col - 1, c), at(row, col + 1, c));
+        }
+      }
+    }
+  }
   return out;
+}
+
+const float* PixelSlices::pointSlice(int t) const {
+  if (t < 0 || t >= thetaSamples_) {
+    throw std::out_of_range("PixelSlices: point slice " + std::to_string(t) + " of " + std::to_string(thetaSamples_));
+  }
+  const std::size_t n = static_cast<std::size_t>(mapSize(level_)) * static_cast<std::size_t>(mapSize(level_));
+  return pointTexels_.data() + static_cast<std::size_t>(t) * n * shared::kTexelFloats;
 }
 
 const float* PixelSlices::slice(int t) const {
@@ -189,9 +215,13 @@ void setRotation(detail::FusedPass& pass, const EulerYXY& r) {
   pass.columnFraction = static_cast<float>(offset - whole);
 }
 
-// ρ_c at one object-frame direction: the kernel's per-direction lookup in
-// scalar float (fused_kernel.cpp: Rᵀω, θ', φ', bilinear taps).
-std::array<float, 3> sliceAt(const detail::FusedPass& p, const glm::vec3& w) {
+// ρ_c at one object-frame direction for a point light: Rᵀω, θ', φ' as the
+// kernel computes them (fused_kernel.cpp), then Catmull-Rom over 4 × 4 taps
+// of the point slices (shared::catmullRomWeights; rows clamped, columns
+// wrapped), the two slices of the blend taken tap by tap. Zero below the
+// slices' cut and inside the lobe path's core, as the pass reads them.
+std::array<float, 3> pointRhoAt(const detail::FusedPass& p, const PixelSlices& slices, const shared::SliceBlend& blend,
+                                const glm::vec3& w) {
   const int m = 1 << p.level;
   const float x1 = p.cosAlpha * w.x - p.sinAlpha * w.z;  // R_y(−α)
   const float z1 = p.sinAlpha * w.x + p.cosAlpha * w.z;
@@ -204,20 +234,26 @@ std::array<float, 3> sliceAt(const detail::FusedPass& p, const glm::vec3& w) {
   const float rowPos = std::min(std::max(theta * (static_cast<float>(m) / shared::kPiF) - 0.5f, 0.0f), static_cast<float>(m - 1));
   const float colPos = phi * (static_cast<float>(m) / (2.0f * shared::kPiF)) - p.columnFraction;
   const float rowFloor = std::floor(rowPos), colFloor = std::floor(colPos);
-  const float tRow = rowPos - rowFloor, tCol = colPos - colFloor;
+  const glm::vec4 wr = shared::catmullRomWeights(rowPos - rowFloor);
+  const glm::vec4 wc = shared::catmullRomWeights(colPos - colFloor);
   const int r0 = static_cast<int>(rowFloor);
-  const int r1 = std::min(r0 + 1, m - 1);
   const int c0 = (static_cast<int>(colFloor) - p.columnShift) & (m - 1);
-  const int c1 = (c0 + 1) & (m - 1);
-  std::array<float, 3> out{};
-  for (std::size_t c = 0; c < 3; ++c) {
-    auto texel = [&](int row, int col) { return p.slice[static_cast<std::size_t>((row << p.level) | col) * shared::kTexelFloats + c]; };
-    const float a = texel(r0, c0), b = texel(r0, c1), cc = texel(r1, c0), e = texel(r1, c1);
-    const float top = tCol * (b - a) + a;
-    const float bottom = tCol * (e - cc) + cc;
-    out[c] = tRow * (bottom - top) + top;
+  const float* first = slices.pointSlice(static_cast<int>(blend.first));
+  const float* second = blend.weight != 0.0f ? slices.pointSlice(static_cast<int>(blend.second)) : first;
+  glm::vec3 sum(0.0f);
+  for (int i = 0; i < 4; ++i) {
+    const int row = std::min(std::max(r0 - 1 + i, 0), m - 1);
+    glm::vec3 across(0.0f);
+    for (int j = 0; j < 4; ++j) {
+      const std::size_t k = static_cast<std::size_t>((row << p.level) | ((c0 - 1 + j) & (m - 1))) * shared::kTexelFloats;
+      const glm::vec3 a(first[k], first[k + 1], first[k + 2]);
+      const glm::vec3 b(second[k], second[k + 1], second[k + 2]);
+      across += wc[j] * (a + blend.weight * (b - a));
+    }
+    sum += wr[i] * across;
   }
-  return out;
+  // The cubic overshoots below zero beside a steep lobe; ρ never is.
+  return {std::max(sum.x, 0.0f), std::max(sum.y, 0.0f), std::max(sum.z, 0.0f)};
 }
 
 detail::FusedPass makePass(const PixelSlices& slices, const float* slice, const EulerYXY& r) {
@@ -294,7 +330,7 @@ std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBl
   std::array<float, 3> out = energyKept(pass, energy);
   for (std::size_t k = 0; k < lights.size(); ++k) {
     if (((visibleLights >> k) & 1u) == 0) continue;
-    const std::array<float, 3> rho = sliceAt(pass, lights[k].direction);
+    const std::array<float, 3> rho = pointRhoAt(pass, slices, blend, lights[k].direction);
     for (std::size_t c = 0; c < 3; ++c) out[c] += lights[k].power[c] * rho[c];
   }
   if (lobe) {

@@ -143,7 +143,8 @@ void VulkanRenderer::Impl::ensureResolution(int w, int h) {
       return;
     }
     fusedPass->bind({&samples, &shade, &objects, &sliceTexels, &lightTexels, &visibilityTexels, &directionTexels,
-                     &pointLights, &radiance, &counter, &masks, &sliceEnergy, &lobes, &lobeLightTexels});
+                     &pointLights, &radiance, &counter, &masks, &sliceEnergy, &lobes, &lobeLightTexels,
+                     &pointSliceTexels});
     return;
   }
 

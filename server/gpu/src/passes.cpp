@@ -38,7 +38,8 @@ void setFusedSkip(ObjectInfo& info, int level, int lastNonZeroRow) {
 
 std::vector<BindingKind> fusedBindings() {
   using enum BindingKind;
-  return {Storage, Storage, Storage, Texels, Texels, Texels, Texels, Storage, Storage, Storage, Storage, Storage, Storage, Texels};
+  return {Storage, Storage, Storage, Texels, Texels, Texels, Texels, Storage, Storage, Storage, Storage, Storage, Storage, Texels,
+          Texels};
 }
 
 std::vector<BindingKind> splitsumBindings() {

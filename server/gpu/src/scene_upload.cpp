@@ -23,6 +23,7 @@ void VulkanRenderer::Impl::uploadScene() {
   // Slices: global slice s = object's base + t, channel c at (s·3 + c)·N
   // (the rotation contract's binding 1).
   std::vector<float> sliceData;
+  std::vector<float> pointData;  // fused: the slices as point values, laid out as sliceData
   std::vector<std::uint32_t> method;
   std::vector<glm::vec4> pos, nor;
   std::vector<std::uint32_t> tri;
@@ -50,6 +51,7 @@ void VulkanRenderer::Impl::uploadScene() {
       const PixelSlices pixelSlices = PixelSlices::synthesize(p.table);
       info.sliceBase = static_cast<std::uint32_t>(sliceData.size() / (shared::kTexelFloats * n));
       sliceData.insert(sliceData.end(), pixelSlices.texels().begin(), pixelSlices.texels().end());
+      pointData.insert(pointData.end(), pixelSlices.pointTexels().begin(), pixelSlices.pointTexels().end());
       setFusedSkip(info, level, pixelSlices.lastNonZeroRow());
       for (std::size_t t = 0; t < T; ++t) {
         const std::array<float, 3>& e = pixelSlices.energy(static_cast<int>(t));
@@ -172,6 +174,7 @@ void VulkanRenderer::Impl::uploadScene() {
     const std::vector<glm::vec4> dirs = pixelCentreDirections(level);
     upload(directions, dirs.data(), dirs.size() * sizeof(glm::vec4), kTexelUsage);
     upload(sliceEnergy, energies.data(), energies.size() * sizeof(glm::vec4));
+    upload(pointSlices, pointData.data(), pointData.size() * sizeof(float), kTexelUsage);
     upload(lobes, lobeData.data(), lobeData.size() * sizeof(shared::SliceLobe));
     // No object with a lobe path: one zero texel, never read (a buffer may not be empty).
     const glm::vec4 none(0.0f);
@@ -254,6 +257,7 @@ void VulkanRenderer::Impl::createFusedPipeline(std::uint32_t local) {
   directionTexels = TexelView(context, directions, VK_FORMAT_R32G32B32A32_SFLOAT, sizeof(glm::vec4));
   visibilityTexels = TexelView(context, visibility, VK_FORMAT_R32_UINT, sizeof(std::uint32_t));
   lobeLightTexels = TexelView(context, lobeLight, VK_FORMAT_R32G32B32A32_SFLOAT, sizeof(glm::vec4));
+  pointSliceTexels = TexelView(context, pointSlices, VK_FORMAT_R32G32B32A32_SFLOAT, sizeof(glm::vec4));
   lightTexelData.resize(prepared.objects.size() * coefficients);
 
   // No scratch: a workgroup keeps only its reduction's vec3 per invocation,

@@ -79,7 +79,8 @@ struct VulkanRenderer::Impl {
   // The light is device-local (buffer.h); each frame writes it here and
   // records the copy, where it is staged, ahead of the pass that reads it.
   BufferUpload lightUpload;
-  // `fused`: the slices in pixel form (texels), the visibility bits (in
+  // `fused`: the slices in pixel form (texels) and as point values
+  // (`pointSlices`, the point lights' lookup), the visibility bits (in
   // `visibility`, every vertex's words in global vertex order), the light in
   // pixel form per frame (in `light`), the pixel-centre directions; per
   // frame the point lights (PointLight, kMaxPointLights per object).
@@ -88,13 +89,13 @@ struct VulkanRenderer::Impl {
   // ObjectInfo::sliceBase + t) its SliceLobe, and the prefiltered light.
   // Its frame is fused's (renderFused) with shaders/splitsum.comp as the pass.
   bool splitsum = false;
-  Buffer directions, pointLights;
+  Buffer directions, pointLights, pointSlices;
   // `fused`: per global slice its ∫ρ (vec4) and its lobe (SliceLobe), and
   // the prefiltered light (core/prefiltered_light.h) the lobe path reads.
   Buffer sliceEnergy, lobes, lobeLight;
   BufferUpload pointLightUpload;
   // fused.comp reads these through texel views (BindingKind::Texels).
-  TexelView sliceTexels, lightTexels, directionTexels, visibilityTexels, lobeLightTexels;
+  TexelView sliceTexels, lightTexels, directionTexels, visibilityTexels, lobeLightTexels, pointSliceTexels;
   std::vector<glm::vec4> lightTexelData;  // this frame's light texels, before upload
   std::vector<PointLight> pointLightData;         // this frame's point lights, before upload
   std::uint32_t fusedGroups = 0;     // the most workgroups of the fused dispatch

@@ -76,7 +76,7 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
   std::vector<FusedLight> lights;
   std::vector<std::vector<FusedPointLight>> pointLights(kObjects);
   std::vector<ObjectInfo> objects(kObjects);
-  std::vector<float> texels;
+  std::vector<float> texels, pointTexels;
   std::vector<glm::vec4> lightTexels;
   std::vector<PointLight> lightRecords(kObjects * shared::kMaxPointLights);
   for (std::size_t o = 0; o < kObjects; ++o) {
@@ -89,6 +89,7 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
     objects[o].pointLights = static_cast<std::uint32_t>(kLights);
     setFusedSkip(objects[o], level, slices[o].lastNonZeroRow());
     texels.insert(texels.end(), slices[o].texels().begin(), slices[o].texels().end());
+    pointTexels.insert(pointTexels.end(), slices[o].pointTexels().begin(), slices[o].pointTexels().end());
     lightTexels.resize(lightTexels.size() + n);
     fusedLightTexels(lights[o].planes, std::span<glm::vec4>(lightTexels).last(n));
     for (std::size_t k = 0; k < kLights; ++k) {
@@ -190,6 +191,7 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
   Buffer shadeBuf = upload(shade.data(), shade.size() * sizeof(ShadeSample));
   Buffer objectBuf = upload(objects.data(), objects.size() * sizeof(ObjectInfo));
   Buffer texelBuf = upload(texels.data(), texels.size() * sizeof(float));
+  Buffer pointTexelBuf = upload(pointTexels.data(), pointTexels.size() * sizeof(float));
   Buffer lightBuf = upload(lightTexels.data(), lightTexels.size() * sizeof(glm::vec4));
   Buffer bitsBuf = upload(bits.words().data(), bits.storedBytes());
   Buffer dirBuf = upload(dirs.data(), dirs.size() * sizeof(glm::vec4));
@@ -202,6 +204,7 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
   Buffer prefilterBuf = upload(prefiltered.texels().data(), prefiltered.texels().size_bytes());
   const TexelView prefilterView(context, prefilterBuf, VK_FORMAT_R32G32B32A32_SFLOAT, sizeof(glm::vec4));
   const TexelView texelView(context, texelBuf, VK_FORMAT_R32G32B32A32_SFLOAT, sizeof(glm::vec4));
+  const TexelView pointTexelView(context, pointTexelBuf, VK_FORMAT_R32G32B32A32_SFLOAT, sizeof(glm::vec4));
   const TexelView lightView(context, lightBuf, VK_FORMAT_R32G32B32A32_SFLOAT, sizeof(glm::vec4));
   const TexelView bitsView(context, bitsBuf, VK_FORMAT_R32_UINT, sizeof(std::uint32_t));
   const TexelView dirView(context, dirBuf, VK_FORMAT_R32G32B32A32_SFLOAT, sizeof(glm::vec4));
@@ -209,7 +212,7 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
                     {{0, static_cast<std::uint32_t>(level)}, {2, 64u}, {4, pc.interpolate ? 1u : 0u},
                      {5, static_cast<std::uint32_t>(kPrefilterFinest)}});
   p.bind({&sampleBuf, &shadeBuf, &objectBuf, &texelView, &lightView, &bitsView, &dirView, &pointBuf, &radiance,
-          &counterBuf, &maskBuf, &energyBuf, &lobeBuf, &prefilterView});
+          &counterBuf, &maskBuf, &energyBuf, &lobeBuf, &prefilterView, &pointTexelView});
   context.submit([&](VkCommandBuffer cb) { p.dispatch(cb, {kGroups, 1, 1}); });
   std::vector<glm::vec4> got(kPixels);
   radiance.read(got.data(), got.size() * sizeof(glm::vec4));

@@ -2,10 +2,13 @@
 // shared_layout_check.comp) against the same lines read as C++: the preorder
 // key and its decoding, the child quadrant and signs, the detail index and
 // its inverse, for every block and band of levels 1–7 and sampled blocks up
-// to the largest level whose keys fit 32 bits. Bit for bit.
+// to the largest level whose keys fit 32 bits, bit for bit; and the point
+// lights' lookup (Catmull-Rom weights, the point value from a texel's mean),
+// to float rounding (a device may fuse a multiply and an add).
 #include <gtest/gtest.h>
 
 #include <bit>
+#include <cmath>
 #include <random>
 #include <span>
 #include <vector>
@@ -23,6 +26,17 @@ using shared::uint;
 
 glm::uvec4 packCase(uint n, uint band, uint l, uint i, uint j) { return {n, band * 256 + l, i, j}; }
 
+float lookupInput(uint k, uint s) { return static_cast<float>((k * (7u + 2u * s) + 3u * s) % 53u) / 13.0f; }
+
+// The C++ reading of the lookup results of case k: the four weights, then
+// the point value and t.
+std::array<glm::vec4, 2> expectedLookup(uint k) {
+  const float t = static_cast<float>(k % 101u) / 101.0f;
+  const float point = shared::pointFromMean(lookupInput(k, 0), lookupInput(k, 1), lookupInput(k, 2), lookupInput(k, 3),
+                                            lookupInput(k, 4));
+  return {shared::catmullRomWeights(t), glm::vec4(point, t, 0.0f, 0.0f)};
+}
+
 // The C++ reading of what the shader writes for one case.
 std::array<glm::uvec4, 3> expected(const glm::uvec4& c) {
   const uint n = c.x, band = c.y >> 8, l = c.y & 255u, i = c.z, j = c.w;
@@ -37,7 +51,7 @@ std::array<glm::uvec4, 3> expected(const glm::uvec4& c) {
           glm::uvec4(index, p.band, p.level, (p.i << 16) | p.j)};
 }
 
-TEST(SharedLayout, ShaderAndCppAgreeOnTheHaarNumbers) {
+TEST(SharedLayout, ShaderAndCppAgreeOnTheHaarNumbersAndTheLookup) {
   HAARCAST_REQUIRE_VULKAN();
   std::vector<glm::uvec4> cases;
   for (uint n = 1; n <= shared::kFusedMaxLevel; ++n) {
@@ -60,7 +74,7 @@ TEST(SharedLayout, ShaderAndCppAgreeOnTheHaarNumbers) {
   }
 
   Context context(testing::testOptions());
-  Buffer in(context, cases.size() * sizeof(glm::uvec4)), out(context, 3 * cases.size() * sizeof(glm::uvec4));
+  Buffer in(context, cases.size() * sizeof(glm::uvec4)), out(context, 5 * cases.size() * sizeof(glm::uvec4));
   in.upload(std::span<const glm::uvec4>(cases));
   ComputePipeline check(context, "shared_layout_check.comp", 2, 4);
   check.bind({&in, &out});
@@ -69,16 +83,28 @@ TEST(SharedLayout, ShaderAndCppAgreeOnTheHaarNumbers) {
     check.dispatch(cb, {(count + 63) / 64, 1, 1}, &count, sizeof count);
     computeBarrier(cb);
   });
-  std::vector<glm::uvec4> got(3 * cases.size());
+  std::vector<glm::uvec4> got(5 * cases.size());
   out.download(std::span<glm::uvec4>(got));
 
   std::size_t wrong = 0;
   for (std::size_t k = 0; k < cases.size(); ++k) {
     const std::array<glm::uvec4, 3> want = expected(cases[k]);
+    const std::array<glm::vec4, 2> lookup = expectedLookup(static_cast<uint>(k));
+    for (std::size_t r = 0; r < 2; ++r) {
+      const glm::vec4 g(std::bit_cast<float>(got[5 * k + 3 + r].x), std::bit_cast<float>(got[5 * k + 3 + r].y),
+                        std::bit_cast<float>(got[5 * k + 3 + r].z), std::bit_cast<float>(got[5 * k + 3 + r].w));
+      for (int e = 0; e < 4; ++e) {
+        if (std::abs(g[e] - lookup[r][e]) <= 1e-6f * (1.0f + std::abs(lookup[r][e]))) continue;
+        if (++wrong <= 10) {
+          ADD_FAILURE() << "case " << k << (r == 0 ? " Catmull-Rom weight " : " point value/t ") << e << ": GLSL "
+                        << g[e] << ", C++ " << lookup[r][e];
+        }
+      }
+    }
     for (std::size_t r = 0; r < 3; ++r) {
-      if (got[3 * k + r] == want[r]) continue;
+      if (got[5 * k + r] == want[r]) continue;
       if (++wrong <= 10) {
-        const glm::uvec4& g = got[3 * k + r];
+        const glm::uvec4& g = got[5 * k + r];
         ADD_FAILURE() << "case (n " << cases[k].x << ", band " << (cases[k].y >> 8) << ", l " << (cases[k].y & 255u)
                       << ", i " << cases[k].z << ", j " << cases[k].w << ") result " << r << ": GLSL (" << g.x << ", "
                       << g.y << ", " << g.z << ", " << g.w << "), C++ (" << want[r].x << ", " << want[r].y << ", "
@@ -86,7 +112,7 @@ TEST(SharedLayout, ShaderAndCppAgreeOnTheHaarNumbers) {
       }
     }
   }
-  EXPECT_EQ(wrong, 0u) << "of " << 3 * cases.size() << " results";
+  EXPECT_EQ(wrong, 0u) << "of " << 5 * cases.size() << " results";
   testing::expectNoValidationMessages(context);
 }
 

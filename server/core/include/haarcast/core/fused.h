@@ -54,11 +54,15 @@ class PixelSlices {
   int thetaSamples() const { return thetaSamples_; }
   std::span<const float> texels() const { return texels_; }
   const float* slice(int t) const;
+  // Slice t as point values at the texel centres (shared::pointFromMean),
+  // in the same layout: what the point lights read (shared::catmullRomWeights).
+  const float* pointSlice(int t) const;
+  std::span<const float> pointTexels() const { return pointTexels_; }
   // The last map row with a non-zero texel in any slice: below it every
   // lookup reads zeros (a slice is ρ·max(cos θᵢ, 0), so this is about the
   // equator), which lets the pass skip directions that cannot contribute.
   int lastNonZeroRow() const { return lastNonZeroRow_; }
-  std::size_t storedBytes() const { return texels_.size() * sizeof(float); }
+  std::size_t storedBytes() const { return (texels_.size() + pointTexels_.size()) * sizeof(float); }
   // ∫ ρ_c dω of slice t (the directional albedo, cos θᵢ included), R, G, B.
   const std::array<float, 3>& energy(int t) const { return energy_.at(static_cast<std::size_t>(t)); }
 
@@ -67,6 +71,7 @@ class PixelSlices {
   int thetaSamples_ = 0;
   int lastNonZeroRow_ = -1;
   std::vector<float> texels_;
+  std::vector<float> pointTexels_;
   std::vector<std::array<float, 3>> energy_;
 };
 
@@ -82,7 +87,8 @@ struct FusedLight {
 };
 
 // A bright light taken out of the map (render/light_split.h) and shaded as a
-// direction: I_c += power_c · ρ_c(Rᵀd) when the pixel sees it. `direction`
+// direction: I_c += power_c · ρ_c(Rᵀd) when the pixel sees it, ρ read from
+// the point slices (PixelSlices::pointSlice) by Catmull-Rom. `direction`
 // is a unit vector in the object's frame; power_c = Σ L_c·ΔΩ over the map
 // texels it replaces.
 struct FusedPointLight {

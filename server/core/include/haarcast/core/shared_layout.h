@@ -90,6 +90,32 @@ struct SliceBlend {
   float weight;
 };
 
+// The point lights' lookup of a slice (fused.h FusedPointLight). A slice
+// texel is the mean of ρ·cos over its solid angle (BrdfSliceTable), which
+// is what the pass over the map's directions sums. A point light wants ρ at
+// one direction, and a bilinear blend of means blurs a lobe twice, by the
+// texel and by the tent between centres: a sun's highlight on ggx:0.3 at
+// level 6 came out low at its peak and high on its tail (docs/design.md,
+// "Point lights read points"). So point lights read the point table
+// (PixelSlices::pointSlice: each mean less a 24th of its discrete
+// Laplacian, the value at the texel's centre to second order) through
+// Catmull-Rom's cubic, which passes through those values: taps at −1, 0,
+// +1, +2 about the floor of the position, weighted for its fraction t.
+HC_FUNCTION vec4 catmullRomWeights(float t) {
+  const float t2 = t * t;
+  const float t3 = t2 * t;
+  return vec4(0.5f * (2.0f * t2 - t3 - t), 0.5f * (3.0f * t3 - 5.0f * t2 + 2.0f), 0.5f * (4.0f * t2 - 3.0f * t3 + t),
+              0.5f * (t3 - t2));
+}
+
+// The point value at a texel's centre from its mean and its four
+// neighbours' (rows clamped at the poles, columns wrapped, as the lookups
+// take them): m − ∇²m/24, the midpoint rule's second-order term. Never
+// below zero, as ρ·cos is not (near the horizon the correction overshoots).
+HC_FUNCTION float pointFromMean(float mean, float up, float down, float left, float right) {
+  return max(mean - (up + down + left + right - 4.0f * mean) / 24.0f, 0.0f);
+}
+
 HC_FUNCTION SliceBlend sliceBlendAt(float thetaOut, uint thetaSamples, uint interpolate) {
   const float cells = float(thetaSamples);
   const float u = clamp(thetaOut, 0.0f, 0.5f * kPiF) * (cells / (0.5f * kPiF));  // in cells, [0, T]
