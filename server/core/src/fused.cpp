@@ -313,12 +313,26 @@ std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBl
   if (lobe && lobe->coreAngle >= static_cast<float>(kPi)) return lobeShade(*lobe, blend, r, visibleLights);
   checkSameLevel(light.level, level, "the light");
   const std::size_t n = static_cast<std::size_t>(mapSize(level)) * static_cast<std::size_t>(mapSize(level));
-  scratch.visibility.resize(n);
-  blendVisibility(visibility, level, scratch.visibility);
+  // Three vertices' bits are blended in the pass; otherwise (another count,
+  // or vectors wider than a word) here, into V.
+  static const bool bitsInPass = detail::fusedLanes() <= 32;
+  const bool inPass = bitsInPass && visibility.size() == 3;
+  if (!inPass) {
+    scratch.visibility.resize(n);
+    blendVisibility(visibility, level, scratch.visibility);
+  }
 
   detail::FusedPass pass = makePass(slices, blendedSlice(slices, blend, scratch), r);
   pass.light = light.planes.data();
-  pass.visibility = scratch.visibility.data();
+  if (inPass) {
+    pass.visibility = nullptr;
+    for (std::size_t v = 0; v < 3; ++v) {
+      pass.bits[v] = visibility[v].words;
+      pass.bitWeight[v] = visibility[v].weight;
+    }
+  } else {
+    pass.visibility = scratch.visibility.data();
+  }
   std::array<float, 3> energy = sliceEnergy(slices, blend);
   shared::SliceLobe core{};
   if (lobe) {

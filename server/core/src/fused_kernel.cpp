@@ -38,7 +38,8 @@ HWY_INLINE V Atan2(D d, V y, V x) {
   return hn::CopySign(a, y);
 }
 
-void FusedSample(const FusedPass& p, float* HWY_RESTRICT out) {
+template <bool kBits>
+void FusedSampleWith(const FusedPass& p, float* HWY_RESTRICT out) {
   const hn::ScalableTag<float> d;
   const hn::RebindToSigned<decltype(d)> di;
   using VF = hn::Vec<decltype(d)>;
@@ -70,6 +71,11 @@ void FusedSample(const FusedPass& p, float* HWY_RESTRICT out) {
   const float* HWY_RESTRICT l1 = p.light + n;
   const float* HWY_RESTRICT l2 = p.light + 2 * n;
   const float* HWY_RESTRICT vis = p.visibility;
+  // Lane j tests bit j of the 32-bit word shifted to the vector's first
+  // direction (lanes ≤ 32: fusedLanes).
+  const VI laneBit = hn::Shl(hn::Set(di, 1), hn::Iota(di, 0));
+  const VF bitWeight0 = hn::Set(d, p.bitWeight[0]), bitWeight1 = hn::Set(d, p.bitWeight[1]);
+  const VF bitWeight2 = hn::Set(d, p.bitWeight[2]);
 
   VF accR = zero, accG = zero, accB = zero;
   VF sumR = zero, sumG = zero, sumB = zero;
@@ -114,7 +120,19 @@ void FusedSample(const FusedPass& p, float* HWY_RESTRICT out) {
       return hn::MulAdd(tRow, hn::Sub(bottom, top), top);
     };
     // W_c = (L_c·ΔΩ)·V, formed only for the directions that are not skipped.
-    const VF v = hn::LoadU(d, vis + i);
+    VF v;
+    if constexpr (kBits) {
+      // V = ((0 + b₀·bit₀) + b₁·bit₁) + b₂·bit₂, blendVisibility's sums.
+      const std::size_t word = i / 32, shift = i % 32;
+      auto seen = [&](const std::uint32_t* bits) {
+        return hn::RebindMask(d, hn::TestBit(hn::Set(di, static_cast<int32_t>(bits[word] >> shift)), laneBit));
+      };
+      v = hn::Add(zero, hn::IfThenElseZero(seen(p.bits[0]), bitWeight0));
+      v = hn::Add(v, hn::IfThenElseZero(seen(p.bits[1]), bitWeight1));
+      v = hn::Add(v, hn::IfThenElseZero(seen(p.bits[2]), bitWeight2));
+    } else {
+      v = hn::LoadU(d, vis + i);
+    }
     const VF dOmega = hn::LoadU(d, omega + i);
     // Outside the lobe path's core (ρ·0 there: the core is the path's).
     const auto outside = hn::Le(hn::MulAdd(x1, axisX, hn::MulAdd(y2, axisY, hn::Mul(z2, axisZ))), coreCos);
@@ -136,7 +154,17 @@ void FusedSample(const FusedPass& p, float* HWY_RESTRICT out) {
   out[5] = hn::GetLane(hn::SumOfLanes(d, sumB));
 }
 
+void FusedSample(const FusedPass& p, float* HWY_RESTRICT out) {
+  if (p.visibility) {
+    FusedSampleWith<false>(p, out);
+  } else {
+    FusedSampleWith<true>(p, out);
+  }
+}
+
 const char* FusedTarget() { return hwy::TargetName(HWY_TARGET); }
+
+std::size_t FusedLanes() { return hn::Lanes(hn::ScalableTag<float>()); }
 
 }  // namespace HWY_NAMESPACE
 }  // namespace haarcast::detail
@@ -146,8 +174,10 @@ HWY_AFTER_NAMESPACE();
 namespace haarcast::detail {
 HWY_EXPORT(FusedSample);
 HWY_EXPORT(FusedTarget);
+HWY_EXPORT(FusedLanes);
 
 void fusedSample(const FusedPass& pass, float out[6]) { HWY_DYNAMIC_DISPATCH(FusedSample)(pass, out); }
 const char* fusedTarget() { return HWY_DYNAMIC_DISPATCH(FusedTarget)(); }
+std::size_t fusedLanes() { return HWY_DYNAMIC_DISPATCH(FusedLanes)(); }
 }  // namespace haarcast::detail
 #endif

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 
 namespace haarcast::detail {
 
@@ -19,7 +20,12 @@ struct FusedPass {
   int level = 0;
   const float* slice = nullptr;   // R, G, B, 0 texels (shared::kTexelFloats)
   const float* light = nullptr;       // L_c·ΔΩ, three planes of N
-  const float* visibility = nullptr;  // V, N
+  const float* visibility = nullptr;  // V, N; or, when null, the blend of `bits`:
+  // V(ω) = Σ_v bitWeight[v]·bit_v(ω), three vertices' visibility words
+  // (core VisibilityBits: direction i at bit i % 32 of word i / 32), formed
+  // in the pass in blendVisibility's order, so the sums are the same.
+  const std::uint32_t* bits[3] = {nullptr, nullptr, nullptr};
+  float bitWeight[3] = {0.0f, 0.0f, 0.0f};
   PixelDirections directions;
   // Rᵀ = R_y(−γ) R_x(−β) R_y(−α): α turns the directions, β tilts them,
   // and γ is an offset of the source column, split into a whole number of
@@ -39,5 +45,8 @@ struct FusedPass {
 // directions sample it.
 void fusedSample(const FusedPass& pass, float out[6]);
 const char* fusedTarget();
+// The target's float lanes: the pass forms V from the bits only where a
+// vector's lanes lie in one word (≤ 32).
+std::size_t fusedLanes();
 
 }  // namespace haarcast::detail
