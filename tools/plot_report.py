@@ -16,7 +16,11 @@ DIR, the files that report.json names:
       so that bar heights compare across variants, materials and levels.
   glossiness.file  (glossiness.png)
       The glossiness tiles (glossiness.tiles, one PNG per material and light
-      coefficient count, written by eval) laid out in a labelled grid.
+      coefficient count, written by eval) laid out in a labelled grid, one
+      screen pixel per tile pixel when the tiles are 128 px or more.
+
+Every figure's title names its frame size, map level and machine (the CPU
+model and core count of report.json's machine, config.machine for eval).
 
 A loadtest report ("kind": "loadtest") gets the three files it lists under
 "figures": loadtest_bandwidth.png (Mbit/s per client against clients, a line
@@ -39,9 +43,10 @@ import sys
 DPI = 100
 MSE_SIZE_IN = (12.0, 5.0)      # one (level, material) figure: 1200×500 px
 LOADTEST_SIZE_IN = (8.0, 5.0)  # each loadtest figure: 800×500 px
-TILE_IN = 2.0                  # a glossiness tile is drawn 200 px wide …
+TILE_IN = 2.0                  # a glossiness tile under 128 px is drawn 200 px wide …
 TILE_GAP_IN = 0.1              # … 10 px apart
-SHEET_MARGINS_IN = {"left": 0.9, "right": 0.15, "top": 0.75, "bottom": 0.15}
+NATIVE_TILE_PX = 128           # … one from 128 px up at its own size, pixel for pixel
+SHEET_MARGINS_IN = {"left": 0.9, "right": 0.15, "top": 0.95, "bottom": 0.15}
 
 # Okabe–Ito: distinguishable with colour-vision deficiencies.
 COLOURS = ["#E69F00", "#56B4E9", "#009E73", "#F0E442", "#0072B2", "#D55E00", "#CC79A7", "#999999"]
@@ -80,6 +85,14 @@ def need(node, *path):
         except (KeyError, IndexError, TypeError):
             raise ReportError("report.json lacks " + ".".join(str(k) for k in path[: i + 1]))
     return node
+
+
+def machine_text(report):
+    """"AMD EPYC, 2 cores": the machine a report ran on, for figure titles."""
+    m = report.get("machine") or report.get("config", {}).get("machine") or {}
+    cpu = m.get("cpu_model") or "unknown CPU"
+    cores = m.get("cores")
+    return "%s, %d core%s" % (cpu, cores, "" if cores == 1 else "s") if cores else cpu
 
 
 def level_number(level_key):
@@ -149,9 +162,11 @@ def mse_figure(plt, report, level_key, material, ylim):
     axes[0].set_ylabel("MSE over the object's pixels (linear RGB)")
     handles, labels = axes[0].get_legend_handles_labels()
     fig.legend(handles, labels, title="environment", loc="center right", frameon=False)
-    fig.suptitle("haar against spatial: %s, level %d (%d×%d maps)" % (material, level, 2 ** level, 2 ** level),
-                 fontsize=13)
-    fig.subplots_adjust(left=0.08, right=0.87, top=0.82, bottom=0.11, wspace=0.06)
+    config = report.get("config", {})
+    fig.suptitle("haar against spatial: %s, level %d (%d×%d maps)\n%s² frames, %d model(s) × %s rotation(s); %s"
+                 % (material, level, 2 ** level, 2 ** level, config.get("frame", "?"), len(models),
+                    config.get("rotations_per_model", "?"), machine_text(report)), fontsize=12)
+    fig.subplots_adjust(left=0.08, right=0.87, top=0.78, bottom=0.11, wspace=0.06)
     return fig
 
 
@@ -177,7 +192,10 @@ def glossiness_figure(plt, report, base_dir):
         raise ReportError("report.json: glossiness.tiles is not %d rows of %d" % (len(ks), len(materials)))
     rows, cols = len(ks), len(materials)
     m = SHEET_MARGINS_IN
-    step = TILE_IN + TILE_GAP_IN
+    tile_px = g.get("tile_size", 0)
+    native = tile_px >= NATIVE_TILE_PX
+    tile_in = tile_px / DPI if native else TILE_IN
+    step = tile_in + TILE_GAP_IN
     width = m["left"] + cols * step - TILE_GAP_IN + m["right"]
     height = m["top"] + rows * step - TILE_GAP_IN + m["bottom"]
     fig = plt.figure(figsize=(width, height), dpi=DPI)
@@ -188,11 +206,11 @@ def glossiness_figure(plt, report, base_dir):
                 raise ReportError("glossiness tile %s is missing (report.json names it)" % path)
             ax = fig.add_axes([
                 (m["left"] + c * step) / width,
-                1.0 - (m["top"] + r * step + TILE_IN) / height,
-                TILE_IN / width,
-                TILE_IN / height,
+                1.0 - (m["top"] + r * step + tile_in) / height,
+                tile_in / width,
+                tile_in / height,
             ])
-            ax.imshow(mpimg.imread(path), interpolation="nearest")
+            ax.imshow(mpimg.imread(path), interpolation="nearest")  # native: pixel for pixel
             ax.set_xticks([])
             ax.set_yticks([])
             for side in ax.spines.values():
@@ -201,9 +219,12 @@ def glossiness_figure(plt, report, base_dir):
                 ax.set_title(materials[c], fontsize=11, pad=4)
             if c == 0:
                 ax.set_ylabel("k = %d" % ks[r], fontsize=11, rotation=0, ha="right", va="center", labelpad=6)
-    fig.suptitle("Glossiness: %s in %s, level %d; rows = k light coefficients kept"
-                 % (g.get("model", "?"), g.get("environment", "?"), g.get("level", 0)),
-                 fontsize=12, y=1.0 - 0.12 / height, va="top")
+    level = g.get("level", 0)
+    fig.suptitle("Glossiness: %s in %s, %s at level %d (%d×%d maps)\nrows: k light coefficients kept\n"
+                 "%s² frames, %d px tiles; %s"
+                 % (g.get("model", "?"), g.get("environment", "?"), g.get("method", "haar"), level, 2 ** level,
+                    2 ** level, g.get("frame_size", "?"), tile_px, machine_text(report)),
+                 fontsize=10, y=1.0 - 0.06 / height, va="top")
     return fig
 
 
@@ -233,9 +254,15 @@ def clients_axis(ax, report):
     ax.set_axisbelow(True)
 
 
+def frame_sizes(report):
+    """"32×32" or "32×32, 64×64": the runs' frame sizes."""
+    sizes = sorted({(r["width"], r["height"]) for r in report.get("runs", []) if "width" in r})
+    return ", ".join("%d×%d" % s for s in sizes) or "?"
+
+
 def loadtest_subtitle(report):
-    return "level %s, %s s per run, load average %s at the start" % (
-        report.get("level", "?"), report.get("seconds_per_run", "?"),
+    return "runs at level %s, frames %s, %s s each\n%s, load average %s at the start" % (
+        report.get("level", "?"), frame_sizes(report), report.get("seconds_per_run", "?"), machine_text(report),
         report.get("machine", {}).get("load_average_at_start", "?"))
 
 
@@ -298,7 +325,8 @@ def storage_figure(plt, report):
     ax.set_ylabel("bytes (log scale)")
     ax.grid(axis="y", color="#dddddd", linewidth=0.6)
     ax.set_axisbelow(True)
-    ax.set_title("BRDF coefficient data each method holds, and the PRT downloads", fontsize=11)
+    ax.set_title("BRDF coefficient data each method holds, and the PRT downloads\n" + loadtest_subtitle(report),
+                 fontsize=10)
     ax.legend(frameon=False, fontsize=8, loc="upper left")
     fig.tight_layout()
     return fig

@@ -67,12 +67,6 @@ constexpr const char* kQuickSizes = "32";
 constexpr double kQuickSeconds = 2.0;
 constexpr int kQuickLevel = 4;
 
-std::string loadAverage() {
-  std::ifstream in("/proc/loadavg");
-  std::string a, b, c;
-  return in >> a >> b >> c ? a + " " + b + " " + c : "unknown";
-}
-
 // The renderer options `haarcast serve` gives a session of this method and
 // level (serve_command.cpp: RenderOptions defaults, the cache folder, k =
 // its default 256, antialias auto = on for the CPU backend).
@@ -160,8 +154,7 @@ int run(const LoadtestArgs& a) {
   report.seconds = a.seconds;
   report.warmupPoses = a.warmup;
   report.fpsCap = a.fpsCap;
-  report.cores = std::thread::hardware_concurrency();
-  report.loadAverage = loadAverage();
+  report.machine = machineInfo();
 
   // Storage first, in this process and before any run: the server then finds
   // the slice tables and visibility in the shared cache.
@@ -298,6 +291,10 @@ int run(const LoadtestArgs& a) {
   const fs::path json = fs::path(a.out) / "report.json";
   std::ofstream(json) << toJson(report).dump(2) << '\n';
   const FigureRun drawn = drawReportFigures(json);
+  // The reported wall time is the reader's wait, figures included.
+  report.figuresSeconds = drawn.seconds;
+  report.wallSeconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  std::ofstream(json) << toJson(report).dump(2) << '\n';
   std::string note;
   if (drawn.status == FigureRun::Status::Drawn) {
     for (const char* f : kLoadtestFigures) note += std::string("![") + f + "](" + f + ")\n\n";

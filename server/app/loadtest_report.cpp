@@ -89,12 +89,13 @@ nlohmann::json toJson(const LoadtestReport& r) {
   j["kind"] = "loadtest";  // plot_report.py draws the loadtest figures for this kind
   j["command"] = r.command;
   j["server"] = {{"where", r.server}, {"device", r.device}, {"process_figures_from", r.figuresSource}};
-  j["machine"] = {{"cores", r.cores}, {"load_average_at_start", r.loadAverage}};
+  j["machine"] = toJson(r.machine);
   j["level"] = r.level;
   j["seconds_per_run"] = r.seconds;
   j["warmup_poses_per_client"] = r.warmupPoses;
   j["fps_cap"] = r.fpsCap;
   j["wall_seconds"] = r.wallSeconds;
+  j["figures_seconds"] = r.figuresSeconds;
   j["coefficient_bytes_per_frame_from"] = r.coefficientSource;
   const auto baselines = prtBaselines(r);
   j["runs"] = nlohmann::json::array();
@@ -167,11 +168,12 @@ std::string toMarkdown(const LoadtestReport& r, const std::string& figuresNote) 
   std::string md = "# haarcast loadtest\n\n";
   md += "Command: `" + r.command + "`  \n";
   md += "Server: " + r.server + (r.device.empty() ? "" : ", device \"" + r.device + "\"") + "  \n";
-  md += "Machine: " + std::to_string(r.cores) + " cores, load average at start " + r.loadAverage +
+  md += "Machine: " + describeMachine(toJson(r.machine)) + ", load average at start " + r.machine.loadAverage +
         " (other work on the machine slows every figure here)  \n";
   md += "Level " + std::to_string(r.level) + ", " + fixed(r.seconds, "%.1f") + " s per run after " +
         std::to_string(r.warmupPoses) + " warm-up pose(s) per client, fps cap " + fixed(r.fpsCap, "%.0f") +
-        ", closed loop (one pose in flight per client); wall time " + fixed(r.wallSeconds, "%.0f") + " s.\n\n";
+        ", closed loop (one pose in flight per client); wall time " + fixed(r.wallSeconds, "%.0f") + " s, of which " +
+        fixed(r.figuresSeconds, "%.1f") + " s drawing the figures.\n\n";
 
   const auto baselines = prtBaselines(r);
   md += "| method | clients | size | encoding | fps/client min / median / max | latency p50 / p99 (ms) | Mbit/s per client | "

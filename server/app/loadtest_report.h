@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "loadtest_server.h"
+#include "machine_info.h"
 #include "loadtest_storage.h"
 #include "run_stats.h"
 
@@ -64,13 +65,13 @@ struct LoadtestReport {
   double seconds = 0.0;
   std::uint32_t warmupPoses = 0;
   double fpsCap = 0.0;
-  std::string loadAverage;      // /proc/loadavg at the start: the machine's other work
-  unsigned cores = 0;
+  MachineInfo machine;          // CPU, cores, and /proc/loadavg at the start: the machine's other work
   std::vector<RunRecord> runs;
   MethodStorage runStorage;     // at the runs' level: stored_bytes of every run and the baselines
   MethodStorage storage;        // at the storage level (6 by default)
   SharedStorage shared;         // visibility, light, meshes at the runs' level
-  double wallSeconds = 0.0;
+  double wallSeconds = 0.0;     // the whole command, the figures included
+  double figuresSeconds = 0.0;  // of which drawing the figures
 };
 
 // The PRT download of a baseline at the runs' level, and the seconds of

@@ -1,10 +1,15 @@
 # `haarcast eval --quick` runs and writes report.md, report.json (with the
-# keys the issue names), the glossiness tiles and, when python3 has
+# keys the issue names), the seed's Tables 1–4 at levels 5 and 6 beside the
+# paper's figures, glossiness tiles of 128 px or more and, when python3 has
 # matplotlib, the figures drawn from report.json by tools/plot_report.py.
 # Without matplotlib it must still succeed and say what to install.
 # -DHAARCAST=<binary> -DOUT=<dir> [-DDATA=<data dir>]
+#
+# --quick's own sizes take a minute or two on two cores; the suite keeps
+# every section and key but renders the tables on the sphere alone at 12²
+# and the glossiness at level 4, 128² (the smallest frame a tile allows).
 file(REMOVE_RECURSE "${OUT}")
-set(args eval --quick --out "${OUT}")
+set(args eval --quick --models sphere --tables-frame 12 --gloss-frame 128 --gloss-level 4 --out "${OUT}")
 if(DATA AND IS_DIRECTORY "${DATA}")
   list(APPEND args --data "${DATA}")
 endif()
@@ -18,7 +23,7 @@ foreach(f report.md report.json)
   endif()
 endforeach()
 file(READ "${OUT}/report.json" json)
-foreach(key tables truth shadow_truth methods_ranked timings glossiness figures)
+foreach(key config tables truth shadow_truth methods_ranked timings glossiness figures)
   string(JSON type ERROR_VARIABLE e TYPE "${json}" ${key})
   if(e OR NOT type STREQUAL "OBJECT")
     message(FATAL_ERROR "report.json lacks the object \"${key}\"")
@@ -26,7 +31,6 @@ foreach(key tables truth shadow_truth methods_ranked timings glossiness figures)
 endforeach()
 # haar's default equals spatial to float rounding: its seed PSNR must be far
 # above any lossy figure, and faithful's must be a finite number.
-string(JSON level GET "${json}" tables)
 string(JSON first MEMBER "${json}" tables 0)
 string(JSON material MEMBER "${json}" tables ${first} 0)
 string(JSON env MEMBER "${json}" tables ${first} ${material} 0)
@@ -34,6 +38,57 @@ string(JSON refined GET "${json}" tables ${first} ${material} ${env} refined)
 if(refined LESS 120)
   message(FATAL_ERROR "refined seed PSNR ${refined} dB: haar no longer reproduces spatial")
 endif()
+
+# The seed's Tables 1–4, each at its level (5 or 6), with the paper's
+# figures as the seed prints them (Galileo, Grace, RNL, St. Petersburg,
+# Uffizi) beside ours, in report.json and in report.md.
+set(paper_1 "alum-bronze;6;110.82;110.92;111.54;110.76;111.02")
+set(paper_2 "alum-bronze;5;111.17;111.81;112.56;111.29;111.62")
+set(paper_3 "blue-metallic-paint;6;104.28;104.64;104.97;104.66;104.73")
+set(paper_4 "blue-metallic-paint;5;105.49;106.11;106.20;105.55;105.49")
+string(JSON tables_n LENGTH "${json}" seed_tables)
+if(NOT tables_n EQUAL 4)
+  message(FATAL_ERROR "report.json's seed_tables has ${tables_n} tables, not the seed's 4")
+endif()
+file(READ "${OUT}/report.md" tables_md)
+math(EXPR last_table "${tables_n} - 1")
+foreach(t RANGE ${last_table})
+  math(EXPR number "${t} + 1")
+  list(GET paper_${number} 0 want_material)
+  list(GET paper_${number} 1 want_level)
+  string(JSON number_got GET "${json}" seed_tables ${t} table)
+  string(JSON material GET "${json}" seed_tables ${t} material)
+  string(JSON level GET "${json}" seed_tables ${t} level)
+  if(NOT number_got EQUAL number OR NOT material STREQUAL want_material OR NOT level EQUAL want_level)
+    message(FATAL_ERROR "seed_tables[${t}] is Table ${number_got}, ${material} at level ${level}, "
+                        "not Table ${number}, ${want_material} at level ${want_level}")
+  endif()
+  string(JSON ours GET "${json}" tables level${level} ${material} ${env} refined)
+  foreach(e RANGE 4)
+    math(EXPR i "${e} + 2")
+    list(GET paper_${number} ${i} want)
+    string(JSON got GET "${json}" seed_tables ${t} rows ${e} paper)
+    if(NOT got EQUAL want)
+      message(FATAL_ERROR "Table ${number}, column ${e}: the paper's figure is ${want}, report.json says ${got}")
+    endif()
+    if(NOT tables_md MATCHES "\\| ${want} \\|")
+      message(FATAL_ERROR "report.md does not show the paper's ${want} (Table ${number})")
+    endif()
+  endforeach()
+  string(JSON why GET "${json}" seed_tables ${t} why)
+  if(NOT why MATCHES "exact up to float rounding" OR NOT tables_md MATCHES "### Table ${number}: ${material}, level ${level}")
+    message(FATAL_ERROR "Table ${number}: no table in report.md or no reason why ours differ: ${why}")
+  endif()
+endforeach()
+if(NOT tables_md MATCHES "\\| ours: refined \\| ours: faithful \\| paper \\|")
+  message(FATAL_ERROR "report.md's Tables 1–4 have no paper column beside ours")
+endif()
+string(JSON cpu GET "${json}" config machine cpu_model)
+string(JSON cores GET "${json}" config machine cores)
+if(cpu STREQUAL "" OR cores LESS 1)
+  message(FATAL_ERROR "report.json does not name the machine: cpu_model \"${cpu}\", cores ${cores}")
+endif()
+message(STATUS "Tables 1–4 at levels 5 and 6 beside the paper's; machine ${cpu}, ${cores} cores")
 
 # The shadow truth: two scenes at least; the first with its floor, a fused
 # row of plausible brightness, the shadowed/lit split, and its table in
@@ -98,7 +153,12 @@ if(NOT ranked_md MATCHES "## Methods ranked: speed, storage, truth" OR NOT ranke
 endif()
 message(STATUS "methods ranked: splitsum keeps ${splitsum_bytes} bytes, fused ${fused_bytes}")
 
-# The glossiness tiles report.json names exist (eval writes them itself).
+# The glossiness tiles report.json names exist (eval writes them itself),
+# each a square PNG of at least 128 px.
+string(JSON tile_size GET "${json}" glossiness tile_size)
+if(tile_size LESS 128)
+  message(FATAL_ERROR "the glossiness tiles are ${tile_size} px, under 128")
+endif()
 string(JSON rows LENGTH "${json}" glossiness tiles)
 math(EXPR last_row "${rows} - 1")
 foreach(r RANGE ${last_row})
@@ -109,8 +169,49 @@ foreach(r RANGE ${last_row})
     if(NOT EXISTS "${OUT}/${tile}")
       message(FATAL_ERROR "report.json names the glossiness tile ${tile}, which eval did not write")
     endif()
+    file(READ "${OUT}/${tile}" ihdr OFFSET 16 LIMIT 8 HEX)  # the PNG's width and height, big-endian
+    string(SUBSTRING "${ihdr}" 0 8 w_hex)
+    string(SUBSTRING "${ihdr}" 8 8 h_hex)
+    math(EXPR w "0x${w_hex}")
+    math(EXPR h "0x${h_hex}")
+    if(NOT w EQUAL tile_size OR NOT h EQUAL tile_size)
+      message(FATAL_ERROR "${tile} is ${w}×${h}, not the ${tile_size}² report.json says")
+    endif()
   endforeach()
 endforeach()
+
+# The reported time is the whole run's, figures included: total_s covers
+# every stage's seconds and, when they were drawn, figures_s. (CMake's math
+# is integer: seconds become whole milliseconds.)
+function(milliseconds out seconds)
+  if(seconds MATCHES "[eE]-")
+    set(${out} 0 PARENT_SCOPE)  # under a millisecond
+    return()
+  endif()
+  string(REGEX MATCH "^([0-9]+)(\\.([0-9]*))?" whole "${seconds}")
+  set(integer "${CMAKE_MATCH_1}")
+  set(fraction "${CMAKE_MATCH_3}000")
+  string(SUBSTRING "${fraction}" 0 3 fraction)
+  string(REGEX REPLACE "^0+([0-9])" "\\1" fraction "${fraction}")
+  math(EXPR ms "${integer} * 1000 + ${fraction}")
+  set(${out} ${ms} PARENT_SCOPE)
+endfunction()
+string(JSON total GET "${json}" timings total_s)
+milliseconds(total_ms ${total})
+string(JSON stage_count LENGTH "${json}" timings)
+math(EXPR last_stage "${stage_count} - 1")
+set(stages_ms 0)
+foreach(i RANGE ${last_stage})
+  string(JSON key MEMBER "${json}" timings ${i})
+  if(NOT key STREQUAL "total_s")
+    string(JSON s GET "${json}" timings ${key})
+    milliseconds(ms ${s})
+    math(EXPR stages_ms "${stages_ms} + ${ms}")
+  endif()
+endforeach()
+if(total_ms LESS stages_ms)
+  message(FATAL_ERROR "timings.total_s ${total} s is less than its stages' sum, ${stages_ms} ms")
+endif()
 
 # The figures: drawn, or a message that names the package to install.
 string(JSON first_level MEMBER "${json}" figures mse 0)
@@ -123,6 +224,10 @@ if(err MATCHES "figures not drawn")
   endif()
   message(STATUS "no python3 with matplotlib here: the figures were not drawn, as eval said")
 else()
+  string(JSON figures_s ERROR_VARIABLE e GET "${json}" timings figures_s)
+  if(e OR NOT md MATCHES "\\| figures \\(tools/plot_report.py")
+    message(FATAL_ERROR "the figures were drawn but the timings leave them out")
+  endif()
   foreach(f glossiness.png ${mse_plot})
     if(NOT EXISTS "${OUT}/${f}")
       message(FATAL_ERROR "eval --quick says nothing about the figures but did not write ${f}:\n${err}")
@@ -134,9 +239,11 @@ else()
 endif()
 
 # No usable python3 (`false` stands in for one without matplotlib): eval still
-# succeeds, writes the report and names the package.
+# succeeds, writes the report and names the package. Only the sections with
+# figures run (--seed-only): the others were checked above.
 file(REMOVE_RECURSE "${OUT}-no-python")
 list(TRANSFORM args REPLACE "^${OUT}$" "${OUT}-no-python")
+list(APPEND args --seed-only)
 execute_process(COMMAND "${CMAKE_COMMAND}" -E env HAARCAST_PYTHON=false "${HAARCAST}" ${args}
   RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
 if(NOT rc EQUAL 0)

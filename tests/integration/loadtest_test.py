@@ -9,7 +9,8 @@ table, every key of docs/loadtest.md with sane values (fps > 0, latency
 p50 ≤ p99, bits/s > 0, …), the PRT baseline's arithmetic, table's stored
 bytes at least 100× haar's at level 6, report.md's table, and that the
 server child is gone afterwards. Then the plot script draws the three
-figures from it, each an 800×500 PNG with labelled axes, a title and a
+figures from it, each an 800×500 PNG with labelled axes, a title that
+names the frame size, level and machine (CPU model and cores), and a
 legend; without matplotlib that part is skipped with a message naming the
 package (the rest still runs).
 """
@@ -144,9 +145,14 @@ def check_axes(report_path, script):
     with open(report_path, encoding="utf-8") as f:
         report = json.load(f)
     plt = plot_report.load_matplotlib()
+    machine = report.get("machine", {})
+    check(machine.get("cpu_model") and machine.get("cores", 0) >= 1, "report.json's machine is %s" % machine)
+    says = ["frames 32×32", "level %d" % report["level"], machine.get("cpu_model", "?"), "%d core" % machine.get("cores", 0)]
     for name, fig in plot_report.loadtest_figures(plt, report):
         ax = fig.axes[0]
         check(ax.get_xlabel() and ax.get_ylabel() and ax.get_title(), "%s lacks an axis label or title" % name)
+        for part in says:
+            check(part in ax.get_title(), "%s's title does not say %r: %r" % (name, part, ax.get_title()))
         check(ax.get_legend() is not None, "%s has no legend" % name)
         if name == "loadtest_storage.png":
             check(ax.get_yscale() == "log", "the storage figure's y axis is %s, not log" % ax.get_yscale())

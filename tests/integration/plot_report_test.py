@@ -8,8 +8,9 @@ refined's MSE is near 1e-17 (one exactly 0), faithful's near 1e-5. The test
 runs the script as `haarcast eval` does and checks that every PNG is written
 at its documented size and is a real picture (many colours, not one flat
 fill); then it imports the script to check that every MSE axis is logarithmic,
-labelled, titled, with a legend, and that all of them share one y range that
-spans both variants. Exits 77 (ctest's skip code here) when no python3 with
+labelled, titled, with a legend, that all of them share one y range that
+spans both variants, and that every figure's title names its frame size,
+level and machine. Tiles of 128 px or more are laid out pixel for pixel. Exits 77 (ctest's skip code here) when no python3 with
 matplotlib is found, naming the package to install.
 """
 
@@ -23,6 +24,8 @@ import sys
 import zlib
 
 SKIP = 77
+MACHINE = {"cpu_model": "Test CPU 9000", "cores": 3, "load_average_at_start": "0.00 0.00 0.00"}
+MACHINE_TEXT = "Test CPU 9000, 3 cores"
 
 
 def python_with_matplotlib():
@@ -70,7 +73,8 @@ def make_report(work):
     ks = [4, 16, 64, 256]
     gloss_materials = ["steel", "blue-metallic-paint", "alum-bronze"]
     report = {
-        "config": {"environments": environments, "models": models, "levels": [5, 6], "quick": False},
+        "config": {"environments": environments, "models": models, "levels": [5, 6], "quick": False,
+                   "frame": 24, "rotations_per_model": 1, "machine": MACHINE},
         "mse": {},
         "tables": {},
         "figures": {"mse": {}},
@@ -79,6 +83,8 @@ def make_report(work):
             "model": "bunny",
             "environment": "grace",
             "level": 6,
+            "method": "haar",
+            "frame_size": 256,
             "light_coefficients": ks,
             "materials": gloss_materials,
             "tile_size": 24,
@@ -128,18 +134,32 @@ def check_picture(path, expected_size):
                              % (path, colours, ink, float(pixels.std())))
 
 
-def check_axes(script, report):
-    """Imports the script and checks the MSE figures' axes themselves."""
+def load_script(script):
     import importlib.util
 
     spec = importlib.util.spec_from_file_location("plot_report", script)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
+    return module
+
+
+def check_title(name, title, *parts):
+    """The title names each of parts (frame size, level, machine)."""
+    for part in parts:
+        if part not in title:
+            raise AssertionError("%s's title does not say %r: %r" % (name, part, title))
+
+
+def check_axes(script, report, work):
+    """Imports the script and checks the figures' axes and titles themselves (tiles in work)."""
+    module = load_script(script)
     plt = module.load_matplotlib()
     ranges = set()
     for name, fig in module.mse_figures(plt, report):
         if not fig._suptitle or not fig._suptitle.get_text():
             raise AssertionError("%s has no title" % name)
+        level = name.split("_")[1][len("level"):]
+        check_title(name, fig._suptitle.get_text(), "level %s" % level, "24² frames", MACHINE_TEXT)
         if not fig.legends or len(fig.legends[0].get_texts()) != len(report["config"]["environments"]):
             raise AssertionError("%s has no legend with one entry per environment" % name)
         for ax in fig.axes:
@@ -158,6 +178,20 @@ def check_axes(script, report):
     lo, hi = ranges.pop()
     if not (lo <= 1e-17 and hi >= 1e-4):
         raise AssertionError("the shared y range %g..%g does not span both variants" % (lo, hi))
+    fig = module.glossiness_figure(plt, report, work)
+    check_title("glossiness.png", fig._suptitle.get_text(), "level 6", "256² frames",
+                "%d px tiles" % report["glossiness"]["tile_size"], MACHINE_TEXT)
+    plt.close(fig)
+
+
+def native_tiles(work, report, size):
+    """The tiles again at size px: 128 or more is drawn pixel for pixel."""
+    for r, row in enumerate(report["glossiness"]["tiles"]):
+        for c, name in enumerate(row):
+            write_png(os.path.join(work, name), size, size, lambda x, y, r=r, c=c: (x % 256, y % 256, 50 * r + 30 * c))
+    report["glossiness"]["tile_size"] = size
+    with open(os.path.join(work, "report.json"), "w") as f:
+        json.dump(report, f, indent=2)
 
 
 def main():
@@ -183,12 +217,21 @@ def main():
         raise AssertionError("plot_report.py failed (%d):\n%s%s" % (run.returncode, run.stdout, run.stderr))
 
     # 12×5 in at 100 dpi; the sheet: 0.9 + 3·2.0 + 2·0.1 + 0.15 in wide,
-    # 0.75 + 4·2.0 + 3·0.1 + 0.15 in high (the script's layout constants).
+    # 0.95 + 4·2.0 + 3·0.1 + 0.15 in high (the script's layout constants).
     for level_key, materials in report["figures"]["mse"].items():
         for name in materials.values():
             check_picture(os.path.join(args.work, name), (1200, 500))
-    check_picture(os.path.join(args.work, "glossiness.png"), (725, 920))
-    check_axes(args.script, report)
+    check_picture(os.path.join(args.work, "glossiness.png"), (725, 940))
+    check_axes(args.script, report, args.work)
+
+    # 140 px tiles, one sheet pixel each: 0.9 + 3·1.4 + 2·0.1 + 0.15 in wide,
+    # 0.95 + 4·1.4 + 3·0.1 + 0.15 in high.
+    native_tiles(args.work, report, 140)
+    run = subprocess.run([python, args.script, os.path.join(args.work, "report.json")],
+                         capture_output=True, text=True)
+    if run.returncode != 0:
+        raise AssertionError("plot_report.py failed on 140 px tiles (%d):\n%s" % (run.returncode, run.stderr))
+    check_picture(os.path.join(args.work, "glossiness.png"), (545, 700))
 
     # A tile that report.json names but that is missing: a clear error, status 2.
     os.remove(os.path.join(args.work, report["glossiness"]["tiles"][1][2]))
