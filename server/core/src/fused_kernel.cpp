@@ -38,7 +38,10 @@ HWY_INLINE V Atan2(D d, V y, V x) {
   return hn::CopySign(a, y);
 }
 
-template <bool kBits>
+// kBits: V from the three vertices' bits (FusedPass::bits); kCore: a lobe
+// path's core to leave out (coreCos ≤ 1). Each a copy of the loop without
+// the other's work.
+template <bool kBits, bool kCore>
 void FusedSampleWith(const FusedPass& p, float* HWY_RESTRICT out) {
   const hn::ScalableTag<float> d;
   const hn::RebindToSigned<decltype(d)> di;
@@ -135,10 +138,13 @@ void FusedSampleWith(const FusedPass& p, float* HWY_RESTRICT out) {
     }
     const VF dOmega = hn::LoadU(d, omega + i);
     // Outside the lobe path's core (ρ·0 there: the core is the path's).
-    const auto outside = hn::Le(hn::MulAdd(x1, axisX, hn::MulAdd(y2, axisY, hn::Mul(z2, axisZ))), coreCos);
-    const VF rhoR = hn::IfThenElseZero(outside, lookup(red));
-    const VF rhoG = hn::IfThenElseZero(outside, lookup(green));
-    const VF rhoB = hn::IfThenElseZero(outside, lookup(blue));
+    VF rhoR = lookup(red), rhoG = lookup(green), rhoB = lookup(blue);
+    if constexpr (kCore) {
+      const auto outside = hn::Le(hn::MulAdd(x1, axisX, hn::MulAdd(y2, axisY, hn::Mul(z2, axisZ))), coreCos);
+      rhoR = hn::IfThenElseZero(outside, rhoR);
+      rhoG = hn::IfThenElseZero(outside, rhoG);
+      rhoB = hn::IfThenElseZero(outside, rhoB);
+    }
     accR = hn::MulAdd(hn::Mul(hn::LoadU(d, l0 + i), v), rhoR, accR);
     accG = hn::MulAdd(hn::Mul(hn::LoadU(d, l1 + i), v), rhoG, accG);
     accB = hn::MulAdd(hn::Mul(hn::LoadU(d, l2 + i), v), rhoB, accB);
@@ -155,10 +161,12 @@ void FusedSampleWith(const FusedPass& p, float* HWY_RESTRICT out) {
 }
 
 void FusedSample(const FusedPass& p, float* HWY_RESTRICT out) {
+  // A cosine is at most 1: coreCos above it leaves out nothing.
+  const bool core = p.coreCos <= 1.0f;
   if (p.visibility) {
-    FusedSampleWith<false>(p, out);
+    core ? FusedSampleWith<false, true>(p, out) : FusedSampleWith<false, false>(p, out);
   } else {
-    FusedSampleWith<true>(p, out);
+    core ? FusedSampleWith<true, true>(p, out) : FusedSampleWith<true, false>(p, out);
   }
 }
 
