@@ -1,13 +1,13 @@
 #version 450
-// The "tonemap" stage's exposure: render::frameLogAverage of the resolved
-// frame (the log-average Rec. 709 luminance of the lit object pixels, or of
-// every lit pixel when no object pixel is lit; render/tonemap.cpp
-// logAverageLuminance), then render::applyExposure (the key exposure,
-// clamped to ±maxStops, eased from the previous frame's), left in
-// ExposureResult (shared_layout.h) for the encoding pass and the host.
-// One workgroup: LOCAL invocations stride over the pixels, then a tree
-// reduction in shared memory (in a fixed order, so a frame measures the same
-// every time).
+// The "tonemap" stage's exposure: the frame metered by the rule of
+// core/shared_exposure.h (every pixel with luminance > 0, object pixels
+// weighted, the key exposure held down by a highlight guard), eased from
+// the previous frame's, left in ExposureResult for the encoding pass and
+// the host. render::meterHistograms and render::meterExposure
+// (render/exposure_meter.cpp) are the same steps on the CPU.
+// One workgroup: LOCAL invocations stride over the pixels adding integer
+// weights to two histograms in shared memory (integer sums: the same in any
+// order), then one invocation reads them out in a fixed order.
 #extension GL_GOOGLE_include_directive : require
 #include "haarcast/core/shared_layout.h"
 
@@ -20,59 +20,55 @@ layout(std430, set = 0, binding = 1) readonly buffer Ids { uvec4 ids[]; };
 layout(std430, set = 0, binding = 2) readonly buffer Radiance { vec4 radiance[]; };
 layout(std430, set = 0, binding = 3) writeonly buffer Result { ExposureResult result; };
 
-shared float objectLog[LOCAL];
-shared uint objectLit[LOCAL];
-shared float allLog[LOCAL];
-shared uint allLit[LOCAL];
+shared uint luminance[kMeterBins];  // weighted counts of log2 Y, 1/16 stop bins
+shared uint peak[kMeterBins];       // the same of the brightest channel
 
 void main() {
   uint lid = gl_LocalInvocationID.x;
+  for (uint b = lid; b < kMeterBins; b += LOCAL) {
+    luminance[b] = 0u;
+    peak[b] = 0u;
+  }
+  barrier();
   uint pixels = frame.width * frame.height;
-  float oSum = 0.0, aSum = 0.0;
-  uint oLit = 0u, aLit = 0u;
   for (uint p = lid; p < pixels; p += LOCAL) {
     vec3 c = radiance[p].rgb;
-    float y = 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b;  // Rec. 709, as logAverageLuminance
+    float y = meterLuminance(c);
     // Black pixels carry no exposure information (and neither do NaN or ∞).
     if (!(y > 0.0) || isinf(y)) continue;
-    float l = log(y);
-    aSum += l;
-    ++aLit;
-    if (ids[p].x != 0u) {
-      oSum += l;
-      ++oLit;
-    }
+    uint w = ids[p].x != 0u ? kMeterObjectWeight : kMeterBackdropWeight;
+    atomicAdd(luminance[meterBin(y)], w);
+    atomicAdd(peak[meterBin(meterPeak(c))], w);
   }
-  objectLog[lid] = oSum;
-  objectLit[lid] = oLit;
-  allLog[lid] = aSum;
-  allLit[lid] = aLit;
   barrier();
-  for (uint half_ = LOCAL / 2u; half_ > 0u; half_ >>= 1u) {
-    if (lid < half_) {
-      objectLog[lid] += objectLog[lid + half_];
-      objectLit[lid] += objectLit[lid + half_];
-      allLog[lid] += allLog[lid + half_];
-      allLit[lid] += allLit[lid + half_];
-    }
-    barrier();
-  }
   if (lid != 0u) return;
-  uint lit = objectLit[0] != 0u ? objectLit[0] : allLit[0];
-  float sumLog = objectLit[0] != 0u ? objectLog[0] : allLog[0];
-  float logAverage = lit != 0u ? exp(sumLog / float(lit)) : 0.0;
-  float stops;
-  if (pc.automatic == 0u) {
-    stops = pc.fixedStops;
-  } else if (!(logAverage > 0.0)) {
-    stops = pc.hasPrevious != 0u ? pc.previousStops : 0.0;  // nothing lit: keep the last exposure
-  } else {
-    float target = clamp(log2(pc.key / logAverage), -pc.maxStops, pc.maxStops);
-    stops = pc.hasPrevious != 0u ? pc.previousStops + clamp(pc.adaptation, 0.0, 1.0) * (target - pc.previousStops)
-                                 : target;
+  uint total = 0u;
+  precise float sumLog2 = 0.0;
+  for (uint b = 0u; b < kMeterBins; ++b) {
+    total += luminance[b];
+    sumLog2 += float(luminance[b]) * meterBinLog2(b);
   }
-  result.logAverage = logAverage;
-  result.stops = stops;
-  result.gain = pc.automatic != 0u ? exp2(stops) : 1.0;
-  result.lit = lit;
+  ExposureResult r;
+  r.logAverage = 0.0;
+  r.meanLog2 = 0.0;
+  r.highlightLog2 = 0.0;
+  float target = 0.0;
+  if (total != 0u) {
+    r.meanLog2 = sumLog2 / float(total);
+    uint need = meterHighlightWeight(total);
+    uint above = 0u, bin = kMeterBins - 1u;
+    for (; bin > 0u; --bin) {
+      above += peak[bin];
+      if (above >= need) break;
+    }
+    r.highlightLog2 = meterBinLog2(bin);
+    r.logAverage = exp2(r.meanLog2);
+    target = meteredStops(r.meanLog2, r.highlightLog2, pc);
+  }
+  r.weight = total;
+  r.stops = exposureStops(total, target, pc);
+  r.gain = pc.automatic != 0u ? exp2(r.stops) : 1.0;
+  r.pad0 = 0u;
+  r.pad1 = 0u;
+  result = r;
 }

@@ -170,6 +170,14 @@ v1::RotationMethod parseMethod(const std::string& name) {
   throw std::invalid_argument("--method must be fused, haar, spatial, matrix, table or splitsum (got \"" + name + "\")");
 }
 
+v1::ToneCurve parseToneCurve(const std::string& name) {
+  if (name.empty()) return v1::TONE_CURVE_UNSPECIFIED;
+  if (name == "reinhard") return v1::TONE_CURVE_REINHARD;
+  if (name == "aces") return v1::TONE_CURVE_ACES;
+  if (name == "agx") return v1::TONE_CURVE_AGX;
+  throw std::invalid_argument("--tone must be reinhard, aces or agx (got \"" + name + "\")");
+}
+
 std::string methodName(v1::RotationMethod method) {
   switch (method) {
     case v1::ROTATION_METHOD_HAAR: return "haar";

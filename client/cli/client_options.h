@@ -65,6 +65,8 @@ std::uint32_t maxLevel();
 
 // "fused" | "haar" | "spatial" | "matrix" | "table"; "" = server default.
 v1::RotationMethod parseMethod(const std::string& name);
+// --tone reinhard | aces | agx ("" → unspecified: the server's, Reinhard).
+v1::ToneCurve parseToneCurve(const std::string& name);
 std::string methodName(v1::RotationMethod method);
 
 }  // namespace haarcast::client

@@ -172,6 +172,7 @@ int run(int argc, char** argv) {
   bool json = false;
   bool checkNotBlank = false;
   std::string exposure = "auto";
+  std::string tone;
   double maxClipped = -1.0;
   bool quiet = false;
   bool perFrame = false;
@@ -197,8 +198,12 @@ int run(int argc, char** argv) {
                  "Map level n, 2^n x 2^n: " + std::to_string(minLevel()) + ".." + std::to_string(maxLevel()) +
                      " as far as the server allows (its Welcome says; 0 = the server's default)")
       ->check(CLI::Range(0u, maxLevel()));
-  app.add_option("--exposure", exposure, "auto (the lit object pixels' log-average → 0.18, eased) or fixed stops, e.g. -1")
+  app.add_option("--exposure", exposure,
+                 "auto (the whole frame metered, objects weighted 4×: log-average → 0.18, held down so the brightest 1% "
+                 "does not clip; eased) or fixed stops, e.g. -1")
       ->capture_default_str();
+  app.add_option("--tone", tone, "Tone curve: reinhard | aces | agx (default: the server's, reinhard)")
+      ->check(CLI::IsMember({"reinhard", "aces", "agx"}));
   app.add_option("--max-clipped", maxClipped,
                  "Fail a frame with more than this fraction of pixels at 255 (blown out), e.g. 0.02; decodes every frame")
       ->check(CLI::Range(0.0, 1.0));
@@ -265,6 +270,7 @@ int run(int argc, char** argv) {
     const Exposure e = parseExposure(exposure);
     settings->set_exposure_mode(e.mode);
     settings->set_exposure_stops(e.stops);
+    settings->set_tone_curve(parseToneCurve(tone));
     settings->set_h264_bitrate_kbps(h264.bitrateKbps);
     settings->set_h264_keyframe_interval(h264.keyframeInterval);
     if (!scene.empty() || !materials.empty()) {

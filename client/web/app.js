@@ -58,7 +58,7 @@ function onWelcome(w) {
   startH264View(w.encoding === Encoding.values.ENCODING_H264);
   showWelcomeSettings(w);
   showScenes(w.scenes);
-  for (const id of ['scene', 'method', 'level', 'coefficients', 'exposure-auto', 'exposure', 'reset-view']) {
+  for (const id of ['scene', 'method', 'level', 'coefficients', 'exposure-auto', 'exposure', 'tone', 'reset-view']) {
     $(id).disabled = false;
   }
   view.pendingScene = null;

@@ -9,7 +9,7 @@ import { ctx, setFrameSize } from './layout.js';
 import { state } from './page_state.js';
 import { frameTiming } from './resolution.js';
 import { sceneShown } from './scene_panel.js';
-import { Encoding, ExposureMode, methodName } from './schema.js';
+import { Encoding, ExposureMode, methodName, toneName } from './schema.js';
 import { generation } from './session.js';
 import { setEffective, showFrameExposure } from './settings_panel.js';
 import { showBanner } from './status.js';
@@ -35,6 +35,7 @@ export async function onFrame(f, gen) {
   if (f.settings) setEffective(f.settings);
   const method = f.settings && f.settings.method ? methodName(f.settings.method) : null;
   const exposureMode = f.settings && f.settings.exposureMode === ExposureMode.values.EXPOSURE_MODE_FIXED ? 'fixed' : 'auto';
+  const tone = f.settings && f.settings.toneCurve ? toneName(f.settings.toneCurve) : null;
   const fresh = () => gen === generation && f.sequence > state.lastShownSequence;
   const shown = () => {
     state.lastShownSequence = f.sequence;
@@ -42,7 +43,7 @@ export async function onFrame(f, gen) {
     // serverMs, latencyMs: what the HUD counted of this frame (NaN: not counted).
     state.lastFrame = { sequence: f.sequence, poseSequence: f.poseSequence, width: f.width, height: f.height,
                         encoding: f.encoding, method, bytes, exposureStops: f.exposureStops, exposureMode,
-                        serverMs, latencyMs };
+                        tone, serverMs, latencyMs };
     showFrameExposure(f.exposureStops, exposureMode);
     // The first frame of a change ends its build on the page, and the first
     // of a new scene lists its objects.

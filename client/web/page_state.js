@@ -1,7 +1,7 @@
 // The state the page's modules share, each piece here and nowhere else: what
 // the page knows of its session (state), what the address asked for (page)
 // and what the user chose on the page (choices).
-import { ExposureMode } from './schema.js';
+import { ExposureMode, toneValue } from './schema.js';
 
 // Exposed for the end-to-end test and for curious users (devtools).
 export const state = {
@@ -45,11 +45,17 @@ export function setPage(p) {
 }
 
 // What the user asked for: the next Hello, after a reconnect, says it again.
-export const choices = { scene: '', method: '', level: 0, k: 0, exposure: { auto: true, stops: 0 }, resolution: 'auto' };
+export const choices = { scene: '', method: '', level: 0, k: 0, exposure: { auto: true, stops: 0 }, tone: '',
+                         resolution: 'auto' };
 
 // The exposure the user chose, as RenderSettings fields.
 export function exposureSettings() {
   return choices.exposure.auto
     ? { exposureMode: ExposureMode.values.EXPOSURE_MODE_AUTO }
     : { exposureMode: ExposureMode.values.EXPOSURE_MODE_FIXED, exposureStops: choices.exposure.stops };
+}
+
+// The tone curve the user chose, as a RenderSettings field ('' → unspecified: the server's).
+export function toneSettings() {
+  return { toneCurve: toneValue(choices.tone) };
 }

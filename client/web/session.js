@@ -5,7 +5,7 @@
 // another protocol version) stops, saying why.
 import { backoffMs } from './frame_stats.js';
 import { helloEncoding } from './h264_view.js';
-import { choices, exposureSettings, page, state } from './page_state.js';
+import { choices, exposureSettings, page, state, toneSettings } from './page_state.js';
 import { helloSize } from './resolution.js';
 import { ClientMessage, Encoding, ErrorCode, ServerMessage, methodValue } from './schema.js';
 import { setStatus, showBanner } from './status.js';
@@ -52,7 +52,7 @@ function hello() {
     protocolVersion: 1, authToken: page.token, width: size.width, height: size.height,
     encoding: Encoding.values[encoding], fpsCap: page.fps, jpegQuality: page.quality, clientName: 'browser',
     settings: { method: methodValue(choices.method), level: choices.level, lightCoefficients: choices.k,
-                ...exposureSettings() },
+                ...exposureSettings(), ...toneSettings() },
   };
   if (choices.scene) {
     h.scene = { scene: choices.scene, objectMaterials: {} };

@@ -1,12 +1,12 @@
-// The rendering and exposure controls. They offer what the server allows
+// The rendering, exposure and tone curve controls. They offer what the server allows
 // (Welcome.limits, the schema's methods), not a copy kept in the page, and
 // they show the settings in effect: a change the server refuses puts them
 // back as they were, and in auto exposure the slider follows the frames.
 import { h264Support } from './h264_decoder.js';
 import { helloEncoding } from './h264_view.js';
 import { formatStops } from './frame_stats.js';
-import { choices, exposureSettings, page, state } from './page_state.js';
-import { ExposureMode, methodName, methodNames, methodValue } from './schema.js';
+import { choices, exposureSettings, page, state, toneSettings } from './page_state.js';
+import { ExposureMode, methodName, methodNames, methodValue, toneName, toneNames } from './schema.js';
 import { restartSession, send } from './session.js';
 import { expectBuild } from './build_view.js';
 import { noteChange } from './view.js';
@@ -59,6 +59,9 @@ export function showWelcomeSettings(w) {
   $('exposure-auto').checked = !fixed;
   if (fixed) slider.value = String(effective.exposureStops || 0);
   choices.exposure = { auto: !fixed, stops: Number(slider.value) };
+  // Tone curves: the schema's, the one in effect selected.
+  fillSelect($('tone'), toneNames.map((t) => [t, t]), toneName(effective.toneCurve) || toneNames[0]);
+  choices.tone = $('tone').value;
 
   settingsBeforeChange = null;
   settingsAfterChange = currentSettings();
@@ -75,6 +78,8 @@ function showSettings(s) {
     if (fixed) $('exposure').value = String(s.exposureStops || 0);
     choices.exposure = { auto: !fixed, stops: Number($('exposure').value) };
   }
+  if (s.toneCurve) selectValue($('tone'), toneName(s.toneCurve));
+  choices.tone = $('tone').value;
   choices.method = $('method').value;
   choices.level = Number($('level').value);
   choices.k = Number($('coefficients').value);
@@ -89,7 +94,7 @@ export function undoSettingsChange() {
 
 function currentSettings() {
   return { method: methodValue($('method').value), level: Number($('level').value),
-           lightCoefficients: Number($('coefficients').value), ...exposureSettings() };
+           lightCoefficients: Number($('coefficients').value), ...exposureSettings(), ...toneSettings() };
 }
 
 function sendSettings(fields) {
@@ -142,6 +147,10 @@ $('exposure-auto').addEventListener('change', () => {
   exposureDirty = true;
 });
 for (const id of ['method', 'level', 'coefficients']) $(id).addEventListener('change', onSettingsControl);
+$('tone').addEventListener('change', () => {
+  choices.tone = $('tone').value;
+  sendSettings(toneSettings());
+});
 
 // The encoding chosen on the page (or ?encoding=): H.264 is asked for only
 // where WebCodecs decodes it; otherwise the reason is shown and the Hello

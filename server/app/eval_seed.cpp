@@ -9,6 +9,7 @@
 
 #include "haarcast/core/rotation.h"
 #include "haarcast/io/image.h"
+#include "haarcast/render/exposure_meter.h"
 #include "haarcast/render/renderer.h"
 #include "haarcast/render/tonemap.h"
 
@@ -166,7 +167,7 @@ nlohmann::json runGlossiness(const SeedRun& run, const std::string& outDir, int 
   for (std::size_t m = 0; m < a.glossMaterials.size(); ++m) {
     // One exposure per material, from its richest render, through the
     // display transform every haarcast image uses (render/tonemap.h).
-    const double stops = render::keyExposure(render::frameLogAverage(byMaterial[m].back(), covered));
+    const double stops = render::meterExposure(byMaterial[m].back(), covered, {}, render::ToneCurve::Reinhard).stops;
     for (std::size_t row = 0; row < ks.size(); ++row) {
       const std::string file = "glossiness/k" + std::to_string(ks[row]) + "_" + a.glossMaterials[m].first + ".png";
       const io::RgbImage tile = cropped(byMaterial[m][row], crop);

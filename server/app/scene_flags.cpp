@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include "haarcast/io/mesh_io.h"
+#include "haarcast/render/exposure_meter.h"
 #include "haarcast/render/renderer.h"
 #include "haarcast/render/tonemap.h"
 
@@ -31,7 +32,14 @@ void addSceneFlags(CLI::App& c, SceneFlags& f) {
   c.add_option("--background", f.background, "env|black (black: only the object's pixels are non-zero)")
       ->capture_default_str();
   c.add_option("--out", f.out, "Output .exr (a .png is written beside it) or .png")->capture_default_str();
-  c.add_option("--exposure", f.exposure, "PNG exposure in stops (default: auto, the lit object pixels' log-average luminance → 0.18)");
+  c.add_option("--exposure", f.exposure,
+               "PNG exposure in stops (default: auto, the whole frame's log-average luminance → 0.18, objects "
+               "weighted 4×, held down so the brightest 1% does not clip)");
+  std::vector<std::string> tones;
+  for (const render::ToneCurve t : render::kToneCurves) tones.emplace_back(render::toneCurveName(t));
+  c.add_option("--tone", f.tone, "PNG tone curve: reinhard|aces|agx (docs/design.md, \"Display\")")
+      ->check(CLI::IsMember(tones))
+      ->capture_default_str();
   c.add_flag("--ground", f.ground, "With --mesh: stand it on a ground that takes its shadows (scene files: the \"ground\" key)");
   addSceneLimitFlags(c, f.limits);
 }
@@ -125,10 +133,11 @@ void checkOutputPath(const SceneFlags& f) {
 
 void writeOutputImages(const SceneFlags& f, const io::RgbImage& image, const std::vector<std::uint8_t>& objectMask) {
   checkOutputPath(f);
-  // The service's display transform (render/tonemap.h); auto exposure over
-  // the lit object pixels unless --exposure fixes it.
-  const double exposure = f.exposure ? *f.exposure : render::keyExposure(render::frameLogAverage(image, objectMask));
-  const std::vector<std::uint8_t> rgba8 = render::tonemapRgba8(image, exposure);
+  // The service's display transform (render/tonemap.h); auto exposure
+  // (render/exposure_meter.h) unless --exposure fixes it.
+  const render::ToneCurve tone = render::parseToneCurve(f.tone).value_or(render::ToneCurve::Reinhard);  // checked by CLI11
+  const double exposure = f.exposure ? *f.exposure : render::meterExposure(image, objectMask, {}, tone).stops;
+  const std::vector<std::uint8_t> rgba8 = render::tonemapRgba8(image, exposure, tone);
   const fs::path out(f.out);
   if (out.extension() == ".exr") {
     io::writeExr(out.string(), image);

@@ -25,6 +25,7 @@ struct SceneFlags {
   std::string background = "env";
   std::string out;
   std::optional<double> exposure;
+  std::string tone = "reinhard";  // render::toneCurveName
   bool ground = false;  // with --mesh: a ground under it (render::addGround)
   render::SceneLimits limits;
 };
@@ -33,7 +34,7 @@ struct SceneFlags {
 void addSceneLimitFlags(CLI::App& command, render::SceneLimits& limits);
 
 // --scene --env --env-layout --mesh --material --up --rotate --width --height
-// --background --out --exposure, and the scene limits
+// --background --out --exposure --tone, and the scene limits
 void addSceneFlags(CLI::App& command, SceneFlags& flags);
 
 // --scene FILE, or one object from --mesh (with --env, --material, --rotate),
@@ -52,8 +53,8 @@ bool antialiasFor(const std::string& flag, const std::string& backend);
 void checkOutputPath(const SceneFlags& flags);
 
 // --out .exr (and a tonemapped .png beside it) or .png; --exposure, or
-// auto exposure over the lit object pixels (render/tonemap.h). Prints what
-// it wrote.
+// auto exposure (render/exposure_meter.h), through --tone's curve
+// (render/tonemap.h). Prints what it wrote.
 void writeOutputImages(const SceneFlags& flags, const io::RgbImage& image, const std::vector<std::uint8_t>& objectMask);
 
 }  // namespace haarcast::app

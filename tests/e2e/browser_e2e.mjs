@@ -18,7 +18,9 @@
 //      and starts the orbit at the new scene's camera; objects are named,
 //      each with the material in effect; a material change is answered;
 //   8. exposure "auto" gives a frame with < 2 % of its pixels at 255, a
-//      fixed +3 stops gives more, and each frame's exposure is shown;
+//      fixed +3 stops gives more, and each frame's exposure is shown; the
+//      tone select offers the schema's curves, starts at reinhard, and a
+//      choice reaches the server (frames come back with it, and differ);
 //   9. at 1200×800 every control is visible without scrolling; at 400×800
 //      nothing is wider than the window; the canvas keeps the frame's aspect
 //      ratio (also for a 128×96 frame) and goes full window and back;
@@ -726,6 +728,22 @@ try {
     await p.waitForFunction(() => window.haarcast.lastFrame.exposureMode === 'auto', null, { timeout: 30000 }).catch(() => {});
     f = (await pick(p)).lastFrame;
     check(f.exposureMode === 'auto', `checking "auto" again brings auto-exposed frames (${f.exposureMode})`);
+
+    // The tone curve: the schema's three, Reinhard in effect at first; AgX
+    // chosen in the select is sent, answered by frames made with it.
+    const tones = await p.evaluate(() => [...document.getElementById('tone').options].map((o) => o.value));
+    check(tones.join(',') === 'reinhard,aces,agx', `the tone select offers ${tones.join(', ')}`);
+    const toneBefore = await p.evaluate(() => document.getElementById('tone').value);
+    check(toneBefore === 'reinhard' && f.tone === 'reinhard',
+          `the tone select shows the curve in effect (${toneBefore}; frames: ${f.tone})`);
+    const reinhardPixels = await canvasPixels(p);
+    await p.selectOption('#tone', 'agx');
+    await p.waitForFunction(() => window.haarcast.lastFrame.tone === 'agx', null, { timeout: 30000 }).catch(() => {});
+    f = (await pick(p)).lastFrame;
+    const agxPixels = await canvasPixels(p);
+    let changed = 0;
+    for (let i = 0; i < Math.min(agxPixels.length, reinhardPixels.length); i++) changed += agxPixels[i] !== reinhardPixels[i];
+    check(f.tone === 'agx' && changed > 0, `choosing agx brings frames made with it (${f.tone}; ${changed} bytes differ)`);
     check(problems.length === 0, `exposure page: no page errors (${problems.join('; ')})`);
     await p.close();
   }

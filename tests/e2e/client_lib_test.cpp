@@ -81,6 +81,17 @@ TEST(Flags, SizeEncodingAndMethod) {
   }
   EXPECT_EQ(methodName(v1::ROTATION_METHOD_SPLITSUM), "splitsum");
   EXPECT_THROW(parseMethod("Haar"), std::invalid_argument);
+  // --tone: unset leaves the server's (Reinhard); a wrong name lists the valid ones.
+  EXPECT_EQ(parseToneCurve(""), v1::TONE_CURVE_UNSPECIFIED);
+  EXPECT_EQ(parseToneCurve("reinhard"), v1::TONE_CURVE_REINHARD);
+  EXPECT_EQ(parseToneCurve("aces"), v1::TONE_CURVE_ACES);
+  EXPECT_EQ(parseToneCurve("agx"), v1::TONE_CURVE_AGX);
+  try {
+    parseToneCurve("filmic");
+    ADD_FAILURE() << "\"filmic\" was taken as a tone curve";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("reinhard, aces or agx"), std::string::npos) << e.what();
+  }
 }
 
 // The H.264 flags: for h264 only, and h264 wants an even size.

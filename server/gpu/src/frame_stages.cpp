@@ -4,6 +4,7 @@
 #include <array>
 #include <vector>
 
+#include "haarcast/render/exposure_meter.h"
 #include "haarcast/render/tonemap.h"
 #include "vulkan_renderer_impl.h"
 
@@ -84,7 +85,7 @@ void VulkanRenderer::Impl::uploadFrameUniforms(const render::FrameRequest& reque
   // A fixed exposure is encoded in the thresholds; an automatic one is a
   // gain the device chooses (exposure.comp) over the thresholds of 0 stops.
   const render::ExposureControl& e = request.exposure;  // checked by render::checkFrameRequest
-  const std::array<float, 256> encoding = render::tonemapThresholds(e.automatic ? 0.0 : e.stops);
+  const std::array<float, 256> encoding = render::tonemapThresholds(e.automatic ? 0.0 : e.stops, request.tone);
   thresholds.write(encoding.data(), sizeof encoding);
 }
 
@@ -92,15 +93,7 @@ void VulkanRenderer::Impl::recordTonemap(VkCommandBuffer cb, const render::Frame
   const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
   resolve->dispatch(cb, {groupsOf(pixels, 64), 1, 1});
   computeBarrier(cb);
-  const render::ExposureControl& e = request.exposure;
-  ExposurePush push{};
-  push.automatic = e.automatic ? 1u : 0u;
-  push.hasPrevious = e.previousStops ? 1u : 0u;
-  push.previousStops = static_cast<float>(e.previousStops.value_or(0.0));
-  push.adaptation = static_cast<float>(e.adaptation);
-  push.fixedStops = static_cast<float>(e.stops);
-  push.key = static_cast<float>(render::kExposureKey);
-  push.maxStops = static_cast<float>(render::kMaxExposureStops);
+  const ExposurePush push = render::exposurePush(request.exposure, request.tone);
   exposure->dispatch(cb, {1, 1, 1}, &push, sizeof push);  // one workgroup reduces the frame
   computeBarrier(cb);
   tonemap->dispatch(cb, {groupsOf(pixels, 64), 1, 1});

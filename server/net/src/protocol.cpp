@@ -184,6 +184,15 @@ std::optional<ProtocolError> mergeSettings(SessionConfig& config, const v1::Rend
       return error(v1::ERROR_CODE_BAD_SETTINGS,
                    "unknown exposure_mode " + std::to_string(s.exposure_mode()) + " (valid: AUTO, FIXED)", fatal);
   }
+  switch (s.tone_curve()) {
+    case v1::TONE_CURVE_UNSPECIFIED: break;  // unchanged (a Hello starts with Reinhard)
+    case v1::TONE_CURVE_REINHARD: next.tone = render::ToneCurve::Reinhard; break;
+    case v1::TONE_CURVE_ACES: next.tone = render::ToneCurve::Aces; break;
+    case v1::TONE_CURVE_AGX: next.tone = render::ToneCurve::Agx; break;
+    default:
+      return error(v1::ERROR_CODE_BAD_SETTINGS,
+                   "unknown tone_curve " + std::to_string(s.tone_curve()) + " (valid: REINHARD, ACES, AGX)", fatal);
+  }
   config = std::move(next);
   return std::nullopt;
 }
@@ -467,6 +476,7 @@ render::FrameRequest frameRequest(const PoseState& pose, const SessionConfig& co
   r.lightCoefficients = config.lightCoefficients;
   r.exposure.automatic = config.autoExposure;
   r.exposure.stops = config.exposureStops;
+  r.tone = config.tone;
   return r;
 }
 
@@ -501,6 +511,15 @@ v1::Backend toWire(Backend backend) {
   return v1::BACKEND_UNSPECIFIED;
 }
 
+v1::ToneCurve toWire(render::ToneCurve tone) {
+  switch (tone) {
+    case render::ToneCurve::Reinhard: return v1::TONE_CURVE_REINHARD;
+    case render::ToneCurve::Aces: return v1::TONE_CURVE_ACES;
+    case render::ToneCurve::Agx: return v1::TONE_CURVE_AGX;
+  }
+  return v1::TONE_CURVE_UNSPECIFIED;
+}
+
 v1::RenderSettings settingsToWire(const SessionConfig& config) {
   v1::RenderSettings s;
   s.set_method(toWire(config.method));
@@ -509,6 +528,7 @@ v1::RenderSettings settingsToWire(const SessionConfig& config) {
   s.set_backend(toWire(config.backend));
   s.set_exposure_mode(config.autoExposure ? v1::EXPOSURE_MODE_AUTO : v1::EXPOSURE_MODE_FIXED);
   s.set_exposure_stops(config.exposureStops);
+  s.set_tone_curve(toWire(config.tone));
   s.set_width(static_cast<std::uint32_t>(config.width));
   s.set_height(static_cast<std::uint32_t>(config.height));
   if (config.encoding == FrameEncoding::H264) {

@@ -21,6 +21,7 @@
 #include "haarcast/core/splitsum.h"
 #include "haarcast/core/triple_product.h"
 #include "haarcast/render/embree_scene.h"
+#include "haarcast/render/exposure_meter.h"
 #include "haarcast/render/point_lights.h"
 #include "haarcast/render/shading.h"
 
@@ -405,9 +406,11 @@ Frame CpuRenderer::renderFrame(const FrameRequest& request, const CancelPoint& c
       }
     }, {}, options_.threads);
   }
-  frame.logAverageLuminance = frameLogAverage(frame.image, frame.objectMask);
-  frame.exposureStops = applyExposure(request.exposure, frame.logAverageLuminance);
-  frame.rgba8 = tonemapRgba8(frame.image, frame.exposureStops);
+  const shared::ExposureResult exposure = meterExposure(frame.image, frame.objectMask, request.exposure, request.tone);
+  frame.logAverageLuminance = exposure.logAverage;
+  // A fixed exposure is reported as asked, as the Vulkan backend does.
+  frame.exposureStops = request.exposure.automatic ? static_cast<double>(exposure.stops) : request.exposure.stops;
+  frame.rgba8 = tonemapRgba8(frame.image, frame.exposureStops, request.tone);
   frame.stages.push_back({"tonemap", since(t0)});
   frame.coefficientBytes = bytes;
   frame.seconds = since(start);

@@ -207,11 +207,6 @@ glm::dvec3 backgroundRadiance(const std::array<SphereMap, 3>& background, const 
   return out;
 }
 
-double frameLogAverage(const io::RgbImage& image, const std::vector<std::uint8_t>& objectMask) {
-  const double objects = logAverageLuminance(image, objectMask);
-  return objects > 0.0 ? objects : logAverageLuminance(image);
-}
-
 void checkFrameRequest(const FrameRequest& r, std::size_t objectCount) {
   auto bad = [](const std::string& what) { throw std::invalid_argument("frame request: " + what); };
   if (r.width < 1 || r.height < 1 || r.width > kMaxFrameSide || r.height > kMaxFrameSide) {

@@ -2,38 +2,110 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <string>
 
 namespace haarcast::render {
 
-double toneCurve(double x) {
-  if (!(x > 0.0)) return 0.0;  // also NaN
-  if (x >= kToneWhite) return 1.0;
-  return x * (1.0 + x / (kToneWhite * kToneWhite)) / (1.0 + x);
-}
-
 namespace {
 
-// x with toneCurve(x) = y, for y in (0, 1]: the positive root of
-// x²/W² + (1 − y)·x − y = 0, written without the cancellation of the
-// textbook form at small y.
-double inverseToneCurve(double y) {
-  const double b = 1.0 - y;
-  return 2.0 * y / (b + std::sqrt(b * b + 4.0 * y / (kToneWhite * kToneWhite)));
+// Narkowicz's ACES fit: x(ax + b) / (x(cx + d) + e).
+constexpr double kAcesA = 2.51, kAcesB = 0.03, kAcesC = 2.43, kAcesD = 0.59, kAcesE = 0.14;
+// AgX's log2 window: middle grey 0.18 with 10 stops below and 6.5 above.
+constexpr double kAgxMinEv = -12.47393, kAgxMaxEv = 4.026069;
+constexpr double kAgxDisplayGamma = 2.2;
+
+// Wrensch's polynomial fit of the AgX base contrast sigmoid on t ∈ [0, 1]
+// (mean squared error 3.7e-6); it rises on all of [0, 1] (the tests check),
+// from −0.00232 to 0.99858.
+double agxSigmoid(double t) {
+  const double t2 = t * t, t4 = t2 * t2;
+  return 15.5 * t4 * t2 - 40.14 * t4 * t + 31.96 * t4 - 6.868 * t2 * t + 0.4298 * t2 + 0.1191 * t - 0.00232;
+}
+
+// The least x with toneCurve(x) ≥ y, for y in (0, 1]; +∞ when the curve
+// never reaches y.
+double inverseToneCurve(double y, ToneCurve curve) {
+  switch (curve) {
+    case ToneCurve::Reinhard: {
+      // The positive root of x²/W² + (1 − y)·x − y = 0, written without the
+      // cancellation of the textbook form at small y.
+      const double b = 1.0 - y;
+      return 2.0 * y / (b + std::sqrt(b * b + 4.0 * y / (kToneWhite * kToneWhite)));
+    }
+    case ToneCurve::Aces: {
+      // (a − cy)·x² + (b − dy)·x − ey = 0 with a − cy > 0 for y ≤ 1: the
+      // positive root, in whichever form does not cancel.
+      const double qa = kAcesA - kAcesC * y, qb = kAcesB - kAcesD * y, qc = kAcesE * y;
+      const double root = std::sqrt(qb * qb + 4.0 * qa * qc);
+      return qb < 0.0 ? (root - qb) / (2.0 * qa) : 2.0 * qc / (qb + root);
+    }
+    case ToneCurve::Agx: {
+      const double s = std::pow(y, 1.0 / kAgxDisplayGamma);
+      if (s > agxSigmoid(1.0)) return std::numeric_limits<double>::infinity();
+      double lo = 0.0, hi = 1.0;  // the sigmoid rises: bisect for the least t with p(t) ≥ s
+      for (int i = 0; i < 64; ++i) {
+        const double mid = 0.5 * (lo + hi);
+        (agxSigmoid(mid) >= s ? hi : lo) = mid;
+      }
+      return std::exp2(kAgxMinEv + hi * (kAgxMaxEv - kAgxMinEv));
+    }
+  }
+  return 0.0;
 }
 
 double srgbToLinear(double v) { return v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4); }
 
 }  // namespace
 
-std::array<float, 256> tonemapThresholds(double exposureStops) {
+std::string_view toneCurveName(ToneCurve curve) {
+  switch (curve) {
+    case ToneCurve::Reinhard: return "reinhard";
+    case ToneCurve::Aces: return "aces";
+    case ToneCurve::Agx: return "agx";
+  }
+  return "?";
+}
+
+std::optional<ToneCurve> parseToneCurve(std::string_view name) {
+  for (const ToneCurve c : kToneCurves)
+    if (toneCurveName(c) == name) return c;
+  return std::nullopt;
+}
+
+std::string toneCurveNames() {
+  std::string out;
+  for (const ToneCurve c : kToneCurves) out += (out.empty() ? "" : ", ") + std::string(toneCurveName(c));
+  return out;
+}
+
+double toneCurve(double x, ToneCurve curve) {
+  if (!(x > 0.0)) return 0.0;  // also NaN
+  switch (curve) {
+    case ToneCurve::Reinhard:
+      if (x >= kToneWhite) return 1.0;
+      return x * (1.0 + x / (kToneWhite * kToneWhite)) / (1.0 + x);
+    case ToneCurve::Aces:
+      return std::min(1.0, x * (kAcesA * x + kAcesB) / (x * (kAcesC * x + kAcesD) + kAcesE));
+    case ToneCurve::Agx: {
+      const double t = std::clamp((std::log2(x) - kAgxMinEv) / (kAgxMaxEv - kAgxMinEv), 0.0, 1.0);
+      return std::pow(std::clamp(agxSigmoid(t), 0.0, 1.0), kAgxDisplayGamma);
+    }
+  }
+  return 0.0;
+}
+
+std::array<float, 256> tonemapThresholds(double exposureStops, ToneCurve curve) {
   const double gain = std::exp2(exposureStops);
   std::array<float, 256> t{};
   for (int k = 1; k < 256; ++k) {
     const double y = srgbToLinear((k - 0.5) / 255.0);
-    t[static_cast<std::size_t>(k)] = static_cast<float>(inverseToneCurve(y) / gain);
+    t[static_cast<std::size_t>(k)] = static_cast<float>(inverseToneCurve(y, curve) / gain);
   }
   return t;
 }
+
+double toneHighlight(ToneCurve curve) { return inverseToneCurve(srgbToLinear((kHighlightCode + 0.5) / 255.0), curve); }
 
 std::uint8_t tonemapByte(float value, const std::array<float, 256>& threshold) {
   // The largest k with value ≥ threshold[k] (0 when none, and for NaN): the
@@ -46,8 +118,8 @@ std::uint8_t tonemapByte(float value, const std::array<float, 256>& threshold) {
   return static_cast<std::uint8_t>(code);
 }
 
-std::vector<std::uint8_t> tonemapRgba8(const io::RgbImage& image, double exposureStops) {
-  const std::array<float, 256> thresholds = tonemapThresholds(exposureStops);
+std::vector<std::uint8_t> tonemapRgba8(const io::RgbImage& image, double exposureStops, ToneCurve curve) {
+  const std::array<float, 256> thresholds = tonemapThresholds(exposureStops, curve);
   const std::size_t pixels = static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height);
   std::vector<std::uint8_t> out(pixels * 4);
   for (std::size_t p = 0; p < pixels; ++p) {
@@ -55,36 +127,6 @@ std::vector<std::uint8_t> tonemapRgba8(const io::RgbImage& image, double exposur
     out[4 * p + 3] = 255;
   }
   return out;
-}
-
-double logAverageLuminance(const io::RgbImage& image, const std::vector<std::uint8_t>& mask) {
-  const std::size_t pixels = image.rgb.size() / 3;
-  double sumLog = 0.0;
-  std::size_t lit = 0;
-  for (std::size_t p = 0; p < pixels; ++p) {
-    if (!mask.empty() && (p >= mask.size() || mask[p] == 0)) continue;
-    const double y = 0.2126 * image.rgb[3 * p] + 0.7152 * image.rgb[3 * p + 1] + 0.0722 * image.rgb[3 * p + 2];
-    // Black pixels (shadowed, or a black backdrop) carry no exposure
-    // information and would drag the key towards burning everything else out.
-    if (!(y > 0.0) || !std::isfinite(y)) continue;
-    sumLog += std::log(y);
-    ++lit;
-  }
-  return lit ? std::exp(sumLog / static_cast<double>(lit)) : 0.0;
-}
-
-double keyExposure(double logAverage) {
-  if (!(logAverage > 0.0) || !std::isfinite(logAverage)) return 0.0;
-  return std::clamp(std::log2(kExposureKey / logAverage), -kMaxExposureStops, kMaxExposureStops);
-}
-
-double applyExposure(const ExposureControl& control, double logAverage) {
-  if (!control.automatic) return control.stops;
-  if (!(logAverage > 0.0)) return control.previousStops.value_or(0.0);
-  const double target = keyExposure(logAverage);
-  if (!control.previousStops) return target;
-  const double a = std::clamp(control.adaptation, 0.0, 1.0);
-  return *control.previousStops + a * (target - *control.previousStops);
 }
 
 double exposureAdaptation(double dtSeconds) {

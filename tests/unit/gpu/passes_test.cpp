@@ -239,8 +239,12 @@ TEST(BatchArgsPass, SizesEveryBatchFromTheCoveredCount) {
   testing::expectNoValidationMessages(context);
 }
 
-TEST(TonemapPass, BackdropAndEncodingMatchTheCpuDefinitions) {
+// Per tone curve (the curve lives in the thresholds the host computes).
+class TonemapPass : public ::testing::TestWithParam<render::ToneCurve> {};
+
+TEST_P(TonemapPass, BackdropAndEncodingMatchTheCpuDefinitions) {
   HAARCAST_REQUIRE_VULKAN();
+  const render::ToneCurve tone = GetParam();
   const int w = 40, h = 30, bgLevel = 5;
   std::mt19937 rng(3);
   std::uniform_real_distribution<float> u(0.0f, 1.0f);
@@ -276,7 +280,7 @@ TEST(TonemapPass, BackdropAndEncodingMatchTheCpuDefinitions) {
   ExposureResult fixed{};
   fixed.gain = 1.0f;
   exposureBuf.write(&fixed, sizeof fixed);
-  const auto thresholds = render::tonemapThresholds(exposure);
+  const auto thresholds = render::tonemapThresholds(exposure, tone);
   thresholdBuf.upload(std::span<const float>(thresholds));
   paramBuf.write(&params, sizeof params);
   idBuf.upload(std::span<const glm::uvec4>(ids));
@@ -311,7 +315,7 @@ TEST(TonemapPass, BackdropAndEncodingMatchTheCpuDefinitions) {
     }
   }
   EXPECT_LT(worstBackdrop, 1e-5) << "backdrop differs from render::backgroundRadiance";
-  const std::vector<std::uint8_t> expected = render::tonemapRgba8(image, exposure);
+  const std::vector<std::uint8_t> expected = render::tonemapRgba8(image, exposure, tone);
   ASSERT_EQ(expected.size(), rgba.size());
   std::size_t differ = 0;
   for (std::size_t i = 0; i < rgba.size(); ++i) {
@@ -322,6 +326,9 @@ TEST(TonemapPass, BackdropAndEncodingMatchTheCpuDefinitions) {
   EXPECT_LE(differ, 2u) << differ << " bytes differ by one";
   testing::expectNoValidationMessages(context);
 }
+
+INSTANTIATE_TEST_SUITE_P(Curves, TonemapPass, ::testing::ValuesIn(render::kToneCurves),
+                         [](const auto& p) { return std::string(render::toneCurveName(p.param)); });
 
 // ---- G-buffer and rotation-input, read back from a real frame ------------
 

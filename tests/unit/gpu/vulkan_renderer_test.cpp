@@ -16,6 +16,7 @@
 #include "frame_compare.h"
 #include "gpu_test_util.h"
 #include "haarcast/gpu/vulkan_renderer.h"
+#include "haarcast/render/exposure_meter.h"
 #include "haarcast/render/renderer.h"
 
 namespace haarcast::gpu {
@@ -43,16 +44,17 @@ const std::vector<std::string> kFusedStages = {"light", "gbuffer", "rotation-inp
 // The stages in pipeline order under the shared names, some coefficient
 // bytes read, and RGBA8 equal to the CPU encoding of the frame's own linear
 // image (within two bytes of rounding).
-void expectStagesAndRgba8(const render::Frame& b, const std::vector<std::string>& names, double exposureStops) {
+void expectStagesAndRgba8(const render::Frame& b, const std::vector<std::string>& names, double exposureStops,
+                          render::ToneCurve tone = render::ToneCurve::Reinhard) {
   EXPECT_EQ(b.exposureStops, exposureStops);
   ASSERT_EQ(b.stages.size(), names.size());
   for (std::size_t i = 0; i < names.size(); ++i) EXPECT_EQ(b.stages[i].name, names[i]);
   EXPECT_GT(b.coefficientBytes, 0u);
-  const auto expected = render::tonemapRgba8(b.image, exposureStops);
+  const auto expected = render::tonemapRgba8(b.image, exposureStops, tone);
   ASSERT_EQ(expected.size(), b.rgba8.size());
   std::size_t differ = 0;
   for (std::size_t i = 0; i < expected.size(); ++i) differ += expected[i] != b.rgba8[i];
-  EXPECT_LE(differ, 2u);
+  EXPECT_LE(differ, 2u) << render::toneCurveName(tone);
 }
 
 // Renders one frame on each backend and checks what the comparison promises.
@@ -161,9 +163,9 @@ TEST_P(FusedMirrorFrame, VulkanMatchesTheCpuBackend) {
 
 INSTANTIATE_TEST_SUITE_P(Levels, FusedMirrorFrame, ::testing::Values(4, 5));
 
-// Auto exposure: the device's frame is measured and exposed as the CPU's
-// (the lit object pixels' log-average, the same transform), and eases from
-// a previous exposure by the fraction asked for.
+// Auto exposure: the device's frame is metered and exposed as the CPU's
+// (core/shared_exposure.h's rule on its own linear image, the same
+// transform), and eases from a previous exposure by the fraction asked for.
 TEST(VulkanRenderer, AutoExposureMatchesTheCpuBackend) {
   HAARCAST_REQUIRE_VULKAN();
   const render::Scene scene = render::defaultScene();
@@ -176,13 +178,42 @@ TEST(VulkanRenderer, AutoExposureMatchesTheCpuBackend) {
   const render::Frame b = gpu.render(request);
   ASSERT_GT(a.logAverageLuminance, 0.0);
   EXPECT_NEAR(b.logAverageLuminance, a.logAverageLuminance, 1e-3 * a.logAverageLuminance);
-  EXPECT_NEAR(a.exposureStops, render::keyExposure(a.logAverageLuminance), 1e-12);
   EXPECT_NEAR(b.exposureStops, a.exposureStops, 1e-3);
+  // On the device's own image the CPU's meter chooses the device's exposure.
+  EXPECT_NEAR(b.exposureStops, render::meterExposure(b.image, b.objectMask, request.exposure, request.tone).stops, 1e-5);
   request.exposure.previousStops = a.exposureStops + 2.0;
   request.exposure.adaptation = 0.25;
   const render::Frame c = gpu.render(request);
   EXPECT_NEAR(c.exposureStops, a.exposureStops + 1.5, 1e-3);
   expectStagesAndRgba8(c, kFusedStages, c.exposureStops);
+  testing::expectNoValidationMessages(gpu.context());
+}
+
+// Each tone curve: the device's bytes are its own linear image encoded by
+// the CPU's transform with that curve, at a fixed and at the auto exposure.
+TEST(VulkanRenderer, EveryToneCurveEncodesAsTheCpu) {
+  HAARCAST_REQUIRE_VULKAN();
+  const render::Scene scene = render::defaultScene();
+  const render::RenderOptions o = frameOptions(RotationMethod::Fused, true);
+  VulkanRenderer gpu(scene, o, testing::testOptions());
+  render::FrameRequest request = requestFor(scene, o.width, o.height);
+  for (const render::ToneCurve tone : render::kToneCurves) {
+    request.tone = tone;
+    request.exposure = render::ExposureControl{};
+    request.exposure.automatic = false;
+    request.exposure.stops = 0.75;
+    const render::Frame fixed = gpu.render(request);
+    expectStagesAndRgba8(fixed, kFusedStages, 0.75, tone);
+    request.exposure = render::ExposureControl{};
+    const render::Frame automatic = gpu.render(request);
+    EXPECT_NEAR(automatic.exposureStops, render::meterExposure(automatic.image, automatic.objectMask, {}, tone).stops, 1e-5)
+        << render::toneCurveName(tone);
+    const auto expected = render::tonemapRgba8(automatic.image, automatic.exposureStops, tone);
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < expected.size(); ++i) differ += expected[i] != automatic.rgba8[i];
+    // The gain multiplies on the device, the CPU divides the thresholds.
+    EXPECT_LE(differ, expected.size() / 1000 + 2) << render::toneCurveName(tone);
+  }
   testing::expectNoValidationMessages(gpu.context());
 }
 

@@ -221,6 +221,37 @@ TEST(Protocol, ExposureModes) {
   EXPECT_TRUE(c.autoExposure);
 }
 
+// Tone curve: Reinhard unless a Hello or later settings choose another; a
+// settings message that leaves it unset keeps it; the request carries it; a
+// value outside the enum is refused naming the valid ones.
+TEST(Protocol, ToneCurves) {
+  v1::Hello hello = goodHello();
+  auto c = std::get<SessionConfig>(configFromHello(hello, Limits{}, Defaults{}, testCatalog()));
+  EXPECT_EQ(c.tone, render::ToneCurve::Reinhard);  // an old client's session: as before
+  EXPECT_EQ(settingsToWire(c).tone_curve(), v1::TONE_CURVE_REINHARD);
+  hello.mutable_settings()->set_tone_curve(v1::TONE_CURVE_AGX);
+  c = std::get<SessionConfig>(configFromHello(hello, Limits{}, Defaults{}, testCatalog()));
+  EXPECT_EQ(c.tone, render::ToneCurve::Agx);
+  v1::RenderSettings s;
+  s.set_tone_curve(v1::TONE_CURVE_ACES);
+  ASSERT_FALSE(applySettings(c, s, Limits{}, testCatalog()));
+  EXPECT_EQ(c.tone, render::ToneCurve::Aces);
+  EXPECT_EQ(frameRequest(initialPose(render::Camera{}, {}), c).tone, render::ToneCurve::Aces);
+  EXPECT_EQ(settingsToWire(c).tone_curve(), v1::TONE_CURVE_ACES);
+  v1::RenderSettings levelOnly;
+  levelOnly.set_level(3);
+  ASSERT_FALSE(applySettings(c, levelOnly, Limits{}, testCatalog()));
+  EXPECT_EQ(c.tone, render::ToneCurve::Aces);
+  v1::RenderSettings bad;
+  bad.set_tone_curve(static_cast<v1::ToneCurve>(9));
+  const auto e = applySettings(c, bad, Limits{}, testCatalog());
+  ASSERT_TRUE(e);
+  EXPECT_EQ(e->code, v1::ERROR_CODE_BAD_SETTINGS);
+  EXPECT_NE(e->message.find("tone_curve 9"), std::string::npos) << e->message;
+  EXPECT_NE(e->message.find("REINHARD, ACES, AGX"), std::string::npos) << e->message;
+  EXPECT_EQ(c.tone, render::ToneCurve::Aces);
+}
+
 TEST(Protocol, SettingsChangeAllOrNothing) {
   auto c = std::get<SessionConfig>(configFromHello(goodHello(), Limits{}, Defaults{}, testCatalog()));
   const auto before = c;

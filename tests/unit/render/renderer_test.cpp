@@ -1,4 +1,5 @@
 // The Renderer interface's CPU backend and the steps every backend shares.
+#include "haarcast/render/exposure_meter.h"
 #include "haarcast/render/renderer.h"
 #include "haarcast/render/shading.h"
 
@@ -144,8 +145,8 @@ TEST(CpuBackend, FramesAreRepeatableAndEqualTheOneShotRender) {
   ASSERT_EQ(a.image.rgb.size(), once.image.rgb.size());
   EXPECT_EQ(a.image.rgb, b.image.rgb);
   EXPECT_EQ(a.image.rgb, once.image.rgb);
-  // Auto exposure by default: the key exposure of the lit object pixels.
-  EXPECT_NEAR(a.exposureStops, keyExposure(frameLogAverage(a.image, a.objectMask)), 1e-12);
+  // Auto exposure by default, metered by exposure_meter.h.
+  EXPECT_EQ(a.exposureStops, meterExposure(a.image, a.objectMask, {}, ToneCurve::Reinhard).stops);
   EXPECT_NE(a.exposureStops, 0.0);
   EXPECT_EQ(a.rgba8, tonemapRgba8(a.image, a.exposureStops));
   // Every stage is reported, in pipeline order (fused, the default, has one

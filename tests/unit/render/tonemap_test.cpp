@@ -1,8 +1,12 @@
 // The display transform (render/tonemap.h) against its formula evaluated
-// directly in double, and auto exposure against hand-computed values.
+// directly in double, for each tone curve, and the curves against values
+// worked out by hand from their published forms. Auto exposure's metering
+// is exposure_meter_test.cpp.
 #include "haarcast/render/tonemap.h"
 
+#include <algorithm>
 #include <cmath>
+#include <string>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -10,26 +14,28 @@
 namespace haarcast::render {
 namespace {
 
-// The formula of tonemap.h written out: gain, Reinhard's extended curve,
-// clamp, IEC 61966-2-1, rounding.
-int directByte(double linear, double stops) {
+// The formula of tonemap.h written out: gain, the curve, clamp,
+// IEC 61966-2-1, rounding.
+int directByte(double linear, double stops, ToneCurve curve) {
   const double x = linear * std::exp2(stops);
   if (!(x > 0.0)) return 0;
-  const double w2 = kToneWhite * kToneWhite;
-  const double y = std::min(1.0, x * (1.0 + x / w2) / (1.0 + x));
+  const double y = std::clamp(toneCurve(x, curve), 0.0, 1.0);
   const double s = y <= 0.0031308 ? 12.92 * y : 1.055 * std::pow(y, 1.0 / 2.4) - 0.055;
   return static_cast<int>(std::lround(s * 255.0));
 }
 
-TEST(Tonemap, BytesAreTheFormulaExceptAtFloatRoundingOfACodeBoundary) {
+class TonemapCurve : public ::testing::TestWithParam<ToneCurve> {};
+
+TEST_P(TonemapCurve, BytesAreTheFormulaExceptAtFloatRoundingOfACodeBoundary) {
+  const ToneCurve curve = GetParam();
   std::mt19937 rng(7);
-  std::uniform_real_distribution<double> logValue(-12.0, 5.0);
+  std::uniform_real_distribution<double> logValue(-16.0, 6.0);
   for (const double stops : {-3.0, 0.0, 1.5}) {
-    const auto thresholds = tonemapThresholds(stops);
+    const auto thresholds = tonemapThresholds(stops, curve);
     int exact = 0, total = 0;
     for (int i = 0; i < 20000; ++i) {
       const float v = static_cast<float>(std::exp2(logValue(rng)));
-      const int expected = directByte(v, stops);
+      const int expected = directByte(v, stops, curve);
       const int got = tonemapByte(v, thresholds);
       ASSERT_LE(std::abs(got - expected), 1) << "value " << v << ", " << stops << " stops";
       exact += got == expected;
@@ -37,11 +43,61 @@ TEST(Tonemap, BytesAreTheFormulaExceptAtFloatRoundingOfACodeBoundary) {
     }
     EXPECT_GE(exact, total - total / 1000) << stops << " stops";
   }
-  const auto t = tonemapThresholds(0.0);
+  const auto t = tonemapThresholds(0.0, curve);
   EXPECT_EQ(tonemapByte(0.0f, t), 0);
   EXPECT_EQ(tonemapByte(-1.0f, t), 0);
   EXPECT_EQ(tonemapByte(NAN, t), 0);
   EXPECT_EQ(tonemapByte(INFINITY, t), 255);
+  // Every code is reached, in order: the curve never falls.
+  for (int k = 2; k < 256; ++k) EXPECT_LT(t[static_cast<std::size_t>(k - 1)], t[static_cast<std::size_t>(k)]) << k;
+  // The highlight guard's value shows as kHighlightCode, a hair more as the next.
+  const double h = toneHighlight(curve);
+  EXPECT_EQ(tonemapByte(static_cast<float>(h * 0.999), t), kHighlightCode);
+  EXPECT_EQ(tonemapByte(static_cast<float>(h * 1.001), t), kHighlightCode + 1);
+}
+
+TEST_P(TonemapCurve, NeverFallsAndStaysWithinZeroToOne) {
+  const ToneCurve curve = GetParam();
+  double previous = 0.0;
+  for (double lx = -20.0; lx <= 10.0; lx += 1.0 / 64.0) {
+    const double y = toneCurve(std::exp2(lx), curve);
+    ASSERT_GE(y, previous) << toneCurveName(curve) << " at 2^" << lx;
+    ASSERT_LE(y, 1.0);
+    previous = y;
+  }
+  EXPECT_EQ(toneCurve(0.0, curve), 0.0);
+  EXPECT_EQ(toneCurve(-1.0, curve), 0.0);
+  EXPECT_EQ(toneCurve(NAN, curve), 0.0);
+  EXPECT_EQ(parseToneCurve(toneCurveName(curve)), curve);
+}
+
+INSTANTIATE_TEST_SUITE_P(Curves, TonemapCurve, ::testing::ValuesIn(kToneCurves),
+                         [](const auto& p) { return std::string(toneCurveName(p.param)); });
+
+// The curves at points worked out from their published forms.
+TEST(Tonemap, CurvesAtHandComputedPoints) {
+  // Reinhard's extended curve, W = 8: 0.18·(1 + 0.18/64)/1.18; 1·(1 + 1/64)/2.
+  EXPECT_NEAR(toneCurve(0.18, ToneCurve::Reinhard), 0.18 * (1.0 + 0.18 / 64.0) / 1.18, 1e-15);
+  EXPECT_NEAR(toneCurve(1.0, ToneCurve::Reinhard), 65.0 / 128.0, 1e-15);
+  // Narkowicz: x = 1 gives (2.51 + 0.03)/(2.43 + 0.59 + 0.14) = 127/158; it
+  // reaches 1 where 0.08x² − 0.56x − 0.14 = 0 (x ≈ 7.24) and stays there.
+  EXPECT_NEAR(toneCurve(1.0, ToneCurve::Aces), 127.0 / 158.0, 1e-15);
+  EXPECT_NEAR(toneCurve(0.18, ToneCurve::Aces), 0.2668989203894968, 1e-15);
+  const double acesWhite = (0.56 + std::sqrt(0.56 * 0.56 + 4.0 * 0.08 * 0.14)) / 0.16;  // ≈ 7.24
+  EXPECT_NEAR(toneCurve(acesWhite * 0.999, ToneCurve::Aces), 1.0, 1e-4);
+  EXPECT_LT(toneCurve(acesWhite * 0.999, ToneCurve::Aces), 1.0);
+  EXPECT_EQ(toneCurve(acesWhite * 1.001, ToneCurve::Aces), 1.0);
+  // AgX: middle grey sits 10/16.5 along the log window, where Wrensch's
+  // polynomial is 0.49673…; raised to 2.2. The window's top, 2^4.026069
+  // (0.18·2^6.5 as the fit rounds it), and all above it show p(1)^2.2 =
+  // 0.99858^2.2; its bottom and below, 0.
+  EXPECT_NEAR(toneCurve(0.18, ToneCurve::Agx), 0.2145190198456818, 1e-6);
+  EXPECT_NEAR(toneCurve(1.0, ToneCurve::Agx), 0.5901591271831184, 1e-6);
+  EXPECT_NEAR(toneCurve(std::exp2(4.026069), ToneCurve::Agx), std::pow(0.99858, 2.2), 1e-12);
+  EXPECT_NEAR(toneCurve(1e3, ToneCurve::Agx), std::pow(0.99858, 2.2), 1e-12);
+  EXPECT_EQ(toneCurve(0.18 * std::exp2(-10.5), ToneCurve::Agx), 0.0);
+  EXPECT_EQ(toneCurveNames(), "reinhard, aces, agx");
+  EXPECT_FALSE(parseToneCurve("filmic"));
 }
 
 TEST(Tonemap, HighlightsRollOffUntilTheWhitePoint) {
@@ -72,38 +128,6 @@ TEST(Tonemap, RgbaIsEachChannelAndOpaqueAlpha) {
     for (std::size_t c = 0; c < 3; ++c) EXPECT_EQ(rgba[4 * p + c], tonemapByte(image.rgb[3 * p + c], t));
     EXPECT_EQ(rgba[4 * p + 3], 255);
   }
-}
-
-TEST(AutoExposure, LogAverageOverTheMaskedLitPixels) {
-  io::RgbImage image = io::makeImage(4, 1);
-  // Grey pixels: luminance equals the value (the Rec. 709 weights sum to 1).
-  const float grey[] = {0.02f, 0.5f, 0.0f, 100.0f};
-  for (int x = 0; x < 4; ++x)
-    for (int c = 0; c < 3; ++c) image.at(0, x, c) = grey[x];
-  // Black pixels carry no exposure information and are left out.
-  EXPECT_NEAR(logAverageLuminance(image, {1, 1, 1, 0}), std::sqrt(0.02 * 0.5), 1e-6);
-  EXPECT_NEAR(logAverageLuminance(image), std::cbrt(0.02 * 0.5 * 100.0), 1e-5);
-  EXPECT_EQ(logAverageLuminance(image, {0, 0, 1, 0}), 0.0);
-  EXPECT_NEAR(keyExposure(0.045), 2.0, 1e-12);  // 0.045 · 2² = 0.18
-  EXPECT_EQ(keyExposure(0.0), 0.0);
-  EXPECT_EQ(keyExposure(1e-30), kMaxExposureStops);
-}
-
-TEST(AutoExposure, FixedAutoAndEasedFromThePreviousFrame) {
-  ExposureControl fixed;
-  fixed.automatic = false;
-  fixed.stops = -1.25;
-  EXPECT_EQ(applyExposure(fixed, 0.045), -1.25);
-  ExposureControl automatic;
-  EXPECT_NEAR(applyExposure(automatic, 0.045), 2.0, 1e-12);
-  EXPECT_EQ(applyExposure(automatic, 0.0), 0.0);
-  automatic.previousStops = 4.0;
-  automatic.adaptation = 0.25;
-  EXPECT_NEAR(applyExposure(automatic, 0.045), 3.5, 1e-12);  // a quarter of the way from 4 to 2
-  EXPECT_EQ(applyExposure(automatic, 0.0), 4.0);             // nothing lit: keep the previous
-  EXPECT_NEAR(exposureAdaptation(kExposureTimeConstant), 1.0 - std::exp(-1.0), 1e-12);
-  EXPECT_EQ(exposureAdaptation(0.0), 0.0);
-  EXPECT_GT(exposureAdaptation(10.0), 0.999);
 }
 
 }  // namespace

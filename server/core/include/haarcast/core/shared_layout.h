@@ -450,28 +450,8 @@ struct DispatchArgs {
   uint pad;
 };
 
-// Auto exposure on the device (exposure.comp): the push block carries the
-// request's render::ExposureControl and the constants of render/tonemap.h;
-// the pass leaves its measure and choice in ExposureResult, which the
-// tonemap pass reads (x = gain · L, gain = 2^stops when automatic, else 1
-// because the thresholds then hold the fixed exposure) and the host reads back.
-struct ExposurePush {
-  uint automatic;      // 1: key exposure of the frame, eased from previousStops
-  uint hasPrevious;    // 1: previousStops holds the stream's last exposure
-  float previousStops;
-  float adaptation;    // 0 … 1, the easing towards the target
-  float fixedStops;    // the exposure when not automatic
-  float key;           // render::kExposureKey
-  float maxStops;      // render::kMaxExposureStops
-  uint pad0;
-};
-
-struct ExposureResult {
-  float logAverage;    // render::frameLogAverage of the resolved frame (0: nothing lit)
-  float stops;         // render::applyExposure
-  float gain;          // what the tonemap pass multiplies by
-  uint lit;            // pixels measured
-};
+// Auto exposure's metering, ExposurePush and ExposureResult.
+#include "haarcast/core/shared_exposure.h"
 
 // The G-buffer pass's push block (gbuffer.vert / .frag).
 struct GBufferPush {
@@ -497,7 +477,7 @@ static_assert(sizeof(RotationSample) == 32 && offsetof(RotationSample, alpha) ==
 static_assert(sizeof(ShadeSample) == 32 && offsetof(ShadeSample, b) == 16 && offsetof(ShadeSample, pixel) == 28);
 static_assert(sizeof(CoverageCounter) == 16 && offsetof(CoverageCounter, groups) == 4);
 static_assert(sizeof(DispatchArgs) == 16 && offsetof(DispatchArgs, groups) == 0);
-static_assert(sizeof(ExposurePush) == 32 && sizeof(ExposureResult) == 16);
+static_assert(sizeof(ExposurePush) == 32 && sizeof(ExposureResult) == 32);
 static_assert(sizeof(GBufferPush) == 80 && offsetof(GBufferPush, objectId) == 64);
 #endif
 

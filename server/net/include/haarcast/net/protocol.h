@@ -106,6 +106,7 @@ struct SessionConfig {
   Backend backend = Backend::Cpu;
   bool autoExposure = true;   // else exposureStops
   double exposureStops = 0.0;
+  render::ToneCurve tone = render::ToneCurve::Reinhard;
   // ENCODING_H264 only (h264_encoder.h has the ranges). A bitrate of 0:
   // none set, the cap follows the size (defaultH264BitrateKbps).
   int h264BitrateKbps = 0;
@@ -160,6 +161,7 @@ render::FrameRequest frameRequest(const PoseState& pose, const SessionConfig& co
 v1::Encoding toWire(FrameEncoding encoding);
 v1::RotationMethod toWire(RotationMethod method);
 v1::Backend toWire(Backend backend);
+v1::ToneCurve toWire(render::ToneCurve tone);
 v1::RenderSettings settingsToWire(const SessionConfig& config);
 v1::ServerLimits limitsToWire(const Limits& limits);
 // The H.264 encoder settings of a config (size, bitrate, keyframe interval,

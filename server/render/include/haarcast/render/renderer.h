@@ -59,6 +59,8 @@ struct FrameRequest {
   std::size_t lightCoefficients = 0;
   // The RGBA8 image's exposure (tonemap.h): automatic by default.
   ExposureControl exposure;
+  // The RGBA8 image's tone curve (tonemap.h).
+  ToneCurve tone = ToneCurve::Reinhard;
   // false: the caller needs only rgba8 (an encoder), so a backend may skip
   // reading the linear image back (Frame::image is then empty).
   bool linearImage = true;
@@ -84,7 +86,7 @@ struct Frame {
   double seconds = 0.0;               // wall time of render()
   std::size_t coefficientBytes = 0;   // coefficient data read this frame (slices, light, visibility, method tables)
   double exposureStops = 0.0;         // the exposure rgba8 was made with
-  double logAverageLuminance = 0.0;   // of the lit object pixels (frameLogAverage); 0: none lit
+  double logAverageLuminance = 0.0;   // auto exposure's weighted log-average (exposure_meter.h); 0: none lit
   // The request's `cancelled` turned true mid-frame: the render stopped at
   // the next tile or batch boundary and the images are empty (an outcome,
   // not an error: nothing is wrong with the request).
@@ -188,10 +190,6 @@ RotationInput rotationInput(const glm::dvec3& normal, const glm::dvec3& towardEy
 // by lightRotation: bilinear (sphere_map.h's bilinearTaps) in the maps.
 glm::dvec3 backgroundRadiance(const std::array<SphereMap, 3>& background, const glm::dmat3& lightRotation,
                               const glm::dvec3& direction);
-
-// What auto exposure measures: the log-average luminance of the lit object
-// pixels (tonemap.h), or of the whole image when no object pixel is lit.
-double frameLogAverage(const io::RgbImage& image, const std::vector<std::uint8_t>& objectMask);
 
 // Throws std::invalid_argument naming the problem.
 void checkFrameRequest(const FrameRequest& request, std::size_t objectCount);
