@@ -6,8 +6,8 @@
 // rule, docs/clients.md says them).
 import { choices, page, state } from './page_state.js';
 import { send } from './session.js';
-import { AutoResolution, FIRST_LIMITS, autoSteps, fpsFloor, frameSize } from './stream_size.js';
-import { noteChange } from './view.js';
+import { AutoResolution, FIRST_LIMITS, STILL_MS, autoSteps, fpsFloor, frameSize } from './stream_size.js';
+import { noteChange, onMove } from './view.js';
 
 const $ = (id) => document.getElementById(id);
 const stage = $('stage');
@@ -37,7 +37,7 @@ const fixedByAddress = () => page.width > 0 && page.height > 0;
 // The size to ask for now.
 export function wantedSize() {
   if (fixedByAddress()) return { width: page.width, height: page.height };
-  const cap = choices.resolution === 'auto' ? auto.capLines : Infinity;
+  const cap = choices.resolution === 'auto' ? auto.wantedCap() : Infinity;
   return frameSize(choices.resolution, viewBox(), limits(), cap);
 }
 
@@ -85,6 +85,18 @@ function viewChanged() {
 }
 new ResizeObserver(viewChanged).observe(stage);
 window.addEventListener('resize', viewChanged);  // devicePixelRatio changes with the browser's zoom
+
+// A still view at its own size (stream_size.js AutoResolution.still): each
+// move restarts the timer, and the first move after a still frame goes
+// back to auto's step before its pose leaves.
+let stillTimer = null;
+onMove(() => {
+  clearTimeout(stillTimer);
+  if (auto.moved()) refit();
+  stillTimer = setTimeout(() => {
+    if (choices.resolution === 'auto' && !fixedByAddress() && auto.still()) refit();
+  }, STILL_MS);
+});
 
 // Each frame's size and server time, for auto's rule.
 export function frameTiming(width, height, serverMs) {

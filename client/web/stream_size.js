@@ -77,7 +77,15 @@ export function autoSteps(viewLines) {
 //     estimate makes the floor (the smallest step when none does);
 //   - up: one step, when the estimate at the next step up is at least
 //     `headroom` × the floor and the size has held for `holdMs`.
+//   - still: the steps hold a frame rate while the view moves, and a view
+//     that has stopped needs none, so once it has been still for STILL_MS
+//     (the page's timer: still()) the view's own size is asked for, one
+//     frame however long the server takes; the next move (moved()) goes
+//     back to the step in effect before its pose is sent.
 // The floor (fpsFloor) and the rule are in docs/clients.md.
+// How long a view stays unmoved before auto shows it at its own size.
+export const STILL_MS = 700;
+
 export class AutoResolution {
   constructor({ frames = 4, headroom = 1.5, holdMs = 3000 } = {}) {
     this.frames = frames;
@@ -87,6 +95,27 @@ export class AutoResolution {
     this.samples = [];         // server ms of frames of the size in effect
     this.pixels = 0;           // the size in effect (the one asked for)
     this.changedAt = -Infinity;
+    this.sharp = false;        // a still view, shown at its own size
+  }
+
+  // The cap to ask for now: the step in effect, or none while still.
+  wantedCap() {
+    return this.sharp ? Infinity : this.capLines;
+  }
+
+  // The view has been still for STILL_MS. True when that changes the size
+  // asked for (auto had stepped down).
+  still() {
+    if (this.sharp || !Number.isFinite(this.capLines)) return false;
+    this.sharp = true;
+    return true;
+  }
+
+  // The view moves. True when the size asked for goes back to the step.
+  moved() {
+    if (!this.sharp) return false;
+    this.sharp = false;
+    return true;
   }
 
   // A new size was asked for (a step, a resize): samples of the old one no
@@ -137,6 +166,7 @@ export class AutoResolution {
 
   // "auto 540p" for the HUD: the step in effect ("auto" at the view's own size).
   label() {
+    if (this.sharp) return `auto (still: full size; ≤${this.capLines}p moving)`;
     return Number.isFinite(this.capLines) ? `auto ≤${this.capLines}p` : 'auto';
   }
 }

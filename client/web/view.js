@@ -23,6 +23,16 @@ export const view = {
   changeFromPose: 0,
 };
 
+// What follows the user's moves (resolution.js: a still view is shown
+// sharp, a moving one at auto's step).
+const moveListeners = [];
+export function onMove(listener) {
+  moveListeners.push(listener);
+}
+function moved() {
+  for (const listener of moveListeners) listener();
+}
+
 // A change was sent: a pose follows it at once, so that the frame made with
 // the change answers a pose of its own.
 export function noteChange() {
@@ -72,6 +82,7 @@ export function steer(target, dx, dy) {
     touched.camera = true;
   }
   view.poseDirty = true;
+  moved();
 }
 
 export function zoom(deltaY) {
@@ -79,6 +90,7 @@ export function zoom(deltaY) {
   orbit.distance = zoomOrbit(orbit, deltaY);
   touched.camera = true;
   view.poseDirty = true;
+  moved();
 }
 
 // Fingers that moved from `fromPx` apart to `toPx` apart (a pinch).
@@ -87,6 +99,7 @@ export function pinch(fromPx, toPx) {
   orbit.distance = pinchOrbit(orbit, fromPx, toPx);
   touched.camera = true;
   view.poseDirty = true;
+  moved();
 }
 
 function sendPose() {

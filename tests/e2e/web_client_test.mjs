@@ -404,6 +404,28 @@ test('auto: a fast server keeps the view\'s own size; one that gets faster is st
   }
 });
 
+test('auto: a still view is asked for at its own size, and the next move goes back to the step', () => {
+  const auto = new AutoResolution();
+  const { sizes, t } = runAuto(auto, { msPerMegapixel: 200, frames: 20 });
+  assert.equal(sizes.at(-1), 360, sizes.join(' '));
+  assert.equal(auto.wantedCap(), 360);
+  // Still: the view's own size, whatever the server's time.
+  assert.equal(auto.still(), true);
+  assert.equal(auto.wantedCap(), Infinity);
+  assert.match(auto.label(), /still: full size; ≤360p moving/);
+  assert.equal(auto.still(), false, 'still twice asks once');
+  // A move: back to 360p, not to the view's size, and the step is kept.
+  assert.equal(auto.moved(), true);
+  assert.equal(auto.wantedCap(), 360);
+  assert.equal(auto.capLines, 360);
+  assert.equal(auto.moved(), false, 'a second move changes nothing');
+  // At the view's own size already there is nothing to sharpen.
+  const fast = new AutoResolution();
+  runAuto(fast, { msPerMegapixel: 20, frames: 10, start: t });
+  assert.equal(fast.still(), false);
+  assert.equal(fast.wantedCap(), Infinity);
+});
+
 test('auto: frames of another size, and frames with no time, are not counted', () => {
   const auto = new AutoResolution();
   auto.asked(1000, 0);
