@@ -32,10 +32,20 @@ export function setHudFolded(folded) {
   state.hudFolded = folded;
 }
 setHudFolded(window.innerWidth < HUD_FOLDED_BELOW_PX);
-$('hud-toggle').addEventListener('click', () => setHudFolded(!state.hudFolded));
+// The width's default follows the window (a phone turned, a window
+// narrowed) until the user folds or unfolds it: then theirs holds.
+let userChose = false;
+const toggle = () => {
+  userChose = true;
+  setHudFolded(!state.hudFolded);
+};
+window.addEventListener('resize', () => {
+  if (!userChose) setHudFolded(window.innerWidth < HUD_FOLDED_BELOW_PX);
+});
+$('hud-toggle').addEventListener('click', toggle);
 document.addEventListener('keydown', (e) => {
   if (e.target instanceof HTMLInputElement || e.target instanceof HTMLSelectElement) return;
-  if (e.key === 'h' && !e.ctrlKey && !e.metaKey && !e.altKey) setHudFolded(!state.hudFolded);
+  if (e.key === 'h' && !e.ctrlKey && !e.metaKey && !e.altKey) toggle();
 });
 
 export function updateHud() {

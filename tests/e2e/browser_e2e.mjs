@@ -810,6 +810,8 @@ try {
     check(JSON.stringify(f.frame) === JSON.stringify(f.want) && f.resizes >= resizesBefore + 1 && f.resizes <= resizesBefore + 2,
           `after resizing to 640×480 the frames are the new view's size (${f.frame} for ${f.want}; ` +
           `${f.resizes - resizesBefore} size(s) asked for five resizes)`);
+    const foldedNow = () => p.evaluate(() => window.haarcast.hudFolded);
+    check(!(await foldedNow()), 'at 640×480 the HUD unfolds: its default follows the window until the user chooses');
     await p.selectOption('#resolution', '360p');
     await p.waitForFunction(() => window.haarcast.lastFrame.height === 360, null, { timeout: 30000 }).catch(() => {});
     f = await fits();
@@ -838,6 +840,10 @@ try {
     await p.keyboard.press('h');
     hb = await hudBox();
     check(hb.folded, 'h folds it again');
+    await p.setViewportSize({ width: 700, height: 500 });
+    await p.waitForTimeout(100);
+    check(await foldedNow(), 'once the user has folded it, a wider window leaves the HUD folded');
+    await p.setViewportSize({ width: 400, height: 300 });
     // Nothing changes for a while: idle, with the last frame's age.
     await p.waitForTimeout(3500);
     const idle = await text(p, '#hud-idle');
