@@ -3,6 +3,9 @@
 // and what the user chose on the page (choices).
 import { ExposureMode, toneValue } from './schema.js';
 
+// The event on window each move of the view (drag, wheel, pinch) sends (view.js → resolution.js).
+export const MOVE_EVENT = 'haarcast-move';
+
 // Exposed for the end-to-end test and for curious users (devtools).
 export const state = {
   welcome: null,

@@ -4,10 +4,10 @@
 // RenderSettings.width/height, after the view is resized (debounced) or
 // when auto steps the size down or up (stream_size.js has the sizes and the
 // rule, docs/clients.md says them).
-import { choices, page, state } from './page_state.js';
+import { MOVE_EVENT, choices, page, state } from './page_state.js';
 import { send } from './session.js';
 import { AutoResolution, FIRST_LIMITS, STILL_MS, autoSteps, fpsFloor, frameSize } from './stream_size.js';
-import { noteChange, onMove } from './view.js';
+import { noteChange } from './view.js';
 
 const $ = (id) => document.getElementById(id);
 const stage = $('stage');
@@ -90,7 +90,7 @@ window.addEventListener('resize', viewChanged);  // devicePixelRatio changes wit
 // move restarts the timer, and the first move after a still frame goes
 // back to auto's step before its pose leaves.
 let stillTimer = null;
-onMove(() => {
+window.addEventListener(MOVE_EVENT, () => {
   clearTimeout(stillTimer);
   if (auto.moved()) refit();
   stillTimer = setTimeout(() => {

@@ -2,7 +2,7 @@
 // light's — and the poses that tell the server about it. A pose carries only
 // what the user touched, so the server keeps the scene's own pose for the rest.
 import { DRAG_DEGREES_PER_PIXEL, dragOrbit, orbitEye, orbitFromCamera, pinchOrbit, zoomOrbit } from './orbit.js';
-import { state } from './page_state.js';
+import { MOVE_EVENT, state } from './page_state.js';
 import { send } from './session.js';
 
 // Set from SceneInfo.camera (orbitFromCamera): the scene's own view is where
@@ -23,14 +23,13 @@ export const view = {
   changeFromPose: 0,
 };
 
-// What follows the user's moves (resolution.js: a still view is shown
-// sharp, a moving one at auto's step).
-const moveListeners = [];
-export function onMove(listener) {
-  moveListeners.push(listener);
-}
+// The user moved the view: an event on window (page_state.js MOVE_EVENT)
+// for what follows moves (resolution.js: a still view is shown sharp, a
+// moving one at auto's step). An event, not a listener list here, because
+// resolution.js is evaluated inside this module's import cycle (view →
+// session → resolution → view) and would read the list before it exists.
 function moved() {
-  for (const listener of moveListeners) listener();
+  window.dispatchEvent(new Event(MOVE_EVENT));
 }
 
 // A change was sent: a pose follows it at once, so that the frame made with
