@@ -14,6 +14,7 @@
 #include "eval_seed.h"
 #include "eval_truth.h"
 #include "machine_info.h"
+#include "number_format.h"
 #include "progress.h"
 #include "report_figures.h"
 #include "seed_tables.h"
@@ -24,12 +25,6 @@ namespace {
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
-
-std::string fmt(double v, int digits = 2) {
-  char b[64];
-  std::snprintf(b, sizeof b, "%.*f", digits, v);
-  return b;
-}
 
 // ["a", "b", 4] → "a, b, 4": lists in report.md's prose.
 std::string listed(const nlohmann::json& array) {

@@ -13,6 +13,7 @@
 #include "haarcast/render/reference.h"
 #include "haarcast/render/renderer.h"
 #include "loadtest_storage.h"
+#include "number_format.h"
 #include "truth_metrics.h"
 
 namespace haarcast::app {
@@ -21,12 +22,6 @@ namespace {
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
-
-std::string fmt(double v, int digits = 2) {
-  char b[64];
-  std::snprintf(b, sizeof b, "%.*f", digits, v);
-  return b;
-}
 
 struct Probe {
   std::string name;

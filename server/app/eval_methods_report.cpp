@@ -4,17 +4,9 @@
 #include <cstdio>
 #include <sstream>
 
+#include "number_format.h"
+
 namespace haarcast::app {
-namespace {
-
-std::string fmt(double v, int digits = 2) {
-  char b[64];
-  std::snprintf(b, sizeof b, "%.*f", digits, v);
-  return b;
-}
-
-}  // namespace
-
 // 1,024 → "1.0 KiB": storage spans five decades here.
 std::string bytesText(double bytes) {
   const char* units[] = {"B", "KiB", "MiB", "GiB"};

@@ -12,6 +12,7 @@
 #include "haarcast/render/exposure_meter.h"
 #include "haarcast/render/renderer.h"
 #include "haarcast/render/tonemap.h"
+#include "number_format.h"
 
 namespace haarcast::app {
 namespace {
@@ -19,12 +20,6 @@ namespace {
 namespace fs = std::filesystem;
 
 std::string levelKey(int level) { return "level" + std::to_string(level); }
-
-std::string fmt(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.2f", v);
-  return b;
-}
 
 // The figure names, recorded in report.json: the script draws to them and
 // report.md links them, so both read them from one place.

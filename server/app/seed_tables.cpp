@@ -6,15 +6,10 @@
 #include <sstream>
 
 #include "machine_info.h"
+#include "number_format.h"
 
 namespace haarcast::app {
 namespace {
-
-std::string fmt(double v, int digits = 2) {
-  char b[64];
-  std::snprintf(b, sizeof b, "%.*f", digits, v);
-  return b;
-}
 
 // "+1.23" / "−1.23": a difference in the report's prose.
 std::string signedDb(double v) { return (v < 0.0 ? "−" : "+") + fmt(std::abs(v)) + " dB"; }
