@@ -103,24 +103,31 @@ vec3 texel(const bool blended, PixelSetup p, uint index) {
   return a + p.weight * (b - a);
 }
 
-// ρ_c at the object-frame direction w0: Rᵀw0, θ', φ', the bilinear taps
-// (core fused.cpp sliceAt, the kernel's lookup). Zero where cos θ' is below
-// the slices' cut (every tap there reads zero texels).
-vec3 rhoAt(const bool blended, PixelSetup p, vec3 w0) {
-  const float rowScale = float(M) / kPi, colScale = float(M) / kTwoPi;
-  const int mask = int(M) - 1;
+// Where the object-frame direction w0 falls in the slice: Rᵀw0, θ', φ' as
+// continuous texel coordinates (row, column before γ's whole columns), as
+// the CPU kernel computes them. False where every tap reads zero: cos θ'
+// below the slices' cut, or inside the lobe path's core.
+bool slicePosition(PixelSetup p, vec3 w0, out vec2 pos) {
   const float x1 = p.cosA * w0.x - p.sinA * w0.z;  // R_y(−α)
   const float z1 = p.sinA * w0.x + p.cosA * w0.z;
   const float y2 = p.cosB * w0.y + p.sinB * z1;    // R_x(−β)
-  if (y2 < p.skipBelowY) return vec3(0.0);
+  if (y2 < p.skipBelowY) return false;
   const float z2 = p.cosB * z1 - p.sinB * w0.y;
-  if (x1 * p.axis.x + y2 * p.axis.y + z2 * p.axis.z > p.coreCos) return vec3(0.0);  // the lobe path's core
+  if (x1 * p.axis.x + y2 * p.axis.y + z2 * p.axis.z > p.coreCos) return false;  // the lobe path's core
   const float theta = atan2Fast(sqrt(x1 * x1 + z2 * z2), y2);
   const float phi = atan2Fast(x1, z2);
-  const float rowPos = min(max(theta * rowScale - 0.5, 0.0), float(M - 1u));
-  const float colPos = phi * colScale - p.fraction;
-  const float rowFloor = floor(rowPos), colFloor = floor(colPos);
-  const float tRow = rowPos - rowFloor, tCol = colPos - colFloor;
+  pos = vec2(min(max(theta * (float(M) / kPi) - 0.5, 0.0), float(M - 1u)), phi * (float(M) / kTwoPi) - p.fraction);
+  return true;
+}
+
+// ρ_c at the object-frame direction w0, bilinear in the slice texels (core
+// fused_kernel.cpp, the pass's lookup).
+vec3 rhoAt(const bool blended, PixelSetup p, vec3 w0) {
+  vec2 pos;
+  if (!slicePosition(p, w0, pos)) return vec3(0.0);
+  const int mask = int(M) - 1;
+  const float rowFloor = floor(pos.x), colFloor = floor(pos.y);
+  const float tRow = pos.x - rowFloor, tCol = pos.y - colFloor;
   const uint r0 = uint(rowFloor);
   const uint r1 = min(r0 + 1u, M - 1u);
   const uint c0 = uint((int(colFloor) - p.shift) & mask);
@@ -134,26 +141,17 @@ vec3 rhoAt(const bool blended, PixelSetup p, vec3 w0) {
   return tRow * (bottom - top) + top;
 }
 
-// ρ_c at the object-frame direction w0 for a point light: Rᵀw0, θ', φ' as
-// rhoAt, then Catmull-Rom over 4 × 4 taps of the point slices (rows
+// ρ_c at the object-frame direction w0 for a point light: slicePosition,
+// then Catmull-Rom over 4 × 4 taps of the point slices (rows
 // clamped, columns wrapped), each tap blended between the two slices
 // (core fused.cpp pointRhoAt; shared_layout.h catmullRomWeights).
 vec3 pointRhoAt(PixelSetup p, vec3 w0) {
-  const float rowScale = float(M) / kPi, colScale = float(M) / kTwoPi;
+  vec2 pos;
+  if (!slicePosition(p, w0, pos)) return vec3(0.0);
   const int mask = int(M) - 1;
-  const float x1 = p.cosA * w0.x - p.sinA * w0.z;  // R_y(−α)
-  const float z1 = p.sinA * w0.x + p.cosA * w0.z;
-  const float y2 = p.cosB * w0.y + p.sinB * z1;    // R_x(−β)
-  if (y2 < p.skipBelowY) return vec3(0.0);
-  const float z2 = p.cosB * z1 - p.sinB * w0.y;
-  if (x1 * p.axis.x + y2 * p.axis.y + z2 * p.axis.z > p.coreCos) return vec3(0.0);  // the lobe path's core
-  const float theta = atan2Fast(sqrt(x1 * x1 + z2 * z2), y2);
-  const float phi = atan2Fast(x1, z2);
-  const float rowPos = min(max(theta * rowScale - 0.5, 0.0), float(M - 1u));
-  const float colPos = phi * colScale - p.fraction;
-  const float rowFloor = floor(rowPos), colFloor = floor(colPos);
-  const vec4 wr = catmullRomWeights(rowPos - rowFloor);
-  const vec4 wc = catmullRomWeights(colPos - colFloor);
+  const float rowFloor = floor(pos.x), colFloor = floor(pos.y);
+  const vec4 wr = catmullRomWeights(pos.x - rowFloor);
+  const vec4 wc = catmullRomWeights(pos.y - colFloor);
   const int r0 = int(rowFloor);
   const int c0 = (int(colFloor) - p.shift) & mask;
   vec3 sum = vec3(0.0);

@@ -53,14 +53,6 @@ render::Scene rankingScene(const render::Environment& environment, const std::st
   return s;
 }
 
-render::ReferenceResult monteCarlo(const TruthRun& run, const render::Scene& scene, const render::ReferenceOptions& ro,
-                                   const std::string& stage) {
-  const render::ReferenceResult r =
-      render::renderReference(scene, ro, monteCarloProgress(run.progress, stage, ro.tolerance, ro.maxSamples));
-  run.progress.finish(stage);
-  return r;
-}
-
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v.empty() ? 0.0 : v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
@@ -74,17 +66,7 @@ nlohmann::json runMethodRanking(const TruthRun& run, std::vector<std::string>& n
   const int level = o.methodsLevel > 0 ? o.methodsLevel : (o.quick ? 4 : 5);
   const int frames = o.quick ? 2 : 5;
   const Probe probe = rankingProbe(o, notes);
-  render::ReferenceOptions ro;
-  ro.width = ro.height = frame;
-  ro.environmentBackground = false;
-  ro.tolerance = o.quick ? 0.05 : 0.003;
-  ro.maxSamples = o.quick ? 256 : 16384;
-  ro.threads = o.threads;
-  if (o.quick) {  // coarser sampling tables: seconds, not tens
-    ro.environmentTableWidth = 256;
-    ro.brdfTableWidth = 64;
-    ro.brdfTableThetaOut = 8;
-  }
+  const render::ReferenceOptions ro = truthReferenceOptions(run, frame, o.quick ? 0.05 : 0.003, o.quick ? 256 : 16384, true);
   // The product's defaults, as `render` draws, one sample per pixel.
   render::RenderOptions defaults;
   defaults.width = defaults.height = frame;

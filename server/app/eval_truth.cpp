@@ -31,7 +31,24 @@ std::string fmtSig(double v, int digits = 3) {
 
 std::string levelKey(int level) { return "level" + std::to_string(level); }
 
-// The Monte Carlo render, with eval's stage progress.
+}  // namespace
+
+render::ReferenceOptions truthReferenceOptions(const TruthRun& run, int frame, double tolerance, std::size_t maxSamples,
+                                               bool coarseQuickTables) {
+  render::ReferenceOptions ro;
+  ro.width = ro.height = frame;
+  ro.environmentBackground = false;
+  ro.tolerance = tolerance;
+  ro.maxSamples = maxSamples;
+  ro.threads = run.options.threads;
+  if (coarseQuickTables && run.options.quick) {
+    ro.environmentTableWidth = 256;
+    ro.brdfTableWidth = 64;
+    ro.brdfTableThetaOut = 8;
+  }
+  return ro;
+}
+
 render::ReferenceResult monteCarlo(const TruthRun& run, const render::Scene& scene, const render::ReferenceOptions& ro,
                                    const std::string& stage) {
   const render::ReferenceResult r =
@@ -39,8 +56,6 @@ render::ReferenceResult monteCarlo(const TruthRun& run, const render::Scene& sce
   run.progress.finish(stage);
   return r;
 }
-
-}  // namespace
 
 // ---- The methods on one glossy object ------------------------------------
 // The sphere in the first environment with the second table material (blue
@@ -50,12 +65,8 @@ render::ReferenceResult monteCarlo(const TruthRun& run, const render::Scene& sce
 // reported beside it: a truth PSNR near that floor measures the noise.
 nlohmann::json runMethodTruth(const TruthRun& run, const render::Scene& scene, nlohmann::json config) {
   const EvalOptions& o = run.options;
-  render::ReferenceOptions ro;
-  ro.width = ro.height = o.quick ? 16 : 48;
-  ro.environmentBackground = false;
-  ro.tolerance = o.quick ? 0.05 : 0.01;
-  ro.maxSamples = o.quick ? 256 : 65536;
-  ro.threads = o.threads;
+  const render::ReferenceOptions ro =
+      truthReferenceOptions(run, o.quick ? 16 : 48, o.quick ? 0.05 : 0.01, o.quick ? 256 : 65536, false);
   const render::ReferenceResult mc = monteCarlo(run, scene, ro, "eval truth: Monte Carlo");
   // The average of two halves differing by RMS d has an error of RMS d/2.
   double mean = 0.0, peak = 0.0;
@@ -228,17 +239,7 @@ std::vector<ShadowScene> shadowScenes(const EvalOptions& o, std::vector<std::str
 nlohmann::json runShadowTruth(const TruthRun& run, std::vector<std::string>& notes) {
   const EvalOptions& o = run.options;
   const int frame = o.truthFrame > 0 ? o.truthFrame : (o.quick ? 16 : 64);
-  render::ReferenceOptions ro;
-  ro.width = ro.height = frame;
-  ro.environmentBackground = false;
-  ro.tolerance = o.quick ? 0.05 : 0.01;
-  ro.maxSamples = o.quick ? 256 : 16384;
-  ro.threads = o.threads;
-  if (o.quick) {  // coarser sampling tables: seconds, not tens
-    ro.environmentTableWidth = 256;
-    ro.brdfTableWidth = 64;
-    ro.brdfTableThetaOut = 8;
-  }
+  const render::ReferenceOptions ro = truthReferenceOptions(run, frame, o.quick ? 0.05 : 0.01, o.quick ? 256 : 16384, true);
   // The product's defaults (light k, visibility, slice blend), as `render`
   // draws; "fused/all-k" keeps every light coefficient, so that the light's
   // truncation and the rest separate.

@@ -26,6 +26,7 @@
 
 #include "eval.h"
 #include "haarcast/render/cpu_renderer.h"
+#include "haarcast/render/reference.h"
 #include "haarcast/render/scene.h"
 #include "progress.h"
 
@@ -37,6 +38,16 @@ struct TruthRun {
   ProgressReporter& progress;
   std::function<void(const std::string&)> log;
 };
+
+// The Monte Carlo truth's options for eval's sections: a frame² render of
+// the object pixels (black background), converged to `tolerance` within
+// `maxSamples` per pixel on the run's threads; with `coarseQuickTables`,
+// --quick samples from coarser tables (seconds, not tens).
+render::ReferenceOptions truthReferenceOptions(const TruthRun& run, int frame, double tolerance, std::size_t maxSamples,
+                                               bool coarseQuickTables);
+// The Monte Carlo render, with eval's stage progress.
+render::ReferenceResult monteCarlo(const TruthRun& run, const render::Scene& scene, const render::ReferenceOptions& ro,
+                                   const std::string& stage);
 
 // report["truth"]: `scene` (one object) against its Monte Carlo render, every
 // method; `config` names what the scene is (model, environment, material).
