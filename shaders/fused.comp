@@ -32,6 +32,12 @@
 // the path takes the whole lobe, steps 1–2 are skipped and invocation 0
 // reads the prefiltered light at the lobe's samples (lobeShade).
 //
+// Each object has its own map level (ObjectInfo::level: M = 2^n, N = M²
+// directions; docs/design.md, "A level per object"): its slices, light,
+// visibility words and the pixel-centre directions of its level start at
+// its own bases in buffers every object shares, and the loops below take M
+// from the sample's object, not from a constant.
+//
 // The large read-only arrays of step 1 (slice texels, light, directions,
 // visibility words) are uniform texel buffers read with texelFetch: on a CPU
 // device (lavapipe) a fetch is one vector gather, where a storage-buffer
@@ -43,23 +49,22 @@
 #include "common/sphere.glsl"
 
 layout(local_size_x_id = 2) in;
-layout(constant_id = 0) const uint LEVEL = 5u;
 layout(constant_id = 4) const uint INTERPOLATE = 1u;    // RenderOptions::interpolateSlices
 layout(constant_id = 5) const uint PREFILTER_FINEST = 9u;  // the prefiltered light's finest level
 
 const uint LOCAL = gl_WorkGroupSize.x;
-const uint M = 1u << LEVEL;
-const uint N = M * M;
-const uint WORDS = N / 32u > 0u ? N / 32u : 1u;  // shared::visibilityWords(LEVEL)
 
 layout(std430, set = 0, binding = 0) readonly buffer Samples { RotationSample samples[]; };
 layout(std430, set = 0, binding = 1) readonly buffer Shade { ShadeSample shade[]; };
 layout(std430, set = 0, binding = 2) readonly buffer Objects { ObjectInfo objects[]; };
-layout(set = 0, binding = 3) uniform samplerBuffer texels;       // slice s, direction k at s·N + k: RGB0
-layout(set = 0, binding = 4) uniform samplerBuffer light;        // object o, direction k at o·N + k: (L·ΔΩ) RGB, 0
-// Global vertex v, direction i: bit i % 32 of word v·WORDS + i / 32 (core VisibilityBits).
+// Object o's slice t, direction k at o.texelBase + t·N + k: RGB0.
+layout(set = 0, binding = 3) uniform samplerBuffer texels;
+layout(set = 0, binding = 4) uniform samplerBuffer light;        // object o, direction k at o.lightBase + k: (L·ΔΩ) RGB, 0
+// Global vertex v of object o, direction i: bit i % 32 of word
+// o.visibilityBase + (v − o.vertexBase)·visibilityWords(o.level) + i / 32 (core VisibilityBits).
 layout(set = 0, binding = 5) uniform usamplerBuffer visibilityBits;
-layout(set = 0, binding = 6) uniform samplerBuffer directions;   // pixel-centre unit vectors (xyz)
+// Pixel-centre unit vectors (xyz) and ΔΩ (w) of every level in use; level n's direction k at o.directionBase + k.
+layout(set = 0, binding = 6) uniform samplerBuffer directions;
 // Object o, light k at o·kMaxPointLights + k; ObjectInfo::pointLights of them are this frame's.
 layout(std430, set = 0, binding = 7) readonly buffer PointLights { PointLight pointLights[]; };
 layout(std430, set = 0, binding = 8) buffer Radiance { vec4 radiance[]; };
@@ -83,6 +88,9 @@ void sync() {
 // What the direction loop needs of a sample.
 struct PixelSetup {
   ShadeSample sh;
+  uint m;                  // M = 2^n of the object's level
+  uint directionBase;      // its level's direction 0
+  uint bits0, bits1, bits2;  // the three vertices' visibility word 0
   uint base0, base1;       // the two slices' texel 0 (equal without a blend)
   float weight;            // of the second slice
   uint lightBase;          // the object's light texel 0
@@ -116,7 +124,7 @@ bool slicePosition(PixelSetup p, vec3 w0, out vec2 pos) {
   if (x1 * p.axis.x + y2 * p.axis.y + z2 * p.axis.z > p.coreCos) return false;  // the lobe path's core
   const float theta = atan2Fast(sqrt(x1 * x1 + z2 * z2), y2);
   const float phi = atan2Fast(x1, z2);
-  pos = vec2(min(max(theta * (float(M) / kPi) - 0.5, 0.0), float(M - 1u)), phi * (float(M) / kTwoPi) - p.fraction);
+  pos = vec2(min(max(theta * (float(p.m) / kPi) - 0.5, 0.0), float(p.m - 1u)), phi * (float(p.m) / kTwoPi) - p.fraction);
   return true;
 }
 
@@ -125,17 +133,17 @@ bool slicePosition(PixelSetup p, vec3 w0, out vec2 pos) {
 vec3 rhoAt(const bool blended, PixelSetup p, vec3 w0) {
   vec2 pos;
   if (!slicePosition(p, w0, pos)) return vec3(0.0);
-  const int mask = int(M) - 1;
+  const int mask = int(p.m) - 1;
   const float rowFloor = floor(pos.x), colFloor = floor(pos.y);
   const float tRow = pos.x - rowFloor, tCol = pos.y - colFloor;
   const uint r0 = uint(rowFloor);
-  const uint r1 = min(r0 + 1u, M - 1u);
+  const uint r1 = min(r0 + 1u, p.m - 1u);
   const uint c0 = uint((int(colFloor) - p.shift) & mask);
   const uint c1 = (c0 + 1u) & uint(mask);
-  const vec3 a = texel(blended, p, r0 * M + c0);
-  const vec3 b = texel(blended, p, r0 * M + c1);
-  const vec3 c = texel(blended, p, r1 * M + c0);
-  const vec3 e = texel(blended, p, r1 * M + c1);
+  const vec3 a = texel(blended, p, r0 * p.m + c0);
+  const vec3 b = texel(blended, p, r0 * p.m + c1);
+  const vec3 c = texel(blended, p, r1 * p.m + c0);
+  const vec3 e = texel(blended, p, r1 * p.m + c1);
   const vec3 top = tCol * (b - a) + a;
   const vec3 bottom = tCol * (e - c) + c;
   return tRow * (bottom - top) + top;
@@ -148,7 +156,7 @@ vec3 rhoAt(const bool blended, PixelSetup p, vec3 w0) {
 vec3 pointRhoAt(PixelSetup p, vec3 w0) {
   vec2 pos;
   if (!slicePosition(p, w0, pos)) return vec3(0.0);
-  const int mask = int(M) - 1;
+  const int mask = int(p.m) - 1;
   const float rowFloor = floor(pos.x), colFloor = floor(pos.y);
   const vec4 wr = catmullRomWeights(pos.x - rowFloor);
   const vec4 wc = catmullRomWeights(pos.y - colFloor);
@@ -156,10 +164,10 @@ vec3 pointRhoAt(PixelSetup p, vec3 w0) {
   const int c0 = (int(colFloor) - p.shift) & mask;
   vec3 sum = vec3(0.0);
   for (int i = 0; i < 4; ++i) {
-    const uint row = uint(clamp(r0 - 1 + i, 0, int(M) - 1));
+    const uint row = uint(clamp(r0 - 1 + i, 0, int(p.m) - 1));
     vec3 across = vec3(0.0);
     for (int j = 0; j < 4; ++j) {
-      const uint k = row * M + uint((c0 - 1 + j) & mask);
+      const uint k = row * p.m + uint((c0 - 1 + j) & mask);
       const vec3 a = texelFetch(pointTexels, int(p.base0 + k)).rgb;
       const vec3 b = texelFetch(pointTexels, int(p.base1 + k)).rgb;
       across += wc[j] * (a + p.weight * (b - a));
@@ -169,9 +177,9 @@ vec3 pointRhoAt(PixelSetup p, vec3 w0) {
   return max(sum, vec3(0.0));  // the cubic overshoots below zero beside a steep lobe
 }
 
-// Bit i of global vertex v's visibility, as 0.0 or 1.0.
-float bitOf(uint v, uint i) {
-  return float((texelFetch(visibilityBits, int(v * WORDS + i / 32u)).r >> (i & 31u)) & 1u);
+// Bit i of the visibility whose word 0 is `base`, as 0.0 or 1.0.
+float bitOf(uint base, uint i) {
+  return float((texelFetch(visibilityBits, int(base + i / 32u)).r >> (i & 31u)) & 1u);
 }
 
 // 1. Σ over the directions of this invocation (i ≡ lid mod LOCAL). Called
@@ -180,14 +188,13 @@ float bitOf(uint v, uint i) {
 vec3 sumDirections(const bool blended, PixelSetup p, out vec3 norm) {
   vec3 acc = vec3(0.0);
   norm = vec3(0.0);
-  for (uint i = p.firstRow * M + gl_LocalInvocationID.x; i < p.endRow * M; i += LOCAL) {
-    const vec4 dir = texelFetch(directions, int(i));  // xyz, and w = ΔΩ
+  for (uint i = p.firstRow * p.m + gl_LocalInvocationID.x; i < p.endRow * p.m; i += LOCAL) {
+    const vec4 dir = texelFetch(directions, int(p.directionBase + i));  // xyz, and w = ΔΩ
     const vec3 rho = rhoAt(blended, p, dir.xyz);
     norm += dir.w * rho;
     // V = ((0 + b0·bit0) + b1·bit1) + b2·bit2, blendVisibility's order (the
     // products are exact, so a fused multiply-add changes nothing).
-    const float vis = p.sh.b[0] * bitOf(p.sh.vertex[0], i) + p.sh.b[1] * bitOf(p.sh.vertex[1], i) +
-                      p.sh.b[2] * bitOf(p.sh.vertex[2], i);
+    const float vis = p.sh.b[0] * bitOf(p.bits0, i) + p.sh.b[1] * bitOf(p.bits1, i) + p.sh.b[2] * bitOf(p.bits2, i);
     const vec3 w = texelFetch(light, int(p.lightBase + i)).rgb * vis;
     acc += w * rho;
   }
@@ -259,10 +266,17 @@ void shadePixel(uint s) {
   }
   PixelSetup p;
   p.sh = sh;
-  p.base0 = (o.sliceBase + blend.first) * N;
-  p.base1 = (o.sliceBase + blend.second) * N;
+  p.m = 1u << o.level;
+  const uint n = p.m * p.m;
+  p.directionBase = o.directionBase;
+  const uint words = visibilityWords(o.level);
+  p.bits0 = o.visibilityBase + (sh.vertex[0] - o.vertexBase) * words;
+  p.bits1 = o.visibilityBase + (sh.vertex[1] - o.vertexBase) * words;
+  p.bits2 = o.visibilityBase + (sh.vertex[2] - o.vertexBase) * words;
+  p.base0 = o.texelBase + blend.first * n;
+  p.base1 = o.texelBase + blend.second * n;
   p.weight = blend.weight;
-  p.lightBase = sh.object * N;
+  p.lightBase = o.lightBase;
   const vec2 sa = sinCosPrecise(rs.alpha), sb = sinCosPrecise(rs.beta);
   p.sinA = sa.x;
   p.cosA = sa.y;
@@ -270,8 +284,8 @@ void shadePixel(uint s) {
   p.cosB = sb.y;
   // Source column = φ'·M/2π − (γ·M/2π + ½): the offset's whole part shifts
   // the integer column, its fraction the float coordinate.
-  float offset = rs.gamma * (float(M) / kTwoPi) + 0.5;
-  offset -= floor(offset / float(M)) * float(M);
+  float offset = rs.gamma * (float(p.m) / kTwoPi) + 0.5;
+  offset -= floor(offset / float(p.m)) * float(p.m);
   const float whole = floor(offset);
   p.shift = int(whole);
   p.fraction = offset - whole;
@@ -300,13 +314,13 @@ void shadePixel(uint s) {
   // The range is uniform over the workgroup, so every device skips the rows
   // outside it for real (the test in rhoAt only masks lanes on SIMD devices).
   p.firstRow = 0u;
-  p.endRow = M;
+  p.endRow = p.m;
   if (p.skipBelowY > -1.0) {
-    const float rowScale = float(M) / kPi;
+    const float rowScale = float(p.m) / kPi;
     const float axis = acosPrecise(clamp(p.cosB, -1.0, 1.0));
     const float reach = acosPrecise(min(p.skipBelowY, 1.0)) + 2e-3;
-    p.firstRow = uint(clamp(floor((axis - reach) * rowScale - 0.5), 0.0, float(M)));
-    p.endRow = uint(clamp(ceil((axis + reach) * rowScale - 0.5) + 1.0, 0.0, float(M)));
+    p.firstRow = uint(clamp(floor((axis - reach) * rowScale - 0.5), 0.0, float(p.m)));
+    p.endRow = uint(clamp(ceil((axis + reach) * rowScale - 0.5) + 1.0, 0.0, float(p.m)));
   }
 
   // Two slices: each tap blends its two texels (ρ is linear in the slice),

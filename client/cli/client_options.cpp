@@ -1,5 +1,7 @@
 #include "client_options.h"
 
+#include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <stdexcept>
@@ -158,6 +160,24 @@ Exposure parseExposure(const std::string& text) {
 
 std::uint32_t minLevel() { return shared::kMinLevel; }
 std::uint32_t maxLevel() { return shared::kFusedMaxLevel; }
+
+LevelRequest parseLevel(const std::string& text) {
+  const std::string valid = "--level must be N, auto or auto:N with N in " + std::to_string(minLevel()) + ".." +
+                            std::to_string(maxLevel()) + " (got \"" + text + "\")";
+  auto number = [&](const std::string& digits) -> std::uint32_t {
+    if (digits.empty() || digits.size() > 2 ||
+        !std::all_of(digits.begin(), digits.end(), [](unsigned char c) { return std::isdigit(c) != 0; })) {
+      throw std::invalid_argument(valid);
+    }
+    const auto n = static_cast<std::uint32_t>(std::stoul(digits));
+    if (n < minLevel() || n > maxLevel()) throw std::invalid_argument(valid);
+    return n;
+  };
+  if (text.empty() || text == "0") return {};
+  if (text == "auto") return {0, v1::LEVEL_MODE_AUTO};
+  if (text.rfind("auto:", 0) == 0) return {number(text.substr(5)), v1::LEVEL_MODE_AUTO};
+  return {number(text), v1::LEVEL_MODE_FIXED};
+}
 
 v1::RotationMethod parseMethod(const std::string& name) {
   if (name.empty()) return v1::ROTATION_METHOD_UNSPECIFIED;

@@ -63,6 +63,16 @@ Exposure parseExposure(const std::string& text);
 std::uint32_t minLevel();
 std::uint32_t maxLevel();
 
+// --level: "" or "0" → the server's default; "N" → every object at level N
+// (LEVEL_MODE_FIXED); "auto" → each object at the level its material
+// needs, up to the cap in effect; "auto:N" → the same with cap N
+// (LEVEL_MODE_AUTO). N within minLevel()..maxLevel().
+struct LevelRequest {
+  std::uint32_t level = 0;  // 0: unchanged
+  v1::LevelMode mode = v1::LEVEL_MODE_UNSPECIFIED;
+};
+LevelRequest parseLevel(const std::string& text);
+
 // "fused" | "haar" | "spatial" | "matrix" | "table"; "" = server default.
 v1::RotationMethod parseMethod(const std::string& name);
 // --tone reinhard | aces | agx ("" → unspecified: the server's, Reinhard).

@@ -158,7 +158,7 @@ int run(int argc, char** argv) {
   unsigned quality = 0;
   H264Options h264;
   std::string method;
-  unsigned level = 0;
+  std::string level;
   unsigned coefficients = 0;
   std::string scene;
   std::vector<std::string> materials;
@@ -196,8 +196,8 @@ int run(int argc, char** argv) {
   app.add_option("--method", method, "Per-pixel method: fused | haar | spatial | matrix | table | splitsum (default: the server's)");
   app.add_option("--level", level,
                  "Map level n, 2^n x 2^n: " + std::to_string(minLevel()) + ".." + std::to_string(maxLevel()) +
-                     " as far as the server allows (its Welcome says; 0 = the server's default)")
-      ->check(CLI::Range(0u, maxLevel()));
+                     " as far as the server allows (its Welcome says), every object at it; auto or auto:N: each "
+                     "object at the level its material needs, N at most (fused); default: the server's");
   app.add_option("--exposure", exposure,
                  "auto (the whole frame metered, objects weighted 4×: log-average → 0.18, held down so the brightest 1% "
                  "does not clip; eased) or fixed stops, e.g. -1")
@@ -265,7 +265,9 @@ int run(int argc, char** argv) {
     base.hello.set_jpeg_quality(quality);
     auto* settings = base.hello.mutable_settings();
     settings->set_method(parseMethod(method));
-    settings->set_level(level);
+    const LevelRequest levelRequest = parseLevel(level);
+    settings->set_level(levelRequest.level);
+    settings->set_level_mode(levelRequest.mode);
     settings->set_light_coefficients(coefficients);
     const Exposure e = parseExposure(exposure);
     settings->set_exposure_mode(e.mode);

@@ -16,8 +16,9 @@ export function showScenes(names) {
   fillSelect($('scene'), names.map((s) => [s, s]));
 }
 
-// The scene in effect: from Welcome, and in answer to each accepted
-// SceneChoice. Another scene resets the view to its own camera (the server
+// The scene in effect: from Welcome, in answer to each accepted
+// SceneChoice, and again with the objects' levels when a renderer built
+// later has other levels than the client was told. Another scene resets the view to its own camera (the server
 // reset its poses to the scene's own); the same scene (a material change)
 // keeps the view.
 export function onSceneInfo(info, fromWelcome) {
@@ -38,6 +39,9 @@ export function onSceneInfo(info, fromWelcome) {
   if (newScene && !fromWelcome) {
     state.sceneReady = false;
     showPreparing(info.name);
+  } else if (!fromWelcome && !state.sceneReady) {
+    // The same scene again before its first frame (the server names its
+    // objects' levels once its renderer is built): still held back.
   } else {
     state.sceneReady = true;
     showObjects(info);

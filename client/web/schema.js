@@ -4,7 +4,7 @@
 // connects; the other modules read them from here.
 /* global protobuf */
 
-export let ClientMessage, ServerMessage, Encoding, RotationMethod, ErrorCode, ExposureMode, ToneCurve;
+export let ClientMessage, ServerMessage, Encoding, RotationMethod, ErrorCode, ExposureMode, ToneCurve, LevelMode;
 export let methodNames = [];  // "haar", …, "fused": the schema's RotationMethod values
 export let toneNames = [];    // "reinhard", "aces", "agx": the schema's ToneCurve values
 
@@ -20,6 +20,7 @@ export async function loadSchema() {
   ErrorCode = root.lookupEnum('haarcast.v1.ErrorCode');
   ExposureMode = root.lookupEnum('haarcast.v1.ExposureMode');
   ToneCurve = root.lookupEnum('haarcast.v1.ToneCurve');
+  LevelMode = root.lookupEnum('haarcast.v1.LevelMode');
   toneNames = Object.keys(ToneCurve.values)
     .filter((n) => n !== 'TONE_CURVE_UNSPECIFIED')
     .map((n) => n.replace('TONE_CURVE_', '').toLowerCase());

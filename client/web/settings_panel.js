@@ -6,7 +6,7 @@ import { h264Support } from './h264_decoder.js';
 import { helloEncoding } from './h264_view.js';
 import { formatStops } from './frame_stats.js';
 import { choices, exposureSettings, page, state, toneSettings } from './page_state.js';
-import { ExposureMode, methodName, methodNames, methodValue, toneName, toneNames } from './schema.js';
+import { ExposureMode, LevelMode, methodName, methodNames, methodValue, toneName, toneNames } from './schema.js';
 import { restartSession, send } from './session.js';
 import { expectBuild } from './build_view.js';
 import { noteChange } from './view.js';
@@ -25,6 +25,7 @@ export function selectValue(select, value) {
 }
 
 let effective = null;  // the RenderSettings in effect: Welcome's, then each frame's
+let autoCap = 0;       // the server's cap of automatic levels (Welcome's level under auto), 0 = unknown
 export function setEffective(settings) {
   effective = settings;
 }
@@ -39,14 +40,16 @@ let exposureDirty = false;
 export function showWelcomeSettings(w) {
   effective = w.settings || {};
   const limits = w.limits || {};
+  autoCap = effective.levelMode === LevelMode.values.LEVEL_MODE_AUTO ? effective.level || 0 : 0;
 
   fillSelect($('method'), methodNames.map((m) => [m, m]), methodName(effective.method) || undefined);
-  // Levels: the server's range, not a copy in the page.
-  const levels = [];
+  // Levels: "auto" (each object at the level its material needs, the cap
+  // the server's), then the server's range, not a copy in the page.
+  const levels = [['auto', 'auto (by material)']];
   if (limits.maxLevel) {
     for (let n = limits.minLevel || 1; n <= limits.maxLevel; n++) levels.push([n, `${n} (${2 ** n}×${2 ** n})`]);
   }
-  fillSelect($('level'), levels, effective.level || undefined);
+  fillSelect($('level'), levels, levelChoice(effective));
   const ks = [16, 64, 256, 1024, 4096].filter((k) => !limits.maxLightCoefficients || k <= limits.maxLightCoefficients);
   fillSelect($('coefficients'), ks.map((k) => [k, String(k)]), effective.lightCoefficients || undefined);
 
@@ -70,7 +73,7 @@ export function showWelcomeSettings(w) {
 function showSettings(s) {
   if (!s) return;
   if (s.method) selectValue($('method'), methodName(s.method));
-  if (s.level) selectValue($('level'), s.level);
+  if (s.level) selectValue($('level'), levelChoice(s));
   if (s.lightCoefficients) selectValue($('coefficients'), s.lightCoefficients);
   if (s.exposureMode) {
     const fixed = s.exposureMode === ExposureMode.values.EXPOSURE_MODE_FIXED;
@@ -81,8 +84,26 @@ function showSettings(s) {
   if (s.toneCurve) selectValue($('tone'), toneName(s.toneCurve));
   choices.tone = $('tone').value;
   choices.method = $('method').value;
-  choices.level = Number($('level').value);
+  choices.level = levelNumber();
   choices.k = Number($('coefficients').value);
+}
+
+// The select's value for settings: "auto" under LEVEL_MODE_AUTO, else the level.
+function levelChoice(s) {
+  if (s.levelMode === LevelMode.values.LEVEL_MODE_AUTO) return 'auto';
+  return s.level || undefined;
+}
+
+// The chosen fixed level, 0 under auto (the page's `level` parameter is a number).
+function levelNumber() {
+  return $('level').value === 'auto' ? 0 : Number($('level').value);
+}
+
+// RenderSettings for the level select: a level is fixed; auto takes the
+// server's cap (or, when the session began fixed, the level in effect).
+function levelSettings() {
+  if ($('level').value === 'auto') return { level: autoCap, levelMode: LevelMode.values.LEVEL_MODE_AUTO };
+  return { level: Number($('level').value), levelMode: LevelMode.values.LEVEL_MODE_FIXED };
 }
 
 // The server refused the last change (BAD_SETTINGS): the session goes on as
@@ -93,7 +114,7 @@ export function undoSettingsChange() {
 }
 
 function currentSettings() {
-  return { method: methodValue($('method').value), level: Number($('level').value),
+  return { method: methodValue($('method').value), ...levelSettings(),
            lightCoefficients: Number($('coefficients').value), ...exposureSettings(), ...toneSettings() };
 }
 
@@ -107,12 +128,13 @@ function sendSettings(fields) {
 
 function onSettingsControl() {
   choices.method = $('method').value;
-  choices.level = Number($('level').value);
+  choices.level = levelNumber();
   choices.k = Number($('coefficients').value);
-  const { method, level, lightCoefficients } = currentSettings();
+  const { method, level, levelMode, lightCoefficients } = currentSettings();
   // What a build, if one comes, is for: the method and the level.
-  expectBuild(`${choices.method} at level ${choices.level} (${2 ** choices.level}×${2 ** choices.level} maps)`);
-  sendSettings({ method, level, lightCoefficients });
+  expectBuild(choices.level ? `${choices.method} at level ${choices.level} (${2 ** choices.level}×${2 ** choices.level} maps)`
+                            : `${choices.method} at levels by material`);
+  sendSettings({ method, level, levelMode, lightCoefficients });
 }
 
 // The exposure change due, if one is: called once per display frame, as the

@@ -23,6 +23,7 @@
 #include "haarcast/gpu/backend.h"
 #include "list_flags.h"
 #include "progress.h"
+#include "haarcast/render/object_levels.h"
 #include "haarcast/render/renderer.h"
 #include "haarcast/render/scene.h"
 
@@ -102,7 +103,12 @@ int run(const BenchArgs& a) {
   if (a.slices != "blend" && a.slices != "nearest") {
     throw std::invalid_argument("--slices must be blend or nearest (got \"" + a.slices + "\")");
   }
-  const std::vector<int> levels = parseIntList(a.levels, "--levels", render::kMinRenderLevel, render::kMaxRenderLevel);
+  std::vector<render::LevelChoice> levels;
+  for (const std::string& item : splitList(a.levels, "--levels")) {
+    const auto choice = render::parseLevelChoice(item);
+    if (!choice) throw std::invalid_argument("--levels: \"" + item + "\" is not " + render::levelChoiceHelp());
+    levels.push_back(*choice);
+  }
   const std::vector<RotationMethod> methods = parseMethodList(a.methods, "--method", true);
   const bool cpu = a.backend != "vulkan", vulkan = a.backend != "cpu";
   if (a.antialias != "on" && a.antialias != "off") {
@@ -148,15 +154,16 @@ int run(const BenchArgs& a) {
     progress.message(text);
   };
 
-  for (const int level : levels) {
+  for (const render::LevelChoice& choice : levels) {
+    const std::string level = choice.name();
     for (const RotationMethod method : methods) {
       render::RenderOptions options;
-      options.level = level;
       options.method = method;
+      render::applyLevelChoice(options, choice);
       options.interpolateSlices = a.slices == "blend";
       options.antialias = antialias;
       options.cacheDir = a.cacheDir == "none" ? "" : a.cacheDir;
-      progress.message("level " + std::to_string(level) + ", " + std::string(methodName(method)) + ": preparing");
+      progress.message("level " + level + ", " + std::string(methodName(method)) + ": preparing");
       std::unique_ptr<render::Renderer> cpuRenderer, gpuRenderer;
       // Slice tables, visibility, rotators: the same progress lines as `render`.
       if (cpu) cpuRenderer = gpu::makeRenderer("cpu", scene, options, {}, progress.callback());
@@ -168,6 +175,11 @@ int run(const BenchArgs& a) {
         out["vulkan_device"] = gpuRenderer->deviceName();
       }
       if (cpuRenderer) out["cpu_device"] = cpuRenderer->deviceName();
+      // Each object's level: the choice's, or under `auto` each one's own.
+      const render::Renderer& any = cpuRenderer ? *cpuRenderer : *gpuRenderer;
+      std::vector<int> objectLevels = any.objectLevels();
+      if (objectLevels.empty()) objectLevels.assign(any.objectCount(), options.level);
+      const std::string levelCell = choice.automatic ? level + " (" + render::describeLevels(objectLevels) + ")" : level;
       for (const auto& [width, height] : sizes) {
         render::FrameRequest request;
         request.width = width;
@@ -176,7 +188,7 @@ int run(const BenchArgs& a) {
         std::map<std::string, Measured> results;
         for (render::Renderer* r : {cpuRenderer.get(), gpuRenderer.get()}) {
           if (!r) continue;
-          progress.message("level " + std::to_string(level) + ", " + std::string(methodName(method)) + ", " +
+          progress.message("level " + level + ", " + std::string(methodName(method)) + ", " +
                            std::to_string(width) + "×" + std::to_string(height) + ", " + r->backend() + ": " +
                            std::to_string(a.frames) + " frames + " + std::to_string(a.warmup) + " warm-up");
           results[r->backend()] = measure(*r, request, a.frames, a.warmup);
@@ -184,7 +196,7 @@ int run(const BenchArgs& a) {
         std::optional<std::pair<double, std::size_t>> agree;
         if (results.count("cpu") && results.count("vulkan")) agree = agreement(results["cpu"].first, results["vulkan"].first);
         for (const auto& [backend, m] : results) {
-          nlohmann::json run{{"backend", backend},       {"level", level},
+          nlohmann::json run{{"backend", backend},       {"level", level}, {"object_levels", objectLevels},
                              {"method", methodName(method)}, {"width", width},
                              {"height", height},         {"frame_seconds", m.frameSeconds},
                              {"fps", m.frameSeconds > 0.0 ? 1.0 / m.frameSeconds : 0.0},
@@ -215,7 +227,7 @@ int run(const BenchArgs& a) {
           if (method == RotationMethod::Fused || method == RotationMethod::Splitsum) run["slices"] = a.slices;
           run["antialias"] = antialias;
           out["runs"].push_back(run);
-          std::string row = "| " + std::to_string(level) + " | " + std::string(methodName(method)) + " | " +
+          std::string row = "| " + levelCell + " | " + std::string(methodName(method)) + " | " +
                             std::to_string(width) + "×" + std::to_string(height) + " | " + backend + " |";
           for (const char* name : {"light", "gbuffer", "rotation-input", "rotation", "triple-product", "fused", "tonemap"}) {
             double seconds = 0.0;
@@ -230,7 +242,7 @@ int run(const BenchArgs& a) {
           std::snprintf(buf, sizeof buf, " %.4f | %.2f | %zu | %s |", m.frameSeconds,
                         m.frameSeconds > 0.0 ? 1.0 / m.frameSeconds : 0.0, m.coefficientBytes, ratio.c_str());
           line(row + buf);
-          rowDone("level " + std::to_string(level) + ", " + std::string(methodName(method)) + ", " +
+          rowDone("level " + level + ", " + std::string(methodName(method)) + ", " +
                       std::to_string(width) + "×" + std::to_string(height) + ", " + backend,
                   m.frameSeconds > 0.0 ? 1.0 / m.frameSeconds : 0.0);
         }
@@ -250,8 +262,9 @@ std::function<int()> addBenchFrameCommand(CLI::App& app) {
   c->add_option("--backend", args->backend, "cpu|vulkan|both (both: ratios from one run)")->capture_default_str();
   c->add_option("--sizes", args->sizes, "Frame sizes, comma-separated: N for N×N, or WxH (e.g. 128,256,1920x1080)")
       ->capture_default_str();
-  c->add_option("--levels", args->levels, "Map levels, comma-separated (" + std::to_string(render::kMinRenderLevel) + ".." +
-                    std::to_string(render::kMaxRenderLevel) + "; the split methods on Vulkan up to 6)")
+  c->add_option("--levels", args->levels,
+                "Map levels, comma-separated, each " + render::levelChoiceHelp() +
+                    " (the split methods on Vulkan up to 6); e.g. auto,6 times automatic levels against level 6 in one run")
       ->capture_default_str();
   c->add_option("--method", args->methods, "Per-pixel methods, comma-separated (" + pixelMethodNames() + "), or all")
       ->capture_default_str();

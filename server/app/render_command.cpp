@@ -7,6 +7,7 @@
 #include <string>
 
 #include "haarcast/gpu/backend.h"
+#include "haarcast/render/object_levels.h"
 #include "haarcast/render/renderer.h"
 #include "haarcast/render/scene.h"
 #include "progress.h"
@@ -21,6 +22,7 @@ namespace fs = std::filesystem;
 struct RenderArgs {
   SceneFlags scene;
   std::string method = "fused", variant = "refined", backend = "cpu", device, cacheDir, antialias = "auto";
+  std::string level = "auto";  // render::parseLevelChoice
   bool validation = gpu::kValidationByDefault;
   render::RenderOptions options;
 };
@@ -36,6 +38,9 @@ int run(RenderArgs& a) {
   if (!variant) throw std::invalid_argument("--haar-variant must be faithful, local or refined (got \"" + a.variant + "\")");
   a.options.method = *method;
   a.options.rotator.haarVariant = *variant;
+  const auto level = render::parseLevelChoice(a.level);
+  if (!level) throw std::invalid_argument("--level must be " + render::levelChoiceHelp() + " (got \"" + a.level + "\")");
+  render::applyLevelChoice(a.options, *level);
   a.options.width = a.scene.width;
   a.options.height = a.scene.height;
   a.options.environmentBackground = environmentBackground(a.scene);
@@ -70,9 +75,20 @@ int run(RenderArgs& a) {
     std::snprintf(buf, sizeof buf, "%s%s %.3f", stages.empty() ? "" : ", ", s.name.c_str(), s.seconds);
     stages += buf;
   }
-  std::fprintf(stderr, "%s on %s: %d×%d, level %d, %s, k = %zu: precompute %.2f s, frame %.3f s (%s)\n",
+  // Each object's level (object_levels.h), named, when they differ.
+  std::vector<int> levels = renderer->objectLevels();
+  if (levels.empty()) levels.assign(renderer->objectCount(), a.options.level);
+  std::string levelText = render::describeLevels(levels);
+  if (render::levelsInUse(levels).size() > 1) {
+    levelText += " (";
+    for (std::size_t k = 0; k < levels.size(); ++k)
+      levelText += (k ? ", " : "") + scene.objects[k].name + " " + std::to_string(levels[k]);
+    levelText += ")";
+  }
+  if (a.options.automaticLevel) levelText += " [" + level->name() + "]";
+  std::fprintf(stderr, "%s on %s: %d×%d, %s, %s, k = %zu: precompute %.2f s, frame %.3f s (%s)\n",
                renderer->backend().c_str(), renderer->deviceName().c_str(), a.options.width, a.options.height,
-               a.options.level, a.method.c_str(), a.options.lightCoefficients, prepare, frame.seconds, stages.c_str());
+               levelText.c_str(), a.method.c_str(), a.options.lightCoefficients, prepare, frame.seconds, stages.c_str());
   return 0;
 }
 
@@ -85,7 +101,7 @@ std::function<int()> addRenderCommand(CLI::App& app) {
   addSceneFlags(*c, args->scene);
   c->add_option("--method", args->method, "Per-pixel method: " + pixelMethodNames())->capture_default_str();
   c->add_option("--haar-variant", args->variant, "faithful|local|refined")->capture_default_str();
-  c->add_option("--level", args->options.level, "Map level n (M = 2^n)")->capture_default_str();
+  c->add_option("--level", args->level, "Map level n (M = 2^n): " + render::levelChoiceHelp())->capture_default_str();
   c->add_option("--light-coeffs", args->options.lightCoefficients, "Light coefficients kept (k)")
       ->capture_default_str();
   c->add_option("--visibility-coeffs", args->options.visibility.keep, "Visibility coefficients kept per vertex")

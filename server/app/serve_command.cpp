@@ -18,6 +18,7 @@
 #include "haarcast/gpu/backend.h"
 #include "haarcast/net/host_check.h"
 #include "haarcast/net/server.h"
+#include "haarcast/render/object_levels.h"
 #include "haarcast/render/renderer.h"
 #include "haarcast/render/scene.h"
 #include "app_paths.h"
@@ -38,7 +39,7 @@ struct ServeArgs {
   std::string antialias = "auto";
   std::string backend = "cpu", method = "fused", encoding = "jpeg";
   std::vector<std::string> backends;  // enabled for clients; empty: just --backend
-  int level = 4;
+  std::string level = "auto";  // render::parseLevelChoice; auto: its cap at most --max-level
   std::size_t lightCoefficients = 256;
   std::vector<std::string> sceneFiles;
   std::string materialsDir, webRoot, protoFile, cacheDir, vulkanDevice;
@@ -84,7 +85,11 @@ int run(ServeArgs& a) {
   if (!method) throw std::invalid_argument("--method must be one of " + pixelMethodNames() + " (got \"" + a.method + "\")");
   auto& d = a.server.defaults;
   d.method = *method;
-  d.level = a.level;
+  const auto level = render::parseLevelChoice(a.level);
+  if (!level) throw std::invalid_argument("--level must be " + render::levelChoiceHelp() + " (got \"" + a.level + "\")");
+  // The default cap follows a lower --max-level; an explicit one must fit it (below).
+  d.level = a.level == "auto" ? std::min(level->level, a.server.limits.maxLevel) : level->level;
+  d.automaticLevel = level->automatic;
   d.lightCoefficients = a.lightCoefficients;
   d.backend = defaultBackend;
   if (a.encoding == "jpeg") d.encoding = net::FrameEncoding::Jpeg;
@@ -103,9 +108,9 @@ int run(ServeArgs& a) {
     throw std::invalid_argument("--max-level " + std::to_string(limits.maxLevel) + " is outside " +
                                 std::to_string(render::kMinRenderLevel) + ".." + std::to_string(render::kMaxRenderLevel));
   }
-  if (a.level < limits.minLevel || a.level > limits.maxLevel) {
-    throw std::invalid_argument("--level " + std::to_string(a.level) + " is outside " + std::to_string(limits.minLevel) +
-                                ".." + std::to_string(limits.maxLevel) + " (see --max-level)");
+  if (d.level < limits.minLevel || d.level > limits.maxLevel) {
+    throw std::invalid_argument("--level " + a.level + " is outside " + std::to_string(limits.minLevel) + ".." +
+                                std::to_string(limits.maxLevel) + " (see --max-level)");
   }
   const auto& admission = a.server.admission;
   for (const auto& [flag, value] : {std::pair{"--max-sessions", admission.sessions},
@@ -188,8 +193,8 @@ int run(ServeArgs& a) {
       scene.objects[i].material.name = c.materials[i];
     }
     render::RenderOptions options = base;
-    options.level = c.level;
     options.method = c.method;
+    render::applyLevelChoice(options, {c.level, c.automaticLevel});
     options.lightCoefficients = c.lightCoefficients;
     const std::string backend(net::backendName(c.backend));
     options.antialias = antialiasFor(antialias, backend);
@@ -259,7 +264,9 @@ std::function<int()> addServeCommand(CLI::App& app) {
   c->add_option("--backends", a->backends, "Backends clients may choose (default: only --backend)")->delimiter(',');
   c->add_option("--antialias", a->antialias, "auto|on|off: edge pixels as the mean of 4 sub-samples (auto: on)")
       ->capture_default_str();
-  c->add_option("--level", a->level, "Default map level n (M = 2^n), within the session limits (--max-level)")
+  c->add_option("--level", a->level,
+                "Default map level n (M = 2^n), within the session limits (--max-level): " + render::levelChoiceHelp() +
+                    "; auto's cap is at most --max-level")
       ->capture_default_str();
   c->add_option("--method", a->method, "Default per-pixel method: " + pixelMethodNames())->capture_default_str();
   c->add_option("--light-coeffs", a->lightCoefficients, "Default light coefficients kept (k)")->capture_default_str();

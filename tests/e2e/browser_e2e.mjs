@@ -477,14 +477,21 @@ try {
   check(h3.method === target, `the HUD shows method ${target} ("${h3.method}")`);
   await page.selectOption('#method', h1.method);
 
-  // The level choices are the server's range (Welcome.limits), not a copy.
+  // The level choices are "auto" and the server's range (Welcome.limits),
+  // not a copy; the one selected is the Welcome's, still after the method
+  // change above (a change of method must not turn automatic levels fixed).
   const levels = await page.evaluate(() => ({
-    options: [...document.querySelectorAll('#level option')].map((o) => Number(o.value)),
+    options: [...document.querySelectorAll('#level option')].map((o) => o.value),
+    selected: document.querySelector('#level').value,
     limits: { min: window.haarcast.welcome.limits.minLevel, max: window.haarcast.welcome.limits.maxLevel },
+    welcome: { level: window.haarcast.welcome.settings.level, auto: window.haarcast.welcome.settings.levelMode === 2 },
   }));
-  const wantLevels = Array.from({ length: levels.limits.max - levels.limits.min + 1 }, (_, i) => levels.limits.min + i);
+  const wantLevels = ['auto', ...Array.from({ length: levels.limits.max - levels.limits.min + 1 },
+                                            (_, i) => String(levels.limits.min + i))];
   check(JSON.stringify(levels.options) === JSON.stringify(wantLevels),
-        `level choices ${levels.options.join(',')} are Welcome.limits ${levels.limits.min}..${levels.limits.max}`);
+        `level choices ${levels.options.join(',')} are auto and Welcome.limits ${levels.limits.min}..${levels.limits.max}`);
+  const wantSelected = levels.welcome.auto ? 'auto' : String(levels.welcome.level);
+  check(levels.selected === wantSelected, `the level select shows the Welcome's ${wantSelected} (${levels.selected})`);
 
   // 7. Scenes and objects.
   section('scenes and materials');

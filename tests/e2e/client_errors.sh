@@ -37,7 +37,7 @@ expect "bad --encoding" 2 "--encoding must be" -- "$client_bin" ws://127.0.0.1:1
 expect "--bitrate without h264" 2 "--bitrate applies to --encoding h264 only" -- "$client_bin" ws://127.0.0.1:1 --bitrate 900
 expect "h264 at an odd size" 2 "even width and height" -- "$client_bin" ws://127.0.0.1:1 --encoding h264 --size 255x256
 expect "wss:// refused" 2 "wss://" -- "$client_bin" wss://127.0.0.1:1
-expect "bad --level" 2 "--level: Value 12 not in range 0 to 7" -- "$client_bin" ws://127.0.0.1:1 --level 12
+expect "bad --level" 2 "--level must be N, auto or auto:N with N in 2..7 (got \"12\")" -- "$client_bin" ws://127.0.0.1:1 --level 12
 expect "bad --exposure" 2 "--exposure must be auto or a number of stops" -- "$client_bin" ws://127.0.0.1:1 --exposure bright
 expect "misspelt flag" 2 "unknown flag --frmes; did you mean --frames?" -- "$client_bin" ws://127.0.0.1:1 --frmes 3
 expect "connection refused" 1 "Connection refused" -- "$client_bin" ws://127.0.0.1:1 --frames 1 --quiet

@@ -94,6 +94,27 @@ TEST(Flags, SizeEncodingAndMethod) {
   }
 }
 
+// --level: a level is fixed, auto (with or without a cap) is automatic,
+// unset is the server's; anything else names the valid forms.
+TEST(Flags, LevelIsFixedAutomaticOrTheServers) {
+  EXPECT_EQ(parseLevel("").mode, v1::LEVEL_MODE_UNSPECIFIED);
+  EXPECT_EQ(parseLevel("0").level, 0u);
+  EXPECT_EQ(parseLevel("5").level, 5u);
+  EXPECT_EQ(parseLevel("5").mode, v1::LEVEL_MODE_FIXED);
+  EXPECT_EQ(parseLevel("auto").level, 0u);
+  EXPECT_EQ(parseLevel("auto").mode, v1::LEVEL_MODE_AUTO);
+  EXPECT_EQ(parseLevel("auto:7").level, 7u);
+  EXPECT_EQ(parseLevel("auto:7").mode, v1::LEVEL_MODE_AUTO);
+  for (const char* bad : {"auto:", "auto:1", "99", "8", "-1", "5x", "fixed", "auto:6:7"}) {
+    try {
+      parseLevel(bad);
+      ADD_FAILURE() << "\"" << bad << "\" was taken as a level";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("N, auto or auto:N"), std::string::npos) << e.what();
+    }
+  }
+}
+
 // The H.264 flags: for h264 only, and h264 wants an even size.
 TEST(Flags, H264OptionsApplyToH264Only) {
   EXPECT_NO_THROW(checkH264Options(v1::ENCODING_H264, {256, 256}, {2000, 60}));

@@ -38,7 +38,12 @@ expect "backend not offered" "--backend gpu is not one this server offers (valid
 expect "missing web root" "--web-root $work/none: no such folder" -- "$bin" serve --web-root "$work/none"
 expect "max level outside the range" "--max-level 9 is outside 2..7" -- "$bin" serve --max-level 9
 expect "serve level over --max-level" "--level 7 is outside 2..6 (see --max-level)" -- "$bin" serve --level 7
-expect "render level outside the range" "level 8 is outside 2..7" -- "$bin" render --level 8 --out "$work/x.exr"
+expect "render level outside the range" '--level must be N (2..7: every object at level N), auto (' -- \
+  "$bin" render --level 8 --out "$work/x.exr"
+expect "render level neither a number nor auto" 'or auto:CAP (at most CAP, 2..7) (got "fine")' -- \
+  "$bin" render --level fine --out "$work/x.exr"
+expect "bench-frame level cap outside the range" '--levels: "auto:9" is not N (2..7' -- "$bin" bench-frame --levels 5,auto:9
+expect "serve level cap over --max-level" "--level auto:7 is outside 2..6 (see --max-level)" -- "$bin" serve --level auto:7
 expect "unknown method" "--method must be one of fused" -- "$bin" render --method fast --out "$work/x.exr"
 expect "material without a mesh" "--material applies to --mesh" -- "$bin" render --material velvet --out "$work/x.exr"
 expect "output folder missing" "--out $work/none/x.exr: the folder $work/none does not exist" -- \

@@ -174,12 +174,15 @@ std::vector<shared::SliceLobe> measureLobes(const Brdf& brdf, const std::vector<
 }
 
 LobeCore chooseLobeCore(const Brdf& brdf, const std::vector<double>& thetaOut, int level) {
+  return chooseLobeCore(brdf, thetaOut, level, measureLobes(brdf, thetaOut));
+}
+
+LobeCore chooseLobeCore(const Brdf& brdf, const std::vector<double>& thetaOut, int level,
+                        std::vector<shared::SliceLobe> lobes) {
   const double texel = kPi / mapSize(level);
   LobeCore out;
-  out.lobes = measureLobes(brdf, thetaOut);
-  float sharpest = static_cast<float>(kPi);
-  for (const shared::SliceLobe& lobe : out.lobes) sharpest = std::min(sharpest, lobe.median.x);
-  if (out.lobes.empty() || sharpest > kLobeMedianTexels * texel) {
+  out.lobes = std::move(lobes);
+  if (out.lobes.empty() || sharpestMedian(out.lobes) > kLobeMedianTexels * texel) {
     out.lobes.clear();
     return out;
   }
@@ -197,6 +200,31 @@ LobeCore chooseLobeCore(const Brdf& brdf, const std::vector<double>& thetaOut, i
     out.lobes = std::move(cores);
   }
   return out;
+}
+
+int chooseLevel(const Brdf& brdf, const std::vector<double>& thetaOut, std::span<const shared::SliceLobe> lobes,
+                int cap, int floor) {
+  const int n = chooseLevel(lobes, cap, floor);
+  const std::vector<shared::SliceLobe> whole(lobes.begin(), lobes.end());
+  for (int level = std::min(floor, cap); level < n; ++level) {
+    if (chooseLobeCore(brdf, thetaOut, level, whole).angle >= static_cast<float>(kPi)) return level;
+  }
+  return n;
+}
+
+double sharpestMedian(std::span<const shared::SliceLobe> lobes) {
+  double sharpest = kPi;
+  for (const shared::SliceLobe& lobe : lobes) sharpest = std::min(sharpest, static_cast<double>(lobe.median.x));
+  return sharpest;
+}
+
+int chooseLevel(std::span<const shared::SliceLobe> lobes, int cap, int floor) {
+  floor = std::min(floor, cap);
+  // m ≥ K·π/2ⁿ ⇔ n ≥ log₂(K·π/m): the smallest whole n, within [floor, cap].
+  const double median = sharpestMedian(lobes);
+  if (!(median > 0.0)) return cap;
+  const double n = std::ceil(std::log2(kLevelMedianTexels * kPi / median) - 1e-9);
+  return static_cast<int>(std::clamp(n, static_cast<double>(floor), static_cast<double>(cap)));
 }
 
 }  // namespace haarcast

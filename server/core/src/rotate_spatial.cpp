@@ -1,5 +1,8 @@
 // spatial: inverse Haar → resample at the rotated directions → forward Haar.
 #include <cmath>
+#include <stdexcept>
+
+#include "haarcast/core/parallel.h"
 
 #include "haarcast/core/rotation.h"
 #include "rotators.h"
@@ -19,6 +22,33 @@ SphereMap rotateSpatialMap(const SphereMap& f, const EulerYXY& r) {
     }
   }
   return g;
+}
+
+std::array<SphereMap, 3> rotateSpatialMapsDown(const std::array<SphereMap, 3>& maps, const EulerYXY& r, int level) {
+  const glm::dmat3 rt = glm::transpose(rotationMatrix(r));
+  const int fine = maps[0].level();
+  if (maps[1].level() != fine || maps[2].level() != fine) {
+    throw std::invalid_argument("rotateSpatialMapsDown: the three maps are at different levels");
+  }
+  const int m = maps[0].size();
+  std::array<SphereMap, 3> turned{SphereMap(fine), SphereMap(fine), SphereMap(fine)};
+  parallelFor(static_cast<std::size_t>(m), [&](std::size_t row) {
+    const int i = static_cast<int>(row);
+    for (int j = 0; j < m; ++j) {
+      const Spherical src = directionToSpherical(rt * sphericalToDirection(rowTheta(fine, i), colPhi(fine, j)));
+      const BilinearTaps t = bilinearTaps(fine, src.theta, src.phi);
+      for (std::size_t c = 0; c < 3; ++c) {
+        const SphereMap& f = maps[c];
+        // SphereMap::sampleBilinear's sum, in its order.
+        const double top = (1.0 - t.tCol) * f.at(t.row[0], t.col[0]) + t.tCol * f.at(t.row[0], t.col[1]);
+        const double bottom = (1.0 - t.tCol) * f.at(t.row[1], t.col[0]) + t.tCol * f.at(t.row[1], t.col[1]);
+        turned[c].at(i, j) = static_cast<float>((1.0 - t.tRow) * top + t.tRow * bottom);
+      }
+    }
+  });
+  if (level == fine) return turned;
+  for (SphereMap& map : turned) map = map.downsampled(level);
+  return turned;
 }
 
 HaarMap rotateSpatial(const HaarMap& f, const EulerYXY& r) {

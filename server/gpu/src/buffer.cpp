@@ -12,6 +12,7 @@ namespace {
 const char* useName(MemoryUse use) {
   switch (use) {
     case MemoryUse::Host: return "host-visible";
+    case MemoryUse::Readback: return "readback";
     case MemoryUse::DeviceInput: return "device input";
     case MemoryUse::DeviceOnly: return "device-only";
   }

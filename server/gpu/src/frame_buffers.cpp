@@ -88,7 +88,7 @@ void VulkanRenderer::Impl::releaseResolution() {
   destroyTarget(subTarget);
   maskUpload = BufferUpload();
   for (Buffer* b : {&gbufIds, &gbufNormals, &gbufPositions, &samples, &shade, &counter, &radiance, &rgba8, &rotated,
-                    &batchArgs, &subIds, &subNormals, &edges, &masks}) {
+                    &radianceOut, &batchArgs, &subIds, &subNormals, &edges, &masks}) {
     *b = Buffer();
   }
   width = height = 0;
@@ -103,7 +103,10 @@ void VulkanRenderer::Impl::ensureResolution(int w, int h) {
   const std::size_t pixels = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
   const auto uw = static_cast<std::uint32_t>(w), uh = static_cast<std::uint32_t>(h);
   target = createTarget(uw, uh);
-  gbufIds = Buffer(context, pixels * sizeof(glm::uvec4));
+  // What the host reads back each frame is Readback (cached system memory,
+  // gpu/memory.h): the ids (the object mask), the samples and shading
+  // points the host traces shadow rays from, the counter, the RGBA8 image.
+  gbufIds = Buffer(context, pixels * sizeof(glm::uvec4), kStorageUsage, MemoryUse::Readback);
   gbufNormals = Buffer(context, pixels * sizeof(glm::vec4));
   gbufPositions = Buffer(context, pixels * sizeof(glm::vec4));
   edges = Buffer(context, pixels * sizeof(std::uint32_t));
@@ -118,15 +121,17 @@ void VulkanRenderer::Impl::ensureResolution(int w, int h) {
     subNormals = Buffer(context, sizeof(std::uint32_t), kStorageUsage, MemoryUse::DeviceOnly);
     sampleCapacity = pixels;
   }
-  samples = Buffer(context, sampleCapacity * sizeof(RotationSample));
-  shade = Buffer(context, sampleCapacity * sizeof(ShadeSample));
+  samples = Buffer(context, sampleCapacity * sizeof(RotationSample), kStorageUsage, MemoryUse::Readback);
+  shade = Buffer(context, sampleCapacity * sizeof(ShadeSample), kStorageUsage, MemoryUse::Readback);
   // The covered-pixel count and `fused`'s indirect dispatch arguments.
   counter = Buffer(context, sizeof(CoverageCounter),
                    VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
-                       VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
+                       VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT,
+                   MemoryUse::Readback);
   // Per pixel, then (antialiasing) per sub-sample slot (shared_layout.h subsampleSlot).
   radiance = Buffer(context, (options.antialias ? 1 + shared::kSubsamples : 1) * pixels * sizeof(glm::vec4));
-  rgba8 = Buffer(context, pixels * sizeof(std::uint32_t));
+  rgba8 = Buffer(context, pixels * sizeof(std::uint32_t), kStorageUsage, MemoryUse::Readback);
+  radianceOut = Buffer(context, pixels * sizeof(glm::vec4), kStorageUsage, MemoryUse::Readback);
 
   rotationInput->bind({&frameParams, &objects, &gbufIds, &gbufNormals, &triangles, &samples, &shade, &counter, &subIds,
                        &subNormals, &edges});

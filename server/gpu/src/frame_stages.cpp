@@ -97,6 +97,13 @@ void VulkanRenderer::Impl::recordTonemap(VkCommandBuffer cb, const render::Frame
   exposure->dispatch(cb, {1, 1, 1}, &push, sizeof push);  // one workgroup reduces the frame
   computeBarrier(cb);
   tonemap->dispatch(cb, {groupsOf(pixels, 64), 1, 1});
+  if (request.linearImage) {
+    // The pixels' radiance (the first `pixels` entries) into host memory.
+    computeBarrier(cb);
+    const VkBufferCopy region{0, 0, pixels * sizeof(glm::vec4)};
+    vkCmdCopyBuffer(cb, radiance.handle(), radianceOut.handle(), 1, &region);
+    computeBarrier(cb);
+  }
 }
 
 void VulkanRenderer::Impl::finishExposure(const render::FrameRequest& request, render::Frame& frame) const {

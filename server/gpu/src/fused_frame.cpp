@@ -117,8 +117,11 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
   HC_CHECK_LE(lightCount, std::size_t{shared::kMaxPointLights});
   for (std::size_t i = 0; i < objectCount; ++i) {
     const render::ResolvedObject& o = resolved.objects[i];
-    if (fused) fusedLightTexels(o.fusedLight.planes, std::span<glm::vec4>(lightTexelData).subspan(i * coefficients, coefficients));
     ObjectInfo& info = objectInfo[i];
+    if (fused) {
+      const std::size_t n = o.fusedLight.planes.size() / 3;  // N at the object's level
+      fusedLightTexels(o.fusedLight.planes, std::span<glm::vec4>(lightTexelData).subspan(info.lightBase, n));
+    }
     for (int c = 0; c < 3; ++c) info.rotation[c] = glm::vec4(glm::vec3(o.rotation[c]), 0.0f);
     for (int c = 0; c < 3; ++c) info.toLight[c] = glm::vec4(o.toLight[c], 0.0f);
     HC_CHECK_EQ(o.pointLights.size(), lightCount);
@@ -183,7 +186,7 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
   for (std::size_t p = 0; p < pixels; ++p) frame.objectMask[p] = ids[p].x != 0 ? 1 : 0;
   if (request.linearImage) {
     frame.image = io::makeImage(width, height);
-    const auto* rad = static_cast<const glm::vec4*>(radiance.mapped());
+    const auto* rad = static_cast<const glm::vec4*>(radianceOut.mapped());
     for (std::size_t p = 0; p < pixels; ++p) {
       for (std::size_t c = 0; c < 3; ++c) frame.image.rgb[3 * p + c] = rad[p][static_cast<int>(c)];
     }
@@ -202,12 +205,13 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
   }
   const auto* rs = static_cast<const RotationSample*>(samples.mapped());
   const auto* sh = static_cast<const ShadeSample*>(shade.mapped());
-  const std::size_t visibilityBytes = 3 * visibilityWords * sizeof(std::uint32_t);
   for (std::uint32_t i = 0; i < covered; ++i) {
     if (sh[i].object >= objectCount || prepared.objects[sh[i].object].ground) continue;
+    const int objectLevel = prepared.objects[sh[i].object].level;
+    const std::size_t visibilityBytes = 3 * shared::visibilityWords(static_cast<shared::uint>(objectLevel)) * sizeof(std::uint32_t);
     const shared::SliceBlend blend =
         shared::sliceBlendAt(rs[i].thetaOut, static_cast<shared::uint>(options.thetaSamples), options.interpolateSlices ? 1u : 0u);
-    bytes += fusedPixelBytes(level, blend.weight != 0.0f && blend.second != blend.first, visibilityBytes);
+    bytes += fusedPixelBytes(objectLevel, blend.weight != 0.0f && blend.second != blend.first, visibilityBytes);
   }
   frame.coefficientBytes = bytes;
   frame.seconds = secondsSince(start);

@@ -53,6 +53,15 @@ std::optional<MemoryPlacement> chooseMemory(const VkPhysicalDeviceMemoryProperti
       if (!type) return std::nullopt;
       return MemoryPlacement{*type, true, false};
     }
+    case MemoryUse::Readback: {
+      constexpr VkMemoryPropertyFlags kCached = kHostShared | VK_MEMORY_PROPERTY_HOST_CACHED_BIT;
+      auto type = firstType(memory, typeBits, kCached, kDeviceLocal);
+      if (!type) type = firstType(memory, typeBits, kCached);
+      if (!type) type = firstType(memory, typeBits, kHostShared, kDeviceLocal);
+      if (!type) type = firstType(memory, typeBits, kHostShared);
+      if (!type) return std::nullopt;
+      return MemoryPlacement{*type, true, false};
+    }
     case MemoryUse::DeviceInput: {
       if (directInputs) {
         if (const auto type = wholeDeviceMemoryMapped(memory, typeBits)) return MemoryPlacement{*type, true, false};

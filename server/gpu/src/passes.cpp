@@ -1,5 +1,6 @@
 #include "haarcast/gpu/passes.h"
 
+#include "haarcast/core/fused.h"
 #include "haarcast/core/sphere_map.h"
 #include "haarcast/render/shading.h"
 
@@ -64,6 +65,20 @@ std::vector<glm::vec4> pixelCentreDirections(int level) {
     // w: the pixel's solid angle, as core fused's table holds it (float).
     const auto omega = static_cast<float>(pixelSolidAngle(level, i));
     for (int j = 0; j < m; ++j) out.emplace_back(glm::vec3(sphericalToDirection(rowTheta(level, i), colPhi(level, j))), omega);
+  }
+  return out;
+}
+
+DirectionTable pixelCentreDirections(std::span<const int> levels) {
+  std::vector<int> sorted(levels.begin(), levels.end());
+  std::sort(sorted.begin(), sorted.end());
+  sorted.erase(std::unique(sorted.begin(), sorted.end()), sorted.end());
+  DirectionTable out;
+  for (const int level : sorted) {
+    checkFusedLevel(level);
+    out.base[static_cast<std::size_t>(level)] = static_cast<std::uint32_t>(out.directions.size());
+    const std::vector<glm::vec4> one = pixelCentreDirections(level);
+    out.directions.insert(out.directions.end(), one.begin(), one.end());
   }
   return out;
 }

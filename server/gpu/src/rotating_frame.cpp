@@ -87,17 +87,19 @@ render::Frame VulkanRenderer::Impl::renderRotating(const render::FrameRequest& r
   lastBatches = (covered + batch - 1) / batch;
 
   // ---- Results ---------------------------------------------------------------
-  frame.image = io::makeImage(width, height);
   frame.objectMask.assign(pixels, 0);
   frame.rgba8.resize(pixels * 4);
   {
-    const auto* rad = static_cast<const glm::vec4*>(radiance.mapped());
     const auto* ids = static_cast<const glm::uvec4*>(gbufIds.mapped());
+    for (std::size_t p = 0; p < pixels; ++p) frame.objectMask[p] = ids[p].x != 0 ? 1 : 0;
+    rgba8.read(frame.rgba8.data(), frame.rgba8.size());
+  }
+  if (request.linearImage) {
+    frame.image = io::makeImage(width, height);
+    const auto* rad = static_cast<const glm::vec4*>(radianceOut.mapped());
     for (std::size_t p = 0; p < pixels; ++p) {
       for (std::size_t c = 0; c < 3; ++c) frame.image.rgb[3 * p + c] = rad[p][static_cast<int>(c)];
-      frame.objectMask[p] = ids[p].x != 0 ? 1 : 0;
     }
-    rgba8.read(frame.rgba8.data(), frame.rgba8.size());
   }
   finishExposure(request, frame);
 

@@ -31,13 +31,18 @@ void VulkanRenderer::Impl::uploadScene() {
   std::vector<std::uint32_t> bits;  // fused: every vertex's visibility words, global vertex order
   std::vector<glm::vec4> energies;           // fused: per global slice, ∫ρ_c (rgb)
   std::vector<shared::SliceLobe> lobeData;   // fused: per global slice, its lobe (zero: none)
-  visibilityWords = shared::visibilityWords(static_cast<shared::uint>(level));
   objectInfo.resize(objectCount);
+  // fused: each object at its own level (PreparedObject::level), its data
+  // at its own bases (ObjectInfo), the directions of every level in use in
+  // one table.
+  const DirectionTable directionTable = fused ? pixelCentreDirections(prepared.objectLevels()) : DirectionTable{};
+  fusedLightTexelCount = 0;
   for (std::size_t k = 0; k < objectCount; ++k) {
     const render::PreparedObject& p = prepared.objects[k];
     ObjectInfo& info = objectInfo[k];
+    const int objectLevel = fused ? p.level : level;
     if (splitsum ? p.lobes.size() != T
-                 : static_cast<std::size_t>(p.table.thetaSamples()) != T || p.table.level() != level) {
+                 : static_cast<std::size_t>(p.table.thetaSamples()) != T || p.table.level() != objectLevel) {
       throw std::logic_error("Vulkan backend: object " + p.name + " has a slice table unlike the options");
     }
     info.thetaSamples = static_cast<std::uint32_t>(T);
@@ -47,12 +52,20 @@ void VulkanRenderer::Impl::uploadScene() {
       info.sliceBase = static_cast<std::uint32_t>(lobeData.size());
       lobeData.insert(lobeData.end(), p.lobes.begin(), p.lobes.end());
     } else if (fused) {
-      // The slices in pixel form, RGB0 texels (core PixelSlices), slice s at s·N texels.
+      // The slices in pixel form, RGB0 texels (core PixelSlices), the
+      // object's slice t at texelBase + t·N of its level; its energies and
+      // lobes at global slice sliceBase + t; its light at lightBase.
       const PixelSlices pixelSlices = PixelSlices::synthesize(p.table);
-      info.sliceBase = static_cast<std::uint32_t>(sliceData.size() / (shared::kTexelFloats * n));
+      const std::size_t objectN = static_cast<std::size_t>(mapSize(p.level)) * static_cast<std::size_t>(mapSize(p.level));
+      info.level = static_cast<std::uint32_t>(p.level);
+      info.sliceBase = static_cast<std::uint32_t>(energies.size());
+      info.texelBase = static_cast<std::uint32_t>(sliceData.size() / shared::kTexelFloats);
+      info.lightBase = static_cast<std::uint32_t>(fusedLightTexelCount);
+      info.directionBase = directionTable.base[static_cast<std::size_t>(p.level)];
+      fusedLightTexelCount += objectN;
       sliceData.insert(sliceData.end(), pixelSlices.texels().begin(), pixelSlices.texels().end());
       pointData.insert(pointData.end(), pixelSlices.pointTexels().begin(), pixelSlices.pointTexels().end());
-      setFusedSkip(info, level, pixelSlices.lastNonZeroRow());
+      setFusedSkip(info, p.level, pixelSlices.lastNonZeroRow());
       for (std::size_t t = 0; t < T; ++t) {
         const std::array<float, 3>& e = pixelSlices.energy(static_cast<int>(t));
         energies.emplace_back(e[0], e[1], e[2], 0.0f);
@@ -112,12 +125,14 @@ void VulkanRenderer::Impl::uploadScene() {
     if (fused) {
       // fused reads the bits (core VisibilityBits), never the lists.
       const VisibilityBits& b = p.visibilityBits;
-      if (b.pointCount() != mesh.positions.size() || b.level() != level || b.wordsPerPoint() != visibilityWords) {
+      if (b.pointCount() != mesh.positions.size() || b.level() != p.level ||
+          b.wordsPerPoint() != shared::visibilityWords(static_cast<shared::uint>(p.level))) {
         throw std::logic_error("Vulkan backend: object " + p.name + " has visibility bits for " +
                                std::to_string(b.pointCount()) + " points at level " + std::to_string(b.level()) +
                                " for " + std::to_string(mesh.positions.size()) + " vertices at level " +
-                               std::to_string(level));
+                               std::to_string(p.level));
       }
+      info.visibilityBase = static_cast<std::uint32_t>(bits.size());
       bits.insert(bits.end(), b.words().begin(), b.words().end());
       continue;
     }
@@ -170,9 +185,9 @@ void VulkanRenderer::Impl::uploadScene() {
   for (const SphereMap& map : prepared.background) bg.insert(bg.end(), map.values().begin(), map.values().end());
   upload(background, bg.data(), bg.size() * sizeof(float));
   if (fused) {
-    // The pixel-centre directions, as core fused builds them (double → float).
-    const std::vector<glm::vec4> dirs = pixelCentreDirections(level);
-    upload(directions, dirs.data(), dirs.size() * sizeof(glm::vec4), kTexelUsage);
+    // The pixel-centre directions of every level in use, as core fused
+    // builds them (double → float).
+    upload(directions, directionTable.directions.data(), directionTable.directions.size() * sizeof(glm::vec4), kTexelUsage);
     upload(sliceEnergy, energies.data(), energies.size() * sizeof(glm::vec4));
     upload(pointSlices, pointData.data(), pointData.size() * sizeof(float), kTexelUsage);
     upload(lobes, lobeData.data(), lobeData.size() * sizeof(shared::SliceLobe));
@@ -193,12 +208,12 @@ void VulkanRenderer::Impl::uploadScene() {
     rays = std::make_unique<RayScene>(std::move(instances));
   }
   // The light: per object and channel a header and at most (N − 1)/3 blocks;
-  // for `fused` its pixel form, N RGB0 texels per object (fusedLightTexels).
+  // for `fused` its pixel form, N RGB0 texels per object at its level (fusedLightTexels).
   // Written every frame, device-local like the other inputs: its upload (and
   // staging buffer, where there is one) lives as long as the renderer.
   if (!splitsum) {
     light = Buffer(context,
-                   fused ? objectCount * n * sizeof(glm::vec4) : objectCount * 3 * (1 + (n - 1) / 3) * sizeof(glm::uvec4),
+                   fused ? fusedLightTexelCount * sizeof(glm::vec4) : objectCount * 3 * (1 + (n - 1) / 3) * sizeof(glm::uvec4),
                    fusedUsage, MemoryUse::DeviceInput);
     lightUpload = BufferUpload(context, light);
   }
@@ -217,7 +232,7 @@ void VulkanRenderer::Impl::uploadScene() {
   }
   frameParams = Buffer(context, sizeof(FrameParams));
   thresholds = Buffer(context, 256 * sizeof(float));
-  exposureResult = Buffer(context, sizeof(ExposureResult));
+  exposureResult = Buffer(context, sizeof(ExposureResult), kStorageUsage, MemoryUse::Readback);
 
   const auto lvl = static_cast<std::uint32_t>(level);
   // Constant 2 is rotate_spatial.comp's local size (the other methods'
@@ -258,7 +273,7 @@ void VulkanRenderer::Impl::createFusedPipeline(std::uint32_t local) {
   visibilityTexels = TexelView(context, visibility, VK_FORMAT_R32_UINT, sizeof(std::uint32_t));
   lobeLightTexels = TexelView(context, lobeLight, VK_FORMAT_R32G32B32A32_SFLOAT, sizeof(glm::vec4));
   pointSliceTexels = TexelView(context, pointSlices, VK_FORMAT_R32G32B32A32_SFLOAT, sizeof(glm::vec4));
-  lightTexelData.resize(prepared.objects.size() * coefficients);
+  lightTexelData.resize(fusedLightTexelCount);
 
   // No scratch: a workgroup keeps only its reduction's vec3 per invocation,
   // so the dispatch may have as many groups as the device allows: 65,536 on
@@ -273,8 +288,7 @@ void VulkanRenderer::Impl::createFusedPipeline(std::uint32_t local) {
   if (limits.fusedGroups) fusedGroups = std::min(fusedGroups, limits.fusedGroups);
   fusedPass = std::make_unique<ComputePipeline>(
       context, "fused.comp", fusedBindings(), 0,
-      std::vector<SpecConstant>{{0, static_cast<std::uint32_t>(level)},
-                                {2, fusedLocal},
+      std::vector<SpecConstant>{{2, fusedLocal},
                                 {4, options.interpolateSlices ? 1u : 0u},
                                 {5, static_cast<std::uint32_t>(std::max(prepared.lobeLight.finestLevel(), 0))}});
 }

@@ -76,6 +76,7 @@ VulkanRenderer::~VulkanRenderer() = default;
 std::string VulkanRenderer::deviceName() const { return impl_->context.info().name; }
 const render::RenderOptions& VulkanRenderer::options() const { return impl_->options; }
 std::size_t VulkanRenderer::objectCount() const { return impl_->prepared.objects.size(); }
+std::vector<int> VulkanRenderer::objectLevels() const { return impl_->prepared.objectLevels(); }
 render::Frame VulkanRenderer::render(const render::FrameRequest& request) { return impl_->render(request); }
 Context& VulkanRenderer::context() { return impl_->context; }
 const render::PreparedScene& VulkanRenderer::prepared() const { return impl_->prepared; }

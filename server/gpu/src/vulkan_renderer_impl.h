@@ -61,7 +61,7 @@ struct VulkanRenderer::Impl {
   VulkanRendererLimits limits;
   render::PreparedScene prepared;
   Context context;
-  int level = 0;
+  int level = 0;                 // RenderOptions::level: every object's, or for `fused` the cap (objects at their own: PreparedObject::level)
   std::size_t coefficients = 0;  // N = 4^level
   std::string methodName;
 
@@ -100,7 +100,7 @@ struct VulkanRenderer::Impl {
   std::vector<PointLight> pointLightData;         // this frame's point lights, before upload
   std::uint32_t fusedGroups = 0;     // the most workgroups of the fused dispatch
   std::uint32_t fusedLocal = 0;      // its local size
-  std::size_t visibilityWords = 0;   // W: words per vertex
+  std::size_t fusedLightTexelCount = 0;  // Σ over objects of N at each one's level
   // The point lights' shadow rays (render/point_lights.h), on the host: every
   // prepared object as an instance, posed per frame (setTransform), as the
   // CPU backend's ray scene.
@@ -131,6 +131,9 @@ struct VulkanRenderer::Impl {
   GBufferTarget target;     // the pixel centres
   GBufferTarget subTarget;  // antialiasing: the sub-samples, at twice the resolution
   Buffer gbufIds, gbufNormals, gbufPositions, samples, shade, counter, radiance, rgba8, rotated;
+  // The frame's linear image for the host (Readback), copied from `radiance`
+  // (which the passes keep on the device) only when a request asks for it.
+  Buffer radianceOut;
   // `fused`: per covered sample its point-light shadow bits (bit k: sees
   // light k), computed on the host between the frame's two submissions.
   Buffer masks;

@@ -22,7 +22,7 @@ std::string welcomeMessage(const SessionConfig& config, const Catalog& catalog, 
   *w->mutable_settings() = settingsToWire(config);
   w->set_object_count(static_cast<std::uint32_t>(facts.objectCount));
   w->set_device(facts.device);
-  *w->mutable_scene_info() = sceneInfo(config, catalog);
+  *w->mutable_scene_info() = sceneInfo(config, catalog, facts.objectLevels);
   *w->mutable_limits() = limitsToWire(limits);
   return serialize(m);
 }
@@ -69,9 +69,9 @@ std::string errorLabel(v1::ErrorCode code) {
   return name.empty() ? std::to_string(static_cast<int>(code)) : name;
 }
 
-std::string sceneInfoMessage(const SessionConfig& config, const Catalog& catalog) {
+std::string sceneInfoMessage(const SessionConfig& config, const Catalog& catalog, const std::vector<int>& objectLevels) {
   v1::ServerMessage m;
-  *m.mutable_scene_info() = sceneInfo(config, catalog);
+  *m.mutable_scene_info() = sceneInfo(config, catalog, objectLevels);
   return serialize(m);
 }
 

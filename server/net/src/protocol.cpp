@@ -100,11 +100,23 @@ std::optional<ProtocolError> mergeSettings(SessionConfig& config, const v1::Rend
   if (s.level() != 0) {
     if (s.level() < static_cast<std::uint32_t>(limits.minLevel) || s.level() > static_cast<std::uint32_t>(limits.maxLevel)) {
       return error(v1::ERROR_CODE_BAD_SETTINGS,
-                   "level " + std::to_string(s.level()) + " is outside " + std::to_string(limits.minLevel) + ".." +
-                       std::to_string(limits.maxLevel),
+                   std::string(s.level_mode() == v1::LEVEL_MODE_AUTO ? "level cap " : "level ") + std::to_string(s.level()) +
+                       " is outside " + std::to_string(limits.minLevel) + ".." + std::to_string(limits.maxLevel),
                    fatal);
     }
     next.level = static_cast<int>(s.level());
+  }
+  // A level alone is a fixed level (as before level_mode); a mode with
+  // level 0 keeps the level in effect, as the level or as the cap.
+  switch (s.level_mode()) {
+    case v1::LEVEL_MODE_UNSPECIFIED:
+      if (s.level() != 0) next.automaticLevel = false;
+      break;
+    case v1::LEVEL_MODE_FIXED: next.automaticLevel = false; break;
+    case v1::LEVEL_MODE_AUTO: next.automaticLevel = true; break;
+    default:
+      return error(v1::ERROR_CODE_BAD_SETTINGS,
+                   "unknown level_mode " + std::to_string(s.level_mode()) + " (valid: FIXED = 1, AUTO = 2)", fatal);
   }
   if (s.light_coefficients() != 0) {
     if (s.light_coefficients() > limits.maxLightCoefficients) {
@@ -279,7 +291,8 @@ std::string SessionConfig::rendererKey() const {
   std::ostringstream key;
   key << "scene=" << scene << ";materials=";
   for (const auto& m : materials) key << m << ',';
-  key << ";level=" << level << ";method=" << methodName(method) << ";backend=" << backendName(backend);
+  key << ";level=" << (automaticLevel ? "auto:" : "") << level << ";method=" << methodName(method)
+      << ";backend=" << backendName(backend);
   return key.str();
 }
 
@@ -345,6 +358,7 @@ std::variant<SessionConfig, ProtocolError> configFromHello(const v1::Hello& hell
   c.jpegQuality = hello.jpeg_quality() ? static_cast<int>(hello.jpeg_quality()) : defaults.jpegQuality;
   c.method = defaults.method;
   c.level = defaults.level;
+  c.automaticLevel = defaults.automaticLevel;
   c.lightCoefficients = defaults.lightCoefficients;
   c.backend = defaults.backend;
   if (auto e = mergeScene(c, hello.scene(), catalog, true)) return *e;
@@ -524,6 +538,7 @@ v1::RenderSettings settingsToWire(const SessionConfig& config) {
   v1::RenderSettings s;
   s.set_method(toWire(config.method));
   s.set_level(static_cast<std::uint32_t>(config.level));
+  s.set_level_mode(config.automaticLevel ? v1::LEVEL_MODE_AUTO : v1::LEVEL_MODE_FIXED);
   s.set_light_coefficients(static_cast<std::uint32_t>(config.lightCoefficients));
   s.set_backend(toWire(config.backend));
   s.set_exposure_mode(config.autoExposure ? v1::EXPOSURE_MODE_AUTO : v1::EXPOSURE_MODE_FIXED);
@@ -563,7 +578,7 @@ v1::ServerLimits limitsToWire(const Limits& limits) {
   return l;
 }
 
-v1::SceneInfo sceneInfo(const SessionConfig& config, const Catalog& catalog) {
+v1::SceneInfo sceneInfo(const SessionConfig& config, const Catalog& catalog, const std::vector<int>& objectLevels) {
   v1::SceneInfo info;
   info.set_name(config.scene);
   const Catalog::SceneEntry* scene = catalog.findScene(config.scene);
@@ -585,6 +600,7 @@ v1::SceneInfo sceneInfo(const SessionConfig& config, const Catalog& catalog) {
     const bool named = scene && i < scene->objectNames.size() && !scene->objectNames[i].empty();
     o->set_name(named ? scene->objectNames[i] : "object " + std::to_string(i));
     o->set_material(config.materials[i]);
+    if (i < objectLevels.size()) o->set_level(static_cast<std::uint32_t>(objectLevels[i]));
     if (scene && i < scene->poses.size()) {
       auto* pose = o->mutable_pose();
       pose->set_object(static_cast<std::uint32_t>(i));

@@ -132,9 +132,9 @@ void RenderSession::onHello(const v1::Hello& hello, Clock::time_point now) {
     pose_ = initialPose(scene->camera, scene->poses);
     requested_ = now;
   }
-  log(format("hello from \"%s\": %dx%d %s, %.1f fps, level %d, %s, %s, scene \"%s\"", clientName_.c_str(),
+  log(format("hello from \"%s\": %dx%d %s, %.1f fps, level %s%d, %s, %s, scene \"%s\"", clientName_.c_str(),
              config_.width, config_.height, std::string(encodingName(config_.encoding)).c_str(), config_.fps,
-             config_.level, std::string(methodName(config_.method)).c_str(),
+             config_.automaticLevel ? "auto:" : "", config_.level, std::string(methodName(config_.method)).c_str(),
              std::string(backendName(config_.backend)).c_str(), sanitizeForLog(config_.scene).c_str()));
   prepareRenderer();
 }
@@ -183,7 +183,10 @@ void RenderSession::adopt(SessionConfig next, bool announceScene, Clock::time_po
       pose_.sequence = sequence;  // later poses stay newer
     }
   }
-  if (announceScene && welcomed_) port_.send(sceneInfoMessage(config_, catalog_));
+  if (announceScene && welcomed_) {
+    port_.send(sceneInfoMessage(config_, catalog_));  // levels not known until its renderer is built
+    announcedLevels_.clear();
+  }
   // The frame in flight answers the old config: cancelled at its next tile,
   // so the new one starts without waiting for a frame nobody wants.
   if (inFlight_ && current_) current_->cancelled.store(true);
@@ -234,12 +237,16 @@ void RenderSession::onPrepared(const std::string& key, std::shared_ptr<PreparedR
     std::lock_guard lock(mutex_);
     requested_ = std::max(requested_, now);  // the build was no frame's time
   }
+  const std::vector<int> levels = renderer_->renderer->objectLevels();
   if (!welcomed_) {
     welcomed_ = true;
     lastStats_ = now;
     port_.send(welcomeMessage(config_, catalog_, options_.limits,
-                              {id_, renderer_->renderer->objectCount(), renderer_->renderer->deviceName()}));
+                              {id_, renderer_->renderer->objectCount(), renderer_->renderer->deviceName(), levels}));
+  } else if (levels != announcedLevels_) {
+    port_.send(sceneInfoMessage(config_, catalog_, levels));
   }
+  announcedLevels_ = levels;
   wantFrame_ = true;
   maybeRender(now);
 }

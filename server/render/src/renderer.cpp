@@ -11,6 +11,7 @@
 #include "haarcast/core/lobe.h"
 #include "haarcast/core/splitsum.h"
 #include "haarcast/io/slice_cache.h"
+#include "haarcast/render/object_levels.h"
 #include "haarcast/render/shading.h"
 #include "haarcast/render/visibility_cache.h"
 
@@ -37,8 +38,13 @@ void checkRenderOptions(const RenderOptions& o) {
 }
 
 BrdfSliceTable objectSliceTable(const SceneObject& object, const RenderOptions& options, const RenderProgress& progress) {
+  return objectSliceTable(object, options, options.level, progress);
+}
+
+BrdfSliceTable objectSliceTable(const SceneObject& object, const RenderOptions& options, int level,
+                                const RenderProgress& progress) {
   SliceTableOptions table;
-  table.level = options.level;
+  table.level = level;
   table.thetaSamples = options.thetaSamples;
   table.supersampling = options.sliceSupersampling;
   auto tableProgress = [&](int done, int total) {
@@ -58,33 +64,44 @@ PreparedScene prepareScene(const Scene& scene, const RenderOptions& options, con
   checkObjectCount(scene.objects.size(), options.sceneLimits);
   // splitsum keeps none: its visibility is one ray per pixel.
   const bool splitsum = options.method == RotationMethod::Splitsum;
-  std::size_t triangles = 0, visibilityBytes = 0;
-  const std::size_t perVertex = splitsum ? 0
-                                : options.method == RotationMethod::Fused
-                                    ? 4 * visibilityWordsPerPoint(options.level)
-                                    : 8 * std::min<std::size_t>(options.visibility.keep, std::size_t{1} << (2 * options.level));
-  for (const SceneObject& object : scene.objects) {
-    triangles += object.mesh->triangles.size();
-    visibilityBytes += object.mesh->positions.size() * perVertex;
-  }
+  const bool fused = options.method == RotationMethod::Fused;
+  std::size_t triangles = 0;
+  for (const SceneObject& object : scene.objects) triangles += object.mesh->triangles.size();
   if (triangles > options.sceneLimits.maxTriangles) {
     throw std::invalid_argument("render: the scene has " + std::to_string(triangles) + " triangles, over the limit of " +
                                 std::to_string(options.sceneLimits.maxTriangles) + " (--max-scene-triangles)");
   }
+  // Each object's level (its lobes measured, for `fused`): the visibility
+  // is counted at each object's own.
+  std::vector<ObjectLevel> levels = chooseObjectLevels(scene, options);
+  auto perVertex = [&](int level) -> std::size_t {
+    return splitsum ? 0
+           : fused  ? 4 * visibilityWordsPerPoint(level)
+                    : 8 * std::min<std::size_t>(options.visibility.keep, std::size_t{1} << (2 * level));
+  };
+  std::size_t visibilityBytes = 0;
+  int finest = 0;
+  for (std::size_t k = 0; k < scene.objects.size(); ++k) {
+    visibilityBytes += scene.objects[k].mesh->positions.size() * perVertex(levels[k].level);
+    finest = std::max(finest, levels[k].level);
+  }
   if (visibilityBytes > options.sceneLimits.maxVisibilityBytes) {
     throw std::invalid_argument("render: the scene's visibility would take " + std::to_string(visibilityBytes >> 20) +
-                                " MB at level " + std::to_string(options.level) + ", over the limit of " +
-                                std::to_string(options.sceneLimits.maxVisibilityBytes >> 20) + " MB (--max-visibility-mb)");
+                                " MB at level " + std::to_string(finest) + (options.automaticLevel ? " at most" : "") +
+                                ", over the limit of " + std::to_string(options.sceneLimits.maxVisibilityBytes >> 20) +
+                                " MB (--max-visibility-mb)");
   }
   // Refinement adds vertices (visibility_refine.h: up to max(growth × V,
   // floor) an object); where that could pass the limit, the scene is drawn
   // unrefined rather than over the operator's memory cap.
   RefineOptions refine = options.refine;
-  if (options.method == RotationMethod::Fused && refine.rounds > 0) {
+  if (fused && refine.rounds > 0) {
     std::size_t bound = 0;
-    for (const SceneObject& object : scene.objects) {
+    for (std::size_t k = 0; k < scene.objects.size(); ++k) {
+      const SceneObject& object = scene.objects[k];
       const std::size_t v = object.mesh->positions.size();
-      bound += perVertex * (object.ground ? v : std::max(static_cast<std::size_t>(refine.growth * static_cast<double>(v)), refine.floor));
+      bound += perVertex(levels[k].level) *
+               (object.ground ? v : std::max(static_cast<std::size_t>(refine.growth * static_cast<double>(v)), refine.floor));
     }
     if (bound > options.sceneLimits.maxVisibilityBytes) refine.rounds = 0;
   }
@@ -96,10 +113,11 @@ PreparedScene prepareScene(const Scene& scene, const RenderOptions& options, con
     PreparedObject& p = prepared.objects[k];
     p.name = object.name;
     p.pose = object.pose;
+    p.level = levels[k].level;
     object.mesh->validate();
     p.mesh = withNormals(object.mesh);  // a mesh built in code may come without them
     // splitsum's only precompute is its lobes (below): no slice table.
-    if (!splitsum) p.table = objectSliceTable(object, options, progress);
+    if (!splitsum) p.table = objectSliceTable(object, options, p.level, progress);
     p.ground = object.ground;
     p.groundAlbedo = object.groundAlbedo;
     p.sphereCentre = p.mesh->bounds().centre();
@@ -109,7 +127,7 @@ PreparedScene prepareScene(const Scene& scene, const RenderOptions& options, con
       prepared.ground = k;
     }
     VisibilityOptions vis = options.visibility;
-    vis.level = options.level;
+    vis.level = p.level;
     p.shadowShift = static_cast<float>(vis.offset * p.mesh->bounds().radius());
     auto visibilityProgress = [&](std::size_t done, std::size_t total) {
       if (progress) progress("visibility " + object.name, done, total);
@@ -119,7 +137,7 @@ PreparedScene prepareScene(const Scene& scene, const RenderOptions& options, con
       // prefiltered light along its mirror direction (core/splitsum.h).
       p.lobes = measureLobes(*object.material.brdf, lobeThetaOut(options.thetaSamples));
       p.lobePath = true;
-    } else if (options.method == RotationMethod::Fused) {
+    } else if (fused) {
       if (p.ground || refine.rounds == 0) {
         p.visibilityBits = loadOrComputeVisibilityBits(*p.mesh, vis, options.cacheDir, visibilityProgress);
       } else {
@@ -134,31 +152,53 @@ PreparedScene prepareScene(const Scene& scene, const RenderOptions& options, con
   prepared.light = scene.environment.maps(options.level);
   prepared.background = scene.environment.maps(kBackgroundLevel);
   if (splitsum) prepared.lobeLight = PrefilteredLight::build(prepared.background);
-  if (options.method == RotationMethod::Fused) {
+  if (fused) {
     // Lights found on the backdrop's fine map (light_split.h: their
-    // directions to a tenth of a degree), the rest at the render's level.
-    LightSplit split = splitLight(prepared.background, options.level, options.pointLights);
+    // directions to a tenth of a degree), the rest at each level in use:
+    // the solid-angle mean of the fine map's rest (SphereMap::downsampled).
+    LightSplit split = splitLight(prepared.background, options.pointLights);
     prepared.pointLights = std::move(split.lights);
-    prepared.restLight = std::move(split.rest);
-    const std::array<SphereMap, 3>& rest = prepared.restLight;
+    prepared.restLight.assign(static_cast<std::size_t>(kBackgroundLevel) + 1, {});
+    for (const int level : levelsInUse(prepared.objectLevels())) {
+      for (const int at : {level, lightTurnLevel(level)}) {
+        std::array<SphereMap, 3>& rest = prepared.restLight[static_cast<std::size_t>(at)];
+        if (rest[0].level() == at && rest[0].pixelCount() > 1) continue;
+        for (std::size_t c = 0; c < 3; ++c) rest[c] = split.rest[c].downsampled(at);
+      }
+    }
     for (std::size_t k = 0; k < prepared.objects.size(); ++k) {
       PreparedObject& p = prepared.objects[k];
       if (p.ground) continue;  // shaded in closed form
       std::vector<double> thetaOut;
       for (int t = 0; t < p.table.thetaSamples(); ++t) thetaOut.push_back(p.table.thetaOut(t));
-      LobeCore core = chooseLobeCore(*scene.objects[k].material.brdf, thetaOut, options.level);
+      LobeCore core = chooseLobeCore(*scene.objects[k].material.brdf, thetaOut, p.level, std::move(levels[k].lobes));
       p.lobes = std::move(core.lobes);
       p.lobeCore = core.angle;
       p.lobePath = p.lobeCore > 0.0f;
       // The prefiltered light (5.6 MB at level 9) only where a pixel can read it.
       if (p.lobePath && prepared.lobeLight.empty()) prepared.lobeLight = PrefilteredLight::build(prepared.background);
     }
+    const std::array<SphereMap, 3>& rest = prepared.restLightAt(finest);
     prepared.restLuminance = SphereMap(rest[0].level());
     for (int r = 0; r < rest[0].size(); ++r)
       for (int c = 0; c < rest[0].size(); ++c)
         prepared.restLuminance.at(r, c) = static_cast<float>(luminance709(rest[0].at(r, c), rest[1].at(r, c), rest[2].at(r, c)));
   }
   return prepared;
+}
+
+const std::array<SphereMap, 3>& PreparedScene::restLightAt(int level) const {
+  if (level < 0 || static_cast<std::size_t>(level) >= restLight.size() || restLight[static_cast<std::size_t>(level)][0].level() != level ||
+      restLight[static_cast<std::size_t>(level)][0].pixelCount() <= 1) {
+    throw std::out_of_range("render: no rest light at level " + std::to_string(level) + " (no object uses it)");
+  }
+  return restLight[static_cast<std::size_t>(level)];
+}
+
+std::vector<int> PreparedScene::objectLevels() const {
+  std::vector<int> out;
+  for (const PreparedObject& p : objects) out.push_back(p.level);
+  return out;
 }
 
 std::array<SparseHaar, 3> lightInObjectFrame(const std::array<SphereMap, 3>& worldLight, const glm::dmat3& objectRotation,
@@ -254,9 +294,9 @@ void resolveFusedLight(const PreparedScene& prepared, const PreparedObject& obje
                        ResolvedObject& o) {
   // L_obj(ω) = L(Mω), M = lightRotationᵀ·objectRotation (lightInObjectFrame).
   const EulerYXY toObject = eulerFromMatrix(glm::transpose(glm::transpose(lightRotation) * o.rotation));
-  std::array<SphereMap, 3> weighted;
-  for (std::size_t c = 0; c < 3; ++c)
-    weighted[c] = rotateSpatialMap(prepared.restLight[c], toObject).weightedBySolidAngle();
+  std::array<SphereMap, 3> weighted =
+      rotateSpatialMapsDown(prepared.restLightAt(lightTurnLevel(object.level)), toObject, object.level);
+  for (SphereMap& map : weighted) map = map.weightedBySolidAngle();
   const int level = weighted[0].level();
   const int m = mapSize(level);
   if (groundNormal && !object.ground) {

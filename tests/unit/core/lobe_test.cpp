@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <random>
 #include <vector>
 
@@ -13,6 +14,7 @@
 #include "haarcast/core/brdf_slices.h"
 #include "haarcast/core/fused.h"
 #include "haarcast/core/prefiltered_light.h"
+#include "haarcast/core/splitsum.h"
 #include "test_maps.h"
 
 namespace haarcast {
@@ -146,6 +148,63 @@ TEST(LobeCore, MirrorsTakeThePathHazyMirrorsTheirCoreRoughLobesNone) {
   const LobeCore lambert = chooseLobeCore(*makeLambert(glm::dvec3(0.8)), thetaOut, 5);
   EXPECT_EQ(lambert.angle, 0.0f);
   EXPECT_TRUE(lambert.lobes.empty());
+}
+
+TEST(ChooseLevel, LambertTakesTheFloorGlossyAMiddleLevelAMirrorTheCap) {
+  // The table's θₒ at the default 16 slices (BrdfSliceTable, splitsum.h).
+  const std::vector<double> thetaOut = lobeThetaOut(16);
+  auto levelOf = [&](const Brdf& brdf, int cap) {
+    const std::vector<shared::SliceLobe> lobes = measureLobes(brdf, thetaOut);
+    std::printf("sharpest median %.4f rad (%.2f°): level %d of cap %d\n", sharpestMedian(lobes),
+                sharpestMedian(lobes) * 180.0 / kPi, chooseLevel(lobes, cap), cap);
+    return chooseLevel(lobes, cap);
+  };
+  const auto lambert = makeLambert(glm::dvec3(0.8));
+  EXPECT_EQ(levelOf(*lambert, 6), kAutoLevelFloor);
+  EXPECT_EQ(levelOf(*lambert, 7), kAutoLevelFloor);
+  // ggx:0.3: its sharpest median (at the most grazing slice, where the
+  // horizon cuts the lobe) m, and the level n = ⌈log₂(K·π/m)⌉ of the rule.
+  const auto rough = makeGgx(glm::dvec3(0.0), glm::dvec3(0.9), 0.3);
+  const std::vector<shared::SliceLobe> roughLobes = measureLobes(*rough, thetaOut);
+  const double m = sharpestMedian(roughLobes);
+  const int expected = static_cast<int>(std::ceil(std::log2(kLevelMedianTexels * kPi / m)));
+  EXPECT_GT(expected, kAutoLevelFloor) << "a middle level";
+  EXPECT_LT(expected, 7);
+  EXPECT_EQ(levelOf(*rough, 7), expected);
+  EXPECT_GE(m, kLevelMedianTexels * kPi / mapSize(expected)) << "its median spans K texels there";
+  EXPECT_LT(m, kLevelMedianTexels * kPi / mapSize(expected - 1)) << "and not one level coarser";
+  // A near-mirror is under K texels at any level `fused` takes: the cap.
+  const auto mirror = makeGgx(glm::dvec3(0.0), glm::dvec3(0.9), 0.02);
+  EXPECT_EQ(levelOf(*mirror, 6), 6);
+  EXPECT_EQ(levelOf(*mirror, 7), 7);
+  EXPECT_EQ(chooseLevel({}, 6), kAutoLevelFloor) << "no lobes: nothing to resolve";
+  EXPECT_EQ(levelOf(*lambert, 3), 3) << "a cap below the floor wins";
+}
+
+TEST(ChooseLevel, ANearMirrorWhoseWholeLobeThePathTakesGetsTheCoarsestSuchLevel) {
+  const std::vector<double> thetaOut = lobeThetaOut(16);
+  // Step 2: where the lobe path takes the whole lobe, the coarsest level
+  // at which it does. This near-mirror's whole lobe lies within 4 texels of
+  // its axis at the floor, at every θₒ: the floor, whose pixels are the cap's.
+  const auto mirror = makeGgx(glm::dvec3(0.0), glm::dvec3(0.9), 0.005);
+  const std::vector<shared::SliceLobe> mirrorLobes = measureLobes(*mirror, thetaOut);
+  EXPECT_EQ(chooseLevel(*mirror, thetaOut, mirrorLobes, 6), kAutoLevelFloor);
+  EXPECT_FLOAT_EQ(chooseLobeCore(*mirror, thetaOut, kAutoLevelFloor, mirrorLobes).angle, static_cast<float>(kPi));
+  // ggx:0.02's grazing slices spread past 4 texels of the floor (2 % of the
+  // energy): its core is split off at every level, and it keeps the cap.
+  const auto glossyMirror = makeGgx(glm::dvec3(0.0), glm::dvec3(0.9), 0.02);
+  EXPECT_EQ(chooseLevel(*glossyMirror, thetaOut, measureLobes(*glossyMirror, thetaOut), 6), 6);
+  // A mirror over a diffuse base (as measured chrome) has its core split
+  // off at every level: the cap, where the pass resolves the most of the rest.
+  const auto hazy = makeGgx(glm::dvec3(0.3), glm::dvec3(0.9), 0.005);
+  EXPECT_EQ(chooseLevel(*hazy, thetaOut, measureLobes(*hazy, thetaOut), 6), 6);
+  // Lobes without a path keep step 1's level.
+  const auto rough = makeGgx(glm::dvec3(0.0), glm::dvec3(0.9), 0.3);
+  const std::vector<shared::SliceLobe> roughLobes = measureLobes(*rough, thetaOut);
+  EXPECT_EQ(chooseLevel(*rough, thetaOut, roughLobes, 6), chooseLevel(roughLobes, 6));
+  EXPECT_GT(chooseLevel(roughLobes, 6), kAutoLevelFloor);
+  const auto lambert = makeLambert(glm::dvec3(0.8));
+  EXPECT_EQ(chooseLevel(*lambert, thetaOut, measureLobes(*lambert, thetaOut), 6), kAutoLevelFloor);
 }
 
 TEST(LobePath, SamplesFollowTheLobeWhereTheHorizonCutsIt) {

@@ -118,7 +118,7 @@ TEST(Antialias, VulkanMatchesTheCpuBackend) {
   EXPECT_LE(std::max(gpuEdges, cpuEdges) - std::min(gpuEdges, cpuEdges), 2u);
   EXPECT_LE(wordsDiffer, 2u + gpuEdges / 50);
   EXPECT_EQ(c.mismatched, 0u);
-  EXPECT_GE(c.psnr, testing::kFusedPsnrFloor);
+  EXPECT_GE(c.psnr, testing::fusedPsnrFloor(gpu.context()));
   testing::expectNoValidationMessages(gpu.context());
 }
 

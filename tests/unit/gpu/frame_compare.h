@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "haarcast/gpu/context.h"
 #include "haarcast/render/renderer.h"
 
 namespace haarcast::gpu::testing {
@@ -23,8 +24,13 @@ inline const std::string& cacheDir() {
   return path;
 }
 
-// Vulkan fused vs CPU fused, whole frames (measured: see docs/gpu.md).
-inline constexpr double kFusedPsnrFloor = 115.0;  // measured 127.7–135.5 dB on lavapipe (float rounding only)
+// Vulkan fused vs CPU fused, whole frames (measured: see docs/gpu.md). On a
+// CPU device (lavapipe) the G-buffer interpolates from unsnapped floats and
+// frames differ by float rounding only: 127.7–135.5 dB measured. A hardware
+// rasteriser snaps vertices to its sub-pixel grid first, which moves each
+// pixel's shading point by up to ~1/256 px (GBufferPass): 88 dB measured on
+// an H200, so there the floor is the project's Vulkan = CPU bar, 80 dB.
+inline double fusedPsnrFloor(const Context& context) { return context.info().type == "cpu" ? 115.0 : 80.0; }
 
 inline render::RenderOptions frameOptions(RotationMethod method, bool background) {
   render::RenderOptions o;

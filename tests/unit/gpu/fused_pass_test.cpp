@@ -7,7 +7,9 @@
 // (bits past the light count set too: both sides must ignore them). The
 // ground's samples against its closed form, groundRadiance + Σ_k bit_k·power_k.
 // Fewer workgroups than samples, so each group loops over several samples,
-// ground and not.
+// ground and not. The objects may sit at different map levels (ObjectInfo::
+// level and its bases: docs/design.md, "A level per object"): object 2 at
+// the case's second level, the others at its first.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -53,6 +55,7 @@ BrdfSliceTable randomTable(int level, int thetaSamples, bool upperOnly, std::mt1
 struct PassCase {
   int level;
   bool interpolate;
+  int other = 0;  // object 2's level; 0: `level` too
 };
 
 class FusedPass : public ::testing::TestWithParam<PassCase> {};
@@ -67,9 +70,12 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
   constexpr std::size_t kGround = 3;
   constexpr std::size_t kLights = 5;            // of kMaxPointLights; mask bits 5–7 must be ignored
   constexpr std::uint32_t kGroups = 5;          // fewer than the samples: groups loop
-  std::mt19937 rng(static_cast<unsigned>(100 + level));
+  std::mt19937 rng(static_cast<unsigned>(100 + level + 10 * pc.other));
   std::uniform_real_distribution<float> u(0.0f, 1.0f);
-  const std::size_t n = static_cast<std::size_t>(mapSize(level)) * static_cast<std::size_t>(mapSize(level));
+  std::vector<int> levels(kObjects, level);
+  if (pc.other) levels[2] = pc.other;  // a plain object (0 and 1 have lobe paths, 3 is the ground)
+  auto directionsOf = [](int l) { return static_cast<std::size_t>(mapSize(l)) * static_cast<std::size_t>(mapSize(l)); };
+  const DirectionTable directionTable = pixelCentreDirections(levels);
 
   // The objects: their slices (pixel form), light and point lights.
   std::vector<PixelSlices> slices;
@@ -80,14 +86,20 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
   std::vector<glm::vec4> lightTexels;
   std::vector<PointLight> lightRecords(kObjects * shared::kMaxPointLights);
   for (std::size_t o = 0; o < kObjects; ++o) {
-    slices.push_back(PixelSlices::synthesize(randomTable(level, kThetaSamples, o == 1, rng)));
+    const int l = levels[o];
+    const std::size_t n = directionsOf(l);
+    slices.push_back(PixelSlices::synthesize(randomTable(l, kThetaSamples, o == 1, rng)));
     std::array<SphereMap, 3> weighted;
-    for (auto& map : weighted) map = randomMap(level, 0.0, 0.02, rng);
+    for (auto& map : weighted) map = randomMap(l, 0.0, 0.02, rng);
     lights.push_back(FusedLight::fromWeightedMaps(weighted));
+    objects[o].level = static_cast<std::uint32_t>(l);
     objects[o].sliceBase = static_cast<std::uint32_t>(o * kThetaSamples);
+    objects[o].texelBase = static_cast<std::uint32_t>(texels.size() / shared::kTexelFloats);
+    objects[o].lightBase = static_cast<std::uint32_t>(lightTexels.size());
+    objects[o].directionBase = directionTable.base[static_cast<std::size_t>(l)];
     objects[o].thetaSamples = kThetaSamples;
     objects[o].pointLights = static_cast<std::uint32_t>(kLights);
-    setFusedSkip(objects[o], level, slices[o].lastNonZeroRow());
+    setFusedSkip(objects[o], l, slices[o].lastNonZeroRow());
     texels.insert(texels.end(), slices[o].texels().begin(), slices[o].texels().end());
     pointTexels.insert(pointTexels.end(), slices[o].pointTexels().begin(), slices[o].pointTexels().end());
     lightTexels.resize(lightTexels.size() + n);
@@ -112,7 +124,7 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
   // a random prefiltered light (finest level 5) and a random turn into its frame.
   constexpr std::size_t kLobeAll = 1, kLobeSplit = 0;
   constexpr int kPrefilterFinest = 5;
-  const float coreAngle = 2.0f * static_cast<float>(kPi) / static_cast<float>(mapSize(level));
+  const float coreAngle = 2.0f * static_cast<float>(kPi) / static_cast<float>(mapSize(levels[kLobeSplit]));
   std::vector<shared::SliceLobe> lobes(kObjects * kThetaSamples);
   std::vector<glm::vec4> energies;
   for (std::size_t o = 0; o < kObjects; ++o) {
@@ -145,16 +157,24 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
   const PrefilteredLight prefiltered = PrefilteredLight::build(prefilterMaps);
   objects[kGround].groundRadiance = glm::vec4(u(rng), u(rng), u(rng), 0.0f);
 
-  // Samples: three vertices each (their random bits), a rotation, θₒ, a mask.
-  VisibilityBits bits(level, 3 * kPixels);
-  {
-    std::vector<std::uint32_t> words(bits.pointCount() * bits.wordsPerPoint());
+  // Samples: three vertices each (their random bits), a rotation, θₒ, a
+  // mask. Each object has 3·kPixels vertices at its level (sample i's are
+  // 3i … 3i + 2 of its object's), one after the other.
+  std::vector<VisibilityBits> bits;
+  std::vector<std::uint32_t> allWords;
+  for (std::size_t o = 0; o < kObjects; ++o) {
+    const std::size_t n = directionsOf(levels[o]);
+    bits.emplace_back(levels[o], 3 * kPixels);
+    std::vector<std::uint32_t> words(bits[o].pointCount() * bits[o].wordsPerPoint());
     std::uniform_int_distribution<std::uint32_t> word;
     const std::uint32_t spare = n < 32 ? (1u << n) - 1u : ~0u;  // no bit past the map's directions
     for (std::size_t w = 0; w < words.size(); ++w) words[w] = word(rng) & spare;
-    bits.assign(words);
+    bits[o].assign(words);
+    ASSERT_EQ(bits[o].wordsPerPoint(), shared::visibilityWords(static_cast<shared::uint>(levels[o])));
+    objects[o].vertexBase = static_cast<std::uint32_t>(o * 3 * kPixels);
+    objects[o].visibilityBase = static_cast<std::uint32_t>(allWords.size());
+    allWords.insert(allWords.end(), words.begin(), words.end());
   }
-  ASSERT_EQ(bits.wordsPerPoint(), shared::visibilityWords(static_cast<shared::uint>(level)));
   std::vector<RotationSample> samples(kPixels);
   std::vector<ShadeSample> shade(kPixels);
   std::vector<std::uint32_t> masks(kPixels);
@@ -168,7 +188,7 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
     s.pixel = static_cast<std::uint32_t>(i);
     ShadeSample& sh = shade[i];
     sh.object = static_cast<std::uint32_t>(i % kObjects);
-    for (std::uint32_t v = 0; v < 3; ++v) sh.vertex[v] = static_cast<std::uint32_t>(3 * i + v);
+    for (std::uint32_t v = 0; v < 3; ++v) sh.vertex[v] = objects[sh.object].vertexBase + static_cast<std::uint32_t>(3 * i + v);
     const float a = u(rng), b = u(rng) * (1.0f - a);
     sh.b[0] = a;
     sh.b[1] = b;
@@ -178,7 +198,7 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
     masks[i] = i < 3 ? 0xFFu : i < 6 ? 0u : static_cast<std::uint32_t>(rng() & 0xFFu);
     if (sh.object != kGround && i % 4 != 3) masks[i] |= shared::kLobeSeenBit;  // the lobe ray: mostly seen
   }
-  const std::vector<glm::vec4> dirs = pixelCentreDirections(level);
+  const std::vector<glm::vec4>& dirs = directionTable.directions;
   const CoverageCounter counter{static_cast<std::uint32_t>(kPixels), {kGroups, 1, 1}};
 
   Context context(testing::testOptions());
@@ -193,7 +213,7 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
   Buffer texelBuf = upload(texels.data(), texels.size() * sizeof(float));
   Buffer pointTexelBuf = upload(pointTexels.data(), pointTexels.size() * sizeof(float));
   Buffer lightBuf = upload(lightTexels.data(), lightTexels.size() * sizeof(glm::vec4));
-  Buffer bitsBuf = upload(bits.words().data(), bits.storedBytes());
+  Buffer bitsBuf = upload(allWords.data(), allWords.size() * sizeof(std::uint32_t));
   Buffer dirBuf = upload(dirs.data(), dirs.size() * sizeof(glm::vec4));
   Buffer pointBuf = upload(lightRecords.data(), lightRecords.size() * sizeof(PointLight));
   Buffer radiance(context, kPixels * sizeof(glm::vec4));
@@ -209,8 +229,7 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
   const TexelView bitsView(context, bitsBuf, VK_FORMAT_R32_UINT, sizeof(std::uint32_t));
   const TexelView dirView(context, dirBuf, VK_FORMAT_R32G32B32A32_SFLOAT, sizeof(glm::vec4));
   ComputePipeline p(context, "fused.comp", fusedBindings(), 0,
-                    {{0, static_cast<std::uint32_t>(level)}, {2, 64u}, {4, pc.interpolate ? 1u : 0u},
-                     {5, static_cast<std::uint32_t>(kPrefilterFinest)}});
+                    {{2, 64u}, {4, pc.interpolate ? 1u : 0u}, {5, static_cast<std::uint32_t>(kPrefilterFinest)}});
   p.bind({&sampleBuf, &shadeBuf, &objectBuf, &texelView, &lightView, &bitsView, &dirView, &pointBuf, &radiance,
           &counterBuf, &maskBuf, &energyBuf, &lobeBuf, &prefilterView, &pointTexelView});
   context.submit([&](VkCommandBuffer cb) { p.dispatch(cb, {kGroups, 1, 1}); });
@@ -232,9 +251,9 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
       continue;
     }
     const shared::SliceBlend blend = shared::sliceBlendAt(samples[i].thetaOut, kThetaSamples, pc.interpolate ? 1u : 0u);
-    const std::array<WeightedBits, 3> vis = {WeightedBits{bits.point(3 * i).data(), shade[i].b[0]},
-                                             WeightedBits{bits.point(3 * i + 1).data(), shade[i].b[1]},
-                                             WeightedBits{bits.point(3 * i + 2).data(), shade[i].b[2]}};
+    const std::array<WeightedBits, 3> vis = {WeightedBits{bits[o].point(3 * i).data(), shade[i].b[0]},
+                                             WeightedBits{bits[o].point(3 * i + 1).data(), shade[i].b[1]},
+                                             WeightedBits{bits[o].point(3 * i + 2).data(), shade[i].b[2]}};
     const EulerYXY r{samples[i].alpha, samples[i].beta, samples[i].gamma};
     const LobePath path{&prefiltered,
                         std::span<const shared::SliceLobe>(lobes).subspan(o * kThetaSamples, kThetaSamples), toLight,
@@ -270,17 +289,20 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
   std::printf("lobe path: %d samples all on it, %d in part\n", lobeSamples[0], lobeSamples[1]);
   EXPECT_GT(lobeSamples[0], 3);
   EXPECT_GT(lobeSamples[1], 3);
-  std::printf("fused pass, level %d, %s: max |gpu − cpu| / max|I| = %.3g (point lights up to %.0f%% of a sample)\n",
-              level, pc.interpolate ? "blended slices" : "nearest slice", worst, 100.0 * lightShare);
+  std::printf("fused pass, level %d (object 2 at %d), %s: max |gpu − cpu| / max|I| = %.3g (point lights up to %.0f%% of a sample)\n",
+              level, levels[2], pc.interpolate ? "blended slices" : "nearest slice", worst, 100.0 * lightShare);
   EXPECT_LT(worst, 1e-5);
   testing::expectNoValidationMessages(context);
 }
 
 INSTANTIATE_TEST_SUITE_P(Cases, FusedPass,
                          ::testing::Values(PassCase{2, true}, PassCase{4, true}, PassCase{4, false}, PassCase{5, false},
-                                           PassCase{5, true}, PassCase{6, true}, PassCase{7, true}),
+                                           PassCase{5, true}, PassCase{6, true}, PassCase{7, true},
+                                           // Objects at two levels in one dispatch.
+                                           PassCase{4, true, 6}, PassCase{6, false, 3}, PassCase{2, true, 7}),
                          [](const auto& c) {
                            return "level" + std::to_string(c.param.level) +
+                                  (c.param.other ? "_and" + std::to_string(c.param.other) : std::string()) +
                                   (c.param.interpolate ? "_blend" : "_nearest");
                          });
 

@@ -90,6 +90,20 @@ TEST(MemoryPlacement, DiscreteGpuWithResizableBarMapsInputsDirectly) {
   expectPlacement(chooseMemory(m, kAllTypes, MemoryUse::DeviceOnly), 1, false, false);
 }
 
+// What the host reads back goes to cached system memory on a discrete GPU
+// (the host reads a BAR window uncached, a bus round trip per load), and to
+// the cached type wherever memory is one: lavapipe, an integrated GPU.
+TEST(MemoryPlacement, ReadbackIsCachedAndOffTheCardWhereThereIsAChoice) {
+  expectPlacement(chooseMemory(discreteWithBar(), kAllTypes, MemoryUse::Readback), 4, true, false);
+  expectPlacement(chooseMemory(discreteWithoutBar(), kAllTypes, MemoryUse::Readback), 4, true, false);
+  expectPlacement(chooseMemory(integrated(), kAllTypes, MemoryUse::Readback), 2, true, false);
+  expectPlacement(chooseMemory(lavapipe(), kAllTypes, MemoryUse::Readback), 0, true, false);
+  // Without a cached type: coherent system memory, then the BAR window.
+  expectPlacement(chooseMemory(discreteWithBar(), (1u << 3) | (1u << 5), MemoryUse::Readback), 3, true, false);
+  expectPlacement(chooseMemory(discreteWithBar(), 1u << 5, MemoryUse::Readback), 5, true, false);
+  EXPECT_FALSE(chooseMemory(discreteWithBar(), (1u << 1) | (1u << 2), MemoryUse::Readback).has_value());
+}
+
 TEST(MemoryPlacement, OnlyTheTypesTheBufferAllows) {
   const auto m = discreteWithoutBar();
   // Only system memory allowed: inputs are mapped there (read over the bus).

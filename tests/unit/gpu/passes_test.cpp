@@ -359,7 +359,16 @@ render::RenderOptions tinyOptions() {
   return o;
 }
 
-TEST(GBufferPass, CoverageNormalsAndBarycentricsMatchEmbree) {
+// A hardware rasteriser snaps vertices to its sub-pixel grid (8 bits on
+// NVIDIA) before it interpolates, so its barycentrics at a pixel centre are
+// those of a point up to ~1/256 px away: tiny on screen, but on a
+// triangle a fraction of a pixel wide, seen edge-on, up to 0.02 in
+// barycentrics (measured on an H200). Lavapipe interpolates from unsnapped
+// floats. So what is asserted on every device is what must hold: the
+// G-buffer's point lies on its triangle at its own barycentrics, its
+// normal is the mesh's at them, and it is seen through the pixel's centre
+// to within a small fraction of a pixel; Embree's barycentrics are printed.
+TEST(GBufferPass, CoverageAndSurfacePointsMatchEmbreeAtPixelCentres) {
   HAARCAST_REQUIRE_VULKAN();
   const render::Scene scene = testScene();
   const render::RenderOptions o = tinyOptions();
@@ -378,7 +387,7 @@ TEST(GBufferPass, CoverageNormalsAndBarycentricsMatchEmbree) {
   const RayScene rays(std::move(instances));
   const render::CameraRays camera(scene.camera, request.width, request.height);
   std::size_t objectPixels = 0, mismatched = 0, sameTriangle = 0;
-  double worstNormal = 0.0, worstBary = 0.0, worstPosition = 0.0;
+  double worstNormal = 0.0, worstOnTriangle = 0.0, worstScreen = 0.0, worstBary = 0.0;
   for (int y = 0; y < request.height; ++y) {
     for (int x = 0; x < request.width; ++x) {
       const std::size_t p = static_cast<std::size_t>(y) * request.width + x;
@@ -392,30 +401,41 @@ TEST(GBufferPass, CoverageNormalsAndBarycentricsMatchEmbree) {
         ++mismatched;
         continue;
       }
-      if (!hit || hit->triangle != ids[p].y) continue;
-      ++sameTriangle;
-      const Mesh& mesh = *gpu.prepared().objects[hit->object].mesh;
-      const glm::uvec3 tri = mesh.triangles[hit->triangle];
-      const double b[3] = {1.0 - hit->u - hit->v, hit->u, hit->v};
+      if (!ids[p].x) continue;
+      if (hit && hit->triangle == ids[p].y) {
+        ++sameTriangle;
+        worstBary = std::max({worstBary, static_cast<double>(std::abs(std::bit_cast<float>(ids[p].z) - hit->u)),
+                              static_cast<double>(std::abs(std::bit_cast<float>(ids[p].w) - hit->v))});
+      }
+      // The G-buffer's own triangle and barycentrics.
+      const render::PreparedObject& object = gpu.prepared().objects[ids[p].x - 1];
+      const Mesh& mesh = *object.mesh;
+      ASSERT_LT(ids[p].y, mesh.triangles.size());
+      const glm::uvec3 tri = mesh.triangles[ids[p].y];
+      const double u = std::bit_cast<float>(ids[p].z), v = std::bit_cast<float>(ids[p].w);
+      const double b[3] = {1.0 - u - v, u, v};
       const glm::dvec3 n = glm::normalize(b[0] * glm::dvec3(mesh.normals[tri.x]) + b[1] * glm::dvec3(mesh.normals[tri.y]) +
                                           b[2] * glm::dvec3(mesh.normals[tri.z]));
       const glm::dvec3 pos = b[0] * glm::dvec3(mesh.positions[tri.x]) + b[1] * glm::dvec3(mesh.positions[tri.y]) +
                              b[2] * glm::dvec3(mesh.positions[tri.z]);
       worstNormal = std::max(worstNormal, glm::length(glm::normalize(glm::dvec3(normals[p])) - n));
-      worstPosition = std::max(worstPosition, glm::length(glm::dvec3(positions[p]) - pos));
-      worstBary = std::max({worstBary, static_cast<double>(std::abs(std::bit_cast<float>(ids[p].z) - hit->u)),
-                            static_cast<double>(std::abs(std::bit_cast<float>(ids[p].w) - hit->v))});
+      worstOnTriangle = std::max(worstOnTriangle, glm::length(glm::dvec3(positions[p]) - pos));
+      // Where the point is seen, in pixels from the pixel's centre.
+      const glm::dvec3 world = glm::dvec3(object.pose.objectToWorld() * glm::dvec4(glm::dvec3(positions[p]), 1.0));
+      const glm::dvec3 seen = glm::normalize(world - camera.origin());
+      const double pixelAngle = glm::length(camera.directionAt(x + 1.5, y + 0.5) - camera.direction(x, y));
+      worstScreen = std::max(worstScreen, glm::length(seen - camera.direction(x, y)) / pixelAngle);
     }
   }
-  std::printf("G-buffer: %zu object pixels, %zu coverage mismatches, %zu on the same triangle; max normal %.2g, "
-              "barycentric %.2g, position %.2g\n",
-              objectPixels, mismatched, sameTriangle, worstNormal, worstBary, worstPosition);
+  std::printf("G-buffer: %zu object pixels, %zu coverage mismatches, %zu on Embree's triangle (barycentrics within "
+              "%.2g); its points: normal %.2g, off their triangle %.2g, %.2g px from the pixel centre\n",
+              objectPixels, mismatched, sameTriangle, worstBary, worstNormal, worstOnTriangle, worstScreen);
   ASSERT_GT(objectPixels, 300u);
   EXPECT_LE(static_cast<double>(mismatched), 0.005 * static_cast<double>(objectPixels) + 1.0);
   EXPECT_GT(sameTriangle, objectPixels * 9 / 10);
   EXPECT_LT(worstNormal, 1e-3);
-  EXPECT_LT(worstBary, 1e-3);
-  EXPECT_LT(worstPosition, 1e-3);
+  EXPECT_LT(worstOnTriangle, 1e-4);
+  EXPECT_LT(worstScreen, 0.05);
   testing::expectNoValidationMessages(gpu.context());
 }
 

@@ -268,6 +268,69 @@ TEST(Protocol, SettingsChangeAllOrNothing) {
   EXPECT_EQ(c.lightCoefficients, 32u);
 }
 
+// Automatic levels (RenderSettings.level_mode): the server's default at
+// Hello, a level alone a fixed level as before the field, a mode with level
+// 0 the level in effect (as the level or the cap), a cap checked as a level
+// is; the renderer differs between a fixed level and the same cap.
+TEST(Protocol, LevelModeIsAutomaticOrFixedCompatibly) {
+  Defaults defaults;
+  defaults.level = 6;
+  defaults.automaticLevel = true;
+  auto c = std::get<SessionConfig>(configFromHello(goodHello(), Limits{}, defaults, testCatalog()));
+  EXPECT_TRUE(c.automaticLevel);
+  EXPECT_EQ(c.level, 6);
+  EXPECT_EQ(settingsToWire(c).level_mode(), v1::LEVEL_MODE_AUTO);
+  EXPECT_EQ(settingsToWire(c).level(), 6u);
+  const std::string automaticKey = c.rendererKey();
+  v1::RenderSettings levelOnly;  // an older client's
+  levelOnly.set_level(6);
+  ASSERT_FALSE(applySettings(c, levelOnly, Limits{}, testCatalog()));
+  EXPECT_FALSE(c.automaticLevel) << "a level alone is a fixed level";
+  EXPECT_NE(c.rendererKey(), automaticKey);
+  EXPECT_EQ(settingsToWire(c).level_mode(), v1::LEVEL_MODE_FIXED);
+  v1::RenderSettings unchanged;  // neither: nothing changes
+  unchanged.set_light_coefficients(32);
+  ASSERT_FALSE(applySettings(c, unchanged, Limits{}, testCatalog()));
+  EXPECT_FALSE(c.automaticLevel);
+  v1::RenderSettings backToAuto;
+  backToAuto.set_level_mode(v1::LEVEL_MODE_AUTO);
+  ASSERT_FALSE(applySettings(c, backToAuto, Limits{}, testCatalog()));
+  EXPECT_TRUE(c.automaticLevel);
+  EXPECT_EQ(c.level, 6) << "level 0: the level in effect, now the cap";
+  EXPECT_EQ(c.rendererKey(), automaticKey);
+  v1::RenderSettings cap;
+  cap.set_level_mode(v1::LEVEL_MODE_AUTO);
+  cap.set_level(5);
+  ASSERT_FALSE(applySettings(c, cap, Limits{}, testCatalog()));
+  EXPECT_TRUE(c.automaticLevel);
+  EXPECT_EQ(c.level, 5);
+  Limits limits;
+  limits.maxLevel = 6;
+  cap.set_level(7);
+  const auto tooFine = applySettings(c, cap, limits, testCatalog());
+  ASSERT_TRUE(tooFine);
+  EXPECT_EQ(tooFine->code, v1::ERROR_CODE_BAD_SETTINGS);
+  EXPECT_NE(tooFine->message.find("level cap 7 is outside"), std::string::npos) << tooFine->message;
+  EXPECT_EQ(c.level, 5) << "all or nothing";
+  v1::RenderSettings bad;
+  bad.set_level_mode(static_cast<v1::LevelMode>(9));
+  const auto unknown = applySettings(c, bad, Limits{}, testCatalog());
+  ASSERT_TRUE(unknown);
+  EXPECT_NE(unknown->message.find("level_mode 9"), std::string::npos) << unknown->message;
+  EXPECT_NE(unknown->message.find("AUTO = 2"), std::string::npos) << unknown->message;
+  v1::RenderSettings fixed;
+  fixed.set_level_mode(v1::LEVEL_MODE_FIXED);
+  ASSERT_FALSE(applySettings(c, fixed, Limits{}, testCatalog()));
+  EXPECT_FALSE(c.automaticLevel);
+  EXPECT_EQ(c.level, 5) << "level 0: the cap in effect, now the level";
+  // The scene info says each object's level where the renderer knows it.
+  const v1::SceneInfo info = sceneInfo(c, testCatalog(), {5, 6});
+  ASSERT_GE(info.objects_size(), 2);
+  EXPECT_EQ(info.objects(0).level(), 5u);
+  EXPECT_EQ(info.objects(1).level(), 6u);
+  EXPECT_EQ(sceneInfo(c, testCatalog()).objects(0).level(), 0u) << "0: not known yet";
+}
+
 // A resized client window: RenderSettings.width and height change the frame
 // size mid-session under Hello's rules (the limits, the pixel budget, even
 // for H.264), all or nothing, never fatal; the renderer stays the same.

@@ -4,6 +4,7 @@
 // checked message by message and instant by instant.
 #include "haarcast/net/render_session.h"
 
+#include <algorithm>
 #include <condition_variable>
 #include <deque>
 #include <functional>
@@ -118,9 +119,9 @@ struct Fixture {
     ASSERT_EQ(port.prepared.size(), 1u);
     session.onPrepared(port.prepared.back().rendererKey(), prepared(), "", t0);
   }
-  static std::shared_ptr<PreparedRenderer> prepared() {
+  static std::shared_ptr<PreparedRenderer> prepared(std::vector<int> levels = {}) {
     auto p = std::make_shared<PreparedRenderer>();
-    p->renderer = std::make_unique<StubRenderer>();
+    p->renderer = std::make_unique<StubRenderer>(std::move(levels));
     return p;
   }
   // Runs the last order as a worker would and hands the frame back.
@@ -220,6 +221,22 @@ TEST(RenderSession, SceneSwitchAnnouncesSceneInfoAndBuildsItsRenderer) {
   f.session.onBuildProgress(f.port.prepared.back().rendererKey(), {"slices b", 0, 1, 2, 0.1, 0.0});
   EXPECT_EQ(f.port.sent.back().build_progress().stage(), "slices b");
   EXPECT_TRUE(f.port.sent[f.port.sent.size() - 2].has_scene_info());
+  // The SceneInfo could not say the objects' levels (0); once the new
+  // renderer is built, a second one does, and only when they changed.
+  EXPECT_EQ(f.port.sent[f.port.sent.size() - 2].scene_info().objects(0).level(), 0u);
+  f.session.onPrepared(f.port.prepared.back().rendererKey(), Fixture::prepared({6, 5}), "", f.t0);
+  const auto levelsInfo = std::find_if(f.port.sent.rbegin(), f.port.sent.rend(),
+                                       [](const v1::ServerMessage& s) { return s.has_scene_info(); });
+  ASSERT_NE(levelsInfo, f.port.sent.rend());
+  ASSERT_GE(levelsInfo->scene_info().objects_size(), 2);
+  EXPECT_EQ(levelsInfo->scene_info().objects(0).level(), 6u);
+  EXPECT_EQ(levelsInfo->scene_info().objects(1).level(), 5u);
+  const auto infos = [&] {
+    return std::count_if(f.port.sent.begin(), f.port.sent.end(), [](const v1::ServerMessage& s) { return s.has_scene_info(); });
+  };
+  const auto before = infos();
+  f.session.onPrepared(f.port.prepared.back().rendererKey(), Fixture::prepared({6, 5}), "", f.t0);
+  EXPECT_EQ(infos(), before) << "the same levels are not announced twice";
   // A material change on the same scene is a SceneChoice too: SceneInfo again.
   m.mutable_scene()->mutable_object_materials()->insert({1, "phong:16"});
   f.receive(m, f.t0);

@@ -9,6 +9,7 @@
 // its elevation is β and its azimuth α; γ turns the slice about the normal.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -147,6 +148,17 @@ std::vector<EulerYXY> randomRotations(int count, std::uint32_t seed);
 // forward Haar. The seed's ground truth.
 HaarMap rotateSpatial(const HaarMap& f, const EulerYXY& r);
 SphereMap rotateSpatialMap(const SphereMap& f, const EulerYXY& r);
+// Three maps (a light's R, G, B) turned as rotateSpatialMap turns each, the
+// taps found once per pixel for the three and the rows on parallelFor's
+// threads, then each averaged down to `level` ≤ their level by solid angle
+// (SphereMap::downsampled). `fused` turns its light into each object's
+// frame this way from a map two levels finer than the object's
+// (render/renderer.cpp): turned at the object's own level, the bilinear
+// lookups of a coarse map lost or gained up to 6 % of the light's integral
+// (a Lambert torus under adams_place_bridge_1k.hdr: 0.94 at level 4, 0.97
+// at 5, 1.01 at 6, 1.00 at 7), which showed as a whole object too dark or
+// too bright (docs/evaluation.md, "A level per object").
+std::array<SphereMap, 3> rotateSpatialMapsDown(const std::array<SphereMap, 3>& maps, const EulerYXY& r, int level);
 
 // A pure φ-shift by `radians`, applied to Haar coefficients: exact (a
 // permutation of pixels) when radians is a whole number of pixels, linear

@@ -268,7 +268,9 @@ struct FrameParams {
 };
 
 // Per object: object → world rotation (columns), where its slices, method
-// data, vertices and triangles start.
+// data, vertices and triangles start; for `fused` its own map level and
+// where its level's data start in the buffers every object shares (objects
+// at different levels lie side by side: docs/design.md, "A level per object").
 struct ObjectInfo {
   vec4 rotation[3];
   uint sliceBase;      // global slice index of its θ slice 0
@@ -282,6 +284,14 @@ struct ObjectInfo {
   vec4 groundRadiance; // a ground object: the radiance of its unshadowed map light (rgb)
   vec4 toLight[3];     // `fused`'s lobe path: object frame → the environment's, this frame (columns)
   vec4 lobeCore;       // x: cos of the lobe path's core angle (core fused.h LobePath::coreAngle), −1: the path takes all; yzw: 0
+  uint level;          // `fused`: its map level n (M = 2^n, N = M² directions)
+  uint texelBase;      // `fused`: texel of its slice 0 (slice texels and point texels); slice t at texelBase + t·N
+  uint lightBase;      // `fused`: texel of its light's direction 0 this frame
+  uint directionBase;  // `fused`: its level's pixel-centre directions in the table of every level in use
+  uint visibilityBase; // `fused`: word of its vertex 0's bits; global vertex v at visibilityBase + (v − vertexBase)·visibilityWords(level)
+  uint levelPad0;
+  uint levelPad1;
+  uint levelPad2;
 };
 
 // ObjectInfo::flags: the object is the scene's ground, a Lambert plane that
@@ -465,8 +475,9 @@ struct GBufferPush {
 #ifdef __cplusplus
 static_assert(sizeof(FrameParams) == 128 && offsetof(FrameParams, tanHalf) == 96 &&
               offsetof(FrameParams, fusedGroups) == 124);
-static_assert(sizeof(ObjectInfo) == 160 && offsetof(ObjectInfo, toLight) == 96 && offsetof(ObjectInfo, sliceBase) == 48 &&
-              offsetof(ObjectInfo, skipBelowY) == 68 && offsetof(ObjectInfo, groundRadiance) == 80);
+static_assert(sizeof(ObjectInfo) == 192 && offsetof(ObjectInfo, toLight) == 96 && offsetof(ObjectInfo, sliceBase) == 48 &&
+              offsetof(ObjectInfo, skipBelowY) == 68 && offsetof(ObjectInfo, groundRadiance) == 80 &&
+              offsetof(ObjectInfo, level) == 160 && offsetof(ObjectInfo, visibilityBase) == 176);
 static_assert(sizeof(PointLight) == 32);
 static_assert(sizeof(SliceLobe) == 48 + 16 * kLobeSamples && offsetof(SliceLobe, median) == 16 &&
               offsetof(SliceLobe, core) == 32 && offsetof(SliceLobe, samples) == 48);

@@ -2,8 +2,10 @@
 // and heaps (VkPhysicalDeviceMemoryProperties), testable without a device.
 //
 //   use           memory                                         host access
-//   Host          host-visible + coherent, device-local too      mapped
+//   Host          host-visible + coherent, device-local too      mapped (written by the host)
 //                 where a type offers both
+//   Readback      host-visible + coherent + cached, preferring   mapped (read by the host)
+//                 a type that is not device-local
 //   DeviceInput   device-local                                   mapped where all of device-local memory is
 //                                                                host-visible (CPU devices, integrated GPUs,
 //                                                                resizable BAR); else staged: the host writes a
@@ -15,6 +17,12 @@
 // a heap as large as the largest device-local heap. A discrete GPU without
 // resizable BAR offers such a type too, but only as a 256 MiB window onto
 // its memory; inputs of hundreds of MiB do not belong there.
+//
+// Readback exists because the host reads device-local host-visible memory
+// (a BAR window) uncached, one PCIe round trip per load: on an H200 with
+// resizable BAR a 256² fused frame spent about 0.5 s reading its G-buffer
+// ids and samples back that way (1.7 fps), where cached system memory
+// reads at memory speed. The device writes it over the bus instead, once.
 #pragma once
 
 #include <cstdint>
@@ -25,7 +33,8 @@
 namespace haarcast::gpu {
 
 enum class MemoryUse {
-  Host,         // written or read by the host every frame: uniforms, results read back
+  Host,         // written by the host every frame: uniforms, per-object records, staging
+  Readback,     // written by the device, read by the host: results, samples the host traces
   DeviceInput,  // large and read-only to the passes, written by the host (scene data, the light)
   DeviceOnly,   // written and read by the device alone (intermediates)
 };

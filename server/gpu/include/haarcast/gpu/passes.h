@@ -52,13 +52,24 @@ std::vector<glm::uvec4> packSparseLists(std::span<const SparseHaar> lists, int l
 std::size_t blockCount(const SparseHaar& list);
 
 // fused.comp's directions: the unit vectors of a level's pixel centres, row
-// by row (w unused), computed in double as core fused's and rounded to float.
+// by row (w: the pixel's solid angle), computed in double as core fused's
+// and rounded to float.
 std::vector<glm::vec4> pixelCentreDirections(int level);
+
+// The directions of several levels in one table, for objects at their own
+// levels (ObjectInfo::directionBase): each level's pixelCentreDirections
+// once, ascending; level l's direction 0 at base[l] (0 for levels not in it).
+struct DirectionTable {
+  std::vector<glm::vec4> directions;
+  std::array<std::uint32_t, shared::kFusedMaxLevel + 1> base{};
+};
+DirectionTable pixelCentreDirections(std::span<const int> levels);
 
 // fused.comp's bindings: 0 samples, 1 shade, 2 objects (storage); 3 slice
 // texels (RGBA32F texels); 4 light (RGBA32F texels, fusedLightTexels); 5
-// visibility bits (R32UI texels: every vertex's shared::visibilityWords words,
-// global vertex order); 6 directions (RGBA32F texels); 7 point lights
+// visibility bits (R32UI texels: every vertex's shared::visibilityWords words
+// at its object's level, global vertex order); 6 directions (RGBA32F
+// texels, a DirectionTable); 7 point lights
 // (PointLight, kMaxPointLights per object), 8 radiance, 9 counter, 10 the
 // samples' point-light masks (a uint per sample) (storage).
 std::vector<BindingKind> fusedBindings();

@@ -75,6 +75,7 @@ class VulkanRenderer final : public render::Renderer {
   std::string deviceName() const override;
   const render::RenderOptions& options() const override;
   std::size_t objectCount() const override;
+  std::vector<int> objectLevels() const override;
   render::Frame render(const render::FrameRequest& request) override;
 
   // ---- For tests and diagnostics: the last frame's intermediate data -----

@@ -39,6 +39,7 @@ struct WelcomeFacts {
   std::string sessionId;
   std::size_t objectCount = 0;
   std::string device;
+  std::vector<int> objectLevels;  // render::Renderer::objectLevels (SceneInfo.Object.level)
 };
 std::string welcomeMessage(const SessionConfig& config, const Catalog& catalog, const Limits& limits,
                            const WelcomeFacts& facts);
@@ -66,7 +67,8 @@ std::string statsMessage(const StatsFigures& figures);
 // "ERROR_CODE_BAD_MESSAGE" → "bad_message": the /metrics label and log word.
 std::string errorLabel(v1::ErrorCode code);
 
-std::string sceneInfoMessage(const SessionConfig& config, const Catalog& catalog);
+std::string sceneInfoMessage(const SessionConfig& config, const Catalog& catalog,
+                             const std::vector<int>& objectLevels = {});
 std::string pongMessage(std::uint64_t nonce);
 std::string errorMessage(const ProtocolError& error);
 // The stage goes out through publicStageName (build_progress.h).

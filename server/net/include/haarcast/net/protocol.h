@@ -57,7 +57,8 @@ struct Defaults {
   FrameEncoding encoding = FrameEncoding::Jpeg;
   int jpegQuality = 85;
   RotationMethod method = RotationMethod::Haar;
-  int level = 5;
+  int level = 5;                // fixed: the level; automatic: the cap
+  bool automaticLevel = false;  // RenderSettings.level_mode AUTO (render::RenderOptions::automaticLevel)
   std::size_t lightCoefficients = 256;
   Backend backend = Backend::Cpu;
 };
@@ -101,7 +102,8 @@ struct SessionConfig {
   std::string scene;                   // a Catalog scene name
   std::vector<std::string> materials;  // per object, offered specs
   RotationMethod method = RotationMethod::Haar;
-  int level = 5;
+  int level = 5;                // fixed: the level; automatic: the cap
+  bool automaticLevel = false;  // each object its own level (render/object_levels.h)
   std::size_t lightCoefficients = 256;
   Backend backend = Backend::Cpu;
   bool autoExposure = true;   // else exposureStops
@@ -169,7 +171,9 @@ v1::ServerLimits limitsToWire(const Limits& limits);
 // defaultH264BitrateKbps of its size and fps.
 H264Settings h264Settings(const SessionConfig& config);
 // The config's scene, its objects (named by the catalog) and their materials.
-v1::SceneInfo sceneInfo(const SessionConfig& config, const Catalog& catalog);
+// objectLevels: each object's map level where the renderer is ready
+// (render::Renderer::objectLevels), else empty (SceneInfo.Object.level 0).
+v1::SceneInfo sceneInfo(const SessionConfig& config, const Catalog& catalog, const std::vector<int>& objectLevels = {});
 
 // Serialised ServerMessages (the builders of each message: messages.h).
 std::string serialize(const v1::ServerMessage& message);

@@ -176,6 +176,10 @@ class RenderSession {
 
   // Strand state.
   bool hello_ = false, welcomed_ = false, wantFrame_ = false, inFlight_ = false, paceArmed_ = false;
+  // The objects' levels the client was last told (Welcome, SceneInfo): a
+  // renderer built later with other levels (a new scene, material or level
+  // mode) is announced by a SceneInfo that carries them.
+  std::vector<int> announcedLevels_;
   bool closed_ = false;
   int badMessages_ = 0;
   std::string clientName_;  // sanitised for the log

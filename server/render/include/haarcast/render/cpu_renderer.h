@@ -38,7 +38,15 @@ namespace haarcast::render {
 struct RenderOptions {
   int width = 128;
   int height = 128;
-  int level = 5;                          // map level of light, slices and visibility
+  // Map level of light, slices and visibility: every object's, or with
+  // automaticLevel the cap of `fused`'s levels per object.
+  int level = 5;
+  // `fused` only: each object at its own level, the smallest at which its
+  // material's lobe spans enough texels (core/lobe.h chooseLevel), within
+  // [kAutoLevelFloor, level] (render/object_levels.h). Off here, so that
+  // measurements and tests keep one level; `render` and `serve` turn it on.
+  // The other methods keep `level` for every object.
+  bool automaticLevel = false;
   RotationMethod method = kDefaultPixelMethod;
   // fused: blend the two nearest θₒ slices (false: the nearest alone, as the
   // rotating methods do).
@@ -52,7 +60,7 @@ struct RenderOptions {
   std::size_t lightCoefficients = 256;    // k: the light's largest coefficients kept
   int thetaSamples = 16;                  // BRDF slices per channel
   int sliceSupersampling = 4;
-  VisibilityOptions visibility;           // its level is overridden by `level`
+  VisibilityOptions visibility;           // its level is overridden by each object's
   // fused: the light's brightest regions taken out as point lights with a
   // shadow ray per pixel each (core/light_split.h); maxLights 0 = none,
   // at most shared::kMaxPointLights.

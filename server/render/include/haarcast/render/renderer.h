@@ -20,6 +20,7 @@
 //   "tonemap"         exposure, sRGB, RGBA8 (and the linear image kept for EXR)
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <array>
 #include <cstdint>
@@ -100,6 +101,9 @@ class Renderer {
   virtual std::string deviceName() const = 0;  // e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
   virtual const RenderOptions& options() const = 0;
   virtual std::size_t objectCount() const = 0;
+  // Each object's map level (PreparedObject::level), in scene order; empty
+  // where a renderer does not say.
+  virtual std::vector<int> objectLevels() const { return {}; }
   // Whether render() may run on several threads at once. The CPU backend's
   // prepared data is immutable and each call keeps its own scratch, so it
   // may; a Vulkan renderer owns one set of device buffers and may not (the
@@ -116,6 +120,9 @@ class Renderer {
 // Once per scene: what both backends upload or use, computed by the same code.
 struct PreparedObject {
   std::string name;
+  // Its map level: slices, visibility and, per frame, `fused`'s light
+  // (RenderOptions::level, or with automaticLevel its own: object_levels.h).
+  int level = 0;
   std::shared_ptr<const Mesh> mesh;    // with normals, object frame
   BrdfSliceTable table;                // unrotated slices: the only BRDF data kept
   // Per vertex, object frame: the Haar methods' top-k lists (empty for
@@ -147,10 +154,17 @@ struct PreparedScene {
   std::array<SphereMap, 3> light;       // world frame, level n, radiance (no solid angle)
   std::array<SphereMap, 3> background;  // world frame, level kBackgroundLevel, for the backdrop
   // `fused` only: the light split (core/light_split.h) in the environment's
-  // frame: its point lights, and the map without them.
+  // frame: its point lights, and the map without them at each object's
+  // level and at the level each is turned from (lightTurnLevel), each the
+  // solid-angle mean of the backdrop's rest (restLightAt).
   std::vector<DirectionalLight> pointLights;
-  std::array<SphereMap, 3> restLight;
-  SphereMap restLuminance;              // its Rec. 709 luminance (the ground's hidden sky, point_lights.h)
+  std::vector<std::array<SphereMap, 3>> restLight;  // [level] 0 … kBackgroundLevel: empty where not needed
+  SphereMap restLuminance;              // the finest object level's rest, Rec. 709 luminance (the ground's hidden sky, point_lights.h)
+  // The rest at a level some object uses or is turned from; throws
+  // std::out_of_range otherwise.
+  const std::array<SphereMap, 3>& restLightAt(int level) const;
+  // Each object's level, in scene order (PreparedObject::level).
+  std::vector<int> objectLevels() const;
   PrefilteredLight lobeLight;           // `fused`, `splitsum`: the backdrop's maps at every level, for the lobe path (empty when no object has one)
   std::optional<std::size_t> ground;    // index of the ground object, if any
 };
@@ -158,10 +172,23 @@ struct PreparedScene {
 // Level of the backdrop maps: fine enough to look like the probe (512²).
 inline constexpr int kBackgroundLevel = 9;
 
-// One object's slice table at options.level, from options.cacheDir when
-// cached there; progress as stage "slices NAME". prepareScene uses it, and so
-// does whatever sizes the tables without preparing the rest (loadtest).
+// `fused`: the level an object's light is turned into its frame at, then
+// averaged down to the object's by solid angle (core rotateSpatialMapsDown:
+// turned at the object's own level, a coarse map's bilinear lookups lost or
+// gained up to 6 % of the light). Two levels finer, but not past 7 (unless
+// the object's is): a Lambert torus at level 6 measured 0.54 % relative L2
+// turned from level 7 and 0.49 % from 8, which costs 4× as much each frame
+// (docs/evaluation.md, "A level per object").
+inline constexpr int kLightTurnFinest = 7;
+inline int lightTurnLevel(int level) { return std::max(level, std::min(level + 2, kLightTurnFinest)); }
+
+// One object's slice table at options.level (or at `level`), from
+// options.cacheDir when cached there; progress as stage "slices NAME".
+// prepareScene uses it, and so does whatever sizes the tables without
+// preparing the rest (loadtest).
 BrdfSliceTable objectSliceTable(const SceneObject& object, const RenderOptions& options,
+                                const RenderProgress& progress = {});
+BrdfSliceTable objectSliceTable(const SceneObject& object, const RenderOptions& options, int level,
                                 const RenderProgress& progress = {});
 
 // Slice tables (cached in options.cacheDir), visibility (cached), light and

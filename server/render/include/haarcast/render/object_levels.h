@@ -1,0 +1,65 @@
+// `fused`'s map level per object (RenderOptions::automaticLevel), chosen
+// from each object's material before anything else is prepared: the slice
+// tables, the visibility bits (and their refinement) and each frame's light
+// of an object are then all at its level, and a rough object no longer pays
+// for the level a near-mirror beside it needs (docs/design.md, "A level per
+// object"). The rule is core/lobe.h chooseLevel.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "haarcast/core/shared_layout.h"
+#include "haarcast/render/cpu_renderer.h"
+#include "haarcast/render/scene.h"
+
+namespace haarcast::render {
+
+struct ObjectLevel {
+  int level = 0;
+  // `fused`: its lobes measured whole at the slice table's θₒ (core
+  // measureLobes), from which the level and the lobe path are chosen; empty
+  // for the ground (shaded in closed form) and for the other methods.
+  std::vector<shared::SliceLobe> lobes;
+};
+
+// Per scene object, in order. Fixed (automaticLevel false) or a method
+// other than `fused`: options.level for every object. Automatic:
+// chooseLevel within [kAutoLevelFloor, options.level], the ground at the
+// floor (its map light is one closed form, its pixels read no map).
+std::vector<ObjectLevel> chooseObjectLevels(const Scene& scene, const RenderOptions& options);
+
+// The distinct levels of the objects, ascending.
+std::vector<int> levelsInUse(const std::vector<int>& objectLevels);
+
+// What a user or client asks for: one level for every object, or automatic
+// levels up to a cap. `render` and `serve` default to automatic, cap 6:
+// what a near-mirror gets (with the lobe path for its core), the level the
+// service already allowed at most (net::Limits::maxLevel), level 7 costing
+// 4× per pixel for what docs/evaluation.md ("A level per object") measures.
+inline constexpr int kDefaultLevelCap = 6;
+// The one level of the methods other than `fused` under automatic levels:
+// the default they always had (their cost grows with the level as fused's
+// does, and nothing chooses a level per object for them).
+inline constexpr int kDefaultFixedLevel = 5;
+struct LevelChoice {
+  int level = kDefaultLevelCap;  // fixed: the level; automatic: the cap
+  bool automatic = true;
+  std::string name() const;      // "5", "auto" (the default cap) or "auto:7"
+  bool operator==(const LevelChoice&) const = default;
+};
+// "N", "auto" or "auto:CAP" with N and CAP in kMinRenderLevel..kMaxRenderLevel;
+// nullopt for anything else.
+std::optional<LevelChoice> parseLevelChoice(std::string_view text);
+// What the flags' help and errors say the valid choices are.
+std::string levelChoiceHelp();
+// options.level and automaticLevel for a choice and options.method: fused
+// takes it as it is; another method under automatic levels takes
+// min(cap, kDefaultFixedLevel), one level for every object.
+void applyLevelChoice(RenderOptions& options, const LevelChoice& choice);
+// "level 5" for one level, else "levels 4, 6" (each object's, in scene order).
+std::string describeLevels(const std::vector<int>& objectLevels);
+
+}  // namespace haarcast::render
