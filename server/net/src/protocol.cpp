@@ -17,6 +17,13 @@ bool finite(const v1::Vec3& v) { return std::isfinite(v.x()) && std::isfinite(v.
 glm::dvec3 toGlm(const v1::Vec3& v) { return {v.x(), v.y(), v.z()}; }
 
 // "a, b, c" (at most `most` items, then "… (n in all)").
+// Shortest form: "170", "0.5", not std::to_string's "170.000000".
+std::string numberText(double v) {
+  std::ostringstream text;
+  text << v;
+  return text.str();
+}
+
 std::string joined(const std::vector<std::string>& items, std::size_t most = 24) {
   std::string out;
   for (std::size_t i = 0; i < items.size() && i < most; ++i) out += (i ? ", " : "") + items[i];
@@ -420,9 +427,13 @@ std::optional<ProtocolError> applyPose(PoseState& state, const v1::PoseUpdate& u
     if (c.has_target()) next.camera.target = toGlm(c.target());
     if (c.has_up()) next.camera.up = toGlm(c.up());
     if (c.fov_y_degrees() != 0.0) {
-      if (c.fov_y_degrees() <= 0.0 || c.fov_y_degrees() >= 179.0) {
+      // The renderer's range (render/renderer.h), the one definition.
+      if (!(c.fov_y_degrees() >= render::kMinFovDegrees && c.fov_y_degrees() <= render::kMaxFovDegrees)) {
         return error(v1::ERROR_CODE_BAD_MESSAGE,
-                     "pose " + std::to_string(update.sequence()) + ": fov_y_degrees must be in (0, 179)", false);
+                     "pose " + std::to_string(update.sequence()) + ": fov_y_degrees " + numberText(c.fov_y_degrees()) +
+                         " is outside " + numberText(render::kMinFovDegrees) + ".." +
+                         numberText(render::kMaxFovDegrees),
+                     false);
       }
       next.camera.fovYDegrees = c.fov_y_degrees();
     }
