@@ -26,55 +26,11 @@
 #include <functional>
 #include <string>
 
-#include "haarcast/core/light_split.h"
-#include "haarcast/core/rotation.h"
 #include "haarcast/io/image.h"
+#include "haarcast/render/render_options.h"
 #include "haarcast/render/scene.h"
-#include "haarcast/render/visibility.h"
-#include "haarcast/render/visibility_refine.h"
 
 namespace haarcast::render {
-
-struct RenderOptions {
-  int width = 128;
-  int height = 128;
-  // Map level of light, slices and visibility: every object's, or with
-  // automaticLevel the cap of `fused`'s levels per object.
-  int level = 5;
-  // `fused` only: each object at its own level, the smallest at which its
-  // material's lobe spans enough texels (core/lobe.h chooseLevel), within
-  // [kAutoLevelFloor, level] (render/object_levels.h). Off here, so that
-  // measurements and tests keep one level; `render` and `serve` turn it on.
-  // The other methods keep `level` for every object.
-  bool automaticLevel = false;
-  RotationMethod method = kDefaultPixelMethod;
-  // fused: blend the two nearest θₒ slices (false: the nearest alone, as the
-  // rotating methods do).
-  bool interpolateSlices = true;
-  // Edge pixels drawn as the mean of shared::kSubsamples sub-samples
-  // (shared_layout.h); interior pixels keep one sample at the centre. Off
-  // here, so that measurements compare one sample per pixel with the
-  // reference; `render` and `serve` turn it on for what users look at.
-  bool antialias = false;
-  RotatorOptions rotator;
-  std::size_t lightCoefficients = 256;    // k: the light's largest coefficients kept
-  int thetaSamples = 16;                  // BRDF slices per channel
-  int sliceSupersampling = 4;
-  VisibilityOptions visibility;           // its level is overridden by each object's
-  // fused: the light's brightest regions taken out as point lights with a
-  // shadow ray per pixel each (core/light_split.h); maxLights 0 = none,
-  // at most shared::kMaxPointLights.
-  LightSplitOptions pointLights;
-  RefineOptions refine;                   // fused: the mesh refined where visibility changes (visibility_refine.h)
-  SceneLimits sceneLimits;                // objects, triangles, visibility memory (prepareScene)
-  bool environmentBackground = true;      // false: black where no object is
-  std::string cacheDir;                   // slice-table and visibility cache; empty = none
-  unsigned threads = 0;                   // 0 = hardware concurrency
-};
-
-// Throws std::invalid_argument naming the bad option (sizes over 8192², level
-// outside 2..8 — 2..7 for fused —, k = 0, …).
-void checkRenderOptions(const RenderOptions& options);
 
 struct RenderTimings {
   double precompute = 0.0;  // slice tables, rotators, visibility
@@ -88,10 +44,6 @@ struct RenderResult {
   std::vector<std::uint8_t> objectMask;  // 1 where an object was hit
   RenderTimings timings;
 };
-
-// progress(stage, done, total) for long stages, on the calling thread; may be
-// empty.
-using RenderProgress = std::function<void(const std::string& stage, std::size_t done, std::size_t total)>;
 
 RenderResult renderCpu(const Scene& scene, const RenderOptions& options, const RenderProgress& progress = {});
 

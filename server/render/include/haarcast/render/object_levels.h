@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "haarcast/core/shared_layout.h"
-#include "haarcast/render/cpu_renderer.h"
+#include "haarcast/render/render_options.h"
 #include "haarcast/render/scene.h"
 
 namespace haarcast::render {

@@ -41,7 +41,7 @@
 #include "haarcast/core/shared_layout.h"
 #include "haarcast/core/sphere_map.h"
 #include "haarcast/io/image.h"
-#include "haarcast/render/cpu_renderer.h"
+#include "haarcast/render/render_options.h"
 #include "haarcast/render/point_lights.h"
 #include "haarcast/render/scene.h"
 #include "haarcast/render/tonemap.h"
@@ -221,16 +221,6 @@ glm::dvec3 backgroundRadiance(const std::array<SphereMap, 3>& background, const 
 // Throws std::invalid_argument naming the problem.
 void checkFrameRequest(const FrameRequest& request, std::size_t objectCount);
 
-// The bounds a frame request must keep (checkFrameRequest), one set for every
-// backend, the service and the clients.
-inline constexpr int kMaxFrameSide = 8192;
-// Map levels every per-pixel method accepts on both backends (`fused`'s cap).
-inline constexpr int kMinRenderLevel = static_cast<int>(shared::kMinLevel);
-inline constexpr int kMaxRenderLevel = static_cast<int>(shared::kFusedMaxLevel);
-inline constexpr double kMinFovDegrees = 1.0;
-inline constexpr double kMaxFovDegrees = 170.0;
-inline constexpr double kMinEyeDistance = 1e-3;  // eye to target, scene units
-inline constexpr double kMaxEyeDistance = 1e4;
 
 // One frame resolved once, for every backend: the request checked, and per
 // object its pose in effect, the light in its frame (cut to k) and, for
