@@ -67,9 +67,9 @@ TEST(ObjectLevels, ChoicesParseNameAndApply) {
   EXPECT_EQ(parseLevelChoice("auto:7"), (LevelChoice{7, true}));
   for (const char* bad : {"", "1", "8", "auto:", "auto:9", "auto:x", "automatic", "5x", "-5", "auto6"})
     EXPECT_FALSE(parseLevelChoice(bad).has_value()) << bad;
-  EXPECT_EQ(LevelChoice(5, false).name(), "5");
-  EXPECT_EQ(LevelChoice(kDefaultLevelCap, true).name(), "auto");
-  EXPECT_EQ(LevelChoice(7, true).name(), "auto:7");
+  EXPECT_EQ((LevelChoice{5, false}).name(), "5");
+  EXPECT_EQ((LevelChoice{kDefaultLevelCap, true}).name(), "auto");
+  EXPECT_EQ((LevelChoice{7, true}).name(), "auto:7");
   RenderOptions o;
   applyLevelChoice(o, {7, true});
   EXPECT_TRUE(o.automaticLevel);
