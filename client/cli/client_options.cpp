@@ -6,6 +6,11 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include <google/protobuf/descriptor.h>
 
 #include "haarcast/core/shared_layout.h"
 
@@ -179,35 +184,69 @@ LevelRequest parseLevel(const std::string& text) {
   return {number(text), v1::LEVEL_MODE_FIXED};
 }
 
+namespace {
+
+// A wire enum's values by their names as users type them: the value's name
+// after the enum's prefix, in lower case ("ROTATION_METHOD_FUSED" → "fused"),
+// UNSPECIFIED left out. The proto is the one table, as for the browser
+// client, which reads the same enums from the same file.
+std::vector<std::pair<std::string, int>> wireNames(const google::protobuf::EnumDescriptor* e, std::string_view prefix) {
+  std::vector<std::pair<std::string, int>> names;
+  for (int i = 0; i < e->value_count(); ++i) {
+    const google::protobuf::EnumValueDescriptor* v = e->value(i);
+    if (v->number() == 0) continue;
+    std::string name = v->name().substr(prefix.size());
+    std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    names.emplace_back(std::move(name), v->number());
+  }
+  return names;
+}
+
+// "a, b or c".
+std::string choiceList(const std::vector<std::pair<std::string, int>>& names) {
+  std::string list;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (i > 0) list += i + 1 == names.size() ? " or " : ", ";
+    list += names[i].first;
+  }
+  return list;
+}
+
+// The value named `name` ("" → 0, unspecified); else invalid_argument naming
+// the flag and every valid name.
+int parseWireName(const std::vector<std::pair<std::string, int>>& names, const std::string& name, const char* flag) {
+  if (name.empty()) return 0;
+  for (const auto& [n, value] : names) {
+    if (n == name) return value;
+  }
+  throw std::invalid_argument(std::string(flag) + " must be " + choiceList(names) + " (got \"" + name + "\")");
+}
+
+const std::vector<std::pair<std::string, int>>& methodNames() {
+  static const auto names = wireNames(v1::RotationMethod_descriptor(), "ROTATION_METHOD_");
+  return names;
+}
+
+const std::vector<std::pair<std::string, int>>& toneNames() {
+  static const auto names = wireNames(v1::ToneCurve_descriptor(), "TONE_CURVE_");
+  return names;
+}
+
+}  // namespace
+
 v1::RotationMethod parseMethod(const std::string& name) {
-  if (name.empty()) return v1::ROTATION_METHOD_UNSPECIFIED;
-  if (name == "haar") return v1::ROTATION_METHOD_HAAR;
-  if (name == "spatial") return v1::ROTATION_METHOD_SPATIAL;
-  if (name == "matrix") return v1::ROTATION_METHOD_MATRIX;
-  if (name == "table") return v1::ROTATION_METHOD_TABLE;
-  if (name == "fused") return v1::ROTATION_METHOD_FUSED;
-  if (name == "splitsum") return v1::ROTATION_METHOD_SPLITSUM;
-  throw std::invalid_argument("--method must be fused, haar, spatial, matrix, table or splitsum (got \"" + name + "\")");
+  return static_cast<v1::RotationMethod>(parseWireName(methodNames(), name, "--method"));
 }
 
 v1::ToneCurve parseToneCurve(const std::string& name) {
-  if (name.empty()) return v1::TONE_CURVE_UNSPECIFIED;
-  if (name == "reinhard") return v1::TONE_CURVE_REINHARD;
-  if (name == "aces") return v1::TONE_CURVE_ACES;
-  if (name == "agx") return v1::TONE_CURVE_AGX;
-  throw std::invalid_argument("--tone must be reinhard, aces or agx (got \"" + name + "\")");
+  return static_cast<v1::ToneCurve>(parseWireName(toneNames(), name, "--tone"));
 }
 
 std::string methodName(v1::RotationMethod method) {
-  switch (method) {
-    case v1::ROTATION_METHOD_HAAR: return "haar";
-    case v1::ROTATION_METHOD_SPATIAL: return "spatial";
-    case v1::ROTATION_METHOD_MATRIX: return "matrix";
-    case v1::ROTATION_METHOD_TABLE: return "table";
-    case v1::ROTATION_METHOD_FUSED: return "fused";
-    case v1::ROTATION_METHOD_SPLITSUM: return "splitsum";
-    default: return "default";
+  for (const auto& [name, value] : methodNames()) {
+    if (value == method) return name;
   }
+  return "default";
 }
 
 }  // namespace haarcast::client
