@@ -97,6 +97,16 @@ INSTANTIATE_TEST_SUITE_P(Methods, WholeFrame,
                                            RotationMethod::Table),
                          [](const auto& param) { return std::string(methodName(param.param)); });
 
+// The scene's poses with its second object and the light turned, so that
+// the frames compare rotated slices and a light in each object's frame.
+render::FrameRequest turnedRequest(const render::Scene& scene, const render::RenderOptions& o) {
+  render::FrameRequest request = requestFor(scene, o.width, o.height);
+  request.poses = scenePoses(scene);
+  request.poses[1].rotateDegrees += glm::dvec3(10.0, 25.0, -5.0);
+  request.lightRotation = rotationMatrix({0.3, -0.4, 0.1});
+  return request;
+}
+
 // `fused` on Vulkan (fused.comp, one indirect dispatch) against the CPU
 // backend's fused frame, levels 4–7, 64×64, environment backdrop. The floor
 // is set below the measured PSNR (docs/gpu.md) with room for device
@@ -110,10 +120,7 @@ TEST_P(FusedFrame, VulkanMatchesTheCpuBackend) {
   o.level = GetParam();
   const auto cpu = render::makeCpuRenderer(scene, o);
   VulkanRenderer gpu(scene, o, testing::testOptions());
-  render::FrameRequest request = requestFor(scene, o.width, o.height);
-  request.poses = scenePoses(scene);
-  request.poses[1].rotateDegrees += glm::dvec3(10.0, 25.0, -5.0);
-  request.lightRotation = rotationMatrix({0.3, -0.4, 0.1});
+  const render::FrameRequest request = turnedRequest(scene, o);
   const render::Frame a = cpu->render(request);
   const render::Frame b = gpu.render(request);
   const Comparison c = compare(a, b);
@@ -148,10 +155,7 @@ TEST(FusedFrame, ObjectsAtTheirOwnLevelsMatchTheCpuBackend) {
   EXPECT_EQ(levels[0], 5);
   EXPECT_EQ(levels[1], 6);
   EXPECT_EQ(levels[2], 5);
-  render::FrameRequest request = requestFor(scene, o.width, o.height);
-  request.poses = scenePoses(scene);
-  request.poses[1].rotateDegrees += glm::dvec3(10.0, 25.0, -5.0);
-  request.lightRotation = rotationMatrix({0.3, -0.4, 0.1});
+  const render::FrameRequest request = turnedRequest(scene, o);
   const render::Frame a = cpu->render(request);
   const render::Frame b = gpu.render(request);
   const Comparison c = compare(a, b);
@@ -179,10 +183,7 @@ TEST_P(FusedMirrorFrame, VulkanMatchesTheCpuBackend) {
   o.level = GetParam();
   const auto cpu = render::makeCpuRenderer(scene, o);
   VulkanRenderer gpu(scene, o, testing::testOptions());
-  render::FrameRequest request = requestFor(scene, o.width, o.height);
-  request.poses = scenePoses(scene);
-  request.poses[1].rotateDegrees += glm::dvec3(10.0, 25.0, -5.0);
-  request.lightRotation = rotationMatrix({0.3, -0.4, 0.1});
+  const render::FrameRequest request = turnedRequest(scene, o);
   const render::Frame a = cpu->render(request);
   const render::Frame b = gpu.render(request);
   const Comparison c = compare(a, b);
