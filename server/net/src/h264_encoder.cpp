@@ -1,10 +1,8 @@
 #include "haarcast/net/h264_encoder.h"
 
-#include <algorithm>
-#include <cmath>
 #include <mutex>
-#include <sstream>
 #include <stdexcept>
+#include <string>
 
 extern "C" {
 #include <libavcodec/avcodec.h>
@@ -15,8 +13,6 @@ extern "C" {
 #include <libavutil/rational.h>
 #include <libswscale/swscale.h>
 }
-
-#include "haarcast/io/image.h"
 
 namespace haarcast::net {
 namespace {
