@@ -20,20 +20,32 @@ ServerOptions grpcOptions() {
   return o;
 }
 
-std::shared_ptr<grpc::Channel> channelTo(std::uint16_t port) {
+// How a client's transport takes data its application has not read.
+enum class Window {
+  kGrows,  // gRPC's default: the window grows with the measured bandwidth
+  kFixed,  // no bandwidth probe: once the window is full the server's write waits
+};
+
+std::shared_ptr<grpc::Channel> channelTo(std::uint16_t port, Window window = Window::kGrows) {
   // A connection of its own per client: gRPC would otherwise share one
   // between channels with the same target, and the tests want clients
   // that are independent on the wire.
   grpc::ChannelArguments args;
   args.SetInt(GRPC_ARG_USE_LOCAL_SUBCHANNEL_POOL, 1);
+  // Without the probe a client that never reads stops the server's write
+  // for good; with it the transport keeps buffering unread frames, ~1 a
+  // second, for tens of seconds before the write stalls (measured: 15–19
+  // frames of 256 KiB), and whether that fits a test's time is luck.
+  if (window == Window::kFixed) args.SetInt(GRPC_ARG_HTTP2_BDP_PROBE, 0);
   args.SetMaxReceiveMessageSize(64 << 20);
   return grpc::CreateCustomChannel("127.0.0.1:" + std::to_string(port), grpc::InsecureChannelCredentials(), args);
 }
 
 class GrpcClient {
  public:
-  explicit GrpcClient(std::uint16_t port, const std::string& authorization = std::string("Bearer ") + kToken)
-      : stub_(v1::Render::NewStub(channelTo(port))) {
+  explicit GrpcClient(std::uint16_t port, const std::string& authorization = std::string("Bearer ") + kToken,
+                      Window window = Window::kGrows)
+      : stub_(v1::Render::NewStub(channelTo(port, window))) {
     if (!authorization.empty()) context_.AddMetadata("authorization", authorization);
     context_.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(60));
     stream_ = stub_->Session(&context_);
@@ -241,14 +253,14 @@ TEST(GrpcServer, StopSendsShuttingDownAndReturnsPromptly) {
 TEST(GrpcServer, AClientThatStopsReadingIsCutAndAnotherGoesOn) {
   TestServer server(grpcOptions());
   const auto port = server.server().grpcPort();
-  GrpcClient stalled(port);
+  GrpcClient stalled(port, std::string("Bearer ") + kToken, Window::kFixed);
   stalled.send(hello(256, 256, v1::ENCODING_RAW_RGBA8, 30));
   ASSERT_TRUE(stalled.expect(v1::ServerMessage::kWelcome));
   GrpcClient other(port);
   other.send(hello(32, 32));
   ASSERT_TRUE(other.frameFor(0));
-  // The stalled client sends poses and never reads: its 256 KiB frames fill
-  // the HTTP/2 windows, the server's write stops completing, and after
+  // The stalled client sends poses and never reads: its first 256 KiB frame
+  // fills the HTTP/2 window, the server's write stops completing, and after
   // writeStallSeconds (1.5 s here) the server cuts it.
   const auto& m = server.server().metrics();
   std::uint64_t sequence = 0;
