@@ -42,6 +42,7 @@
 #include "haarcast/core/rotation.h"
 #include "haarcast/core/sphere_map.h"
 #include "haarcast/core/triple_product.h"
+#include "haarcast/core/visibility_bits.h"
 
 namespace {
 
@@ -272,6 +273,9 @@ struct PixelInputs {
   std::array<SparseHaar, 3> light;
   std::array<PreparedLight, 3> preparedLight;
   std::vector<std::array<SparseHaar, 3>> triangles;  // per-vertex visibility
+  // The same visibility as the renderer's bits (visibility_bits.h): map
+  // direction i at bit i % 32 of word i / 32.
+  std::vector<std::array<std::vector<std::uint32_t>, 3>> triangleBits;
   std::vector<std::array<double, 3>> barycentrics;
 };
 
@@ -308,6 +312,7 @@ const PixelInputs& pixelInputs(int level) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   for (std::size_t t = 0; t < kTriangleCount; ++t) {
     std::array<SparseHaar, 3> vertices;
+    std::array<std::vector<std::uint32_t>, 3> bits;
     for (SparseHaar& v : vertices) {
       const glm::dvec3 blocker = glm::normalize(glm::dvec3(1.0, 0.3 * u(rng), 0.5 * u(rng)));
       const double cone = 0.8 + 0.1 * u(rng), tilt = 0.2 * u(rng);
@@ -316,8 +321,13 @@ const PixelInputs& pixelInputs(int level) {
         return glm::dot(d, blocker) > cone ? 0.0 : 1.0;
       });
       v = keepLargest(forwardHaar(map), 64);
+      std::vector<std::uint32_t>& words = bits[static_cast<std::size_t>(&v - vertices.data())];
+      words.assign((map.values().size() + 31) / 32, 0u);
+      for (std::size_t i = 0; i < map.values().size(); ++i)
+        if (map.values()[i] > 0.5f) words[i / 32] |= 1u << (i % 32);
     }
     in.triangles.push_back(std::move(vertices));
+    in.triangleBits.push_back(std::move(bits));
     const double a = 0.5 * (u(rng) + 1.0), b = 0.5 * (1.0 - a) * (u(rng) + 1.0);
     in.barycentrics.push_back({a, b, 1.0 - a - b});
   }
@@ -391,6 +401,35 @@ void BM_FusedPixel(benchmark::State& state) {
   state.SetLabel(fusedTargetName());
 }
 BENCHMARK(BM_FusedPixel)->DenseRange(4, 7)->Unit(benchmark::kMicrosecond);
+
+// The pixel as the renderer shades it: the three vertices' visibility bits
+// blended inside the pass (fused_kernel.cpp), no point light, no lobe path.
+void BM_FusedPixelBits(benchmark::State& state) {
+  const int level = static_cast<int>(state.range(0));
+  const PixelInputs& in = pixelInputs(level);
+  const std::vector<EulerYXY>& rs = rotations();
+  const auto slices = static_cast<shared::uint>(in.pixelSlices.thetaSamples());
+  FusedScratch scratch;
+  float radiance = 0.0f;
+  std::size_t i = 0;
+  for (auto _ : state) {
+    const EulerYXY& r = rs[i & (kRotationCount - 1)];
+    const auto& bits = in.triangleBits[i & (kTriangleCount - 1)];
+    const std::array<double, 3>& b = in.barycentrics[i & (kTriangleCount - 1)];
+    const std::array<WeightedBits, 3> vis{WeightedBits{bits[0].data(), static_cast<float>(b[0])},
+                                          WeightedBits{bits[1].data(), static_cast<float>(b[1])},
+                                          WeightedBits{bits[2].data(), static_cast<float>(b[2])}};
+    const auto first = static_cast<shared::uint>(i % slices);
+    const shared::SliceBlend blend{first, std::min(first + 1u, slices - 1u), 0.5f};
+    const std::array<float, 3> rgb = fusedShade(in.pixelSlices, blend, r, in.fusedLight, vis, {}, 0u, scratch);
+    radiance += rgb[0] + rgb[1] + rgb[2];
+    benchmark::DoNotOptimize(radiance);
+    ++i;
+  }
+  setCounters(state, level);
+  state.SetLabel(fusedTargetName());
+}
+BENCHMARK(BM_FusedPixelBits)->DenseRange(4, 7)->Unit(benchmark::kMicrosecond);
 
 // The lean pixel's parts on their own: where its time goes (merge_visibility
 // includes preparing the merged list, once per pixel).

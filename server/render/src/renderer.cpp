@@ -318,6 +318,34 @@ void resolveFusedLight(const PreparedScene& prepared, const PreparedObject& obje
 
 }  // namespace
 
+struct FusedLightCache::Entry {
+  Key key;
+  FusedLight fusedLight;
+  std::vector<FusedPointLight> pointLights;
+  std::array<float, 3> groundFlat{};
+};
+
+bool FusedLightCache::find(std::size_t index, const Key& key, ResolvedObject& o) const {
+  std::shared_ptr<const Entry> entry;
+  {
+    const std::lock_guard lock(mutex_);
+    if (index < entries_.size()) entry = entries_[index];
+  }
+  if (!entry || !(entry->key == key)) return false;
+  o.fusedLight = entry->fusedLight;
+  o.pointLights = entry->pointLights;
+  o.groundFlat = entry->groundFlat;
+  hits_.fetch_add(1);
+  return true;
+}
+
+void FusedLightCache::store(std::size_t index, const Key& key, const ResolvedObject& o) {
+  auto entry = std::make_shared<const Entry>(Entry{key, o.fusedLight, o.pointLights, o.groundFlat});
+  const std::lock_guard lock(mutex_);
+  if (entries_.size() <= index) entries_.resize(index + 1);
+  entries_[index] = std::move(entry);
+}
+
 ResolvedFrame resolveFrame(const PreparedScene& prepared, const RenderOptions& options, const FrameRequest& request) {
   checkFrameRequest(request, prepared.objects.size());
   ResolvedFrame out;
@@ -364,7 +392,12 @@ ResolvedFrame resolveFrame(const PreparedScene& prepared, const RenderOptions& o
   for (std::size_t i = 0; i < out.objects.size(); ++i) {
     ResolvedObject& o = out.objects[i];
     if (fused) {
-      resolveFusedLight(prepared, prepared.objects[i], request.lightRotation, groundNormal, out.pointLightDirections, o);
+      // Everything resolveFusedLight reads that a request changes.
+      const FusedLightCache::Key key{request.lightRotation, o.rotation, groundNormal};
+      if (!prepared.fusedLightCache->find(i, key, o)) {
+        resolveFusedLight(prepared, prepared.objects[i], request.lightRotation, groundNormal, out.pointLightDirections, o);
+        prepared.fusedLightCache->store(i, key, o);
+      }
       out.lightBytes += o.fusedLight.planes.size() * sizeof(float);
       continue;
     }

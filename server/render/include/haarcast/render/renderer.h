@@ -23,9 +23,11 @@
 #include <algorithm>
 #include <cstddef>
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -148,6 +150,34 @@ struct PreparedObject {
   float lobeCore = 0.0f;  // the lobe path's core angle (fused.h LobePath::coreAngle); π: the path takes all
 };
 
+struct ResolvedObject;
+
+// `fused`: each object's last light in its frame (resolveFrame), kept while
+// the light, the object and the ground have not turned. An orbiting camera,
+// the most common interaction, then pays nothing for the light; a turned
+// object or light misses and is resolved afresh. Shared by the copies of a
+// PreparedScene, and safe to use from concurrent frames.
+class FusedLightCache {
+ public:
+  struct Key {
+    glm::dmat3 lightRotation{1.0};
+    glm::dmat3 objectRotation{1.0};
+    std::optional<glm::dvec3> groundNormal;
+    bool operator==(const Key&) const = default;
+  };
+  // Copies the kept light of object `index` into `o` when it was resolved
+  // for `key`; false otherwise.
+  bool find(std::size_t index, const Key& key, ResolvedObject& o) const;
+  void store(std::size_t index, const Key& key, const ResolvedObject& o);
+  std::size_t hits() const { return hits_.load(); }
+
+ private:
+  struct Entry;
+  mutable std::atomic<std::size_t> hits_{0};
+  mutable std::mutex mutex_;
+  std::vector<std::shared_ptr<const Entry>> entries_;  // by object index
+};
+
 struct PreparedScene {
   Scene scene;
   std::vector<PreparedObject> objects;
@@ -167,6 +197,7 @@ struct PreparedScene {
   std::vector<int> objectLevels() const;
   PrefilteredLight lobeLight;           // `fused`, `splitsum`: the backdrop's maps at every level, for the lobe path (empty when no object has one)
   std::optional<std::size_t> ground;    // index of the ground object, if any
+  std::shared_ptr<FusedLightCache> fusedLightCache = std::make_shared<FusedLightCache>();
 };
 
 // Level of the backdrop maps: fine enough to look like the probe (512²).
