@@ -124,7 +124,7 @@ bool slicePosition(PixelSetup p, vec3 w0, out vec2 pos) {
   if (x1 * p.axis.x + y2 * p.axis.y + z2 * p.axis.z > p.coreCos) return false;  // the lobe path's core
   const float theta = atan2Fast(sqrt(x1 * x1 + z2 * z2), y2);
   const float phi = atan2Fast(x1, z2);
-  pos = vec2(min(max(theta * (float(p.m) / kPi) - 0.5, 0.0), float(p.m - 1u)), phi * (float(p.m) / kTwoPi) - p.fraction);
+  pos = vec2(min(max(theta * (float(p.m) / kPiF) - 0.5, 0.0), float(p.m - 1u)), phi * (float(p.m) / kTwoPiF) - p.fraction);
   return true;
 }
 
@@ -284,7 +284,7 @@ void shadePixel(uint s) {
   p.cosB = sb.y;
   // Source column = φ'·M/2π − (γ·M/2π + ½): the offset's whole part shifts
   // the integer column, its fraction the float coordinate.
-  float offset = rs.gamma * (float(p.m) / kTwoPi) + 0.5;
+  float offset = rs.gamma * (float(p.m) / kTwoPiF) + 0.5;
   offset -= floor(offset / float(p.m)) * float(p.m);
   const float whole = floor(offset);
   p.shift = int(whole);
@@ -316,7 +316,7 @@ void shadePixel(uint s) {
   p.firstRow = 0u;
   p.endRow = p.m;
   if (p.skipBelowY > -1.0) {
-    const float rowScale = float(p.m) / kPi;
+    const float rowScale = float(p.m) / kPiF;
     const float axis = acosPrecise(clamp(p.cosB, -1.0, 1.0));
     const float reach = acosPrecise(min(p.skipBelowY, 1.0)) + 2e-3;
     p.firstRow = uint(clamp(floor((axis - reach) * rowScale - 0.5), 0.0, float(p.m)));

@@ -14,7 +14,7 @@
 //   binding 3: output, local sample i channel c at (i·3 + c)·N.
 //   Dispatch (count, 3, 1): one workgroup per (sample, channel).
 
-// kPi, the few-ULP transcendentals (sinCosPrecise, atan2Precise,
+// The few-ULP transcendentals (sinCosPrecise, atan2Precise,
 // acosPrecise: Vulkan's own may be off by thousands of ULP, lavapipe's are)
 // and rotationYXY, rotX, rotY of core/rotation.cpp.
 #include "common/sphere.glsl"

@@ -110,8 +110,8 @@ void main() {
   mat3 rt = transpose(rotationYXY(s.alpha, s.beta, s.gamma));
   for (uint k = tid; k < uint(N); k += uint(LOCAL)) {
     int i = int(k) / M, j = int(k) % M;
-    vec2 tp = directionToSpherical(rt * sphericalToDirection((float(i) + 0.5) * kPi / float(M),
-                                                             (float(j) + 0.5) * kTwoPi / float(M)));
+    vec2 tp = directionToSpherical(rt * sphericalToDirection((float(i) + 0.5) * kPiF / float(M),
+                                                             (float(j) + 0.5) * kTwoPiF / float(M)));
     Taps t = bilinearTaps(LEVEL, tp.x, tp.y);
     float top = (1.0 - t.t.y) * map[t.rc.x * M + t.rc.z] + t.t.y * map[t.rc.x * M + t.rc.w];
     float bottom = (1.0 - t.t.y) * map[t.rc.y * M + t.rc.z] + t.t.y * map[t.rc.y * M + t.rc.w];

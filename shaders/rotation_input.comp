@@ -64,7 +64,7 @@ void emit(uvec4 id, vec3 normal, vec3 direction, uint slot) {
   }
 
   // nearestSlice: the cell of [0, π/2] split into T that holds θₒ.
-  int t = clamp(int(floor(clamp(thetaOut, 0.0, kPi / 2.0) / (kPi / 2.0) * float(o.thetaSamples))), 0,
+  int t = clamp(int(floor(clamp(thetaOut, 0.0, kPiF / 2.0) / (kPiF / 2.0) * float(o.thetaSamples))), 0,
                 int(o.thetaSamples) - 1);
 
   uint k = atomicAdd(counter.covered, 1u);

@@ -41,8 +41,15 @@ inline constexpr int findMSB(uint x) { return static_cast<int>(std::bit_width(x)
 #define HC_CONSTEXPR
 #endif
 
-// π in float, for the float paths (CPU kernels and shaders alike).
-HC_CONST float kPiF = 3.14159265358979323846f;
+// π, written once: kPi for the C++ double paths (core/sphere_map.h takes
+// it from here), kPiF and kTwoPiF for the float paths, CPU kernels and
+// shaders alike (2π is exact as twice the float of π).
+#define HC_PI 3.14159265358979323846
+#ifdef __cplusplus
+inline constexpr double kPi = HC_PI;
+#endif
+HC_CONST float kPiF = float(HC_PI);
+HC_CONST float kTwoPiF = 2.0f * kPiF;
 
 // Map levels every per-pixel method accepts (level n = 2^n × 2^n).
 HC_CONST uint kMinLevel = 2u;
@@ -497,6 +504,7 @@ static_assert(sizeof(GBufferPush) == 80 && offsetof(GBufferPush, objectId) == 64
 #undef HC_CONST
 #undef HC_FUNCTION
 #undef HC_CONSTEXPR
+#undef HC_PI
 #endif
 
 #endif  // HAARCAST_CORE_SHARED_LAYOUT_H
