@@ -9,7 +9,7 @@
 //  (1) f's exact differences across every pixel boundary, fT (θ) and fP (φ).
 //      They depend on the slice only, so the host derives them once per slice
 //      at load time (rotation_data.cpp, by rotate_haar's own formulas) and
-//      passes them in binding 2; they are not stored assets.
+//      passes them in kRotateMethodDataBinding; they are not stored assets.
 //  (2) g's differences by the finite chain rule: g(p₂) − g(p₁) = f(S(p₂)) −
 //      f(S(p₁)) summed over the source cells the straight path crosses
 //      (walk()). Invocations run over pixel boundaries: the θ-group makes

@@ -21,7 +21,7 @@ void VulkanRenderer::Impl::uploadScene() {
   const std::size_t n = coefficients;
 
   // Slices: global slice s = object's base + t, channel c at (s·3 + c)·N
-  // (the rotation contract's binding 1).
+  // (the rotation contract's kRotateSlicesBinding).
   std::vector<float> sliceData;
   std::vector<float> pointData;  // fused: the slices as point values, laid out as sliceData
   std::vector<std::uint32_t> method;
