@@ -15,10 +15,10 @@ const uint LOCAL = 128u;  // the least maxComputeWorkGroupInvocations Vulkan gua
 layout(local_size_x = 128) in;
 layout(push_constant) uniform Push { ExposurePush pc; };
 
-layout(std430, set = 0, binding = 0) readonly buffer Frame { FrameParams frame; };
-layout(std430, set = 0, binding = 1) readonly buffer Ids { uvec4 ids[]; };
-layout(std430, set = 0, binding = 2) readonly buffer Radiance { vec4 radiance[]; };
-layout(std430, set = 0, binding = 3) writeonly buffer Result { ExposureResult result; };
+layout(std430, set = 0, binding = kExposureFrameBinding) readonly buffer Frame { FrameParams frame; };
+layout(std430, set = 0, binding = kExposureIdsBinding) readonly buffer Ids { uvec4 ids[]; };
+layout(std430, set = 0, binding = kExposureRadianceBinding) readonly buffer Radiance { vec4 radiance[]; };
+layout(std430, set = 0, binding = kExposureResultBinding) writeonly buffer Result { ExposureResult result; };
 
 shared uint luminance[kMeterBins];  // weighted counts of log2 Y, 1/16 stop bins
 shared uint peak[kMeterBins];       // the same of the brightest channel

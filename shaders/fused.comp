@@ -54,28 +54,28 @@ layout(constant_id = 5) const uint PREFILTER_FINEST = 9u;  // the prefiltered li
 
 const uint LOCAL = gl_WorkGroupSize.x;
 
-layout(std430, set = 0, binding = 0) readonly buffer Samples { RotationSample samples[]; };
-layout(std430, set = 0, binding = 1) readonly buffer Shade { ShadeSample shade[]; };
-layout(std430, set = 0, binding = 2) readonly buffer Objects { ObjectInfo objects[]; };
+layout(std430, set = 0, binding = kFusedSamplesBinding) readonly buffer Samples { RotationSample samples[]; };
+layout(std430, set = 0, binding = kFusedShadeBinding) readonly buffer Shade { ShadeSample shade[]; };
+layout(std430, set = 0, binding = kFusedObjectsBinding) readonly buffer Objects { ObjectInfo objects[]; };
 // Object o's slice t, direction k at o.texelBase + t·N + k: RGB0.
-layout(set = 0, binding = 3) uniform samplerBuffer texels;
-layout(set = 0, binding = 4) uniform samplerBuffer light;        // object o, direction k at o.lightBase + k: (L·ΔΩ) RGB, 0
+layout(set = 0, binding = kFusedSliceTexelsBinding) uniform samplerBuffer texels;
+layout(set = 0, binding = kFusedLightTexelsBinding) uniform samplerBuffer light;        // object o, direction k at o.lightBase + k: (L·ΔΩ) RGB, 0
 // Global vertex v of object o, direction i: bit i % 32 of word
 // o.visibilityBase + (v − o.vertexBase)·visibilityWords(o.level) + i / 32 (core VisibilityBits).
-layout(set = 0, binding = 5) uniform usamplerBuffer visibilityBits;
+layout(set = 0, binding = kFusedVisibilityTexelsBinding) uniform usamplerBuffer visibilityBits;
 // Pixel-centre unit vectors (xyz) and ΔΩ (w) of every level in use; level n's direction k at o.directionBase + k.
-layout(set = 0, binding = 6) uniform samplerBuffer directions;
+layout(set = 0, binding = kFusedDirectionTexelsBinding) uniform samplerBuffer directions;
 // Object o, light k at o·kMaxPointLights + k; ObjectInfo::pointLights of them are this frame's.
-layout(std430, set = 0, binding = 7) readonly buffer PointLights { PointLight pointLights[]; };
-layout(std430, set = 0, binding = 8) buffer Radiance { vec4 radiance[]; };
-layout(std430, set = 0, binding = 9) readonly buffer Counter { CoverageCounter counter; };
-layout(std430, set = 0, binding = 10) readonly buffer Masks { uint masks[]; };  // sample s: bit k = sees light k
-layout(std430, set = 0, binding = 11) readonly buffer SliceEnergies { vec4 sliceEnergy[]; };  // global slice: ∫ρ_c (rgb)
-layout(std430, set = 0, binding = 12) readonly buffer Lobes { SliceLobe lobes[]; };          // global slice: its lobe
+layout(std430, set = 0, binding = kFusedPointLightsBinding) readonly buffer PointLights { PointLight pointLights[]; };
+layout(std430, set = 0, binding = kFusedRadianceBinding) buffer Radiance { vec4 radiance[]; };
+layout(std430, set = 0, binding = kFusedCounterBinding) readonly buffer Counter { CoverageCounter counter; };
+layout(std430, set = 0, binding = kFusedMasksBinding) readonly buffer Masks { uint masks[]; };  // sample s: bit k = sees light k
+layout(std430, set = 0, binding = kFusedSliceEnergyBinding) readonly buffer SliceEnergies { vec4 sliceEnergy[]; };  // global slice: ∫ρ_c (rgb)
+layout(std430, set = 0, binding = kFusedLobesBinding) readonly buffer Lobes { SliceLobe lobes[]; };          // global slice: its lobe
 // Level l of the prefiltered light at prefilterOffset(l), RGB0 (core PrefilteredLight).
-layout(set = 0, binding = 13) uniform samplerBuffer lobeLight;
+layout(set = 0, binding = kFusedLobeLightTexelsBinding) uniform samplerBuffer lobeLight;
 // The slices as point values at the texel centres (core PixelSlices::pointSlice), laid out as `texels`.
-layout(set = 0, binding = 14) uniform samplerBuffer pointTexels;
+layout(set = 0, binding = kFusedPointSliceTexelsBinding) uniform samplerBuffer pointTexels;
 
 shared vec3 partial[LOCAL];
 shared vec3 partialSum[LOCAL];  // Σ ΔΩ·ρ_c: the lobe's energy as the directions sample it
@@ -124,7 +124,7 @@ bool slicePosition(PixelSetup p, vec3 w0, out vec2 pos) {
   if (x1 * p.axis.x + y2 * p.axis.y + z2 * p.axis.z > p.coreCos) return false;  // the lobe path's core
   const float theta = atan2Fast(sqrt(x1 * x1 + z2 * z2), y2);
   const float phi = atan2Fast(x1, z2);
-  pos = vec2(min(max(theta * (float(p.m) / kPi) - 0.5, 0.0), float(p.m - 1u)), phi * (float(p.m) / kTwoPi) - p.fraction);
+  pos = vec2(min(max(theta * (float(p.m) / kPiF) - 0.5, 0.0), float(p.m - 1u)), phi * (float(p.m) / kTwoPiF) - p.fraction);
   return true;
 }
 
@@ -284,7 +284,7 @@ void shadePixel(uint s) {
   p.cosB = sb.y;
   // Source column = φ'·M/2π − (γ·M/2π + ½): the offset's whole part shifts
   // the integer column, its fraction the float coordinate.
-  float offset = rs.gamma * (float(p.m) / kTwoPi) + 0.5;
+  float offset = rs.gamma * (float(p.m) / kTwoPiF) + 0.5;
   offset -= floor(offset / float(p.m)) * float(p.m);
   const float whole = floor(offset);
   p.shift = int(whole);
@@ -316,7 +316,7 @@ void shadePixel(uint s) {
   p.firstRow = 0u;
   p.endRow = p.m;
   if (p.skipBelowY > -1.0) {
-    const float rowScale = float(p.m) / kPi;
+    const float rowScale = float(p.m) / kPiF;
     const float axis = acosPrecise(clamp(p.cosB, -1.0, 1.0));
     const float reach = acosPrecise(min(p.skipBelowY, 1.0)) + 2e-3;
     p.firstRow = uint(clamp(floor((axis - reach) * rowScale - 0.5), 0.0, float(p.m)));

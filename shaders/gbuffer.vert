@@ -8,9 +8,9 @@
 #include "haarcast/core/shared_layout.h"
 layout(push_constant) uniform Push { GBufferPush pc; };
 
-layout(std430, set = 0, binding = 0) readonly buffer Positions { vec4 positions[]; };  // object frame, global vertex ids
-layout(std430, set = 0, binding = 1) readonly buffer Normals { vec4 normals[]; };
-layout(std430, set = 0, binding = 2) readonly buffer Triangles { uint triangles[]; };
+layout(std430, set = 0, binding = kGBufferPositionsBinding) readonly buffer Positions { vec4 positions[]; };  // object frame, global vertex ids
+layout(std430, set = 0, binding = kGBufferNormalsBinding) readonly buffer Normals { vec4 normals[]; };
+layout(std430, set = 0, binding = kGBufferTrianglesBinding) readonly buffer Triangles { uint triangles[]; };
 
 layout(location = 0) out vec3 outNormal;
 layout(location = 1) out vec3 outPosition;

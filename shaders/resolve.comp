@@ -9,18 +9,18 @@
 //     radiance (slot subsampleSlot), an uncovered one the backdrop in its own
 //     direction, as the CPU backend's shadePixels;
 //   - a covered interior pixel keeps what the shading wrote.
-// Local size 64, one invocation per pixel.
+// Local size kLocalSize, one invocation per pixel.
 #extension GL_GOOGLE_include_directive : require
 #include "common/frame.glsl"
 #include "common/sphere.glsl"
 
-layout(local_size_x = 64) in;
+layout(local_size_x = kLocalSize) in;
 
-layout(std430, set = 0, binding = 0) readonly buffer Frame { FrameParams frame; };
-layout(std430, set = 0, binding = 1) readonly buffer Ids { uvec4 ids[]; };
-layout(std430, set = 0, binding = 2) buffer Radiance { vec4 radiance[]; };  // pixels, then the sub-sample slots
-layout(std430, set = 0, binding = 3) readonly buffer Background { float background[]; };  // [channel][row][col]
-layout(std430, set = 0, binding = 4) readonly buffer Edges { uint edges[]; };
+layout(std430, set = 0, binding = kResolveFrameBinding) readonly buffer Frame { FrameParams frame; };
+layout(std430, set = 0, binding = kResolveIdsBinding) readonly buffer Ids { uvec4 ids[]; };
+layout(std430, set = 0, binding = kResolveRadianceBinding) buffer Radiance { vec4 radiance[]; };  // pixels, then the sub-sample slots
+layout(std430, set = 0, binding = kResolveBackgroundBinding) readonly buffer Background { float background[]; };  // [channel][row][col]
+layout(std430, set = 0, binding = kResolveEdgesBinding) readonly buffer Edges { uint edges[]; };
 
 vec3 backdrop(vec3 direction) {
   if (frame.background == 0u) return vec3(0.0);

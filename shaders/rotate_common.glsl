@@ -8,13 +8,14 @@
 //   constant_id 0 = LEVEL: the map is M×M, M = 2^LEVEL, N = M² coefficients in
 //     the CPU HaarMap quadrant layout (haarcast/core/haar.h).
 //   constant_id 1 = THETA_SAMPLES: slices per channel per object.
-//   push constants: rotate samples first … first+count−1.
-//   binding 0: RotationSample per sample; binding 1: unrotated slices, slice s
-//   channel c at (s·3 + c)·N; binding 2: per-method data (rotation_data.h);
-//   binding 3: output, local sample i channel c at (i·3 + c)·N.
+//   push constants (RotationPush): rotate samples first … first+count−1.
+//   bindings (core/shared_passes.h): kRotateSamplesBinding, RotationSample
+//   per sample; kRotateSlicesBinding, unrotated slices, slice s channel c at
+//   (s·3 + c)·N; kRotateMethodDataBinding, per-method data (rotation_data.h);
+//   kRotateRotatedBinding, output, local sample i channel c at (i·3 + c)·N.
 //   Dispatch (count, 3, 1): one workgroup per (sample, channel).
 
-// kPi, the few-ULP transcendentals (sinCosPrecise, atan2Precise,
+// The few-ULP transcendentals (sinCosPrecise, atan2Precise,
 // acosPrecise: Vulkan's own may be off by thousands of ULP, lavapipe's are)
 // and rotationYXY, rotX, rotY of core/rotation.cpp.
 #include "common/sphere.glsl"
@@ -28,19 +29,14 @@ const uint M = 1u << LEVEL;   // map side
 const uint N = M * M;         // coefficients per map
 const uint HALF = M / 2u;     // blocks per side at the finest detail level
 
-layout(push_constant) uniform RotationPush {
-  uint first;
-  uint count;
-  uint pad0;
-  uint pad1;
-} pushed;
+layout(push_constant) uniform Push { RotationPush pushed; };
 
-layout(std430, set = 0, binding = 0) readonly buffer RotationSamples { RotationSample samples[]; };
-layout(std430, set = 0, binding = 1) readonly buffer Slices { float slices[]; };
-layout(std430, set = 0, binding = 2) readonly buffer MethodData { uint methodData[]; };
+layout(std430, set = 0, binding = kRotateSamplesBinding) readonly buffer RotationSamples { RotationSample samples[]; };
+layout(std430, set = 0, binding = kRotateSlicesBinding) readonly buffer Slices { float slices[]; };
+layout(std430, set = 0, binding = kRotateMethodDataBinding) readonly buffer MethodData { uint methodData[]; };
 // coherent: workgroups read back what their own invocations wrote (after
 // memoryBarrierBuffer and barrier).
-layout(std430, set = 0, binding = 3) coherent buffer Rotated { float rotated[]; };
+layout(std430, set = 0, binding = kRotateRotatedBinding) coherent buffer Rotated { float rotated[]; };
 
 float methodFloat(uint word) { return uintBitsToFloat(methodData[word]); }
 

@@ -9,7 +9,7 @@
 //  (1) f's exact differences across every pixel boundary, fT (θ) and fP (φ).
 //      They depend on the slice only, so the host derives them once per slice
 //      at load time (rotation_data.cpp, by rotate_haar's own formulas) and
-//      passes them in binding 2; they are not stored assets.
+//      passes them in kRotateMethodDataBinding; they are not stored assets.
 //  (2) g's differences by the finite chain rule: g(p₂) − g(p₁) = f(S(p₂)) −
 //      f(S(p₁)) summed over the source cells the straight path crosses
 //      (walk()). Invocations run over pixel boundaries: the θ-group makes
@@ -69,11 +69,11 @@ uint phiField(uint k, uint i, uint b) { return kThetaFields + fieldOffset(k) + i
 // Θ from atan2(ρ, y), which keeps float precision near the poles where
 // acos(y) loses it.
 vec2 sourcePoint(mat3 rt, uint r, uint c) {
-  const vec3 s = rt * sphericalToDirection((float(r) + 0.5) * kPi / float(M), (float(c) + 0.5) * kTwoPi / float(M));
+  const vec3 s = rt * sphericalToDirection((float(r) + 0.5) * kPiF / float(M), (float(c) + 0.5) * kTwoPiF / float(M));
   float srcPhi = atan2Precise(s.x, s.z);  // directionToSpherical: φ from +Z toward +X, 0 at the poles
-  if (srcPhi < 0.0) srcPhi += kTwoPi;
+  if (srcPhi < 0.0) srcPhi += kTwoPiF;
   const float srcTheta = atan2Precise(length(s.xz), s.y);
-  return vec2(srcPhi / kTwoPi * float(M) - 0.5, srcTheta / kPi * float(M) - 0.5);
+  return vec2(srcPhi / kTwoPiF * float(M) - 0.5, srcTheta / kPiF * float(M) - 0.5);
 }
 
 // s at which a coordinate starting at p0 ∈ [0, 1) next crosses an integer.
@@ -151,18 +151,18 @@ float latticeSample(uint field, float y, float x) {
 // the ∂f/∂θ samples, followed by the ∂f/∂φ samples.
 float jacobianDifference(mat3 rt, float row, float col, bool alongTheta, uint derivs) {
   const uint derivTheta = derivs, derivPhi = derivs + HALF * HALF;
-  const vec2 t = sinCosPrecise(row * kPi / float(M)), p = sinCosPrecise(col * kTwoPi / float(M));
+  const vec2 t = sinCosPrecise(row * kPiF / float(M)), p = sinCosPrecise(col * kTwoPiF / float(M));
   const vec3 s = rt * vec3(t.x * p.x, t.y, t.x * p.y);
   const vec3 ds = alongTheta ? rt * vec3(t.y * p.x, -t.x, t.y * p.y) : rt * vec3(t.x * p.y, 0.0, -t.x * p.x);
   const float rho2 = max(s.x * s.x + s.z * s.z, 1e-24), rho = sqrt(rho2);
   const float dTheta = -ds.y / rho;
   const float dPhi = (s.z * ds.x - s.x * ds.z) / rho2;
   float srcPhi = atan2Precise(s.x, s.z);
-  if (srcPhi < 0.0) srcPhi += kTwoPi;
+  if (srcPhi < 0.0) srcPhi += kTwoPiF;
   const float srcTheta = atan2Precise(sqrt(s.x * s.x + s.z * s.z), s.y);
   // Block centres sit at θ = (2i+1)Δθ, φ = (2j+1)Δφ.
-  const float y = srcTheta / kTwoPi * float(M) - 0.5, x = srcPhi / (2.0 * kTwoPi) * float(M) - 0.5;
-  const float step = alongTheta ? kPi / float(M) : kTwoPi / float(M);
+  const float y = srcTheta / kTwoPiF * float(M) - 0.5, x = srcPhi / (2.0 * kTwoPiF) * float(M) - 0.5;
+  const float step = alongTheta ? kPiF / float(M) : kTwoPiF / float(M);
   return step * (latticeSample(derivTheta, y, x) * dTheta + latticeSample(derivPhi, y, x) * dPhi);
 }
 
@@ -335,7 +335,7 @@ void main() {
     if (gl_LocalInvocationIndex == 0u) {
       float rest = 0.0;
       for (uint q = 0u; q < nInv; ++q) rest += momentSums[q];
-      rotated[out0] = (methodFloat(faithfulMap) - rest) * float(M) / (4.0 * kPi);
+      rotated[out0] = (methodFloat(faithfulMap) - rest) * float(M) / (4.0 * kPiF);
     }
   } else if (gl_LocalInvocationIndex == 0u) {
     const vec2 p0 = sourcePoint(rt, 0u, 0u);

@@ -18,7 +18,7 @@
 
 #include "rotate_common.glsl"
 
-layout(local_size_x = 256, local_size_x_id = 2) in;  // the renderer picks the size per device
+layout(local_size_x = kGpuLocalSize, local_size_x_id = 2) in;  // the renderer picks the size per device
 
 shared float buf[N];
 
@@ -46,16 +46,16 @@ void main() {
   // β into [0, π]: R_x(−b) = R_y(π) R_x(b) R_y(−π), so (α, −b, γ) is
   // (α + π, b, γ − π). β − 2π·round(β/2π) is std::remainder (halves to even
   // aside, which only swaps ±π, both of which then land on π).
-  float alpha = rs.alpha, beta = rs.beta - kTwoPi * roundEven(rs.beta / kTwoPi), gamma = rs.gamma;
+  float alpha = rs.alpha, beta = rs.beta - kTwoPiF * roundEven(rs.beta / kTwoPiF), gamma = rs.gamma;
   if (beta < 0.0) {
-    alpha += kPi;
-    gamma -= kPi;
+    alpha += kPiF;
+    gamma -= kPiF;
     beta = -beta;
   }
   // The neighbouring samples k, k+1 and the blend t; a β on a sample (up to
   // rounding) uses that matrix alone.
   const uint last = matrices - 1u;
-  const float u = beta / kPi * float(last);
+  const float u = beta / kPiF * float(last);
   const float nearest = round(u);
   uint k;
   float t;

@@ -59,7 +59,7 @@ void shiftPhiToOutput(float radians, uint out0) {
   // shiftPhi. Per finest block of g: its four pixels, their details to the
   // output, their scaling value to the output's top-left quadrant (which no
   // finest detail occupies).
-  float shift = radians / kTwoPi * float(M);
+  float shift = radians / kTwoPiF * float(M);
   shift -= floor(shift / float(M)) * float(M);
   const float whole = floor(shift);
   const float frac = shift - whole;

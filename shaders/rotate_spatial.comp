@@ -21,17 +21,12 @@ const int LOCAL = int(gl_WorkGroupSize.x);
 const int M = 1 << LEVEL;
 const int N = M * M;
 
-layout(push_constant) uniform Push {
-  uint first;
-  uint count;
-  uint pad0;
-  uint pad1;
-} pc;
+layout(push_constant) uniform Push { RotationPush pc; };
 
-layout(std430, set = 0, binding = 0) readonly buffer Samples { RotationSample samples[]; };
-layout(std430, set = 0, binding = 1) readonly buffer Slices { float slices[]; };
-layout(std430, set = 0, binding = 2) readonly buffer MethodData { uint methodData[]; };
-layout(std430, set = 0, binding = 3) coherent buffer Rotated { float rotated[]; };
+layout(std430, set = 0, binding = kRotateSamplesBinding) readonly buffer Samples { RotationSample samples[]; };
+layout(std430, set = 0, binding = kRotateSlicesBinding) readonly buffer Slices { float slices[]; };
+layout(std430, set = 0, binding = kRotateMethodDataBinding) readonly buffer MethodData { uint methodData[]; };
+layout(std430, set = 0, binding = kRotateRotatedBinding) coherent buffer Rotated { float rotated[]; };
 
 shared float map[N];
 
@@ -110,8 +105,8 @@ void main() {
   mat3 rt = transpose(rotationYXY(s.alpha, s.beta, s.gamma));
   for (uint k = tid; k < uint(N); k += uint(LOCAL)) {
     int i = int(k) / M, j = int(k) % M;
-    vec2 tp = directionToSpherical(rt * sphericalToDirection((float(i) + 0.5) * kPi / float(M),
-                                                             (float(j) + 0.5) * kTwoPi / float(M)));
+    vec2 tp = directionToSpherical(rt * sphericalToDirection((float(i) + 0.5) * kPiF / float(M),
+                                                             (float(j) + 0.5) * kTwoPiF / float(M)));
     Taps t = bilinearTaps(LEVEL, tp.x, tp.y);
     float top = (1.0 - t.t.y) * map[t.rc.x * M + t.rc.z] + t.t.y * map[t.rc.x * M + t.rc.w];
     float bottom = (1.0 - t.t.y) * map[t.rc.y * M + t.rc.z] + t.t.y * map[t.rc.y * M + t.rc.w];

@@ -16,7 +16,7 @@
 
 #include "rotate_common.glsl"
 
-layout(local_size_x = 256, local_size_x_id = 2) in;  // the renderer picks the size per device
+layout(local_size_x = kGpuLocalSize, local_size_x_id = 2) in;  // the renderer picks the size per device
 
 shared float buf[N];
 
@@ -54,10 +54,10 @@ void main() {
   }
 
   // The nearest copy: β_k by rounding, γ_j by rounding around the circle.
-  const int k = clamp(roundHalfAway(beta / kPi * float(elevations - 1)), 0, elevations - 1);
+  const int k = clamp(roundHalfAway(beta / kPiF * float(elevations - 1)), 0, elevations - 1);
   // γ ∈ [−π, π], so the rounded index is ≥ −Kγ/2 − 1: adding 2Kγ keeps %'s
   // operands non-negative (GLSL leaves % of negatives undefined).
-  const int j = (roundHalfAway(gamma / kTwoPi * float(spins)) + 2 * spins) % spins;
+  const int j = (roundHalfAway(gamma / kTwoPiF * float(spins)) + 2 * spins) % spins;
   const uint copyIndex = ((theta * 3u + channel) * uint(elevations) + uint(k)) * uint(spins) + uint(j);
   const uint copy = rs.methodBase + 4u + copyIndex * N;
 

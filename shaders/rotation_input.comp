@@ -5,7 +5,7 @@
 // math as render::rotationInput (shading.cpp shadingFrame, rotation.cpp
 // eulerFromMatrix, brdf_slices.cpp nearestSlice), in float. Covered pixels
 // are compacted through an atomic counter, so their order is arbitrary;
-// every record carries its radiance slot. Local size 64, one invocation per
+// every record carries its radiance slot. Local size kLocalSize, one invocation per
 // pixel.
 //
 // Antialiasing (frame.antialias, shared_layout.h): a pixel whose 3×3
@@ -18,19 +18,19 @@
 #include "common/frame.glsl"
 #include "common/sphere.glsl"
 
-layout(local_size_x = 64) in;
+layout(local_size_x = kLocalSize) in;
 
-layout(std430, set = 0, binding = 0) readonly buffer Frame { FrameParams frame; };
-layout(std430, set = 0, binding = 1) readonly buffer Objects { ObjectInfo objects[]; };
-layout(std430, set = 0, binding = 2) readonly buffer Ids { uvec4 ids[]; };          // G-buffer: object+1, triangle, b1, b2
-layout(std430, set = 0, binding = 3) readonly buffer Normals { vec4 normals[]; };    // G-buffer: object-frame normal
-layout(std430, set = 0, binding = 4) readonly buffer Triangles { uint triangles[]; };  // global vertex ids, 3 per triangle
-layout(std430, set = 0, binding = 5) writeonly buffer Samples { RotationSample samples[]; };
-layout(std430, set = 0, binding = 6) writeonly buffer Shade { ShadeSample shade[]; };
-layout(std430, set = 0, binding = 7) buffer Counter { CoverageCounter counter; };
-layout(std430, set = 0, binding = 8) readonly buffer SubIds { uvec4 subIds[]; };          // the 2× G-buffer
-layout(std430, set = 0, binding = 9) readonly buffer SubNormals { vec4 subNormals[]; };
-layout(std430, set = 0, binding = 10) writeonly buffer Edges { uint edges[]; };  // per pixel: 0, or kEdgeFlag | covered bits
+layout(std430, set = 0, binding = kRotationInputFrameBinding) readonly buffer Frame { FrameParams frame; };
+layout(std430, set = 0, binding = kRotationInputObjectsBinding) readonly buffer Objects { ObjectInfo objects[]; };
+layout(std430, set = 0, binding = kRotationInputIdsBinding) readonly buffer Ids { uvec4 ids[]; };          // G-buffer: object+1, triangle, b1, b2
+layout(std430, set = 0, binding = kRotationInputNormalsBinding) readonly buffer Normals { vec4 normals[]; };    // G-buffer: object-frame normal
+layout(std430, set = 0, binding = kRotationInputTrianglesBinding) readonly buffer Triangles { uint triangles[]; };  // global vertex ids, 3 per triangle
+layout(std430, set = 0, binding = kRotationInputSamplesBinding) writeonly buffer Samples { RotationSample samples[]; };
+layout(std430, set = 0, binding = kRotationInputShadeBinding) writeonly buffer Shade { ShadeSample shade[]; };
+layout(std430, set = 0, binding = kRotationInputCounterBinding) buffer Counter { CoverageCounter counter; };
+layout(std430, set = 0, binding = kRotationInputSubIdsBinding) readonly buffer SubIds { uvec4 subIds[]; };          // the 2× G-buffer
+layout(std430, set = 0, binding = kRotationInputSubNormalsBinding) readonly buffer SubNormals { vec4 subNormals[]; };
+layout(std430, set = 0, binding = kRotationInputEdgesBinding) writeonly buffer Edges { uint edges[]; };  // per pixel: 0, or kEdgeFlag | covered bits
 
 // One shaded sample: G-buffer record `id` (object + 1, triangle, b1, b2),
 // object-frame normal `normal`, camera ray `direction`, radiance to `slot`.
@@ -64,7 +64,7 @@ void emit(uvec4 id, vec3 normal, vec3 direction, uint slot) {
   }
 
   // nearestSlice: the cell of [0, π/2] split into T that holds θₒ.
-  int t = clamp(int(floor(clamp(thetaOut, 0.0, kPi / 2.0) / (kPi / 2.0) * float(o.thetaSamples))), 0,
+  int t = clamp(int(floor(clamp(thetaOut, 0.0, kPiF / 2.0) / (kPiF / 2.0) * float(o.thetaSamples))), 0,
                 int(o.thetaSamples) - 1);
 
   uint k = atomicAdd(counter.covered, 1u);

@@ -12,19 +12,72 @@
 //   [5k + 3] catmullRomWeights(t), t = (k mod 101)/101, as float bits
 //   [5k + 4] pointFromMean(mean, up, down, left, right) with the five from
 //            lookupInputs(k), and t, as float bits
+// and, from invocation 0, the passes' interface (core/shared_passes.h) as
+// this shader sees it, in binding 2: π and 2π as float bits, its own
+// workgroup size, the numbers of kContract (sizes, levels, every pass's
+// bindings and binding counts, in the C++ test's order), then the push
+// block's RotationPush and BatchArgsPush members as the device read them.
 #extension GL_GOOGLE_include_directive : require
 #include "haarcast/core/shared_layout.h"
 
-layout(local_size_x = 64) in;
-layout(push_constant) uniform Push { uint count; } pc;
+layout(local_size_x = kLocalSize) in;
+layout(push_constant) uniform Push {
+  uint count;
+  uint pad0;
+  uint pad1;
+  uint pad2;
+  RotationPush rotation;
+  BatchArgsPush batchArgs;
+} pc;
 layout(std430, set = 0, binding = 0) readonly buffer Cases { uvec4 cases[]; };
 layout(std430, set = 0, binding = 1) writeonly buffer Results { uvec4 results[]; };
+layout(std430, set = 0, binding = 2) writeonly buffer Contract { uint contract[]; };
+
+const uint kContract[] = uint[](
+    kLocalSize, kGpuLocalSize, kMinLevel, kFusedMaxLevel, kRotationMaxLevel, kRotationInputFrameBinding,
+    kRotationInputObjectsBinding, kRotationInputIdsBinding, kRotationInputNormalsBinding,
+    kRotationInputTrianglesBinding, kRotationInputSamplesBinding, kRotationInputShadeBinding,
+    kRotationInputCounterBinding, kRotationInputSubIdsBinding, kRotationInputSubNormalsBinding,
+    kRotationInputEdgesBinding, kRotationInputBindings, kResolveFrameBinding, kResolveIdsBinding,
+    kResolveRadianceBinding, kResolveBackgroundBinding, kResolveEdgesBinding, kResolveBindings,
+    kExposureFrameBinding, kExposureIdsBinding, kExposureRadianceBinding, kExposureResultBinding,
+    kExposureBindings, kTonemapFrameBinding, kTonemapRadianceBinding, kTonemapRgba8Binding,
+    kTonemapThresholdsBinding, kTonemapExposureBinding, kTonemapBindings, kRotateSamplesBinding,
+    kRotateSlicesBinding, kRotateMethodDataBinding, kRotateRotatedBinding, kRotateBindings,
+    kTripleProductShadeBinding, kTripleProductRotatedBinding, kTripleProductLightBinding,
+    kTripleProductVisibilityBinding, kTripleProductRadianceBinding, kTripleProductCounterBinding,
+    kTripleProductBindings, kBatchArgsCounterBinding, kBatchArgsArgsBinding, kBatchArgsBindings,
+    kFusedSamplesBinding, kFusedShadeBinding, kFusedObjectsBinding, kFusedSliceTexelsBinding,
+    kFusedLightTexelsBinding, kFusedVisibilityTexelsBinding, kFusedDirectionTexelsBinding,
+    kFusedPointLightsBinding, kFusedRadianceBinding, kFusedCounterBinding, kFusedMasksBinding,
+    kFusedSliceEnergyBinding, kFusedLobesBinding, kFusedLobeLightTexelsBinding, kFusedPointSliceTexelsBinding,
+    kFusedBindings, kSplitsumSamplesBinding, kSplitsumShadeBinding, kSplitsumObjectsBinding,
+    kSplitsumCounterBinding, kSplitsumMasksBinding, kSplitsumLobesBinding, kSplitsumLobeLightTexelsBinding,
+    kSplitsumRadianceBinding, kSplitsumBindings, kGBufferPositionsBinding, kGBufferNormalsBinding,
+    kGBufferTrianglesBinding, kGBufferBindings);
+
+void writeContract() {
+  uint w = 0u;
+  contract[w++] = floatBitsToUint(kPiF);
+  contract[w++] = floatBitsToUint(kTwoPiF);
+  contract[w++] = gl_WorkGroupSize.x;
+  for (uint i = 0u; i < uint(kContract.length()); ++i) contract[w++] = kContract[i];
+  contract[w++] = pc.rotation.first;
+  contract[w++] = pc.rotation.count;
+  contract[w++] = pc.rotation.pad0;
+  contract[w++] = pc.rotation.pad1;
+  contract[w++] = pc.batchArgs.batch;
+  contract[w++] = pc.batchArgs.batches;
+  contract[w++] = pc.batchArgs.pad0;
+  contract[w++] = pc.batchArgs.pad1;
+}
 
 // Five lookup inputs from a case index, the same in the C++ test.
 float lookupInput(uint k, uint s) { return float((k * (7u + 2u * s) + 3u * s) % 53u) / 13.0; }
 
 void main() {
   const uint k = gl_GlobalInvocationID.x;
+  if (k == 0u) writeContract();
   if (k >= pc.count) return;
   const uvec4 c = cases[k];
   const uint n = c.x, band = c.y >> 8u, l = c.y & 255u, i = c.z, j = c.w;

@@ -23,16 +23,16 @@ layout(local_size_x_id = 2) in;
 layout(constant_id = 4) const uint INTERPOLATE = 1u;       // RenderOptions::interpolateSlices
 layout(constant_id = 5) const uint PREFILTER_FINEST = 9u;  // the prefiltered light's finest level
 
-layout(std430, set = 0, binding = 0) readonly buffer Samples { RotationSample samples[]; };
-layout(std430, set = 0, binding = 1) readonly buffer Shade { ShadeSample shade[]; };
-layout(std430, set = 0, binding = 2) readonly buffer Objects { ObjectInfo objects[]; };
-layout(std430, set = 0, binding = 3) readonly buffer Counter { CoverageCounter counter; };
-layout(std430, set = 0, binding = 4) readonly buffer Masks { uint masks[]; };  // sample s: kLobeSeenBit = its mirror ray escapes
+layout(std430, set = 0, binding = kSplitsumSamplesBinding) readonly buffer Samples { RotationSample samples[]; };
+layout(std430, set = 0, binding = kSplitsumShadeBinding) readonly buffer Shade { ShadeSample shade[]; };
+layout(std430, set = 0, binding = kSplitsumObjectsBinding) readonly buffer Objects { ObjectInfo objects[]; };
+layout(std430, set = 0, binding = kSplitsumCounterBinding) readonly buffer Counter { CoverageCounter counter; };
+layout(std430, set = 0, binding = kSplitsumMasksBinding) readonly buffer Masks { uint masks[]; };  // sample s: kLobeSeenBit = its mirror ray escapes
 // Object o's lobe t at ObjectInfo::sliceBase + t (core SliceLobe).
-layout(std430, set = 0, binding = 5) readonly buffer Lobes { SliceLobe lobes[]; };
+layout(std430, set = 0, binding = kSplitsumLobesBinding) readonly buffer Lobes { SliceLobe lobes[]; };
 // Level l of the prefiltered light at prefilterOffset(l), RGB0 (core PrefilteredLight).
-layout(set = 0, binding = 6) uniform samplerBuffer lobeLight;
-layout(std430, set = 0, binding = 7) writeonly buffer Radiance { vec4 radiance[]; };
+layout(set = 0, binding = kSplitsumLobeLightTexelsBinding) uniform samplerBuffer lobeLight;
+layout(std430, set = 0, binding = kSplitsumRadianceBinding) writeonly buffer Radiance { vec4 radiance[]; };
 
 #include "common/prefiltered.glsl"
 

@@ -2,7 +2,7 @@
 // The "tonemap" stage's encoding: every pixel's linear radiance (resolve.comp)
 // encoded as render::tonemapRgba8 does (render/tonemap.h): × 2^exposure,
 // Reinhard's extended curve (white kToneWhite), sRGB transfer
-// (IEC 61966-2-1), rounded, alpha 255. Local size 64, one invocation per
+// (IEC 61966-2-1), rounded, alpha 255. Local size kLocalSize, one invocation per
 // pixel.
 //
 // The encoding is not evaluated with pow (loose on Vulkan: lavapipe's
@@ -16,13 +16,13 @@
 #extension GL_GOOGLE_include_directive : require
 #include "common/frame.glsl"
 
-layout(local_size_x = 64) in;
+layout(local_size_x = kLocalSize) in;
 
-layout(std430, set = 0, binding = 0) readonly buffer Frame { FrameParams frame; };
-layout(std430, set = 0, binding = 1) readonly buffer Radiance { vec4 radiance[]; };
-layout(std430, set = 0, binding = 2) writeonly buffer Rgba8 { uint rgba8[]; };
-layout(std430, set = 0, binding = 3) readonly buffer Thresholds { float threshold[256]; };  // [k], k = 1 … 255
-layout(std430, set = 0, binding = 4) readonly buffer Exposure { ExposureResult exposure; };
+layout(std430, set = 0, binding = kTonemapFrameBinding) readonly buffer Frame { FrameParams frame; };
+layout(std430, set = 0, binding = kTonemapRadianceBinding) readonly buffer Radiance { vec4 radiance[]; };
+layout(std430, set = 0, binding = kTonemapRgba8Binding) writeonly buffer Rgba8 { uint rgba8[]; };
+layout(std430, set = 0, binding = kTonemapThresholdsBinding) readonly buffer Thresholds { float threshold[256]; };  // [k], k = 1 … 255
+layout(std430, set = 0, binding = kTonemapExposureBinding) readonly buffer Exposure { ExposureResult exposure; };
 
 // Binary search for the largest k with value ≥ threshold[k] (0 when none,
 // and for NaN, whose comparisons are false).

@@ -3,28 +3,23 @@
 //   radiance_c = Σ_v b_v · tripleProduct(light_c, rotated_c, visibility_v)
 // over the hit triangle's three vertices (the visibility blend is linear, so
 // it distributes over the product, as in cpu_renderer.cpp). One invocation
-// per (sample, channel) of the current rotation batch; local size 64.
+// per (sample, channel) of the current rotation batch; local size kLocalSize.
 #extension GL_GOOGLE_include_directive : require
 #include "common/frame.glsl"
 
-layout(local_size_x = 64) in;
+layout(local_size_x = kLocalSize) in;
 layout(constant_id = 0) const int LEVEL = 5;
 const int M = 1 << LEVEL;
 const int N = M * M;
 
-layout(push_constant) uniform Push {
-  uint first;   // global index of the batch's first sample
-  uint count;   // samples in a full batch (this one may hold fewer: the covered count decides)
-  uint pad0;
-  uint pad1;
-} pc;
+layout(push_constant) uniform Push { RotationPush pc; };
 
-layout(std430, set = 0, binding = 0) readonly buffer Shade { ShadeSample shade[]; };
-layout(std430, set = 0, binding = 1) readonly buffer Rotated { float rotated[]; };
-layout(std430, set = 0, binding = 2) readonly buffer Light { uvec4 light[]; };       // headers [object·3 + c], then blocks
-layout(std430, set = 0, binding = 3) readonly buffer Visibility { uvec4 vis[]; };    // headers [vertex], then blocks
-layout(std430, set = 0, binding = 4) buffer Radiance { vec4 radiance[]; };           // per pixel, linear RGB
-layout(std430, set = 0, binding = 5) readonly buffer Counter { CoverageCounter counter; };
+layout(std430, set = 0, binding = kTripleProductShadeBinding) readonly buffer Shade { ShadeSample shade[]; };
+layout(std430, set = 0, binding = kTripleProductRotatedBinding) readonly buffer Rotated { float rotated[]; };
+layout(std430, set = 0, binding = kTripleProductLightBinding) readonly buffer Light { uvec4 light[]; };       // headers [object·3 + c], then blocks
+layout(std430, set = 0, binding = kTripleProductVisibilityBinding) readonly buffer Visibility { uvec4 vis[]; };    // headers [vertex], then blocks
+layout(std430, set = 0, binding = kTripleProductRadianceBinding) buffer Radiance { vec4 radiance[]; };           // per pixel, linear RGB
+layout(std430, set = 0, binding = kTripleProductCounterBinding) readonly buffer Counter { CoverageCounter counter; };
 
 #define BRDF(i) rotated[i]
 #include "common/triple_product.glsl"
@@ -105,7 +100,7 @@ float tripleProduct(uvec4 lightHeader, uint brdfBase, uvec4 visHeader) {
 void main() {
   uint gid = gl_GlobalInvocationID.x;
   // The batch's samples: the indirect dispatch (batch_args.comp) covers
-  // them in groups of 64, so the last group's extra invocations stop here.
+  // them in groups of kLocalSize, so the last group's extra invocations stop here.
   const uint covered = counter.covered;
   const uint count = covered > pc.first ? min(pc.count, covered - pc.first) : 0u;
   if (gid >= count * 3u) return;

@@ -5,8 +5,8 @@
 #ifndef HAARCAST_SPHERE_GLSL
 #define HAARCAST_SPHERE_GLSL
 
-const float kPi = 3.14159265358979323846;
-const float kTwoPi = 6.28318530717958647692;
+// kPiF and kTwoPiF, with the host's π.
+#include "haarcast/core/shared_layout.h"
 
 // ---- Transcendentals to float precision ----------------------------------
 // Vulkan lets sin, cos, atan and acos be loose (sin/cos to 2^-11 absolute,
@@ -45,7 +45,7 @@ float atan2Precise(float y, float x) {
   float z = t * t;
   float a = base + (((8.05374449538e-2 * z - 1.38776856032e-1) * z + 1.99777106478e-1) * z - 3.33329491539e-1) * z * t + t;
   if (ay > ax) a = 1.57079632679489662 - a;
-  if (x < 0.0) a = kPi - a;
+  if (x < 0.0) a = kPiF - a;
   return y < 0.0 ? -a : a;
 }
 
@@ -68,7 +68,7 @@ float atan2Fast(float y, float x) {
   const float ay = abs(y), ax = abs(x);
   float a = atanUnit(min(ay, ax) / max(max(ay, ax), 1e-30));
   a = ay > ax ? 1.57079632679489662 - a : a;
-  a = x < 0.0 ? kPi - a : a;
+  a = x < 0.0 ? kPiF - a : a;
   return (floatBitsToUint(y) & 0x80000000u) != 0u ? -a : a;  // the sign of y, −0 included (CopySign)
 }
 
@@ -87,8 +87,8 @@ vec2 directionToSpherical(vec3 d) {
   float len = length(d);
   float y = clamp(d.y / len, -1.0, 1.0);
   float phi = atan2Precise(d.x, d.z);
-  if (phi < 0.0) phi += kTwoPi;
-  if (phi >= kTwoPi) phi -= kTwoPi;
+  if (phi < 0.0) phi += kTwoPiF;
+  if (phi >= kTwoPiF) phi -= kTwoPiF;
   return vec2(acosPrecise(y), phi);
 }
 
@@ -100,8 +100,8 @@ struct Taps {
 };
 Taps bilinearTaps(int level, float theta, float phi) {
   int m = 1 << level;
-  float y = clamp(theta / kPi * float(m) - 0.5, 0.0, float(m - 1));
-  float x = phi / kTwoPi * float(m) - 0.5;
+  float y = clamp(theta / kPiF * float(m) - 0.5, 0.0, float(m - 1));
+  float x = phi / kTwoPiF * float(m) - 0.5;
   float fy = floor(y);
   float fx = floor(x);
   Taps t;

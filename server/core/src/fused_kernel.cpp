@@ -17,6 +17,7 @@
 #include <hwy/highway.h>
 
 #include "fused_kernel.h"
+#include "haarcast/core/shared_layout.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace haarcast::detail {
@@ -34,7 +35,7 @@ HWY_INLINE V Atan2(D d, V y, V x) {
   const V ratio = hn::Div(small, hn::Max(big, hn::Set(d, 1e-30f)));
   V a = hn::Atan(d, ratio);
   a = hn::IfThenElse(hn::Gt(ay, ax), hn::Sub(hn::Set(d, 1.57079632679489662f), a), a);
-  a = hn::IfThenElse(hn::Lt(x, hn::Zero(d)), hn::Sub(hn::Set(d, 3.14159265358979324f), a), a);
+  a = hn::IfThenElse(hn::Lt(x, hn::Zero(d)), hn::Sub(hn::Set(d, shared::kPiF), a), a);
   return hn::CopySign(a, y);
 }
 
@@ -57,8 +58,8 @@ void FusedSampleWith(const FusedPass& p, float* HWY_RESTRICT out) {
   const VF axisX = hn::Set(d, p.axisX), axisY = hn::Set(d, p.axisY), axisZ = hn::Set(d, p.axisZ);
   const VF coreCos = hn::Set(d, p.coreCos);
   // Continuous pixel coordinates with centres at integer + ½ (bilinearTaps).
-  const VF rowScale = hn::Set(d, static_cast<float>(m) / 3.14159265358979324f);
-  const VF colScale = hn::Set(d, static_cast<float>(m) / 6.28318530717958648f);
+  const VF rowScale = hn::Set(d, static_cast<float>(m) / shared::kPiF);
+  const VF colScale = hn::Set(d, static_cast<float>(m) / shared::kTwoPiF);
   const VF half = hn::Set(d, 0.5f);
   const VF colFraction = hn::Set(d, p.columnFraction);
   const VF zero = hn::Zero(d);

@@ -103,11 +103,32 @@ void ComputePipeline::bind(std::initializer_list<Bound> resources) {
     throw std::invalid_argument(name_ + ": bind() got " + std::to_string(resources.size()) + " resources for " +
                                 std::to_string(bindings_.size()) + " bindings");
   }
+  std::vector<const Bound*> at;
+  for (const Bound& r : resources) at.push_back(&r);
+  bindAll(at);
+}
+
+void ComputePipeline::bind(std::initializer_list<BindingAt> resources) {
+  std::vector<const Bound*> at(bindings_.size(), nullptr);
+  for (const BindingAt& r : resources) {
+    if (r.binding >= at.size() || at[r.binding]) {
+      throw std::invalid_argument(name_ + ": bind() got binding " + std::to_string(r.binding) +
+                                  (r.binding >= at.size() ? " of " + std::to_string(at.size()) : " twice"));
+    }
+    at[r.binding] = &r.resource;
+  }
+  for (std::size_t i = 0; i < at.size(); ++i) {
+    if (!at[i]) throw std::invalid_argument(name_ + ": bind() got nothing for binding " + std::to_string(i));
+  }
+  bindAll(at);
+}
+
+void ComputePipeline::bindAll(const std::vector<const Bound*>& resources) {
   std::vector<VkDescriptorBufferInfo> infos(resources.size());
   std::vector<VkBufferView> views(resources.size());
   std::vector<VkWriteDescriptorSet> writes(resources.size());
-  std::size_t i = 0;
-  for (const Bound& r : resources) {
+  for (std::size_t i = 0; i < resources.size(); ++i) {
+    const Bound& r = *resources[i];
     const BindingKind kind = bindings_[i];
     writes[i].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
     writes[i].dstSet = set_;
@@ -127,7 +148,6 @@ void ComputePipeline::bind(std::initializer_list<Bound> resources) {
       infos[i] = {r.buffer->handle(), 0, VK_WHOLE_SIZE};
       writes[i].pBufferInfo = &infos[i];
     }
-    ++i;
   }
   vkUpdateDescriptorSets(context_.device(), static_cast<std::uint32_t>(writes.size()), writes.data(), 0, nullptr);
 }

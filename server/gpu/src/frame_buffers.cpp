@@ -133,23 +133,63 @@ void VulkanRenderer::Impl::ensureResolution(int w, int h) {
   rgba8 = Buffer(context, pixels * sizeof(std::uint32_t), kStorageUsage, MemoryUse::Readback);
   radianceOut = Buffer(context, pixels * sizeof(glm::vec4), kStorageUsage, MemoryUse::Readback);
 
-  rotationInput->bind({&frameParams, &objects, &gbufIds, &gbufNormals, &triangles, &samples, &shade, &counter, &subIds,
-                       &subNormals, &edges});
-  resolve->bind({&frameParams, &gbufIds, &radiance, &background, &edges});
-  exposure->bind({&frameParams, &gbufIds, &radiance, &exposureResult});
-  tonemap->bind({&frameParams, &radiance, &rgba8, &thresholds, &exposureResult});
+  using namespace shared;  // the passes' binding names (shared_passes.h)
+  rotationInput->bind({{kRotationInputFrameBinding, &frameParams},
+                       {kRotationInputObjectsBinding, &objects},
+                       {kRotationInputIdsBinding, &gbufIds},
+                       {kRotationInputNormalsBinding, &gbufNormals},
+                       {kRotationInputTrianglesBinding, &triangles},
+                       {kRotationInputSamplesBinding, &samples},
+                       {kRotationInputShadeBinding, &shade},
+                       {kRotationInputCounterBinding, &counter},
+                       {kRotationInputSubIdsBinding, &subIds},
+                       {kRotationInputSubNormalsBinding, &subNormals},
+                       {kRotationInputEdgesBinding, &edges}});
+  resolve->bind({{kResolveFrameBinding, &frameParams},
+                 {kResolveIdsBinding, &gbufIds},
+                 {kResolveRadianceBinding, &radiance},
+                 {kResolveBackgroundBinding, &background},
+                 {kResolveEdgesBinding, &edges}});
+  exposure->bind({{kExposureFrameBinding, &frameParams},
+                  {kExposureIdsBinding, &gbufIds},
+                  {kExposureRadianceBinding, &radiance},
+                  {kExposureResultBinding, &exposureResult}});
+  tonemap->bind({{kTonemapFrameBinding, &frameParams},
+                 {kTonemapRadianceBinding, &radiance},
+                 {kTonemapRgba8Binding, &rgba8},
+                 {kTonemapThresholdsBinding, &thresholds},
+                 {kTonemapExposureBinding, &exposureResult}});
   if (fused || splitsum) {
     // Each sample's point-light mask, written by the host every frame (the
     // frame's "shadow-rays" stage) and read by the fused pass.
     masks = Buffer(context, sampleCapacity * sizeof(std::uint32_t), kStorageUsage, MemoryUse::DeviceInput);
     maskUpload = BufferUpload(context, masks);
     if (splitsum) {
-      fusedPass->bind({&samples, &shade, &objects, &counter, &masks, &lobes, &lobeLightTexels, &radiance});
+      fusedPass->bind({{kSplitsumSamplesBinding, &samples},
+                       {kSplitsumShadeBinding, &shade},
+                       {kSplitsumObjectsBinding, &objects},
+                       {kSplitsumCounterBinding, &counter},
+                       {kSplitsumMasksBinding, &masks},
+                       {kSplitsumLobesBinding, &lobes},
+                       {kSplitsumLobeLightTexelsBinding, &lobeLightTexels},
+                       {kSplitsumRadianceBinding, &radiance}});
       return;
     }
-    fusedPass->bind({&samples, &shade, &objects, &sliceTexels, &lightTexels, &visibilityTexels, &directionTexels,
-                     &pointLights, &radiance, &counter, &masks, &sliceEnergy, &lobes, &lobeLightTexels,
-                     &pointSliceTexels});
+    fusedPass->bind({{kFusedSamplesBinding, &samples},
+                     {kFusedShadeBinding, &shade},
+                     {kFusedObjectsBinding, &objects},
+                     {kFusedSliceTexelsBinding, &sliceTexels},
+                     {kFusedLightTexelsBinding, &lightTexels},
+                     {kFusedVisibilityTexelsBinding, &visibilityTexels},
+                     {kFusedDirectionTexelsBinding, &directionTexels},
+                     {kFusedPointLightsBinding, &pointLights},
+                     {kFusedRadianceBinding, &radiance},
+                     {kFusedCounterBinding, &counter},
+                     {kFusedMasksBinding, &masks},
+                     {kFusedSliceEnergyBinding, &sliceEnergy},
+                     {kFusedLobesBinding, &lobes},
+                     {kFusedLobeLightTexelsBinding, &lobeLightTexels},
+                     {kFusedPointSliceTexelsBinding, &pointSliceTexels}});
     return;
   }
 
@@ -159,7 +199,7 @@ void VulkanRenderer::Impl::ensureResolution(int w, int h) {
   const std::size_t perSample = 3 * coefficients * sizeof(float);
   const std::size_t range = std::min<std::size_t>(kRotatedBudget, lim.maxStorageBufferRange);
   batch = std::min({sampleCapacity, range / perSample, static_cast<std::size_t>(lim.maxComputeWorkGroupCount[0]),
-                    static_cast<std::size_t>(lim.maxComputeWorkGroupCount[0]) * 64 / 3});
+                    static_cast<std::size_t>(lim.maxComputeWorkGroupCount[0]) * shared::kLocalSize / 3});
   if (limits.batchSamples) batch = std::min(batch, limits.batchSamples);
   batch = std::max<std::size_t>(batch, 1);
   maxBatches = (sampleCapacity + batch - 1) / batch;
@@ -167,9 +207,17 @@ void VulkanRenderer::Impl::ensureResolution(int w, int h) {
   batchArgs = Buffer(context, 2 * maxBatches * sizeof(DispatchArgs), kStorageUsage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT,
                      MemoryUse::DeviceOnly);
 
-  rotate->bind({&samples, &slices, &methodData, &rotated});
-  tripleProduct->bind({&shade, &rotated, &light, &visibility, &radiance, &counter});
-  batchArgsPass->bind({&counter, &batchArgs});
+  rotate->bind({{kRotateSamplesBinding, &samples},
+                {kRotateSlicesBinding, &slices},
+                {kRotateMethodDataBinding, &methodData},
+                {kRotateRotatedBinding, &rotated}});
+  tripleProduct->bind({{kTripleProductShadeBinding, &shade},
+                       {kTripleProductRotatedBinding, &rotated},
+                       {kTripleProductLightBinding, &light},
+                       {kTripleProductVisibilityBinding, &visibility},
+                       {kTripleProductRadianceBinding, &radiance},
+                       {kTripleProductCounterBinding, &counter}});
+  batchArgsPass->bind({{kBatchArgsCounterBinding, &counter}, {kBatchArgsArgsBinding, &batchArgs}});
 }
 
 }  // namespace haarcast::gpu

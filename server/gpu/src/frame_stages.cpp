@@ -91,12 +91,12 @@ void VulkanRenderer::Impl::uploadFrameUniforms(const render::FrameRequest& reque
 
 void VulkanRenderer::Impl::recordTonemap(VkCommandBuffer cb, const render::FrameRequest& request) {
   const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
-  resolve->dispatch(cb, {groupsOf(pixels, 64), 1, 1});
+  resolve->dispatch(cb, {groupsOf(pixels, shared::kLocalSize), 1, 1});
   computeBarrier(cb);
   const ExposurePush push = render::exposurePush(request.exposure, request.tone);
   exposure->dispatch(cb, {1, 1, 1}, &push, sizeof push);  // one workgroup reduces the frame
   computeBarrier(cb);
-  tonemap->dispatch(cb, {groupsOf(pixels, 64), 1, 1});
+  tonemap->dispatch(cb, {groupsOf(pixels, shared::kLocalSize), 1, 1});
   if (request.linearImage) {
     // The pixels' radiance (the first `pixels` entries) into host memory.
     computeBarrier(cb);

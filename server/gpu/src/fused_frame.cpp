@@ -149,7 +149,7 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
              {"rotation-input",
               [&](VkCommandBuffer cb) {
                 vkCmdFillBuffer(cb, counter.handle(), 0, VK_WHOLE_SIZE, 0u);
-                rotationInput->dispatch(cb, {groupsOf(pixels, 64), 1, 1});
+                rotationInput->dispatch(cb, {groupsOf(pixels, shared::kLocalSize), 1, 1});
               }}},
             frame);
   if (frame.cancelled) return frame;  // stopped between stages: no images

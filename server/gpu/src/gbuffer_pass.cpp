@@ -73,7 +73,7 @@ void VulkanRenderer::Impl::createGraphicsPipeline() {
   vkCheck(vkCreateRenderPass(device, &rp, nullptr, &renderPass), "vkCreateRenderPass");
 
   // Set 0: positions, normals, triangles (vertex stage storage buffers).
-  gbufferSetLayout = createStorageSetLayout(device, 3, VK_SHADER_STAGE_VERTEX_BIT);
+  gbufferSetLayout = createStorageSetLayout(device, shared::kGBufferBindings, VK_SHADER_STAGE_VERTEX_BIT);
   VkPushConstantRange range{VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(GBufferPush)};
   VkPipelineLayoutCreateInfo pl{};
   pl.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
@@ -156,12 +156,13 @@ void VulkanRenderer::Impl::createGraphicsPipeline() {
   vkDestroyShaderModule(device, vert, nullptr);
   vkDestroyShaderModule(device, frag, nullptr);
 
-  allocateStorageSet(device, gbufferSetLayout, 3, gbufferPool, gbufferSet);
-  const VkDescriptorBufferInfo infos[3] = {{positions.handle(), 0, VK_WHOLE_SIZE},
-                                           {normals.handle(), 0, VK_WHOLE_SIZE},
-                                           {triangles.handle(), 0, VK_WHOLE_SIZE}};
-  std::array<VkWriteDescriptorSet, 3> writes{};
-  for (std::uint32_t i = 0; i < 3; ++i) {
+  allocateStorageSet(device, gbufferSetLayout, shared::kGBufferBindings, gbufferPool, gbufferSet);
+  std::array<VkDescriptorBufferInfo, shared::kGBufferBindings> infos{};
+  infos[shared::kGBufferPositionsBinding] = {positions.handle(), 0, VK_WHOLE_SIZE};
+  infos[shared::kGBufferNormalsBinding] = {normals.handle(), 0, VK_WHOLE_SIZE};
+  infos[shared::kGBufferTrianglesBinding] = {triangles.handle(), 0, VK_WHOLE_SIZE};
+  std::array<VkWriteDescriptorSet, shared::kGBufferBindings> writes{};
+  for (std::uint32_t i = 0; i < shared::kGBufferBindings; ++i) {
     writes[i].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
     writes[i].dstSet = gbufferSet;
     writes[i].dstBinding = i;
@@ -169,7 +170,7 @@ void VulkanRenderer::Impl::createGraphicsPipeline() {
     writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
     writes[i].pBufferInfo = &infos[i];
   }
-  vkUpdateDescriptorSets(device, 3, writes.data(), 0, nullptr);
+  vkUpdateDescriptorSets(device, shared::kGBufferBindings, writes.data(), 0, nullptr);
 }
 
 namespace {

@@ -38,14 +38,19 @@ void setFusedSkip(ObjectInfo& info, int level, int lastNonZeroRow) {
 }
 
 std::vector<BindingKind> fusedBindings() {
-  using enum BindingKind;
-  return {Storage, Storage, Storage, Texels, Texels, Texels, Texels, Storage, Storage, Storage, Storage, Storage, Storage, Texels,
-          Texels};
+  std::vector<BindingKind> kinds(shared::kFusedBindings, BindingKind::Storage);
+  for (const shared::uint b : {shared::kFusedSliceTexelsBinding, shared::kFusedLightTexelsBinding,
+                               shared::kFusedVisibilityTexelsBinding, shared::kFusedDirectionTexelsBinding,
+                               shared::kFusedLobeLightTexelsBinding, shared::kFusedPointSliceTexelsBinding}) {
+    kinds[b] = BindingKind::Texels;
+  }
+  return kinds;
 }
 
 std::vector<BindingKind> splitsumBindings() {
-  using enum BindingKind;
-  return {Storage, Storage, Storage, Storage, Storage, Storage, Texels, Storage};
+  std::vector<BindingKind> kinds(shared::kSplitsumBindings, BindingKind::Storage);
+  kinds[shared::kSplitsumLobeLightTexelsBinding] = BindingKind::Texels;
+  return kinds;
 }
 
 void fusedLightTexels(std::span<const float> planes, std::span<glm::vec4> out) {

@@ -56,22 +56,24 @@ render::Frame VulkanRenderer::Impl::renderRotating(const render::FrameRequest& r
     vkCmdFillBuffer(cb, counter.handle(), 0, VK_WHOLE_SIZE, 0u);
     lightUpload.record(cb);  // where the light is staged: its copy into device memory
     computeBarrier(cb);
-    rotationInput->dispatch(cb, {groupsOf(pixels, 64), 1, 1});
+    rotationInput->dispatch(cb, {groupsOf(pixels, shared::kLocalSize), 1, 1});
     computeBarrier(cb);
-    const std::uint32_t sizes[4] = {static_cast<std::uint32_t>(batch), static_cast<std::uint32_t>(maxBatches), 0, 0};
-    batchArgsPass->dispatch(cb, {groupsOf(maxBatches, 64), 1, 1}, sizes, sizeof sizes);  // batch_args.comp's push block
+    shared::BatchArgsPush sizes{};
+    sizes.batch = static_cast<std::uint32_t>(batch);
+    sizes.batches = static_cast<std::uint32_t>(maxBatches);
+    batchArgsPass->dispatch(cb, {groupsOf(maxBatches, shared::kLocalSize), 1, 1}, &sizes, sizeof sizes);
   });
-  std::vector<BatchPush> pushes(maxBatches);
+  std::vector<shared::RotationPush> pushes(maxBatches);
   for (std::size_t b = 0; b < maxBatches; ++b) {
     pushes[b].first = static_cast<std::uint32_t>(b * batch);
     pushes[b].count = static_cast<std::uint32_t>(batch);  // the shaders stop at the covered count
     // The contract: one workgroup per (sample, channel).
     stages.emplace_back("rotation", [&, b](VkCommandBuffer cb) {
-      rotate->dispatchIndirect(cb, batchArgs, b * sizeof(DispatchArgs), &pushes[b], sizeof(BatchPush));
+      rotate->dispatchIndirect(cb, batchArgs, b * sizeof(DispatchArgs), &pushes[b], sizeof(shared::RotationPush));
     });
     stages.emplace_back("triple-product", [&, b](VkCommandBuffer cb) {
       tripleProduct->dispatchIndirect(cb, batchArgs, (maxBatches + b) * sizeof(DispatchArgs), &pushes[b],
-                                      sizeof(BatchPush));
+                                      sizeof(shared::RotationPush));
     });
   }
   stages.emplace_back("tonemap", [&](VkCommandBuffer cb) { recordTonemap(cb, request); });

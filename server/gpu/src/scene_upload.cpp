@@ -21,7 +21,7 @@ void VulkanRenderer::Impl::uploadScene() {
   const std::size_t n = coefficients;
 
   // Slices: global slice s = object's base + t, channel c at (s·3 + c)·N
-  // (the rotation contract's binding 1).
+  // (the rotation contract's kRotateSlicesBinding).
   std::vector<float> sliceData;
   std::vector<float> pointData;  // fused: the slices as point values, laid out as sliceData
   std::vector<std::uint32_t> method;
@@ -238,12 +238,13 @@ void VulkanRenderer::Impl::uploadScene() {
   // Constant 2 is rotate_spatial.comp's local size (the other methods'
   // shaders fix theirs and ignore it): on a CPU device fewer invocations per
   // workgroup make each barrier cheaper (docs/gpu.md, "Performance").
-  std::uint32_t local = context.info().type == "cpu" ? 64u : 256u;
+  std::uint32_t local = context.info().type == "cpu" ? shared::kLocalSize : shared::kGpuLocalSize;
   if (limits.spatialLocalSize) local = limits.spatialLocalSize;
-  rotationInput = std::make_unique<ComputePipeline>(context, "rotation_input.comp", 11, 0);
-  resolve = std::make_unique<ComputePipeline>(context, "resolve.comp", 5, 0);
-  exposure = std::make_unique<ComputePipeline>(context, "exposure.comp", 4, sizeof(ExposurePush));
-  tonemap = std::make_unique<ComputePipeline>(context, "tonemap.comp", 5, 0);
+  rotationInput = std::make_unique<ComputePipeline>(context, "rotation_input.comp", shared::kRotationInputBindings, 0);
+  resolve = std::make_unique<ComputePipeline>(context, "resolve.comp", shared::kResolveBindings, 0);
+  exposure =
+      std::make_unique<ComputePipeline>(context, "exposure.comp", shared::kExposureBindings, sizeof(ExposurePush));
+  tonemap = std::make_unique<ComputePipeline>(context, "tonemap.comp", shared::kTonemapBindings, 0);
   if (splitsum) {
     createSplitsumPipeline();
     return;
@@ -253,15 +254,16 @@ void VulkanRenderer::Impl::uploadScene() {
     // barriers (the reduction's) then switch no coroutines (docs/gpu.md).
     createFusedPipeline(limits.fusedLocalSize          ? limits.fusedLocalSize
                         : context.info().type == "cpu" ? context.subgroupSize()
-                                                       : 256u);
+                                                       : shared::kGpuLocalSize);
     return;
   }
   rotate = std::make_unique<ComputePipeline>(
-      context, "rotate_" + methodName + ".comp", 4, 16,
+      context, "rotate_" + methodName + ".comp", shared::kRotateBindings, sizeof(shared::RotationPush),
       std::vector<SpecConstant>{{0, lvl}, {1, static_cast<std::uint32_t>(T)}, {2, local}});
-  tripleProduct = std::make_unique<ComputePipeline>(context, "triple_product.comp", 6, 16,
-                                                    std::vector<SpecConstant>{{0, lvl}});
-  batchArgsPass = std::make_unique<ComputePipeline>(context, "batch_args.comp", 2, 16);
+  tripleProduct = std::make_unique<ComputePipeline>(context, "triple_product.comp", shared::kTripleProductBindings,
+                                                    sizeof(shared::RotationPush), std::vector<SpecConstant>{{0, lvl}});
+  batchArgsPass = std::make_unique<ComputePipeline>(context, "batch_args.comp", shared::kBatchArgsBindings,
+                                                    sizeof(shared::BatchArgsPush));
 }
 
 void VulkanRenderer::Impl::createFusedPipeline(std::uint32_t local) {
@@ -303,7 +305,7 @@ void VulkanRenderer::Impl::createSplitsumPipeline() {
   // the indirect dispatch as min(covered, fusedGroups) workgroups, and the
   // invocations stride over the samples beyond. A CPU device runs a
   // workgroup per thread: a few per core are enough.
-  fusedLocal = limits.fusedLocalSize ? limits.fusedLocalSize : 64u;
+  fusedLocal = limits.fusedLocalSize ? limits.fusedLocalSize : shared::kLocalSize;
   const std::size_t maxGroups = context.properties().limits.maxComputeWorkGroupCount[0];
   const std::size_t groups = context.info().type == "cpu" ? 64u : 4096u;
   fusedGroups = static_cast<std::uint32_t>(std::min<std::size_t>(maxGroups, groups));

@@ -41,11 +41,6 @@ inline std::uint32_t groupsOf(std::size_t items, std::uint32_t local) {
   return static_cast<std::uint32_t>((items + local - 1) / local);
 }
 
-// The rotation contract's push block (rotate_*.comp, triple_product.comp).
-struct BatchPush {
-  std::uint32_t first = 0, count = 0, pad0 = 0, pad1 = 0;
-};
-
 // An image with its memory and view.
 struct DeviceImage {
   VkImage image = VK_NULL_HANDLE;

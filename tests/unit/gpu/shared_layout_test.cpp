@@ -4,7 +4,10 @@
 // its inverse, for every block and band of levels 1–7 and sampled blocks up
 // to the largest level whose keys fit 32 bits, bit for bit; and the point
 // lights' lookup (Catmull-Rom weights, the point value from a texel's mean),
-// to float rounding (a device may fuse a multiply and an add).
+// to float rounding (a device may fuse a multiply and an add); and the
+// passes' interface (core/shared_passes.h): π, the workgroup sizes, the level
+// caps and every binding number and count as the shader sees them, and the
+// push blocks' members where C++ puts them.
 #include <gtest/gtest.h>
 
 #include <bit>
@@ -23,6 +26,46 @@ namespace haarcast::gpu {
 namespace {
 
 using shared::uint;
+
+// The check shader's push block: its case count, then the passes' push
+// blocks laid out by C++ (std430 puts each struct at a 16-byte boundary).
+struct CheckPush {
+  uint count = 0, pad0 = 0, pad1 = 0, pad2 = 0;
+  shared::RotationPush rotation{};
+  shared::BatchArgsPush batchArgs{};
+};
+
+// What the shader writes to its contract buffer besides π, 2π and its
+// workgroup size, in the shader's order (shared_layout_check.comp kContract).
+struct Named {
+  const char* name;
+  uint value;
+};
+#define C(x) Named{#x, shared::x}
+const std::vector<Named> kContract = {
+      C(kLocalSize), C(kGpuLocalSize), C(kMinLevel), C(kFusedMaxLevel), C(kRotationMaxLevel),
+      C(kRotationInputFrameBinding), C(kRotationInputObjectsBinding), C(kRotationInputIdsBinding),
+      C(kRotationInputNormalsBinding), C(kRotationInputTrianglesBinding), C(kRotationInputSamplesBinding),
+      C(kRotationInputShadeBinding), C(kRotationInputCounterBinding), C(kRotationInputSubIdsBinding),
+      C(kRotationInputSubNormalsBinding), C(kRotationInputEdgesBinding), C(kRotationInputBindings),
+      C(kResolveFrameBinding), C(kResolveIdsBinding), C(kResolveRadianceBinding), C(kResolveBackgroundBinding),
+      C(kResolveEdgesBinding), C(kResolveBindings), C(kExposureFrameBinding), C(kExposureIdsBinding),
+      C(kExposureRadianceBinding), C(kExposureResultBinding), C(kExposureBindings), C(kTonemapFrameBinding),
+      C(kTonemapRadianceBinding), C(kTonemapRgba8Binding), C(kTonemapThresholdsBinding),
+      C(kTonemapExposureBinding), C(kTonemapBindings), C(kRotateSamplesBinding), C(kRotateSlicesBinding),
+      C(kRotateMethodDataBinding), C(kRotateRotatedBinding), C(kRotateBindings), C(kTripleProductShadeBinding),
+      C(kTripleProductRotatedBinding), C(kTripleProductLightBinding), C(kTripleProductVisibilityBinding),
+      C(kTripleProductRadianceBinding), C(kTripleProductCounterBinding), C(kTripleProductBindings),
+      C(kBatchArgsCounterBinding), C(kBatchArgsArgsBinding), C(kBatchArgsBindings), C(kFusedSamplesBinding),
+      C(kFusedShadeBinding), C(kFusedObjectsBinding), C(kFusedSliceTexelsBinding), C(kFusedLightTexelsBinding),
+      C(kFusedVisibilityTexelsBinding), C(kFusedDirectionTexelsBinding), C(kFusedPointLightsBinding),
+      C(kFusedRadianceBinding), C(kFusedCounterBinding), C(kFusedMasksBinding), C(kFusedSliceEnergyBinding),
+      C(kFusedLobesBinding), C(kFusedLobeLightTexelsBinding), C(kFusedPointSliceTexelsBinding),
+      C(kFusedBindings), C(kSplitsumSamplesBinding), C(kSplitsumShadeBinding), C(kSplitsumObjectsBinding),
+      C(kSplitsumCounterBinding), C(kSplitsumMasksBinding), C(kSplitsumLobesBinding),
+      C(kSplitsumLobeLightTexelsBinding), C(kSplitsumRadianceBinding), C(kSplitsumBindings),
+      C(kGBufferPositionsBinding), C(kGBufferNormalsBinding), C(kGBufferTrianglesBinding), C(kGBufferBindings)};
+#undef C
 
 glm::uvec4 packCase(uint n, uint band, uint l, uint i, uint j) { return {n, band * 256 + l, i, j}; }
 
@@ -74,17 +117,43 @@ TEST(SharedLayout, ShaderAndCppAgreeOnTheHaarNumbersAndTheLookup) {
   }
 
   Context context(testing::testOptions());
-  Buffer in(context, cases.size() * sizeof(glm::uvec4)), out(context, 5 * cases.size() * sizeof(glm::uvec4));
+  const std::size_t contractWords = 3 + kContract.size() + 8;
+  Buffer in(context, cases.size() * sizeof(glm::uvec4)), out(context, 5 * cases.size() * sizeof(glm::uvec4)),
+      contract(context, contractWords * sizeof(uint));
   in.upload(std::span<const glm::uvec4>(cases));
-  ComputePipeline check(context, "shared_layout_check.comp", 2, 4);
-  check.bind({&in, &out});
-  const auto count = static_cast<uint>(cases.size());
+  ComputePipeline check(context, "shared_layout_check.comp", 3, sizeof(CheckPush));
+  check.bind({&in, &out, &contract});
+  CheckPush push;
+  push.count = static_cast<uint>(cases.size());
+  push.rotation = {11u, 12u, 13u, 14u};
+  push.batchArgs = {21u, 22u, 23u, 24u};
   context.submit([&](VkCommandBuffer cb) {
-    check.dispatch(cb, {(count + 63) / 64, 1, 1}, &count, sizeof count);
+    check.dispatch(cb, {(push.count + shared::kLocalSize - 1) / shared::kLocalSize, 1, 1}, &push, sizeof push);
     computeBarrier(cb);
   });
   std::vector<glm::uvec4> got(5 * cases.size());
   out.download(std::span<glm::uvec4>(got));
+
+  // The interface: each number as C++ has it, then what the shader wrote.
+  std::vector<Named> interface = {{"kPiF (bits)", std::bit_cast<uint>(shared::kPiF)},
+                             {"kTwoPiF (bits)", std::bit_cast<uint>(shared::kTwoPiF)},
+                             {"gl_WorkGroupSize.x = kLocalSize", shared::kLocalSize}};
+  interface.insert(interface.end(), kContract.begin(), kContract.end());
+  interface.insert(interface.end(), {{"RotationPush::first", push.rotation.first},
+                           {"RotationPush::count", push.rotation.count},
+                           {"RotationPush::pad0", push.rotation.pad0},
+                           {"RotationPush::pad1", push.rotation.pad1},
+                           {"BatchArgsPush::batch", push.batchArgs.batch},
+                           {"BatchArgsPush::batches", push.batchArgs.batches},
+                           {"BatchArgsPush::pad0", push.batchArgs.pad0},
+                           {"BatchArgsPush::pad1", push.batchArgs.pad1}});
+  ASSERT_EQ(interface.size(), contractWords);
+  std::vector<uint> seen(contractWords);
+  contract.download(std::span<uint>(seen));
+  for (std::size_t w = 0; w < interface.size(); ++w) {
+    EXPECT_EQ(seen[w], interface[w].value)
+        << interface[w].name << ": GLSL " << seen[w] << ", C++ " << interface[w].value;
+  }
 
   std::size_t wrong = 0;
   for (std::size_t k = 0; k < cases.size(); ++k) {

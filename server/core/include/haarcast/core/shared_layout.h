@@ -41,13 +41,24 @@ inline constexpr int findMSB(uint x) { return static_cast<int>(std::bit_width(x)
 #define HC_CONSTEXPR
 #endif
 
-// π in float, for the float paths (CPU kernels and shaders alike).
-HC_CONST float kPiF = 3.14159265358979323846f;
+// π, written once: kPi for the C++ double paths (core/sphere_map.h takes
+// it from here), kPiF and kTwoPiF for the float paths, CPU kernels and
+// shaders alike (2π is exact as twice the float of π).
+#define HC_PI 3.14159265358979323846
+#ifdef __cplusplus
+inline constexpr double kPi = HC_PI;
+#endif
+HC_CONST float kPiF = float(HC_PI);
+HC_CONST float kTwoPiF = 2.0f * kPiF;
 
 // Map levels every per-pixel method accepts (level n = 2^n × 2^n).
 HC_CONST uint kMinLevel = 2u;
 // `fused` on both backends: at level 7 a map is 16,384 pixels.
 HC_CONST uint kFusedMaxLevel = 7u;
+// The rotating methods on the Vulkan backend (rotate_*.comp): a workgroup
+// keeps one map in shared memory, and a level-6 map (16 KiB) is the most
+// Vulkan guarantees room for.
+HC_CONST uint kRotationMaxLevel = 6u;
 
 // Antialiasing (RenderOptions::antialias): a pixel is an edge pixel when the
 // centre samples of its 3×3 neighbourhood do not all see the same object
@@ -441,36 +452,11 @@ struct ShadeSample {
   uint pixel;          // its radiance slot, as RotationSample::pixel
 };
 
-// The rotation-input pass's counter, followed by the indirect dispatch
-// arguments of `fused` (VkDispatchIndirectCommand at byte 4): groups[0] =
-// min(covered, FrameParams::fusedGroups), groups[1] = groups[2] = 1 once
-// any pixel is covered.
-struct CoverageCounter {
-  uint covered;
-  uint groups[3];
-};
-
-// The rotating methods' batches, sized on the device: batch_args.comp
-// writes, from the covered count, per batch b of `batch` samples with
-// count_b = clamp(covered − b·batch, 0, batch), the rotation's arguments
-// (count_b, 3, 1) at [b] and the triple product's (⌈3·count_b / 64⌉, 1, 1)
-// at [batches + b] (VkDispatchIndirectCommand, padded to 16 bytes).
-struct DispatchArgs {
-  uint groups[3];
-  uint pad;
-};
-
 // Auto exposure's metering, ExposurePush and ExposureResult.
 #include "haarcast/core/shared_exposure.h"
 
-// The G-buffer pass's push block (gbuffer.vert / .frag).
-struct GBufferPush {
-  mat4 objectToClip;
-  uint objectId;
-  uint triangleBase;
-  uint pad0;
-  uint pad1;
-};
+// The passes' workgroup sizes, push blocks and bindings.
+#include "haarcast/core/shared_passes.h"
 
 #ifdef __cplusplus
 static_assert(sizeof(FrameParams) == 128 && offsetof(FrameParams, tanHalf) == 96 &&
@@ -490,6 +476,8 @@ static_assert(sizeof(CoverageCounter) == 16 && offsetof(CoverageCounter, groups)
 static_assert(sizeof(DispatchArgs) == 16 && offsetof(DispatchArgs, groups) == 0);
 static_assert(sizeof(ExposurePush) == 32 && sizeof(ExposureResult) == 32);
 static_assert(sizeof(GBufferPush) == 80 && offsetof(GBufferPush, objectId) == 64);
+static_assert(sizeof(RotationPush) == 16 && offsetof(RotationPush, count) == 4);
+static_assert(sizeof(BatchArgsPush) == 16 && offsetof(BatchArgsPush, batches) == 4);
 #endif
 
 #ifdef __cplusplus
@@ -497,6 +485,7 @@ static_assert(sizeof(GBufferPush) == 80 && offsetof(GBufferPush, objectId) == 64
 #undef HC_CONST
 #undef HC_FUNCTION
 #undef HC_CONSTEXPR
+#undef HC_PI
 #endif
 
 #endif  // HAARCAST_CORE_SHARED_LAYOUT_H

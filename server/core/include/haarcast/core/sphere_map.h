@@ -15,7 +15,6 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
-#include <numbers>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -23,10 +22,12 @@
 
 #include <glm/vec3.hpp>
 
+#include "haarcast/core/shared_layout.h"
+
 namespace haarcast {
 
-inline constexpr double kPi = std::numbers::pi;
-inline constexpr double kTwoPi = 2.0 * std::numbers::pi;
+using shared::kPi;  // shared_layout.h, where the shaders read it too
+inline constexpr double kTwoPi = 2.0 * kPi;
 
 // Largest map level the library accepts: level 12 is a 4096² map (64 MiB of
 // floats); anything larger is a mistake in a request, not a real use.

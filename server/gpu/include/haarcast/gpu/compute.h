@@ -42,6 +42,13 @@ struct Bound {
   const TexelView* texels = nullptr;
 };
 
+// A resource for one binding of set 0, named by the pass's binding constant
+// (core/shared_passes.h), the number the shader declares it at.
+struct BindingAt {
+  std::uint32_t binding = 0;
+  Bound resource;
+};
+
 // A VkShaderModule from the embedded SPIR-V of shaders/<name>; throws
 // std::invalid_argument naming the shader when it is not embedded.
 VkShaderModule createShaderModule(Context& context, std::string_view name);
@@ -64,6 +71,8 @@ class ComputePipeline {
   // that uses this pipeline is still running (Context::submit waits, so
   // between submits is fine).
   void bind(std::initializer_list<Bound> resources);
+  // The same by binding number: every binding once, in any order.
+  void bind(std::initializer_list<BindingAt> resources);
   // Binds the pipeline and its descriptor set, pushes `push` and dispatches.
   void dispatch(VkCommandBuffer cb, std::array<std::uint32_t, 3> groups, const void* push = nullptr,
                 std::uint32_t pushBytes = 0) const;
@@ -77,6 +86,8 @@ class ComputePipeline {
 
  private:
   void destroy();
+  // resources[i] for binding i, every binding's.
+  void bindAll(const std::vector<const Bound*>& resources);
   void bindForDispatch(VkCommandBuffer cb, const void* push, std::uint32_t pushBytes) const;
   Context& context_;
   std::string name_;

@@ -65,18 +65,11 @@ struct DirectionTable {
 };
 DirectionTable pixelCentreDirections(std::span<const int> levels);
 
-// fused.comp's bindings: 0 samples, 1 shade, 2 objects (storage); 3 slice
-// texels (RGBA32F texels); 4 light (RGBA32F texels, fusedLightTexels); 5
-// visibility bits (R32UI texels: every vertex's shared::visibilityWords words
-// at its object's level, global vertex order); 6 directions (RGBA32F
-// texels, a DirectionTable); 7 point lights
-// (PointLight, kMaxPointLights per object), 8 radiance, 9 counter, 10 the
-// samples' point-light masks (a uint per sample) (storage).
+// The kinds of fused.comp's and splitsum.comp's bindings, from their names
+// (core/shared_passes.h): the *TexelsBinding ones uniform texel buffers
+// (fused: RGBA32F slices, light, directions, prefiltered light, point
+// slices; R32UI visibility words), the rest storage buffers.
 std::vector<BindingKind> fusedBindings();
-
-// splitsum.comp's bindings: 0 samples, 1 shade, 2 objects, 3 counter, 4 the
-// samples' masks (kLobeSeenBit), 5 lobes (SliceLobe per global lobe)
-// (storage); 6 the prefiltered light (RGBA32F texels); 7 radiance (storage).
 std::vector<BindingKind> splitsumBindings();
 
 // The light of one object as fused.comp reads it: texel k = (L_r, L_g, L_b, 0)
@@ -92,7 +85,7 @@ void setFusedSkip(ObjectInfo& info, int level, int lastNonZeroRow);
 // The level range of the GPU passes: shared memory holds one level-6 map
 // (16 KiB) per workgroup, the least that Vulkan guarantees (and lavapipe's
 // and NVIDIA's budgets allow with room for the method's scratch).
-inline constexpr int kMinGpuLevel = 2;
-inline constexpr int kMaxGpuLevel = 6;
+inline constexpr int kMinGpuLevel = static_cast<int>(shared::kMinLevel);
+inline constexpr int kMaxGpuLevel = static_cast<int>(shared::kRotationMaxLevel);
 
 }  // namespace haarcast::gpu

@@ -1,11 +1,11 @@
-// Host-side packing of the per-method data of the rotation shaders: binding 2
+// Host-side packing of the per-method data of the rotation shaders: kRotateMethodDataBinding
 // (`uint methodData[]`) of shaders/rotate_<method>.comp. One block per object,
 // appended to one word vector; the block's first word offset is the object's
 // RotationSample::methodBase. Floats are stored as their bits
 // (uintBitsToFloat in the shaders). All offsets are in 32-bit words.
 //
 // Layouts (M = 2^n map side, N = M², T = the object's θ slices, slice t of
-// channel c being the object's global slice sliceBase + t in binding 1):
+// channel c being the object's global slice sliceBase + t in kRotateSlicesBinding):
 //
 //  haar, variant refined (RotatorOptions{}) — the rotate_haar.comp step (1)
 //  data: f's exact differences across every pixel boundary, per slice and
