@@ -432,7 +432,7 @@ HC_CONST uint kLobeSeenBit = 1u << 16u;
 // [v·W, (v + 1)·W), W = visibilityWords(level), direction i at bit i % 32 of word i / 32.
 HC_FUNCTION uint visibilityWords(uint level) { return max((1u << (2u * level)) / 32u, 1u); }
 
-// Per covered pixel, what the rotation needs (the rotation contract's binding 0).
+// Per covered pixel, what the rotation needs (the rotation contract's kRotateSamplesBinding, shared_passes.h).
 struct RotationSample {
   uint slice;          // global slice: the object's slice base + nearest θ slice
   uint methodBase;     // the object's offset into the method data, in words
