@@ -79,15 +79,26 @@ std::uint32_t VulkanRenderer::Impl::computeShadowMasks(const render::ResolvedFra
     }, options.threads);
   }
   parallelFor((count.covered + kChunk - 1) / kChunk, [&](std::size_t chunk) {
+    const std::size_t begin = chunk * kChunk;
     const std::size_t end = std::min<std::size_t>(count.covered, (chunk + 1) * kChunk);
-    for (std::size_t s = chunk * kChunk; s < end; ++s) {
+    // The point lights' rays for the chunk's samples at once, in packets
+    // (render::pointLightMasks); samples off every object (a zero normal
+    // faces no light) cast none.
+    thread_local std::vector<render::ShadingPoint> points;
+    thread_local std::vector<std::uint32_t> masks;
+    points.resize(end - begin);
+    for (std::size_t s = begin; s < end; ++s)
+      points[s - begin] = sh[s].object < objectCount ? pointOf(sh[s]) : render::ShadingPoint{{}, glm::vec3(0.0f), 0.0f};
+    masks.resize(points.size());
+    render::pointLightMasks(*rays, points, lightDirections, masks);
+    for (std::size_t s = begin; s < end; ++s) {
       const ShadeSample& sample = sh[s];
       if (sample.object >= objectCount) {
         out[s] = 0;
         continue;
       }
-      const render::ShadingPoint point = pointOf(sample);
-      out[s] = render::pointLightMask(*rays, point, lightDirections);
+      const render::ShadingPoint& point = points[s - begin];
+      out[s] = masks[s - begin];
       if (prepared.objects[sample.object].lobePath) out[s] |= render::lobeRayBit(*rays, point, eye);
       if (groundSky && prepared.objects[sample.object].ground) {
         // Its pixel: the slot itself, or the edge pixel a sub-sample's slot belongs to.

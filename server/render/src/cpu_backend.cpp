@@ -168,7 +168,9 @@ class CpuRenderer final : public Renderer {
   void fillInputs(const ResolvedFrame& resolved, GBuffer& g, const CancelPoint& cancelPoint) const;
   static glm::dvec3 subsampleDirection(const CameraRays& camera, int x, int y, unsigned k);
   // rgb = the sample's radiance; returns the coefficient bytes read.
-  using Shade = std::function<std::size_t(const Sample&, std::array<float, 3>& rgb)>;
+  // `slot` numbers the frame's samples: a centre by its pixel, sub-sample k
+  // of edge pixel e after them, pixels + e·kSubsamples + k (sampleSlot).
+  using Shade = std::function<std::size_t(const Sample&, std::size_t slot, std::array<float, 3>& rgb)>;
   // Every covered pixel: the centre sample shaded, or for an edge pixel the
   // mean of its sub-samples (the backdrop where one misses); rows in
   // parallel. Marks objectMask; returns the bytes read.
@@ -237,11 +239,36 @@ void CpuRenderer::traceGBuffer(const RayScene& rays, const CameraRays& camera, i
   g.centre.assign(pixels, std::nullopt);
   g.width = static_cast<std::size_t>(w);
   g.height = static_cast<std::size_t>(h);
-  parallelFor(static_cast<std::size_t>(h), [&](std::size_t y) {
+  // The centres in 4×4 tiles, one Embree packet each (RayScene::intersectFrom:
+  // neighbouring rays from the eye share their traversal), bands of 4 rows
+  // in parallel.
+  constexpr int kTile = 4;
+  const glm::vec3 eye(camera.origin());
+  parallelFor(static_cast<std::size_t>((h + kTile - 1) / kTile), [&](std::size_t band) {
     cancelPoint();
-    for (int x = 0; x < w; ++x) {
-      const std::size_t i = y * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
-      g.centre[i] = trace(camera.direction(x, static_cast<int>(y)), i);
+    std::array<glm::dvec3, kTile * kTile> exact;
+    std::array<glm::vec3, kTile * kTile> directions;
+    std::array<std::size_t, kTile * kTile> pixel;
+    std::array<std::optional<Hit>, kTile * kTile> hits;
+    const int y0 = static_cast<int>(band) * kTile, y1 = std::min(y0 + kTile, h);
+    for (int x0 = 0; x0 < w; x0 += kTile) {
+      std::size_t n = 0;
+      for (int y = y0; y < y1; ++y) {
+        for (int x = x0; x < std::min(x0 + kTile, w); ++x, ++n) {
+          exact[n] = camera.direction(x, y);
+          directions[n] = glm::vec3(exact[n]);
+          pixel[n] = static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
+        }
+      }
+      rays.intersectFrom(eye, 0.0f, std::span(directions).first(n), std::span(hits).first(n));
+      for (std::size_t k = 0; k < n; ++k) {
+        if (!hits[k]) continue;
+        Sample s;
+        s.hit = *hits[k];
+        s.pixel = static_cast<std::uint32_t>(pixel[k]);
+        s.direction = exact[k];
+        g.centre[pixel[k]] = s;
+      }
     }
   }, {}, options_.threads);
 
@@ -324,7 +351,7 @@ std::size_t CpuRenderer::shadePixels(const GBuffer& g, const FrameRequest& reque
       if (g.centre[i]) frame.objectMask[i] = 1;
       if (g.edge[i] == kInterior) {
         if (!g.centre[i]) continue;  // the backdrop, drawn by the tonemap stage
-        rowBytes += shade(*g.centre[i], rgb);
+        rowBytes += shade(*g.centre[i], i, rgb);
         for (int c = 0; c < 3; ++c) frame.image.at(static_cast<int>(y), x, c) = rgb[static_cast<std::size_t>(c)];
         continue;
       }
@@ -332,7 +359,7 @@ std::size_t CpuRenderer::shadePixels(const GBuffer& g, const FrameRequest& reque
       for (unsigned k = 0; k < shared::kSubsamples; ++k) {
         const auto& s = g.sub[g.edge[i]][k];
         if (s) {
-          rowBytes += shade(*s, rgb);
+          rowBytes += shade(*s, g.centre.size() + g.edge[i] * shared::kSubsamples + k, rgb);
           sum += glm::dvec3(rgb[0], rgb[1], rgb[2]);
         } else if (options_.environmentBackground) {
           sum += backgroundRadiance(prepared_.background, request.lightRotation,
@@ -430,7 +457,7 @@ std::size_t CpuRenderer::shadeRotating(const ResolvedFrame& resolved, const GBuf
   // to the thread time each took.
   const auto t0 = Clock::now();
   std::atomic<std::int64_t> rotationNs{0}, productNs{0};
-  const std::size_t bytes = shadePixels(g, request, camera, frame, [&](const Sample& sample, std::array<float, 3>& rgb) {
+  const std::size_t bytes = shadePixels(g, request, camera, frame, [&](const Sample& sample, std::size_t /*slot*/, std::array<float, 3>& rgb) {
     // Per worker thread, kept across pixels: no allocation per pixel once warm.
     struct Scratch {
       std::array<HaarMap, 3> rotated;
@@ -505,16 +532,44 @@ std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const RayScen
       return samplePoint(frames, resolved, c->hit.object, c->input);
     }, options_.threads);
   }
-  const std::size_t bytes = shadePixels(g, request, camera, frame, [&](const Sample& sample, std::array<float, 3>& rgb) {
+  // The point lights each sample sees: one shadow ray each (point_lights.h),
+  // a pixel row's samples at a time so that each light's rays go in packets.
+  std::vector<std::uint32_t> lightsSeen;
+  if (!resolved.pointLightDirections.empty()) {
+    lightsSeen.assign(g.centre.size() + g.sub.size() * shared::kSubsamples, 0u);
+    parallelFor(g.height, [&](std::size_t y) {
+      cancelPoint();
+      thread_local std::vector<ShadingPoint> points;
+      thread_local std::vector<std::size_t> slots;
+      thread_local std::vector<std::uint32_t> masks;
+      points.clear();
+      slots.clear();
+      auto add = [&](const Sample& s, std::size_t slot) {
+        points.push_back(samplePoint(frames, resolved, s.hit.object, s.input));
+        slots.push_back(slot);
+      };
+      for (std::size_t i = y * g.width; i < (y + 1) * g.width; ++i) {
+        if (g.edge[i] == kInterior) {
+          if (g.centre[i]) add(*g.centre[i], i);
+          continue;
+        }
+        for (unsigned k = 0; k < shared::kSubsamples; ++k)
+          if (const auto& s = g.sub[g.edge[i]][k]) add(*s, g.centre.size() + g.edge[i] * shared::kSubsamples + k);
+      }
+      masks.resize(points.size());
+      pointLightMasks(rays, points, resolved.pointLightDirections, masks);
+      for (std::size_t j = 0; j < slots.size(); ++j) lightsSeen[slots[j]] = masks[j];
+    }, {}, options_.threads);
+  }
+  const std::size_t bytes = shadePixels(g, request, camera, frame, [&](const Sample& sample, std::size_t slot, std::array<float, 3>& rgb) {
     // Per worker thread, kept across pixels: no allocation per pixel.
     thread_local FusedScratch scratch;
     const std::size_t object = sample.hit.object;
     const PreparedObject& p = prepared_.objects[object];
     const ResolvedObject& o = resolved.objects[object];
     const PixelInput& in = sample.input;
-    // The point lights this sample sees: one shadow ray each (point_lights.h).
     const ShadingPoint point = samplePoint(frames, resolved, object, in);
-    std::uint32_t seen = pointLightMask(rays, point, resolved.pointLightDirections);
+    std::uint32_t seen = lightsSeen.empty() ? 0u : lightsSeen[slot];
     if (p.lobePath) seen |= lobeRayBit(rays, point, eye);
     if (p.ground) {
       // The word the Vulkan backend reads too: bits, then the sky's occlusion.
@@ -547,7 +602,7 @@ std::size_t CpuRenderer::shadeSplitsum(const ResolvedFrame& resolved, const RayS
   const auto t0 = Clock::now();
   const ObjectFrames frames(resolved);
   const glm::vec3 eye(camera.origin());
-  const std::size_t bytes = shadePixels(g, request, camera, frame, [&](const Sample& sample, std::array<float, 3>& rgb) {
+  const std::size_t bytes = shadePixels(g, request, camera, frame, [&](const Sample& sample, std::size_t /*slot*/, std::array<float, 3>& rgb) {
     const std::size_t object = sample.hit.object;
     const PreparedObject& p = prepared_.objects[object];
     const ResolvedObject& o = resolved.objects[object];

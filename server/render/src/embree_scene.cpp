@@ -246,6 +246,32 @@ RTCRay toEmbree(const Ray& r) {
 
 }  // namespace
 
+namespace {
+
+// Under ASan rtcOccluded16 was seen never to return (after other tests had
+// run in the process); the sanitized tests trace packets' rays one by one.
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define HAARCAST_ONE_RAY_AT_A_TIME 1
+#endif
+#endif
+
+}  // namespace
+
+Hit RayScene::hitOf(unsigned object, unsigned triangle, float u, float v, float t, const glm::vec3& ng) const {
+  Hit hit;
+  hit.object = object;
+  hit.triangle = triangle;
+  hit.u = u;
+  hit.v = v;
+  hit.t = t;
+  // Embree gives Ng in the mesh's (object) frame, unnormalised.
+  const glm::vec3 n = impl_->normalMatrices[object] * ng;
+  const float len = glm::length(n);
+  if (len > 0.0f) hit.geometricNormal = n / len;
+  return hit;
+}
+
 std::optional<Hit> RayScene::intersect(const Ray& ray) const {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
@@ -255,18 +281,63 @@ std::optional<Hit> RayScene::intersect(const Ray& ray) const {
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
   rtcIntersect1(impl_->top.get(), &context, &rh);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
+  return hitOf(rh.hit.instID[0], rh.hit.primID, rh.hit.u, rh.hit.v, rh.ray.tfar,
+               glm::vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z));
+}
 
-  Hit hit;
-  hit.object = rh.hit.instID[0];
-  hit.triangle = rh.hit.primID;
-  hit.u = rh.hit.u;
-  hit.v = rh.hit.v;
-  hit.t = rh.ray.tfar;
-  // Embree gives Ng in the mesh's (object) frame, unnormalised.
-  const glm::vec3 n = impl_->normalMatrices[hit.object] * glm::vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z);
-  const float len = glm::length(n);
-  if (len > 0.0f) hit.geometricNormal = n / len;
-  return hit;
+void RayScene::intersectFrom(const glm::vec3& origin, float tnear, std::span<const glm::vec3> directions,
+                             std::span<std::optional<Hit>> out) const {
+  if (directions.size() != out.size()) {
+    throw std::invalid_argument("RayScene::intersectFrom: " + std::to_string(directions.size()) + " directions but " +
+                                std::to_string(out.size()) + " results");
+  }
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  constexpr std::size_t kWidth = 16;  // Embree's widest packet, as occludedFrom
+  alignas(64) RTCRayHit16 packet;
+  alignas(64) int valid[kWidth];
+  for (std::size_t first = 0; first < directions.size(); first += kWidth) {
+    const std::size_t n = std::min(kWidth, directions.size() - first);
+    for (std::size_t k = 0; k < kWidth; ++k) {
+      const bool live = k < n;
+      const glm::vec3 d = live ? directions[first + k] : glm::vec3(0.0f, 1.0f, 0.0f);
+      valid[k] = live ? -1 : 0;
+      packet.ray.org_x[k] = origin.x;
+      packet.ray.org_y[k] = origin.y;
+      packet.ray.org_z[k] = origin.z;
+      packet.ray.dir_x[k] = d.x;
+      packet.ray.dir_y[k] = d.y;
+      packet.ray.dir_z[k] = d.z;
+      packet.ray.tnear[k] = tnear;
+      packet.ray.tfar[k] = std::numeric_limits<float>::infinity();
+      packet.ray.time[k] = 0.0f;
+      packet.ray.mask[k] = ~0u;
+      packet.ray.id[k] = static_cast<unsigned>(k);
+      packet.ray.flags[k] = 0;
+      packet.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+      packet.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+    }
+#ifdef HAARCAST_ONE_RAY_AT_A_TIME
+    for (std::size_t k = 0; k < n; ++k) {
+      Ray ray;
+      ray.origin = origin;
+      ray.direction = directions[first + k];
+      ray.tnear = tnear;
+      out[first + k] = intersect(ray);
+    }
+#else
+    rtcIntersect16(valid, impl_->top.get(), &context, &packet);
+    for (std::size_t k = 0; k < n; ++k) {
+      if (packet.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID) {
+        out[first + k] = std::nullopt;
+        continue;
+      }
+      out[first + k] = hitOf(packet.hit.instID[0][k], packet.hit.primID[k], packet.hit.u[k], packet.hit.v[k],
+                             packet.ray.tfar[k], glm::vec3(packet.hit.Ng_x[k], packet.hit.Ng_y[k], packet.hit.Ng_z[k]));
+    }
+#endif
+  }
 }
 
 bool RayScene::occluded(const Ray& ray) const {
@@ -340,19 +411,62 @@ void RayScene::occludedFrom(const glm::vec3& origin, float tnear, std::span<cons
       // Embree marks a blocked ray by setting tfar to −∞, so it is reset.
       packet.tfar[k] = std::numeric_limits<float>::infinity();
     }
-#if defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define HAARCAST_ONE_RAY_AT_A_TIME 1
-#endif
-#endif
 #ifdef HAARCAST_ONE_RAY_AT_A_TIME
-    // Under ASan rtcOccluded16 was seen never to return (after other tests
-    // had run in the process); the sanitized tests trace the same rays one by one.
     for (std::size_t k = 0; k < n; ++k) {
       RTCRay ray{origin.x, origin.y, origin.z, tnear, packet.dir_x[k], packet.dir_y[k], packet.dir_z[k], 0.0f,
                  std::numeric_limits<float>::infinity(), ~0u, 0u, 0u};
       rtcOccluded1(impl_->occlusionScene, &context, &ray);
       packet.tfar[k] = ray.tfar;
+    }
+#else
+    rtcOccluded16(valid, impl_->occlusionScene, &context, &packet);
+#endif
+    for (std::size_t k = 0; k < n; ++k) {
+      out[first + k] = packet.tfar[k] == -std::numeric_limits<float>::infinity() ? 1 : 0;
+    }
+  }
+}
+
+void RayScene::occludedToward(std::span<const glm::vec3> origins, const glm::vec3& direction, float tnear,
+                              std::span<std::uint8_t> out) const {
+  if (origins.size() != out.size()) {
+    throw std::invalid_argument("RayScene::occludedToward: " + std::to_string(origins.size()) + " origins but " +
+                                std::to_string(out.size()) + " results");
+  }
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  constexpr std::size_t kWidth = 16;
+  alignas(64) RTCRay16 packet;
+  alignas(64) int valid[kWidth];
+  for (std::size_t k = 0; k < kWidth; ++k) {
+    packet.dir_x[k] = direction.x;
+    packet.dir_y[k] = direction.y;
+    packet.dir_z[k] = direction.z;
+    packet.tnear[k] = tnear;
+    packet.time[k] = 0.0f;
+    packet.mask[k] = ~0u;
+    packet.id[k] = static_cast<unsigned>(k);
+    packet.flags[k] = 0;
+  }
+  for (std::size_t first = 0; first < origins.size(); first += kWidth) {
+    const std::size_t n = std::min(kWidth, origins.size() - first);
+    for (std::size_t k = 0; k < kWidth; ++k) {
+      const bool live = k < n;
+      const glm::vec3 o = live ? origins[first + k] : origins[first];
+      valid[k] = live ? -1 : 0;
+      packet.org_x[k] = o.x;
+      packet.org_y[k] = o.y;
+      packet.org_z[k] = o.z;
+      packet.tfar[k] = std::numeric_limits<float>::infinity();  // −∞ marks a blocked ray
+    }
+#ifdef HAARCAST_ONE_RAY_AT_A_TIME
+    for (std::size_t k = 0; k < n; ++k) {
+      Ray ray;
+      ray.origin = origins[first + k];
+      ray.direction = direction;
+      ray.tnear = tnear;
+      packet.tfar[k] = occluded(ray) ? -std::numeric_limits<float>::infinity() : 0.0f;
     }
 #else
     rtcOccluded16(valid, impl_->occlusionScene, &context, &packet);

@@ -40,6 +40,31 @@ std::uint32_t pointLightMask(const RayScene& world, const ShadingPoint& p, std::
   return mask;
 }
 
+void pointLightMasks(const RayScene& world, std::span<const ShadingPoint> points, std::span<const glm::vec3> directions,
+                     std::span<std::uint32_t> masks) {
+  HC_CHECK_LE(directions.size(), std::size_t{32});
+  HC_CHECK_EQ(points.size(), masks.size());
+  std::fill(masks.begin(), masks.end(), 0u);
+  // Per thread, kept across calls: no allocation per row.
+  thread_local std::vector<glm::vec3> origins;
+  thread_local std::vector<std::uint32_t> which;
+  thread_local std::vector<std::uint8_t> blocked;
+  for (std::size_t k = 0; k < directions.size(); ++k) {
+    origins.clear();
+    which.clear();
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const ShadingPoint& p = points[i];
+      if (!(glm::dot(p.normal, directions[k]) > 0.0f)) continue;  // below the shading horizon, as pointLightMask
+      origins.push_back(p.position + p.normal * p.shift);
+      which.push_back(static_cast<std::uint32_t>(i));
+    }
+    blocked.resize(origins.size());
+    world.occludedToward(origins, directions[k], 0.0f, blocked);
+    for (std::size_t j = 0; j < origins.size(); ++j)
+      if (!blocked[j]) masks[which[j]] |= 1u << k;
+  }
+}
+
 std::uint32_t lobeRayBit(const RayScene& world, const ShadingPoint& p, const glm::vec3& eye) {
   const glm::vec3 toward = glm::normalize(eye - p.position);
   const glm::vec3 mirror = 2.0f * glm::dot(p.normal, toward) * p.normal - toward;

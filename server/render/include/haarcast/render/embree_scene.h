@@ -75,6 +75,13 @@ class RayScene {
 
   // Closest hit in [tnear, tfar], or none. Thread-safe.
   std::optional<Hit> intersect(const Ray& ray) const;
+  // intersect() for rays that share an origin (a pinhole camera's), as
+  // Embree packets of 16 consecutive directions with the coherent hint:
+  // out[i] = the closest hit of origin + t·directions[i], t ∈ [tnear, ∞).
+  // Fastest when each 16 are neighbours (a 4×4 block of pixels).
+  // Thread-safe. Throws std::invalid_argument if the spans differ in size.
+  void intersectFrom(const glm::vec3& origin, float tnear, std::span<const glm::vec3> directions,
+                     std::span<std::optional<Hit>> out) const;
   // Whether anything lies in [tnear, tfar] (any hit, not the closest: cheaper).
   // Thread-safe.
   bool occluded(const Ray& ray) const;
@@ -92,12 +99,22 @@ class RayScene {
   // in size.
   void occludedFrom(const glm::vec3& origin, float tnear, std::span<const glm::vec3> directions,
                     std::span<std::uint8_t> out) const;
+  // occluded() for rays that share a direction (many points toward one
+  // light), as Embree packets of 16 consecutive origins with the coherent
+  // hint: out[i] = 1 if origins[i] + t·direction, t ∈ [tnear, ∞), is
+  // blocked. Fastest when each 16 are neighbours (a pixel row's points).
+  // Thread-safe. Throws std::invalid_argument if the spans differ in size.
+  void occludedToward(std::span<const glm::vec3> origins, const glm::vec3& direction, float tnear,
+                      std::span<std::uint8_t> out) const;
   // Moves object `object` and rebuilds the top level only (the meshes'
   // structures are kept): the per-frame path for posed objects. Not safe
   // while another thread queries this scene.
   void setTransform(std::size_t object, const glm::mat4& objectToWorld);
 
  private:
+  // A hit as Embree reports it: the normal Ng in the object's frame, unnormalised.
+  Hit hitOf(unsigned object, unsigned triangle, float u, float v, float t, const glm::vec3& ng) const;
+
   struct Impl;
   std::unique_ptr<Impl> impl_;  // null only after a move
 };

@@ -45,6 +45,11 @@ ShadingPoint shadingPoint(const Mesh& mesh, const glm::uvec3& triangle, const fl
 // Bit k set when the point sees direction k (world frame, unit): n·d_k > 0
 // and the ray from position + shift·n toward d_k escapes. At most 32 directions.
 std::uint32_t pointLightMask(const RayScene& world, const ShadingPoint& p, std::span<const glm::vec3> directions);
+// pointLightMask of many points at once, the same bits: each light's rays
+// in packets of 16 neighbouring points (RayScene::occludedToward), which
+// share their traversal. masks[i] is points[i]'s.
+void pointLightMasks(const RayScene& world, std::span<const ShadingPoint> points, std::span<const glm::vec3> directions,
+                     std::span<std::uint32_t> masks);
 
 // shared::kLobeSeenBit when the ray from the point along the mirror
 // direction of the eye escapes (the lobe path's visibility, fused.h: a lobe

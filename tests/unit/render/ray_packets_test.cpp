@@ -1,0 +1,112 @@
+// RayScene's packets (intersectFrom, occludedToward) and the batched point
+// light masks built on them give what the single rays give, ray by ray.
+#include <gtest/gtest.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <random>
+#include <stdexcept>
+#include <vector>
+
+#include <glm/geometric.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "haarcast/assets/procedural_mesh.h"
+#include "haarcast/render/embree_scene.h"
+#include "haarcast/render/point_lights.h"
+
+namespace haarcast {
+namespace {
+
+// A sphere standing on a plane and a second sphere beside it, turned and
+// moved: instances at and away from the identity, hits and misses.
+struct World {
+  Mesh sphere = assets::makeSphere(24);
+  Mesh plane = assets::makePlane(3.0, 4);
+  RayScene rays{{Instance{&plane},
+                 Instance{&sphere, glm::translate(glm::mat4(1.0f), {-0.6f, 0.5f, 0.0f}) * glm::scale(glm::mat4(1.0f), glm::vec3(0.5f))},
+                 Instance{&sphere, glm::translate(glm::mat4(1.0f), {0.7f, 0.4f, 0.2f}) *
+                                       glm::rotate(glm::mat4(1.0f), 0.7f, {0.3f, 1.0f, 0.1f}) * glm::scale(glm::mat4(1.0f), glm::vec3(0.4f))}}};
+};
+
+TEST(RayPackets, IntersectFromGivesEachSingleRaysHit) {
+  const World w;
+  const glm::vec3 eye(0.0f, 1.2f, 4.0f);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(-0.45f, 0.45f);
+  // 1001 rays: the last packet part full; most toward the objects.
+  std::vector<glm::vec3> directions(1001);
+  for (glm::vec3& d : directions) d = glm::normalize(glm::vec3(u(rng), u(rng) - 0.25f, -1.0f));
+  std::vector<std::optional<Hit>> hits(directions.size());
+  w.rays.intersectFrom(eye, 0.0f, directions, hits);
+  std::size_t hit = 0;
+  for (std::size_t i = 0; i < directions.size(); ++i) {
+    const std::optional<Hit> one = w.rays.intersect(Ray{eye, directions[i]});
+    ASSERT_EQ(hits[i].has_value(), one.has_value()) << "ray " << i;
+    if (!one) continue;
+    ++hit;
+    EXPECT_EQ(hits[i]->object, one->object) << "ray " << i;
+    EXPECT_EQ(hits[i]->triangle, one->triangle) << "ray " << i;
+    EXPECT_NEAR(hits[i]->t, one->t, 1e-5f * one->t) << "ray " << i;
+    EXPECT_NEAR(hits[i]->u, one->u, 1e-5f) << "ray " << i;
+    EXPECT_NEAR(hits[i]->v, one->v, 1e-5f) << "ray " << i;
+    EXPECT_NEAR(glm::dot(hits[i]->geometricNormal, one->geometricNormal), 1.0f, 1e-6f) << "ray " << i;
+  }
+  EXPECT_GT(hit, directions.size() / 2);  // both answers are seen
+  EXPECT_LT(hit, directions.size());
+  std::vector<std::optional<Hit>> wrongSize(3);
+  EXPECT_THROW(w.rays.intersectFrom(eye, 0.0f, directions, wrongSize), std::invalid_argument);
+}
+
+TEST(RayPackets, OccludedTowardGivesEachSingleRaysAnswer) {
+  const World w;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(-1.5f, 1.5f);
+  std::vector<glm::vec3> origins(1001);
+  for (glm::vec3& o : origins) o = glm::vec3(u(rng), 0.01f, u(rng));  // just above the plane
+  for (const glm::vec3& toward : {glm::normalize(glm::vec3(0.3f, 1.0f, 0.2f)), glm::normalize(glm::vec3(-1.0f, 0.4f, 0.0f))}) {
+    for (float tnear : {0.0f, 0.2f}) {
+      std::vector<std::uint8_t> out(origins.size(), 2);
+      w.rays.occludedToward(origins, toward, tnear, out);
+      std::size_t blocked = 0;
+      for (std::size_t i = 0; i < origins.size(); ++i) {
+        ASSERT_EQ(out[i], w.rays.occluded(Ray{origins[i], toward, tnear}) ? 1 : 0) << "origin " << i;
+        blocked += out[i];
+      }
+      EXPECT_GT(blocked, 0u);  // both answers are seen
+      EXPECT_LT(blocked, origins.size());
+    }
+  }
+  std::vector<std::uint8_t> wrongSize(3);
+  EXPECT_THROW(w.rays.occludedToward(origins, glm::vec3(0.0f, 1.0f, 0.0f), 0.0f, wrongSize), std::invalid_argument);
+}
+
+TEST(RayPackets, PointLightMasksAreEachPointsMask) {
+  const World w;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(-1.5f, 1.5f);
+  std::normal_distribution<float> g(0.0f, 1.0f);
+  // Points on the plane, each with a normal that faces some lights and not others.
+  std::vector<render::ShadingPoint> points(517);
+  for (render::ShadingPoint& p : points) {
+    p.position = glm::vec3(u(rng), 0.0f, u(rng));
+    p.normal = glm::normalize(glm::vec3(0.6f * g(rng), 1.0f, 0.6f * g(rng)));
+    p.shift = 1e-3f;
+  }
+  const std::vector<glm::vec3> lights{glm::normalize(glm::vec3(0.3f, 1.0f, 0.2f)), glm::normalize(glm::vec3(-1.0f, 0.3f, 0.0f)),
+                                      glm::normalize(glm::vec3(0.9f, 0.15f, -0.4f))};
+  std::vector<std::uint32_t> masks(points.size(), 0xdeadbeefu);
+  render::pointLightMasks(w.rays, points, lights, masks);
+  std::vector<std::size_t> seen(lights.size(), 0);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    ASSERT_EQ(masks[i], render::pointLightMask(w.rays, points[i], lights)) << "point " << i;
+    for (std::size_t k = 0; k < lights.size(); ++k) seen[k] += (masks[i] >> k) & 1u;
+  }
+  for (std::size_t k = 0; k < lights.size(); ++k) {
+    EXPECT_GT(seen[k], 0u) << "light " << k;
+    EXPECT_LT(seen[k], points.size()) << "light " << k;
+  }
+}
+
+}  // namespace
+}  // namespace haarcast
