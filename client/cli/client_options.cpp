@@ -12,7 +12,6 @@
 
 #include <google/protobuf/descriptor.h>
 
-#include "haarcast/core/shared_layout.h"
 
 namespace haarcast::client {
 
@@ -163,19 +162,17 @@ Exposure parseExposure(const std::string& text) {
   throw std::invalid_argument("--exposure must be auto or a number of stops, e.g. -1.5 (got \"" + text + "\")");
 }
 
-std::uint32_t minLevel() { return shared::kMinLevel; }
-std::uint32_t maxLevel() { return shared::kFusedMaxLevel; }
-
 LevelRequest parseLevel(const std::string& text) {
-  const std::string valid = "--level must be N, auto or auto:N with N in " + std::to_string(minLevel()) + ".." +
-                            std::to_string(maxLevel()) + " (got \"" + text + "\")";
+  // The range is the server's (Welcome.limits); it refuses a level outside
+  // it by name, so only the form is checked here.
+  const std::string valid = "--level must be N, auto or auto:N, N a map level the server serves (got \"" + text + "\")";
   auto number = [&](const std::string& digits) -> std::uint32_t {
     if (digits.empty() || digits.size() > 2 ||
         !std::all_of(digits.begin(), digits.end(), [](unsigned char c) { return std::isdigit(c) != 0; })) {
       throw std::invalid_argument(valid);
     }
     const auto n = static_cast<std::uint32_t>(std::stoul(digits));
-    if (n < minLevel() || n > maxLevel()) throw std::invalid_argument(valid);
+    if (n == 0) throw std::invalid_argument(valid);
     return n;
   };
   if (text.empty() || text == "0") return {};

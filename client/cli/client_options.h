@@ -58,15 +58,11 @@ struct Exposure {
 };
 Exposure parseExposure(const std::string& text);
 
-// Map levels every renderer accepts (the servers say which of them they
-// serve in Welcome.limits): shared_layout.h's, the one definition.
-std::uint32_t minLevel();
-std::uint32_t maxLevel();
-
 // --level: "" or "0" → the server's default; "N" → every object at level N
 // (LEVEL_MODE_FIXED); "auto" → each object at the level its material
 // needs, up to the cap in effect; "auto:N" → the same with cap N
-// (LEVEL_MODE_AUTO). N within minLevel()..maxLevel().
+// (LEVEL_MODE_AUTO). N ≥ 1 here; the server checks it against its own
+// range (Welcome.limits) and names that range when it refuses one.
 struct LevelRequest {
   std::uint32_t level = 0;  // 0: unchanged
   v1::LevelMode mode = v1::LEVEL_MODE_UNSPECIFIED;

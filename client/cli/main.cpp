@@ -195,8 +195,8 @@ int run(int argc, char** argv) {
       ->check(CLI::Range(0u, 100000u));
   app.add_option("--method", method, "Per-pixel method: fused | haar | spatial | matrix | table | splitsum (default: the server's)");
   app.add_option("--level", level,
-                 "Map level n, 2^n x 2^n: " + std::to_string(minLevel()) + ".." + std::to_string(maxLevel()) +
-                     " as far as the server allows (its Welcome says), every object at it; auto or auto:N: each "
+                 "Map level n, 2^n x 2^n, in the server's range (its Welcome.limits; a level outside it is "
+                 "refused by name), every object at it; auto or auto:N: each "
                      "object at the level its material needs, N at most (fused); default: the server's");
   app.add_option("--exposure", exposure,
                  "auto (the whole frame metered, objects weighted 4×: log-average → 0.18, held down so the brightest 1% "

@@ -37,7 +37,7 @@ expect "bad --encoding" 2 "--encoding must be" -- "$client_bin" ws://127.0.0.1:1
 expect "--bitrate without h264" 2 "--bitrate applies to --encoding h264 only" -- "$client_bin" ws://127.0.0.1:1 --bitrate 900
 expect "h264 at an odd size" 2 "even width and height" -- "$client_bin" ws://127.0.0.1:1 --encoding h264 --size 255x256
 expect "wss:// refused" 2 "wss://" -- "$client_bin" wss://127.0.0.1:1
-expect "bad --level" 2 "--level must be N, auto or auto:N with N in 2..7 (got \"12\")" -- "$client_bin" ws://127.0.0.1:1 --level 12
+expect "bad --level" 2 "--level must be N, auto or auto:N, N a map level the server serves (got \"12x\")" -- "$client_bin" ws://127.0.0.1:1 --level 12x
 expect "bad --exposure" 2 "--exposure must be auto or a number of stops" -- "$client_bin" ws://127.0.0.1:1 --exposure bright
 expect "misspelt flag" 2 "unknown flag --frmes; did you mean --frames?" -- "$client_bin" ws://127.0.0.1:1 --frmes 3
 expect "connection refused" 1 "Connection refused" -- "$client_bin" ws://127.0.0.1:1 --frames 1 --quiet
@@ -50,6 +50,8 @@ expect "no token" 1 "HTTP 401" -- "$client_bin" "$url" "${common[@]}"
 expect "wrong token" 1 "wrong --token" -- "$client_bin" "$url" "${common[@]}" --token nope
 expect "server Error (level over the server's --max-level)" 1 "is outside 2..6" -- \
   "$client_bin" "$url" "${common[@]}" --token sekret --level 7
+expect "server Error (a level no renderer takes)" 1 "level 12 is outside 2..6" -- \
+  "$client_bin" "$url" "${common[@]}" --token sekret --level 12
 expect "good run, auto exposure, not blown out" 0 "" -- \
   "$client_bin" "$url" "${common[@]}" --token sekret --check-not-blank --max-clipped 0.02
 expect "server Error (unknown material)" 1 "ERROR_CODE_UNKNOWN_MATERIAL" -- \
