@@ -105,15 +105,15 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
     lightTexels.resize(lightTexels.size() + n);
     fusedLightTexels(lights[o].planes, std::span<glm::vec4>(lightTexels).last(n));
     for (std::size_t k = 0; k < kLights; ++k) {
-      FusedPointLight l;
+      FusedPointLight light;
       // Directions all over the sphere: some below the slices' cut (ρ = 0),
       // most not; powers of the order of the map's whole light.
-      l.direction = glm::normalize(glm::vec3(2.0f * u(rng) - 1.0f, 2.0f * u(rng) - 1.0f, 2.0f * u(rng) - 1.0f));
-      for (float& p : l.power) p = 0.5f + 2.0f * u(rng);
-      pointLights[o].push_back(l);
+      light.direction = glm::normalize(glm::vec3(2.0f * u(rng) - 1.0f, 2.0f * u(rng) - 1.0f, 2.0f * u(rng) - 1.0f));
+      for (float& p : light.power) p = 0.5f + 2.0f * u(rng);
+      pointLights[o].push_back(light);
       PointLight& r = lightRecords[o * shared::kMaxPointLights + k];
-      r.direction = glm::vec4(l.direction, 0.0f);
-      r.power = glm::vec4(l.power[0], l.power[1], l.power[2], 0.0f);
+      r.direction = glm::vec4(light.direction, 0.0f);
+      r.power = glm::vec4(light.power[0], light.power[1], light.power[2], 0.0f);
     }
   }
   objects[kGround].flags = shared::kObjectGround;
