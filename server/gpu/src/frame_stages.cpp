@@ -76,8 +76,8 @@ void VulkanRenderer::Impl::runStages(const std::vector<FrameStage>& stages, rend
   }
 }
 
-void VulkanRenderer::Impl::uploadFrameUniforms(const render::FrameRequest& request) {
-  FrameParams params = makeFrameParams(request.camera, request.width, request.height, request.lightRotation,
+void VulkanRenderer::Impl::uploadFrameUniforms(const render::FrameRequest& request, const render::ResolvedFrame& resolved) {
+  FrameParams params = makeFrameParams(resolved.camera, request.width, request.height, request.lightRotation,
                                        options.environmentBackground, prepared.background[0].level());
   params.fusedGroups = fusedGroups;
   params.antialias = options.antialias ? 1u : 0u;

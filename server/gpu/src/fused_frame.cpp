@@ -85,12 +85,12 @@ std::uint32_t VulkanRenderer::Impl::computeShadowMasks(const render::ResolvedFra
     // (render::pointLightMasks); samples off every object (a zero normal
     // faces no light) cast none.
     thread_local std::vector<render::ShadingPoint> points;
-    thread_local std::vector<std::uint32_t> masks;
+    thread_local std::vector<std::uint32_t> lightMasks;
     points.resize(end - begin);
     for (std::size_t s = begin; s < end; ++s)
       points[s - begin] = sh[s].object < objectCount ? pointOf(sh[s]) : render::ShadingPoint{{}, glm::vec3(0.0f), 0.0f};
-    masks.resize(points.size());
-    render::pointLightMasks(*rays, points, lightDirections, masks);
+    lightMasks.resize(points.size());
+    render::pointLightMasks(*rays, points, lightDirections, lightMasks);
     for (std::size_t s = begin; s < end; ++s) {
       const ShadeSample& sample = sh[s];
       if (sample.object >= objectCount) {
@@ -98,7 +98,7 @@ std::uint32_t VulkanRenderer::Impl::computeShadowMasks(const render::ResolvedFra
         continue;
       }
       const render::ShadingPoint& point = points[s - begin];
-      out[s] = masks[s - begin];
+      out[s] = lightMasks[s - begin];
       if (prepared.objects[sample.object].lobePath) out[s] |= render::lobeRayBit(*rays, point, eye);
       if (groundSky && prepared.objects[sample.object].ground) {
         // Its pixel: the slot itself, or the edge pixel a sub-sample's slot belongs to.
@@ -150,13 +150,12 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
     pointLightUpload.write(pointLightData.data(), pointLightData.size() * sizeof(PointLight));
   }
   objects.write(objectInfo.data(), objectInfo.size() * sizeof(ObjectInfo));
-  uploadFrameUniforms(request);
+  uploadFrameUniforms(request, resolved);
   frame.stages.push_back({"light", secondsSince(t0)});
 
   // ---- the device's first part: the samples to shade
-  const glm::dmat4 viewProj = frameViewProjection(request);
   const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
-  runStages({{"gbuffer", [&](VkCommandBuffer cb) { recordGBuffer(cb, request, viewProj); }},
+  runStages({{"gbuffer", [&](VkCommandBuffer cb) { recordGBuffer(cb, resolved); }},
              {"rotation-input",
               [&](VkCommandBuffer cb) {
                 vkCmdFillBuffer(cb, counter.handle(), 0, VK_WHOLE_SIZE, 0u);

@@ -1,15 +1,11 @@
-// The G-buffer pass: its render pass and graphics pipeline, the projection of
-// render::CameraRays' pinhole, and the recording of one frame's raster.
+// The G-buffer pass: its render pass and graphics pipeline, and the
+// recording of one frame's raster with the resolved frame's projection
+// (render::ResolvedFrame::viewProjection, render::CameraRays' pinhole).
 
-#include <algorithm>
 #include <array>
-#include <limits>
 #include <stdexcept>
 
-#include <glm/geometric.hpp>
-
 #include "haarcast/gpu/shaders.h"
-#include "haarcast/render/shading.h"
 
 #include "vulkan_renderer_impl.h"
 
@@ -173,60 +169,12 @@ void VulkanRenderer::Impl::createGraphicsPipeline() {
   vkUpdateDescriptorSets(device, shared::kGBufferBindings, writes.data(), 0, nullptr);
 }
 
-namespace {
-
-// Clip coordinates of a world point for render::CameraRays' pinhole: x right,
-// y down (Vulkan's framebuffer has row 0 at the top, as the image does), and
-// reversed, infinite-far Z (depth = near / distance, greatest wins), whose
-// float precision does not depend on the scene's depth range.
-glm::dmat4 viewProjection(const render::Camera& camera, int width, int height, double nearPlane) {
-  const render::CameraBasis basis = render::cameraBasis(camera, width, height);
-  const glm::dvec3 &f = basis.forward, &r = basis.right, &u = basis.up;
-  const double tanHalf = basis.tanHalf;
-  const double aspect = static_cast<double>(width) / height;
-  const glm::dvec3& e = camera.eye;
-  glm::dmat4 m(0.0);  // m[column][row]
-  const double sx = 1.0 / (tanHalf * aspect), sy = -1.0 / tanHalf;
-  for (int c = 0; c < 3; ++c) {
-    m[c][0] = sx * r[c];
-    m[c][1] = sy * u[c];
-    m[c][2] = 0.0;
-    m[c][3] = f[c];
-  }
-  m[3][0] = -sx * glm::dot(r, e);
-  m[3][1] = -sy * glm::dot(u, e);
-  m[3][2] = nearPlane;
-  m[3][3] = -glm::dot(f, e);
-  return m;
-}
-
-}  // namespace
-
-const render::Pose& VulkanRenderer::Impl::poseOf(const render::FrameRequest& request, std::size_t i) const {
-  return request.poses.empty() ? prepared.objects[i].pose : request.poses[i];
-}
-
-glm::dmat4 VulkanRenderer::Impl::frameViewProjection(const render::FrameRequest& request) const {
-  // Near plane: a fraction of the nearest object's bounding-sphere distance.
-  double nearest = std::numeric_limits<double>::infinity(), farthest = 0.0;
-  for (std::size_t i = 0; i < prepared.objects.size(); ++i) {
-    const Bounds b = prepared.objects[i].mesh->bounds();
-    const glm::dvec3 centre = glm::dvec3(poseOf(request, i).objectToWorld() * glm::dvec4(b.centre(), 1.0));
-    const double radius = b.radius() * poseOf(request, i).scale;
-    const double d = glm::length(centre - request.camera.eye);
-    nearest = std::min(nearest, d - radius);
-    farthest = std::max(farthest, d + radius);
-  }
-  const double nearPlane = nearest > 0.0 ? std::max(0.5 * nearest, 1e-6 * farthest) : 1e-6 * std::max(farthest, 1.0);
-  return viewProjection(request.camera, request.width, request.height, nearPlane);
-}
-
 // Every object rasterised into `t`, then the attachments copied to the
 // storage buffers the compute passes read. The projection is the frame's at
 // any scale: at twice the resolution the pixel centres land on the
 // sub-samples (shared_layout.h).
-void VulkanRenderer::Impl::rasterise(VkCommandBuffer cb, const render::FrameRequest& request,
-                                     const glm::dmat4& viewProj, const GBufferTarget& t, const Buffer& ids,
+void VulkanRenderer::Impl::rasterise(VkCommandBuffer cb, const render::ResolvedFrame& resolved,
+                                     const GBufferTarget& t, const Buffer& ids,
                                      const Buffer& normalsOut, const Buffer* positionsOut) {
   std::array<VkClearValue, 4> clear{};
   clear[3].depthStencil = {0.0f, 0};  // reversed Z: 0 is infinitely far
@@ -246,7 +194,7 @@ void VulkanRenderer::Impl::rasterise(VkCommandBuffer cb, const render::FrameRequ
   vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, gbufferLayout, 0, 1, &gbufferSet, 0, nullptr);
   for (std::size_t i = 0; i < prepared.objects.size(); ++i) {
     GBufferPush push;
-    push.objectToClip = glm::mat4(viewProj * poseOf(request, i).objectToWorld());
+    push.objectToClip = glm::mat4(resolved.viewProjection * resolved.objects[i].objectToWorld);
     push.objectId = static_cast<std::uint32_t>(i);
     push.triangleBase = objectInfo[i].triangleBase;
     vkCmdPushConstants(cb, gbufferLayout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof push,
@@ -265,10 +213,9 @@ void VulkanRenderer::Impl::rasterise(VkCommandBuffer cb, const render::FrameRequ
   }
 }
 
-void VulkanRenderer::Impl::recordGBuffer(VkCommandBuffer cb, const render::FrameRequest& request,
-                                         const glm::dmat4& viewProj) {
-  rasterise(cb, request, viewProj, target, gbufIds, gbufNormals, &gbufPositions);
-  if (options.antialias) rasterise(cb, request, viewProj, subTarget, subIds, subNormals, nullptr);
+void VulkanRenderer::Impl::recordGBuffer(VkCommandBuffer cb, const render::ResolvedFrame& resolved) {
+  rasterise(cb, resolved, target, gbufIds, gbufNormals, &gbufPositions);
+  if (options.antialias) rasterise(cb, resolved, subTarget, subIds, subNormals, nullptr);
 }
 
 }  // namespace haarcast::gpu

@@ -14,7 +14,12 @@ namespace haarcast::gpu {
 
 FrameParams makeFrameParams(const render::Camera& camera, int width, int height, const glm::dmat3& lightRotation,
                             bool background, int backgroundLevel) {
-  const render::CameraBasis basis = render::cameraBasis(camera, width, height);
+  return makeFrameParams(render::cameraBasis(camera, width, height), width, height, lightRotation, background,
+                         backgroundLevel);
+}
+
+FrameParams makeFrameParams(const render::CameraBasis& basis, int width, int height, const glm::dmat3& lightRotation,
+                            bool background, int backgroundLevel) {
   FrameParams f{};
   f.forward = glm::vec4(glm::vec3(basis.forward), 0.0f);
   f.right = glm::vec4(glm::vec3(basis.right), 0.0f);

@@ -15,35 +15,30 @@
 namespace haarcast::gpu {
 
 render::Frame VulkanRenderer::Impl::renderRotating(const render::FrameRequest& request) {
-  render::checkFrameRequest(request, prepared.objects.size());
   const auto start = RendererClock::now();
+  // ---- light (host): resolveFrame, as the CPU backend (it checks the request).
+  auto t0 = RendererClock::now();
+  render::ResolvedFrame resolved = render::resolveFrame(prepared, options, request);
   ensureResolution(request.width, request.height);
   const std::size_t objectCount = prepared.objects.size();
-  const std::size_t k = request.lightCoefficients ? request.lightCoefficients : options.lightCoefficients;
   render::Frame frame;
   frame.width = request.width;
   frame.height = request.height;
   std::size_t bytes = 0;
 
-  // ---- light (host): the same code as the CPU backend ----------------------
-  auto t0 = RendererClock::now();
   std::vector<SparseHaar> lights;
   lights.reserve(objectCount * 3);
   for (std::size_t i = 0; i < objectCount; ++i) {
-    const glm::dmat3 rot = poseOf(request, i).rotation();
-    for (SparseHaar& s : render::lightInObjectFrame(prepared.light, rot, request.lightRotation, k)) {
-      lights.push_back(std::move(s));
-    }
-    for (int c = 0; c < 3; ++c) objectInfo[i].rotation[c] = glm::vec4(glm::vec3(rot[c]), 0.0f);
+    render::ResolvedObject& o = resolved.objects[i];
+    for (SparseHaar& s : o.light) lights.push_back(std::move(s));
+    for (int c = 0; c < 3; ++c) objectInfo[i].rotation[c] = glm::vec4(glm::vec3(o.rotation[c]), 0.0f);
   }
   const std::vector<glm::uvec4> lightPacked = packSparseLists(lights, level);
   lightUpload.write(lightPacked.data(), lightPacked.size() * sizeof(glm::uvec4));
   bytes += (lightPacked.size() - lights.size()) * sizeof(glm::uvec4);
   objects.write(objectInfo.data(), objectInfo.size() * sizeof(ObjectInfo));
-  uploadFrameUniforms(request);
+  uploadFrameUniforms(request, resolved);
   frame.stages.push_back({"light", secondsSince(t0)});
-
-  const glm::dmat4 viewProj = frameViewProjection(request);
 
   // ---- the device's part: one command buffer (timestamps) or one per stage.
   // Every batch the resolution can need is recorded; batch_args.comp sizes
@@ -51,7 +46,7 @@ render::Frame VulkanRenderer::Impl::renderRotating(const render::FrameRequest& r
   // the host does not read the count back mid-frame.
   const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
   std::vector<FrameStage> stages;
-  stages.emplace_back("gbuffer", [&](VkCommandBuffer cb) { recordGBuffer(cb, request, viewProj); });
+  stages.emplace_back("gbuffer", [&](VkCommandBuffer cb) { recordGBuffer(cb, resolved); });
   stages.emplace_back("rotation-input", [&](VkCommandBuffer cb) {
     vkCmdFillBuffer(cb, counter.handle(), 0, VK_WHOLE_SIZE, 0u);
     lightUpload.record(cb);  // where the light is staged: its copy into device memory

@@ -165,14 +165,13 @@ struct VulkanRenderer::Impl {
 
   // gbuffer_pass.cpp
   void createGraphicsPipeline();
-  const render::Pose& poseOf(const render::FrameRequest& request, std::size_t i) const;
-  glm::dmat4 frameViewProjection(const render::FrameRequest& request) const;
-  // Rasterises every object into `t` and copies the attachments to the
-  // buffers given (positions: null to skip).
-  void rasterise(VkCommandBuffer cb, const render::FrameRequest& request, const glm::dmat4& viewProj,
-                 const GBufferTarget& t, const Buffer& ids, const Buffer& normals, const Buffer* positions);
+  // Rasterises every object, posed and projected as the resolved frame
+  // says, into `t` and copies the attachments to the buffers given
+  // (positions: null to skip).
+  void rasterise(VkCommandBuffer cb, const render::ResolvedFrame& resolved, const GBufferTarget& t, const Buffer& ids,
+                 const Buffer& normals, const Buffer* positions);
   // The frame's G-buffer, and with antialiasing the sub-samples' as well.
-  void recordGBuffer(VkCommandBuffer cb, const render::FrameRequest& request, const glm::dmat4& viewProj);
+  void recordGBuffer(VkCommandBuffer cb, const render::ResolvedFrame& resolved);
 
   // frame_buffers.cpp
   void ensureResolution(int w, int h);
@@ -186,7 +185,7 @@ struct VulkanRenderer::Impl {
   // frame_stages.cpp
   // The frame's uniforms (camera, light turn, exposure, the fused dispatch's
   // workgroup count) and the sRGB thresholds of its exposure.
-  void uploadFrameUniforms(const render::FrameRequest& request);
+  void uploadFrameUniforms(const render::FrameRequest& request, const render::ResolvedFrame& resolved);
   // The "tonemap" stage: resolve (backdrop, antialiased edge pixels), the
   // exposure (measured and chosen on the device, exposure.comp), encoding.
   void recordTonemap(VkCommandBuffer cb, const render::FrameRequest& request);

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -364,6 +365,21 @@ ResolvedFrame resolveFrame(const PreparedScene& prepared, const RenderOptions& o
     o.objectToWorld = pose.objectToWorld();
     o.scale = pose.scale;
     o.toLight = glm::mat3(glm::transpose(request.lightRotation) * o.rotation);
+  }
+  out.camera = cameraBasis(request.camera, request.width, request.height);
+  {
+    // Near plane: a fraction of the nearest posed object's bounding-sphere distance.
+    double nearest = std::numeric_limits<double>::infinity(), farthest = 0.0;
+    for (std::size_t i = 0; i < out.objects.size(); ++i) {
+      const Bounds b = prepared.objects[i].mesh->bounds();
+      const glm::dvec3 centre = glm::dvec3(out.objects[i].objectToWorld * glm::dvec4(b.centre(), 1.0));
+      const double radius = b.radius() * out.objects[i].scale;
+      const double d = glm::length(centre - request.camera.eye);
+      nearest = std::min(nearest, d - radius);
+      farthest = std::max(farthest, d + radius);
+    }
+    const double nearPlane = nearest > 0.0 ? std::max(0.5 * nearest, 1e-6 * farthest) : 1e-6 * std::max(farthest, 1.0);
+    out.viewProjection = viewProjection(request.camera, out.camera, request.width, request.height, nearPlane);
   }
   std::optional<glm::dvec3> groundNormal;
   if (prepared.ground) groundNormal = out.objects[*prepared.ground].rotation * glm::dvec3(0.0, 1.0, 0.0);

@@ -22,6 +22,25 @@ CameraBasis cameraBasis(const Camera& camera, int width, int height) {
   return b;
 }
 
+glm::dmat4 viewProjection(const Camera& camera, const CameraBasis& basis, int width, int height, double nearPlane) {
+  const glm::dvec3 &f = basis.forward, &r = basis.right, &u = basis.up;
+  const double aspect = static_cast<double>(width) / height;
+  const glm::dvec3& e = camera.eye;
+  glm::dmat4 m(0.0);  // m[column][row]
+  const double sx = 1.0 / (basis.tanHalf * aspect), sy = -1.0 / basis.tanHalf;
+  for (int c = 0; c < 3; ++c) {
+    m[c][0] = sx * r[c];
+    m[c][1] = sy * u[c];
+    m[c][2] = 0.0;
+    m[c][3] = f[c];
+  }
+  m[3][0] = -sx * glm::dot(r, e);
+  m[3][1] = -sy * glm::dot(u, e);
+  m[3][2] = nearPlane;
+  m[3][3] = -glm::dot(f, e);
+  return m;
+}
+
 CameraRays::CameraRays(const Camera& camera, int width, int height)
     : eye_(camera.eye),
       basis_(cameraBasis(camera, width, height)),

@@ -17,6 +17,7 @@
 #include "haarcast/core/shared_layout.h"
 #include "haarcast/gpu/compute.h"
 #include "haarcast/render/scene.h"
+#include "haarcast/render/shading.h"
 
 namespace haarcast::gpu {
 
@@ -37,6 +38,9 @@ using shared::ShadeSample;
 // the G-buffer's projection) and the frame's settings. The exposure is not
 // among them: it travels in the tonemap pass's thresholds.
 FrameParams makeFrameParams(const render::Camera& camera, int width, int height, const glm::dmat3& lightRotation,
+                            bool background, int backgroundLevel);
+// The same from the basis a resolved frame carries (render::ResolvedFrame::camera).
+FrameParams makeFrameParams(const render::CameraBasis& basis, int width, int height, const glm::dmat3& lightRotation,
                             bool background, int backgroundLevel);
 
 

@@ -46,6 +46,7 @@
 #include "haarcast/render/render_options.h"
 #include "haarcast/render/point_lights.h"
 #include "haarcast/render/scene.h"
+#include "haarcast/render/shading.h"
 #include "haarcast/render/tonemap.h"
 
 namespace haarcast::render {
@@ -275,6 +276,10 @@ struct ResolvedObject {
   glm::mat3 toLight{1.0f};         // fused, splitsum: object frame → the environment's (lightRotationᵀ·rotation)
 };
 struct ResolvedFrame {
+  CameraBasis camera{};               // the request's camera (cameraBasis)
+  // World → clip for a rasteriser (shading.h viewProjection), the near plane
+  // half the distance to the nearest posed object's bounding sphere.
+  glm::dmat4 viewProjection{1.0};
   std::size_t lightCoefficients = 0;  // k in effect (the Haar methods)
   std::vector<ResolvedObject> objects;
   std::size_t lightBytes = 0;         // the light lists, index + value per entry

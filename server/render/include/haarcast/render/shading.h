@@ -3,6 +3,7 @@
 #pragma once
 
 #include <glm/mat3x3.hpp>
+#include <glm/mat4x4.hpp>
 #include <glm/vec3.hpp>
 
 #include "haarcast/render/scene.h"
@@ -23,6 +24,12 @@ struct CameraBasis {
   double tanHalf;
 };
 CameraBasis cameraBasis(const Camera& camera, int width, int height);
+
+// Clip coordinates of a world point for CameraRays' pinhole, as a rasteriser
+// takes them: x right, y down (row 0 at the top, as the image has it), and
+// reversed, infinite-far Z (depth = near / distance, greatest wins), whose
+// float precision does not depend on the scene's depth range.
+glm::dmat4 viewProjection(const Camera& camera, const CameraBasis& basis, int width, int height, double nearPlane);
 
 // A pinhole camera's rays through pixel centres (row 0 at the top).
 class CameraRays {
