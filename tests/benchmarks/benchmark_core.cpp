@@ -374,8 +374,10 @@ BENCHMARK_CAPTURE(BM_HaarPixel, lean, true)->DenseRange(4, 5)->Unit(benchmark::k
 
 // The same pixel by `fused` (fused.h): one pass over the map directions for
 // the three channels, θₒ blend of two slices, the same inputs. Compare with
-// BM_HaarPixel on the same run.
-void BM_FusedPixel(benchmark::State& state) {
+// BM_HaarPixel on the same run. `bits`: the visibility as the renderer holds
+// it, each vertex's bits blended inside the pass (BM_FusedPixelBits); else
+// the vertices' Haar lists merged and synthesised per pixel.
+void fusedPixel(benchmark::State& state, bool bits) {
   const int level = static_cast<int>(state.range(0));
   const PixelInputs& in = pixelInputs(level);
   const std::vector<EulerYXY>& rs = rotations();
@@ -385,14 +387,24 @@ void BM_FusedPixel(benchmark::State& state) {
   std::size_t i = 0;
   for (auto _ : state) {
     const EulerYXY& r = rs[i & (kRotationCount - 1)];
-    const std::array<SparseHaar, 3>& v = in.triangles[i & (kTriangleCount - 1)];
-    const std::array<double, 3>& b = in.barycentrics[i & (kTriangleCount - 1)];
-    const std::array<WeightedVisibility, 3> vis{WeightedVisibility{&v[0], static_cast<float>(b[0])},
-                                                WeightedVisibility{&v[1], static_cast<float>(b[1])},
-                                                WeightedVisibility{&v[2], static_cast<float>(b[2])}};
+    const std::size_t t = i & (kTriangleCount - 1);
+    const std::array<double, 3>& b = in.barycentrics[t];
     const auto first = static_cast<shared::uint>(i % slices);
     const shared::SliceBlend blend{first, std::min(first + 1u, slices - 1u), 0.5f};
-    const std::array<float, 3> rgb = fusedShade(in.pixelSlices, blend, r, in.fusedLight, vis, scratch);
+    std::array<float, 3> rgb{};
+    if (bits) {
+      const auto& words = in.triangleBits[t];
+      const std::array<WeightedBits, 3> vis{WeightedBits{words[0].data(), static_cast<float>(b[0])},
+                                            WeightedBits{words[1].data(), static_cast<float>(b[1])},
+                                            WeightedBits{words[2].data(), static_cast<float>(b[2])}};
+      rgb = fusedShade(in.pixelSlices, blend, r, in.fusedLight, vis, {}, 0u, scratch);
+    } else {
+      const std::array<SparseHaar, 3>& v = in.triangles[t];
+      const std::array<WeightedVisibility, 3> vis{WeightedVisibility{&v[0], static_cast<float>(b[0])},
+                                                  WeightedVisibility{&v[1], static_cast<float>(b[1])},
+                                                  WeightedVisibility{&v[2], static_cast<float>(b[2])}};
+      rgb = fusedShade(in.pixelSlices, blend, r, in.fusedLight, vis, scratch);
+    }
     radiance += rgb[0] + rgb[1] + rgb[2];
     benchmark::DoNotOptimize(radiance);
     ++i;
@@ -400,35 +412,9 @@ void BM_FusedPixel(benchmark::State& state) {
   setCounters(state, level);
   state.SetLabel(fusedTargetName());
 }
+void BM_FusedPixel(benchmark::State& state) { fusedPixel(state, false); }
+void BM_FusedPixelBits(benchmark::State& state) { fusedPixel(state, true); }
 BENCHMARK(BM_FusedPixel)->DenseRange(4, 7)->Unit(benchmark::kMicrosecond);
-
-// The pixel as the renderer shades it: the three vertices' visibility bits
-// blended inside the pass (fused_kernel.cpp), no point light, no lobe path.
-void BM_FusedPixelBits(benchmark::State& state) {
-  const int level = static_cast<int>(state.range(0));
-  const PixelInputs& in = pixelInputs(level);
-  const std::vector<EulerYXY>& rs = rotations();
-  const auto slices = static_cast<shared::uint>(in.pixelSlices.thetaSamples());
-  FusedScratch scratch;
-  float radiance = 0.0f;
-  std::size_t i = 0;
-  for (auto _ : state) {
-    const EulerYXY& r = rs[i & (kRotationCount - 1)];
-    const auto& bits = in.triangleBits[i & (kTriangleCount - 1)];
-    const std::array<double, 3>& b = in.barycentrics[i & (kTriangleCount - 1)];
-    const std::array<WeightedBits, 3> vis{WeightedBits{bits[0].data(), static_cast<float>(b[0])},
-                                          WeightedBits{bits[1].data(), static_cast<float>(b[1])},
-                                          WeightedBits{bits[2].data(), static_cast<float>(b[2])}};
-    const auto first = static_cast<shared::uint>(i % slices);
-    const shared::SliceBlend blend{first, std::min(first + 1u, slices - 1u), 0.5f};
-    const std::array<float, 3> rgb = fusedShade(in.pixelSlices, blend, r, in.fusedLight, vis, {}, 0u, scratch);
-    radiance += rgb[0] + rgb[1] + rgb[2];
-    benchmark::DoNotOptimize(radiance);
-    ++i;
-  }
-  setCounters(state, level);
-  state.SetLabel(fusedTargetName());
-}
 BENCHMARK(BM_FusedPixelBits)->DenseRange(4, 7)->Unit(benchmark::kMicrosecond);
 
 // The lean pixel's parts on their own: where its time goes (merge_visibility

@@ -371,40 +371,41 @@ void RayScene::occludedBatch(std::span<const Ray> rays, std::span<std::uint8_t> 
   }
 }
 
-void RayScene::occludedFrom(const glm::vec3& origin, float tnear, std::span<const glm::vec3> directions,
-                            std::span<std::uint8_t> out) const {
-  if (directions.size() != out.size()) {
-    throw std::invalid_argument("RayScene::occludedFrom: " + std::to_string(directions.size()) + " directions but " +
-                                std::to_string(out.size()) + " results");
-  }
+namespace {
+
+// Rays 0 … count−1, ray i from origin(i) along direction(i), t ∈ [tnear, ∞),
+// traced as Embree packets of 16, its widest, with the coherent hint:
+// out[i] = 1 if blocked. Neighbouring rays (a 4×4 block of map pixels from
+// one point, or a row of points toward one light) share most of their
+// traversal; on the bunny at level 7 packets of 16 took 15–20 % off the
+// rays' time against packets of 8 along a pixel row (AVX-512; about the same
+// either way where Embree runs a packet of 16 as two of 8).
+template <class Origin, class Direction>
+void occludedPackets(RTCScene scene, std::size_t count, float tnear, const Origin& origin, const Direction& direction,
+                     std::span<std::uint8_t> out) {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-  // Packets of 16, Embree's widest: with one origin and neighbouring
-  // directions (a 4×4 block of map pixels) they share most of their
-  // traversal. On the bunny at level 7 that took 15–20 % off the rays' time
-  // against packets of 8 along a pixel row (AVX-512; about the same either
-  // way where Embree runs a packet of 16 as two of 8).
   constexpr std::size_t kWidth = 16;
   alignas(64) RTCRay16 packet;
   alignas(64) int valid[kWidth];
-  // What every ray of every packet shares, set once.
-  for (std::size_t k = 0; k < kWidth; ++k) {
-    packet.org_x[k] = origin.x;
-    packet.org_y[k] = origin.y;
-    packet.org_z[k] = origin.z;
+  for (std::size_t k = 0; k < kWidth; ++k) {  // what every ray of every packet shares, set once
     packet.tnear[k] = tnear;
     packet.time[k] = 0.0f;
     packet.mask[k] = ~0u;
     packet.id[k] = static_cast<unsigned>(k);
     packet.flags[k] = 0;
   }
-  for (std::size_t first = 0; first < directions.size(); first += kWidth) {
-    const std::size_t n = std::min(kWidth, directions.size() - first);
+  for (std::size_t first = 0; first < count; first += kWidth) {
+    const std::size_t n = std::min(kWidth, count - first);
     for (std::size_t k = 0; k < kWidth; ++k) {
       const bool live = k < n;
-      const glm::vec3 d = live ? directions[first + k] : glm::vec3(0.0f, 1.0f, 0.0f);
+      const glm::vec3 o = origin(live ? first + k : first);  // a dead lane copies a live one
+      const glm::vec3 d = direction(live ? first + k : first);
       valid[k] = live ? -1 : 0;
+      packet.org_x[k] = o.x;
+      packet.org_y[k] = o.y;
+      packet.org_z[k] = o.z;
       packet.dir_x[k] = d.x;
       packet.dir_y[k] = d.y;
       packet.dir_z[k] = d.z;
@@ -413,18 +414,28 @@ void RayScene::occludedFrom(const glm::vec3& origin, float tnear, std::span<cons
     }
 #ifdef HAARCAST_ONE_RAY_AT_A_TIME
     for (std::size_t k = 0; k < n; ++k) {
-      RTCRay ray{origin.x, origin.y, origin.z, tnear, packet.dir_x[k], packet.dir_y[k], packet.dir_z[k], 0.0f,
-                 std::numeric_limits<float>::infinity(), ~0u, 0u, 0u};
-      rtcOccluded1(impl_->occlusionScene, &context, &ray);
+      RTCRay ray{packet.org_x[k], packet.org_y[k], packet.org_z[k], tnear, packet.dir_x[k], packet.dir_y[k],
+                 packet.dir_z[k], 0.0f, std::numeric_limits<float>::infinity(), ~0u, 0u, 0u};
+      rtcOccluded1(scene, &context, &ray);
       packet.tfar[k] = ray.tfar;
     }
 #else
-    rtcOccluded16(valid, impl_->occlusionScene, &context, &packet);
+    rtcOccluded16(valid, scene, &context, &packet);
 #endif
-    for (std::size_t k = 0; k < n; ++k) {
-      out[first + k] = packet.tfar[k] == -std::numeric_limits<float>::infinity() ? 1 : 0;
-    }
+    for (std::size_t k = 0; k < n; ++k) out[first + k] = packet.tfar[k] == -std::numeric_limits<float>::infinity() ? 1 : 0;
   }
+}
+
+}  // namespace
+
+void RayScene::occludedFrom(const glm::vec3& origin, float tnear, std::span<const glm::vec3> directions,
+                            std::span<std::uint8_t> out) const {
+  if (directions.size() != out.size()) {
+    throw std::invalid_argument("RayScene::occludedFrom: " + std::to_string(directions.size()) + " directions but " +
+                                std::to_string(out.size()) + " results");
+  }
+  occludedPackets(impl_->occlusionScene, directions.size(), tnear, [&](std::size_t) { return origin; },
+                  [&](std::size_t i) { return directions[i]; }, out);
 }
 
 void RayScene::occludedToward(std::span<const glm::vec3> origins, const glm::vec3& direction, float tnear,
@@ -433,48 +444,8 @@ void RayScene::occludedToward(std::span<const glm::vec3> origins, const glm::vec
     throw std::invalid_argument("RayScene::occludedToward: " + std::to_string(origins.size()) + " origins but " +
                                 std::to_string(out.size()) + " results");
   }
-  RTCIntersectContext context;
-  rtcInitIntersectContext(&context);
-  context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-  constexpr std::size_t kWidth = 16;
-  alignas(64) RTCRay16 packet;
-  alignas(64) int valid[kWidth];
-  for (std::size_t k = 0; k < kWidth; ++k) {
-    packet.dir_x[k] = direction.x;
-    packet.dir_y[k] = direction.y;
-    packet.dir_z[k] = direction.z;
-    packet.tnear[k] = tnear;
-    packet.time[k] = 0.0f;
-    packet.mask[k] = ~0u;
-    packet.id[k] = static_cast<unsigned>(k);
-    packet.flags[k] = 0;
-  }
-  for (std::size_t first = 0; first < origins.size(); first += kWidth) {
-    const std::size_t n = std::min(kWidth, origins.size() - first);
-    for (std::size_t k = 0; k < kWidth; ++k) {
-      const bool live = k < n;
-      const glm::vec3 o = live ? origins[first + k] : origins[first];
-      valid[k] = live ? -1 : 0;
-      packet.org_x[k] = o.x;
-      packet.org_y[k] = o.y;
-      packet.org_z[k] = o.z;
-      packet.tfar[k] = std::numeric_limits<float>::infinity();  // −∞ marks a blocked ray
-    }
-#ifdef HAARCAST_ONE_RAY_AT_A_TIME
-    for (std::size_t k = 0; k < n; ++k) {
-      Ray ray;
-      ray.origin = origins[first + k];
-      ray.direction = direction;
-      ray.tnear = tnear;
-      packet.tfar[k] = occluded(ray) ? -std::numeric_limits<float>::infinity() : 0.0f;
-    }
-#else
-    rtcOccluded16(valid, impl_->occlusionScene, &context, &packet);
-#endif
-    for (std::size_t k = 0; k < n; ++k) {
-      out[first + k] = packet.tfar[k] == -std::numeric_limits<float>::infinity() ? 1 : 0;
-    }
-  }
+  occludedPackets(impl_->occlusionScene, origins.size(), tnear, [&](std::size_t i) { return origins[i]; },
+                  [&](std::size_t) { return direction; }, out);
 }
 
 void RayScene::setTransform(std::size_t object, const glm::mat4& objectToWorld) {
