@@ -1,4 +1,4 @@
-#include "build_progress.h"
+#include "haarcast/client/build_progress.h"
 
 #include <algorithm>
 #include <cmath>

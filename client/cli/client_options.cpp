@@ -1,4 +1,4 @@
-#include "client_options.h"
+#include "haarcast/client/client_options.h"
 
 #include <algorithm>
 #include <cctype>

@@ -1,4 +1,4 @@
-#include "frame_image.h"
+#include "haarcast/client/frame_image.h"
 
 #include <algorithm>
 #include <cmath>
@@ -12,7 +12,7 @@
 #include <png.h>
 #include <turbojpeg.h>
 
-#include "h264_decoder.h"
+#include "haarcast/client/h264_decoder.h"
 
 namespace haarcast::client {
 

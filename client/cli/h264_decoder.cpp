@@ -1,4 +1,4 @@
-#include "h264_decoder.h"
+#include "haarcast/client/h264_decoder.h"
 
 #include <mutex>
 #include <stdexcept>

@@ -3,7 +3,7 @@
 // reason; the other encodings decode as in a full build.
 #include <stdexcept>
 
-#include "h264_decoder.h"
+#include "haarcast/client/h264_decoder.h"
 
 namespace haarcast::client {
 

@@ -15,12 +15,12 @@
 #include <boost/asio/io_context.hpp>
 #include <nlohmann/json.hpp>
 
-#include "build_progress.h"
-#include "client_options.h"
-#include "flag_suggest.h"
-#include "pose_path.h"
-#include "run_stats.h"
-#include "session.h"
+#include "haarcast/client/build_progress.h"
+#include "haarcast/client/client_options.h"
+#include "haarcast/client/flag_suggest.h"
+#include "haarcast/client/pose_path.h"
+#include "haarcast/client/run_stats.h"
+#include "haarcast/client/session.h"
 
 namespace {
 

@@ -1,4 +1,4 @@
-#include "pose_path.h"
+#include "haarcast/client/pose_path.h"
 
 #include <cmath>
 #include <fstream>

@@ -1,4 +1,4 @@
-#include "run_stats.h"
+#include "haarcast/client/run_stats.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "session.h"
+#include "haarcast/client/session.h"
 
 #include <cctype>
 #include <deque>
@@ -15,8 +15,8 @@
 #include <boost/beast/http.hpp>
 #include <boost/beast/websocket.hpp>
 
-#include "build_progress.h"
-#include "frame_image.h"
+#include "haarcast/client/build_progress.h"
+#include "haarcast/client/frame_image.h"
 
 namespace haarcast::client {
 

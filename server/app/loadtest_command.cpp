@@ -19,17 +19,17 @@
 #include <boost/asio/io_context.hpp>
 
 #include "app_paths.h"
-#include "client_options.h"
+#include "haarcast/client/client_options.h"
 #include "haarcast/render/renderer.h"
 #include "list_flags.h"
 #include "loadtest_progress.h"
 #include "loadtest_report.h"
 #include "loadtest_server.h"
 #include "loadtest_storage.h"
-#include "pose_path.h"
+#include "haarcast/client/pose_path.h"
 #include "progress.h"
 #include "report_figures.h"
-#include "session.h"
+#include "haarcast/client/session.h"
 
 namespace haarcast::app {
 namespace {

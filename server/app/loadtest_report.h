@@ -15,7 +15,7 @@
 #include "loadtest_server.h"
 #include "machine_info.h"
 #include "loadtest_storage.h"
-#include "run_stats.h"
+#include "haarcast/client/run_stats.h"
 
 namespace haarcast::app {
 

@@ -11,7 +11,7 @@
 #include "bench_frame_command.h"
 #include "compare_command.h"
 #include "eval.h"
-#include "flag_suggest.h"
+#include "haarcast/client/flag_suggest.h"
 #include "loadtest_command.h"
 #include "progress.h"
 #include "reference_command.h"

@@ -22,7 +22,7 @@
 #include <utility>
 #include <vector>
 
-#include "build_progress.h"  // client: formatDuration
+#include "haarcast/client/build_progress.h"  // client: formatDuration
 
 namespace haarcast::app {
 

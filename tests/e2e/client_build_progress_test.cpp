@@ -13,9 +13,9 @@
 #include <boost/beast/websocket.hpp>
 #include <gtest/gtest.h>
 
-#include "build_progress.h"
-#include "pose_path.h"
-#include "session.h"
+#include "haarcast/client/build_progress.h"
+#include "haarcast/client/pose_path.h"
+#include "haarcast/client/session.h"
 
 namespace haarcast::client {
 namespace {

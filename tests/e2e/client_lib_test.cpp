@@ -13,10 +13,10 @@
 #include <png.h>
 #include <turbojpeg.h>
 
-#include "client_options.h"
-#include "frame_image.h"
-#include "pose_path.h"
-#include "run_stats.h"
+#include "haarcast/client/client_options.h"
+#include "haarcast/client/frame_image.h"
+#include "haarcast/client/pose_path.h"
+#include "haarcast/client/run_stats.h"
 
 namespace haarcast::client {
 namespace {

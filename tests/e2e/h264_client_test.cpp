@@ -17,7 +17,7 @@
 
 #include <gtest/gtest.h>
 
-#include "frame_image.h"
+#include "haarcast/client/frame_image.h"
 #include "haarcast/net/encode.h"
 #include "haarcast/net/h264_encoder.h"
 #include "haarcast/net/protocol.h"

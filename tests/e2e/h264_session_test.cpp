@@ -14,10 +14,10 @@
 #include <boost/beast/websocket.hpp>
 #include <gtest/gtest.h>
 
-#include "frame_image.h"
+#include "haarcast/client/frame_image.h"
 #include "haarcast/net/h264_encoder.h"
-#include "pose_path.h"
-#include "session.h"
+#include "haarcast/client/pose_path.h"
+#include "haarcast/client/session.h"
 
 namespace haarcast::client {
 namespace {

@@ -1,8 +1,8 @@
-// "Did you mean" for misspelt flags and commands (client/cli/flag_suggest.h),
+// "Did you mean" for misspelt flags and commands (client/cli/include/haarcast/client/flag_suggest.h),
 // against a CLI::App built here: typos of one or two edits are matched, a
 // swap of neighbours counts as one, values that start with '-' are not
 // flags, and a word far from every flag gets no guess.
-#include "flag_suggest.h"
+#include "haarcast/client/flag_suggest.h"
 
 #include <gtest/gtest.h>
 

@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <span>
 
-#include "frame_image.h"
+#include "haarcast/client/frame_image.h"
 #include "haarcast/net/h264_encoder.h"
 #include "server_fixture.h"
 

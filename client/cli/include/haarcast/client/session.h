@@ -12,10 +12,10 @@
 
 #include <boost/asio/io_context.hpp>
 
-#include "client_options.h"
+#include "haarcast/client/client_options.h"
 #include "haarcast/proto/haarcast.pb.h"
-#include "pose_path.h"
-#include "run_stats.h"
+#include "haarcast/client/pose_path.h"
+#include "haarcast/client/run_stats.h"
 
 namespace haarcast::client {
 

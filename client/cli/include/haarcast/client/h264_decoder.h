@@ -16,7 +16,7 @@
 #include <memory>
 #include <span>
 
-#include "frame_image.h"
+#include "haarcast/client/frame_image.h"
 
 namespace haarcast::client {
 
