@@ -106,8 +106,10 @@ nlohmann::json seedTableComparison(const nlohmann::json& tables, const nlohmann:
     }
     // Our environments that stand in for none of the seed's (the built-in sky).
     for (const auto& [probe, v] : ours.items()) {
+      // A structured binding named in the lambda by reference is C++20, which
+      // clang 14 (the sanitizer build) lacks: the name goes in as a copy.
       const bool paired = std::any_of(kSeedEnvironments.begin(), kSeedEnvironments.end(),
-                                      [&](const SeedEnvironment& s) { return probe == s.probe; });
+                                      [name = probe](const SeedEnvironment& s) { return name == s.probe; });
       if (!paired) {
         entry["rows"].push_back({{"seed_environment", nullptr}, {"probe", probe}, {"same_scene", false},
                                  {"paper", nullptr}, {"refined", v.at("refined")}, {"faithful", v.at("faithful")}});
