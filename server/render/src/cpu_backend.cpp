@@ -532,35 +532,37 @@ std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const RayScen
       return samplePoint(frames, resolved, c->hit.object, c->input);
     }, options_.threads);
   }
-  // The point lights each sample sees: one shadow ray each (point_lights.h),
-  // a pixel row's samples at a time so that each light's rays go in packets.
-  std::vector<std::uint32_t> lightsSeen;
-  if (!resolved.pointLightDirections.empty()) {
-    lightsSeen.assign(g.centre.size() + g.sub.size() * shared::kSubsamples, 0u);
-    parallelFor(g.height, [&](std::size_t y) {
-      cancelPoint();
-      thread_local std::vector<ShadingPoint> points;
-      thread_local std::vector<std::size_t> slots;
-      thread_local std::vector<std::uint32_t> masks;
-      points.clear();
-      slots.clear();
-      auto add = [&](const Sample& s, std::size_t slot) {
-        points.push_back(samplePoint(frames, resolved, s.hit.object, s.input));
-        slots.push_back(slot);
-      };
-      for (std::size_t i = y * g.width; i < (y + 1) * g.width; ++i) {
-        if (g.edge[i] == kInterior) {
-          if (g.centre[i]) add(*g.centre[i], i);
-          continue;
-        }
-        for (unsigned k = 0; k < shared::kSubsamples; ++k)
-          if (const auto& s = g.sub[g.edge[i]][k]) add(*s, g.centre.size() + g.edge[i] * shared::kSubsamples + k);
+  // Each sample's shading point, and the point lights it sees: one shadow
+  // ray each (point_lights.h), a pixel row's samples at a time so that each
+  // light's rays go in packets. By slot (Shade), for the pass below.
+  const std::size_t slotCount = g.centre.size() + g.sub.size() * shared::kSubsamples;
+  std::vector<ShadingPoint> points(slotCount);
+  std::vector<std::uint32_t> lightsSeen(slotCount, 0u);
+  parallelFor(g.height, [&](std::size_t y) {
+    cancelPoint();
+    thread_local std::vector<ShadingPoint> row;
+    thread_local std::vector<std::size_t> slots;
+    thread_local std::vector<std::uint32_t> masks;
+    row.clear();
+    slots.clear();
+    auto add = [&](const Sample& s, std::size_t slot) {
+      points[slot] = samplePoint(frames, resolved, s.hit.object, s.input);
+      row.push_back(points[slot]);
+      slots.push_back(slot);
+    };
+    for (std::size_t i = y * g.width; i < (y + 1) * g.width; ++i) {
+      if (g.edge[i] == kInterior) {
+        if (g.centre[i]) add(*g.centre[i], i);
+        continue;
       }
-      masks.resize(points.size());
-      pointLightMasks(rays, points, resolved.pointLightDirections, masks);
-      for (std::size_t j = 0; j < slots.size(); ++j) lightsSeen[slots[j]] = masks[j];
-    }, {}, options_.threads);
-  }
+      for (unsigned k = 0; k < shared::kSubsamples; ++k)
+        if (const auto& s = g.sub[g.edge[i]][k]) add(*s, g.centre.size() + g.edge[i] * shared::kSubsamples + k);
+    }
+    if (resolved.pointLightDirections.empty()) return;
+    masks.resize(row.size());
+    pointLightMasks(rays, row, resolved.pointLightDirections, masks);
+    for (std::size_t j = 0; j < slots.size(); ++j) lightsSeen[slots[j]] = masks[j];
+  }, {}, options_.threads);
   const std::size_t bytes = shadePixels(g, request, camera, frame, [&](const Sample& sample, std::size_t slot, std::array<float, 3>& rgb) {
     // Per worker thread, kept across pixels: no allocation per pixel.
     thread_local FusedScratch scratch;
@@ -568,8 +570,8 @@ std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const RayScen
     const PreparedObject& p = prepared_.objects[object];
     const ResolvedObject& o = resolved.objects[object];
     const PixelInput& in = sample.input;
-    const ShadingPoint point = samplePoint(frames, resolved, object, in);
-    std::uint32_t seen = lightsSeen.empty() ? 0u : lightsSeen[slot];
+    const ShadingPoint& point = points[slot];
+    std::uint32_t seen = lightsSeen[slot];
     if (p.lobePath) seen |= lobeRayBit(rays, point, eye);
     if (p.ground) {
       // The word the Vulkan backend reads too: bits, then the sky's occlusion.
