@@ -5,9 +5,9 @@
 // on its own.
 //
 // Contract (shared with rotate_spatial.comp and the host dispatch):
-//   constant_id 0 = LEVEL: the map is M×M, M = 2^LEVEL, N = M² coefficients in
+//   constant_id kSpecLevel = LEVEL: the map is M×M, M = 2^LEVEL, N = M² coefficients in
 //     the CPU HaarMap quadrant layout (haarcast/core/haar.h).
-//   constant_id 1 = THETA_SAMPLES: slices per channel per object.
+//   constant_id kSpecThetaSamples = THETA_SAMPLES: slices per channel per object.
 //   push constants (RotationPush): rotate samples first … first+count−1.
 //   bindings (core/shared_passes.h): kRotateSamplesBinding, RotationSample
 //   per sample; kRotateSlicesBinding, unrotated slices, slice s channel c at
@@ -22,8 +22,8 @@
 // RotationSample (core/shared_layout.h, shared with the host).
 #include "haarcast/core/shared_layout.h"
 
-layout(constant_id = 0) const uint LEVEL = 5u;
-layout(constant_id = 1) const uint THETA_SAMPLES = 16u;
+layout(constant_id = kSpecLevel) const uint LEVEL = 5u;
+layout(constant_id = kSpecThetaSamples) const uint THETA_SAMPLES = 16u;
 
 const uint M = 1u << LEVEL;   // map side
 const uint N = M * M;         // coefficients per map

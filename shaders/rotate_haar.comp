@@ -49,7 +49,7 @@
 
 #include "rotate_common.glsl"
 
-layout(local_size_x = 128, local_size_x_id = 2) in;  // momentSums[] has one entry per invocation
+layout(local_size_x = 128, local_size_x_id = kSpecLocalSize) in;  // momentSums[] has one entry per invocation
 
 // Σ_{k=1}^{K−1} (2^k − 1)·2^k: where the level-K field starts in `fields`.
 uint fieldOffset(uint k) { return ((1u << (2u * k)) - 4u) / 3u - ((1u << k) - 2u); }

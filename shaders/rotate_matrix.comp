@@ -18,7 +18,7 @@
 
 #include "rotate_common.glsl"
 
-layout(local_size_x = kGpuLocalSize, local_size_x_id = 2) in;  // the renderer picks the size per device
+layout(local_size_x = kGpuLocalSize, local_size_x_id = kSpecLocalSize) in;  // the renderer picks the size per device
 
 shared float buf[N];
 

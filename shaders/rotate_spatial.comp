@@ -13,9 +13,9 @@
 #include "common/sphere.glsl"
 #include "haarcast/core/shared_layout.h"  // RotationSample
 
-layout(local_size_x_id = 2) in;
-layout(constant_id = 0) const int LEVEL = 5;
-layout(constant_id = 1) const int THETA_SAMPLES = 16;  // part of the contract; unused here
+layout(local_size_x_id = kSpecLocalSize) in;
+layout(constant_id = kSpecLevel) const int LEVEL = 5;
+layout(constant_id = kSpecThetaSamples) const int THETA_SAMPLES = 16;  // part of the contract; unused here
 
 const int LOCAL = int(gl_WorkGroupSize.x);
 const int M = 1 << LEVEL;

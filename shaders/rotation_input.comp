@@ -2,8 +2,9 @@
 // The "rotation-input" pass: per covered pixel, what the rotation needs (the
 // nearest θₒ slice and the Y-X-Y Euler angles of the local shading frame) and
 // what the triple product needs (object, vertices, barycentrics). The same
-// math as render::rotationInput (shading.cpp shadingFrame, rotation.cpp
-// eulerFromMatrix, brdf_slices.cpp nearestSlice), in float. Covered pixels
+// math as render::rotationInput: the shading frame of core/shared_frame.h,
+// the nearest slice of shared_layout.h's sliceBlendAt, and rotation.cpp's
+// eulerFromMatrix, in float. Covered pixels
 // are compacted through an atomic counter, so their order is arbitrary;
 // every record carries its radiance slot. Local size kLocalSize, one invocation per
 // pixel.
@@ -40,16 +41,9 @@ void emit(uvec4 id, vec3 normal, vec3 direction, uint slot) {
   mat3 toWorld = mat3(o.rotation[0].xyz, o.rotation[1].xyz, o.rotation[2].xyz);
   vec3 wo = transpose(toWorld) * -direction;  // toward the eye, object frame
 
-  // shadingFrame: +Y = n, wo in the (Y, Z) half-plane at φ = 0.
-  float c = clamp(dot(n, wo), -1.0, 1.0);
-  float thetaOut = acosPrecise(max(c, 0.0));
-  vec3 z = wo - c * n;
-  if (dot(z, z) < 1e-16) {  // view along the normal: any tangent will do
-    z = abs(n.x) < 0.9 ? cross(n, vec3(1.0, 0.0, 0.0)) : cross(n, vec3(0.0, 1.0, 0.0));
-  }
-  z = normalize(z);
-  vec3 xAxis = cross(n, z);
-  mat3 m = mat3(xAxis, n, z);
+  float thetaOut;
+  mat3 m = shadingFrame(n, wo, thetaOut);
+  vec3 xAxis = m[0];
 
   // eulerFromMatrix: m·ŷ = n = (sin β sin α, cos β, sin β cos α).
   float beta = acosPrecise(clamp(n.y, -1.0, 1.0));
@@ -63,9 +57,8 @@ void emit(uvec4 id, vec3 normal, vec3 direction, uint slot) {
     gamma = 0.0;
   }
 
-  // nearestSlice: the cell of [0, π/2] split into T that holds θₒ.
-  int t = clamp(int(floor(clamp(thetaOut, 0.0, kPiF / 2.0) / (kPiF / 2.0) * float(o.thetaSamples))), 0,
-                int(o.thetaSamples) - 1);
+  // The nearest slice: BrdfSliceTable::nearestSlice in float.
+  uint t = sliceBlendAt(thetaOut, o.thetaSamples, 0u).first;
 
   uint k = atomicAdd(counter.covered, 1u);
   // `fused`'s indirect dispatch: one workgroup per covered pixel, at most
@@ -77,7 +70,7 @@ void emit(uvec4 id, vec3 normal, vec3 direction, uint slot) {
       atomicMax(counter.groups[2], 1u);
     }
   }
-  samples[k] = RotationSample(o.sliceBase + uint(t), o.methodBase, alpha, beta, gamma, slot, thetaOut, 0u);
+  samples[k] = RotationSample(o.sliceBase + t, o.methodBase, alpha, beta, gamma, slot, thetaOut, 0u);
   uint tri = o.triangleBase + id.y;
   float b1 = uintBitsToFloat(id.z), b2 = uintBitsToFloat(id.w);
   shade[k] = ShadeSample(id.x - 1u, uint[3](triangles[3u * tri], triangles[3u * tri + 1u], triangles[3u * tri + 2u]),

@@ -19,6 +19,7 @@
 // block's RotationPush and BatchArgsPush members as the device read them.
 #extension GL_GOOGLE_include_directive : require
 #include "haarcast/core/shared_layout.h"
+#include "haarcast/core/shared_tonemap.h"
 
 layout(local_size_x = kLocalSize) in;
 layout(push_constant) uniform Push {
@@ -54,7 +55,8 @@ const uint kContract[] = uint[](
     kFusedBindings, kSplitsumSamplesBinding, kSplitsumShadeBinding, kSplitsumObjectsBinding,
     kSplitsumCounterBinding, kSplitsumMasksBinding, kSplitsumLobesBinding, kSplitsumLobeLightTexelsBinding,
     kSplitsumRadianceBinding, kSplitsumBindings, kGBufferPositionsBinding, kGBufferNormalsBinding,
-    kGBufferTrianglesBinding, kGBufferBindings);
+    kGBufferTrianglesBinding, kGBufferBindings, kExposureLocalSize, kSpecLevel, kSpecThetaSamples, kSpecLocalSize,
+    kSpecInterpolate, kSpecPrefilterFinest, kToneCodes);
 
 void writeContract() {
   uint w = 0u;

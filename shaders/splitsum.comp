@@ -19,9 +19,9 @@
 #include "common/frame.glsl"
 #include "common/sphere.glsl"
 
-layout(local_size_x_id = 2) in;
-layout(constant_id = 4) const uint INTERPOLATE = 1u;       // RenderOptions::interpolateSlices
-layout(constant_id = 5) const uint PREFILTER_FINEST = 9u;  // the prefiltered light's finest level
+layout(local_size_x_id = kSpecLocalSize) in;
+layout(constant_id = kSpecInterpolate) const uint INTERPOLATE = 1u;       // RenderOptions::interpolateSlices
+layout(constant_id = kSpecPrefilterFinest) const uint PREFILTER_FINEST = 9u;  // the prefiltered light's finest level
 
 layout(std430, set = 0, binding = kSplitsumSamplesBinding) readonly buffer Samples { RotationSample samples[]; };
 layout(std430, set = 0, binding = kSplitsumShadeBinding) readonly buffer Shade { ShadeSample shade[]; };

@@ -8,7 +8,7 @@
 #include "common/frame.glsl"
 
 layout(local_size_x = kLocalSize) in;
-layout(constant_id = 0) const int LEVEL = 5;
+layout(constant_id = kSpecLevel) const int LEVEL = 5;
 const int M = 1 << LEVEL;
 const int N = M * M;
 

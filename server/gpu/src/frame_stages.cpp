@@ -85,7 +85,7 @@ void VulkanRenderer::Impl::uploadFrameUniforms(const render::FrameRequest& reque
   // A fixed exposure is encoded in the thresholds; an automatic one is a
   // gain the device chooses (exposure.comp) over the thresholds of 0 stops.
   const render::ExposureControl& e = request.exposure;  // checked by render::checkFrameRequest
-  const std::array<float, 256> encoding = render::tonemapThresholds(e.automatic ? 0.0 : e.stops, request.tone);
+  const render::ToneThresholds encoding = render::tonemapThresholds(e.automatic ? 0.0 : e.stops, request.tone);
   thresholds.write(encoding.data(), sizeof encoding);
 }
 

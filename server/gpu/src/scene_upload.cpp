@@ -231,7 +231,7 @@ void VulkanRenderer::Impl::uploadScene() {
     rays = std::make_unique<RayScene>(std::move(instances));
   }
   frameParams = Buffer(context, sizeof(FrameParams));
-  thresholds = Buffer(context, 256 * sizeof(float));
+  thresholds = Buffer(context, sizeof(render::ToneThresholds));
   exposureResult = Buffer(context, sizeof(ExposureResult), kStorageUsage, MemoryUse::Readback);
 
   const auto lvl = static_cast<std::uint32_t>(level);
@@ -259,9 +259,11 @@ void VulkanRenderer::Impl::uploadScene() {
   }
   rotate = std::make_unique<ComputePipeline>(
       context, "rotate_" + methodName + ".comp", shared::kRotateBindings, sizeof(shared::RotationPush),
-      std::vector<SpecConstant>{{0, lvl}, {1, static_cast<std::uint32_t>(T)}, {2, local}});
+      std::vector<SpecConstant>{{shared::kSpecLevel, lvl}, {shared::kSpecThetaSamples, static_cast<std::uint32_t>(T)},
+                                {shared::kSpecLocalSize, local}});
   tripleProduct = std::make_unique<ComputePipeline>(context, "triple_product.comp", shared::kTripleProductBindings,
-                                                    sizeof(shared::RotationPush), std::vector<SpecConstant>{{0, lvl}});
+                                                    sizeof(shared::RotationPush),
+                                                    std::vector<SpecConstant>{{shared::kSpecLevel, lvl}});
   batchArgsPass = std::make_unique<ComputePipeline>(context, "batch_args.comp", shared::kBatchArgsBindings,
                                                     sizeof(shared::BatchArgsPush));
 }
@@ -290,9 +292,9 @@ void VulkanRenderer::Impl::createFusedPipeline(std::uint32_t local) {
   if (limits.fusedGroups) fusedGroups = std::min(fusedGroups, limits.fusedGroups);
   fusedPass = std::make_unique<ComputePipeline>(
       context, "fused.comp", fusedBindings(), 0,
-      std::vector<SpecConstant>{{2, fusedLocal},
-                                {4, options.interpolateSlices ? 1u : 0u},
-                                {5, static_cast<std::uint32_t>(std::max(prepared.lobeLight.finestLevel(), 0))}});
+      std::vector<SpecConstant>{{shared::kSpecLocalSize, fusedLocal},
+                                {shared::kSpecInterpolate, options.interpolateSlices ? 1u : 0u},
+                                {shared::kSpecPrefilterFinest, static_cast<std::uint32_t>(std::max(prepared.lobeLight.finestLevel(), 0))}});
 }
 
 }  // namespace haarcast::gpu
@@ -312,9 +314,9 @@ void VulkanRenderer::Impl::createSplitsumPipeline() {
   if (limits.fusedGroups) fusedGroups = std::min(fusedGroups, limits.fusedGroups);
   fusedPass = std::make_unique<ComputePipeline>(
       context, "splitsum.comp", splitsumBindings(), 0,
-      std::vector<SpecConstant>{{2, fusedLocal},
-                                {4, options.interpolateSlices ? 1u : 0u},
-                                {5, static_cast<std::uint32_t>(prepared.lobeLight.finestLevel())}});
+      std::vector<SpecConstant>{{shared::kSpecLocalSize, fusedLocal},
+                                {shared::kSpecInterpolate, options.interpolateSlices ? 1u : 0u},
+                                {shared::kSpecPrefilterFinest, static_cast<std::uint32_t>(prepared.lobeLight.finestLevel())}});
 }
 
 }  // namespace haarcast::gpu

@@ -166,7 +166,6 @@ class CpuRenderer final : public Renderer {
   void traceGBuffer(const RayScene& rays, const CameraRays& camera, int w, int h, GBuffer& g,
                     const CancelPoint& cancelPoint) const;
   void fillInputs(const ResolvedFrame& resolved, GBuffer& g, const CancelPoint& cancelPoint) const;
-  static glm::dvec3 subsampleDirection(const CameraRays& camera, int x, int y, unsigned k);
   // rgb = the sample's radiance; returns the coefficient bytes read.
   // `slot` numbers the frame's samples: a centre by its pixel, sub-sample k
   // of edge pixel e after them, pixels + e·kSubsamples + k (sampleSlot).
@@ -214,11 +213,6 @@ std::size_t CpuRenderer::rotationBytes(std::size_t object) const {
   const SliceRotator& r = *rotators_[object][0];
   const std::size_t matrices = r.storedBytes() - slice * r.sliceCount();
   return slice + 2 * matrices / static_cast<std::size_t>(std::max(1, options_.rotator.matrixElevations));
-}
-
-glm::dvec3 CpuRenderer::subsampleDirection(const CameraRays& camera, int x, int y, unsigned k) {
-  const double o = shared::kSubsampleOffset;
-  return camera.directionAt(x + 0.5 + ((k & 1u) ? o : -o), y + 0.5 + ((k & 2u) ? o : -o));
 }
 
 void CpuRenderer::traceGBuffer(const RayScene& rays, const CameraRays& camera, int w, int h, GBuffer& g,
@@ -300,7 +294,7 @@ void CpuRenderer::traceGBuffer(const RayScene& rays, const CameraRays& camera, i
       const std::uint32_t e = g.edge[y * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)];
       if (e == kInterior) continue;
       for (unsigned k = 0; k < shared::kSubsamples; ++k)
-        g.sub[e][k] = trace(subsampleDirection(camera, x, static_cast<int>(y), k), y * static_cast<std::size_t>(w) + static_cast<std::size_t>(x));
+        g.sub[e][k] = trace(camera.subsampleDirection(x, static_cast<int>(y), k), y * static_cast<std::size_t>(w) + static_cast<std::size_t>(x));
     }
   }, {}, options_.threads);
 }
@@ -363,7 +357,7 @@ std::size_t CpuRenderer::shadePixels(const GBuffer& g, const FrameRequest& reque
           sum += glm::dvec3(rgb[0], rgb[1], rgb[2]);
         } else if (options_.environmentBackground) {
           sum += backgroundRadiance(prepared_.background, request.lightRotation,
-                                    subsampleDirection(camera, x, static_cast<int>(y), k));
+                                    camera.subsampleDirection(x, static_cast<int>(y), k));
         }
       }
       sum /= static_cast<double>(shared::kSubsamples);

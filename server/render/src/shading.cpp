@@ -1,5 +1,7 @@
 #include "haarcast/render/shading.h"
 
+#include "haarcast/core/shared_frame.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -51,21 +53,17 @@ CameraRays::CameraRays(const Camera& camera, int width, int height)
 glm::dvec3 CameraRays::direction(int x, int y) const { return directionAt(x + 0.5, y + 0.5); }
 
 glm::dvec3 CameraRays::directionAt(double px, double py) const {
-  const double sx = (2.0 * px / width_ - 1.0) * basis_.tanHalf * aspect_;
-  const double sy = (1.0 - 2.0 * py / height_) * basis_.tanHalf;
-  return glm::normalize(basis_.forward + sx * basis_.right + sy * basis_.up);
+  return shared::cameraDirectionAt(basis_.forward, basis_.right, basis_.up, basis_.tanHalf, aspect_,
+                                   static_cast<double>(width_), static_cast<double>(height_), px, py);
+}
+
+glm::dvec3 CameraRays::subsampleDirection(int x, int y, unsigned k) const {
+  return directionAt(shared::subsampleCoordinate<double>(static_cast<shared::uint>(x), k, 1u),
+                     shared::subsampleCoordinate<double>(static_cast<shared::uint>(y), k, 2u));
 }
 
 glm::dmat3 shadingFrame(const glm::dvec3& n, const glm::dvec3& wo, double& thetaOut) {
-  const double c = std::clamp(glm::dot(n, wo), -1.0, 1.0);
-  thetaOut = std::acos(std::max(c, 0.0));
-  glm::dvec3 z = wo - c * n;
-  if (glm::dot(z, z) < 1e-16) {  // view along the normal: any tangent will do
-    z = std::abs(n.x) < 0.9 ? glm::cross(n, glm::dvec3(1, 0, 0)) : glm::cross(n, glm::dvec3(0, 1, 0));
-  }
-  z = glm::normalize(z);
-  const glm::dvec3 x = glm::cross(n, z);  // right-handed: x = y × z
-  return glm::dmat3(x, n, z);
+  return shared::shadingFrame(n, wo, thetaOut);
 }
 
 }  // namespace haarcast::render

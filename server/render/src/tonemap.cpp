@@ -95,31 +95,24 @@ double toneCurve(double x, ToneCurve curve) {
   return 0.0;
 }
 
-std::array<float, 256> tonemapThresholds(double exposureStops, ToneCurve curve) {
+ToneThresholds tonemapThresholds(double exposureStops, ToneCurve curve) {
   const double gain = std::exp2(exposureStops);
-  std::array<float, 256> t{};
-  for (int k = 1; k < 256; ++k) {
-    const double y = srgbToLinear((k - 0.5) / 255.0);
-    t[static_cast<std::size_t>(k)] = static_cast<float>(inverseToneCurve(y, curve) / gain);
+  ToneThresholds t{};
+  for (std::size_t k = 1; k < t.size(); ++k) {
+    const double y = srgbToLinear((static_cast<double>(k) - 0.5) / (shared::kToneCodes - 1));
+    t[k] = static_cast<float>(inverseToneCurve(y, curve) / gain);
   }
   return t;
 }
 
 double toneHighlight(ToneCurve curve) { return inverseToneCurve(srgbToLinear((kHighlightCode + 0.5) / 255.0), curve); }
 
-std::uint8_t tonemapByte(float value, const std::array<float, 256>& threshold) {
-  // The largest k with value ≥ threshold[k] (0 when none, and for NaN): the
-  // same binary search as shaders/tonemap.comp.
-  unsigned code = 0;
-  for (unsigned step = 128; step > 0; step >>= 1) {
-    const unsigned next = code + step;
-    if (next <= 255 && value >= threshold[next]) code = next;
-  }
-  return static_cast<std::uint8_t>(code);
+std::uint8_t tonemapByte(float value, const ToneThresholds& threshold) {
+  return static_cast<std::uint8_t>(shared::tonemapCode(value, threshold));
 }
 
 std::vector<std::uint8_t> tonemapRgba8(const io::RgbImage& image, double exposureStops, ToneCurve curve) {
-  const std::array<float, 256> thresholds = tonemapThresholds(exposureStops, curve);
+  const ToneThresholds thresholds = tonemapThresholds(exposureStops, curve);
   const std::size_t pixels = static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height);
   std::vector<std::uint8_t> out(pixels * 4);
   for (std::size_t p = 0; p < pixels; ++p) {

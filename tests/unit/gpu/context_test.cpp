@@ -30,7 +30,8 @@ TEST(VulkanContext, ErrorsNameTheCallAndTheCode) {
 
 TEST(VulkanContext, EveryShaderIsEmbedded) {
   for (const char* name : {"rotate_spatial.comp", "rotation_input.comp", "triple_product.comp", "resolve.comp",
-                           "exposure.comp", "tonemap.comp", "fused.comp", "splitsum.comp",
+                           "exposure.comp", "tonemap.comp", "fused.comp", "splitsum.comp", "shared_layout_check.comp",
+                           "shared_functions_check.comp",
                            "gbuffer.vert", "gbuffer.frag"}) {
     const auto words = embeddedShader(name);
     ASSERT_GT(words.size(), 5u) << name;

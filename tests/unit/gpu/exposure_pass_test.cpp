@@ -80,7 +80,7 @@ TEST(ExposurePass, MetersAsTheCpuForEveryCurveAndControl) {
   paramBuf.write(&params, sizeof params);
   idBuf.upload(std::span<const glm::uvec4>(f.ids));
   radBuf.upload(std::span<const glm::vec4>(f.radiance));
-  ComputePipeline exposure(context, "exposure.comp", 4, sizeof(ExposurePush));
+  ComputePipeline exposure(context, "exposure.comp", shared::kExposureBindings, sizeof(ExposurePush));
   exposure.bind({&paramBuf, &idBuf, &radBuf, &resultBuf});
 
   render::ExposureControl eased;

@@ -229,7 +229,9 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
   const TexelView bitsView(context, bitsBuf, VK_FORMAT_R32_UINT, sizeof(std::uint32_t));
   const TexelView dirView(context, dirBuf, VK_FORMAT_R32G32B32A32_SFLOAT, sizeof(glm::vec4));
   ComputePipeline p(context, "fused.comp", fusedBindings(), 0,
-                    {{2, 64u}, {4, pc.interpolate ? 1u : 0u}, {5, static_cast<std::uint32_t>(kPrefilterFinest)}});
+                    {{shared::kSpecLocalSize, shared::kLocalSize},
+                     {shared::kSpecInterpolate, pc.interpolate ? 1u : 0u},
+                     {shared::kSpecPrefilterFinest, static_cast<std::uint32_t>(kPrefilterFinest)}});
   p.bind({&sampleBuf, &shadeBuf, &objectBuf, &texelView, &lightView, &bitsView, &dirView, &pointBuf, &radiance,
           &counterBuf, &maskBuf, &energyBuf, &lobeBuf, &prefilterView, &pointTexelView});
   context.submit([&](VkCommandBuffer cb) { p.dispatch(cb, {kGroups, 1, 1}); });

@@ -88,15 +88,14 @@ TEST_P(SpatialRotationPass, MatchesTheCpuRotatorCoefficientByCoefficient) {
       dummy(context, 4), out(context, samples.size() * 3 * n * 4);
   sampleBuf.upload(std::span<const RotationSample>(samples));
   sliceBuf.upload(std::span<const float>(slices));
-  ComputePipeline p(context, "rotate_spatial.comp", 4, 16, {{0, static_cast<std::uint32_t>(level)}, {1, kSlices}});
+  ComputePipeline p(context, "rotate_spatial.comp", shared::kRotateBindings, sizeof(shared::RotationPush),
+                    {{shared::kSpecLevel, static_cast<std::uint32_t>(level)}, {shared::kSpecThetaSamples, kSlices}});
   p.bind({&sampleBuf, &sliceBuf, &dummy, &out});
   // Two dispatches (first = 0 and 10) to exercise the contract's offsets.
-  struct {
-    std::uint32_t first, count, pad0, pad1;
-  } push[2] = {{0, 10, 0, 0}, {10, static_cast<std::uint32_t>(samples.size() - 10), 0, 0}};
+  const shared::RotationPush push[2] = {{0, 10, 0, 0}, {10, static_cast<std::uint32_t>(samples.size() - 10), 0, 0}};
   std::vector<float> rotated(samples.size() * 3 * n);
   for (const auto& pc : push) {
-    context.submit([&](VkCommandBuffer cb) { p.dispatch(cb, {pc.count, 3, 1}, &pc, 16); });
+    context.submit([&](VkCommandBuffer cb) { p.dispatch(cb, {pc.count, 3, 1}, &pc, sizeof pc); });
     out.read(rotated.data() + pc.first * 3 * n, pc.count * 3 * n * 4);
   }
 
@@ -171,10 +170,11 @@ TEST(TripleProductPass, MatchesCoreTripleProductOnRandomSparseInputs) {
     const CoverageCounter covered{kSamples - 1, {0, 0, 0}};
     Buffer counterBuf(context, sizeof covered);
     counterBuf.write(&covered, sizeof covered);
-    ComputePipeline p(context, "triple_product.comp", 6, 16, {{0, static_cast<std::uint32_t>(level)}});
+    ComputePipeline p(context, "triple_product.comp", shared::kTripleProductBindings, sizeof(shared::RotationPush),
+                      {{shared::kSpecLevel, static_cast<std::uint32_t>(level)}});
     p.bind({&shadeBuf, &rotBuf, &lightBuf, &visBuf, &radBuf, &counterBuf});
-    const std::uint32_t push[4] = {0, kSamples, 0, 0};
-    context.submit([&](VkCommandBuffer cb) { p.dispatch(cb, {1, 1, 1}, push, 16); });
+    const shared::RotationPush push{0, kSamples, 0, 0};
+    context.submit([&](VkCommandBuffer cb) { p.dispatch(cb, {1, 1, 1}, &push, sizeof push); });
     std::vector<float> radiance(radianceInit.size());
     radBuf.download(std::span<float>(radiance));
 
@@ -213,14 +213,14 @@ TEST(BatchArgsPass, SizesEveryBatchFromTheCoveredCount) {
   constexpr std::uint32_t kBatch = 97, kBatches = 7;
   Context context(testing::testOptions());
   Buffer counterBuf(context, sizeof(CoverageCounter)), args(context, 2 * kBatches * sizeof(DispatchArgs));
-  ComputePipeline p(context, "batch_args.comp", 2, 16);
+  ComputePipeline p(context, "batch_args.comp", shared::kBatchArgsBindings, sizeof(shared::BatchArgsPush));
   p.bind({&counterBuf, &args});
   for (const std::uint32_t covered : {0u, 1u, 96u, 97u, 98u, 500u, kBatch * kBatches}) {
     const CoverageCounter c{covered, {0, 0, 0}};
     counterBuf.write(&c, sizeof c);
-    const std::uint32_t push[4] = {kBatch, kBatches, 0, 0};
+    const shared::BatchArgsPush push{kBatch, kBatches, 0, 0};
     context.submit([&](VkCommandBuffer cb) {
-      p.dispatch(cb, {1, 1, 1}, push, sizeof push);
+      p.dispatch(cb, {1, 1, 1}, &push, sizeof push);
       computeBarrier(cb);
     });
     std::vector<DispatchArgs> got(2 * kBatches);
@@ -274,7 +274,7 @@ TEST_P(TonemapPass, BackdropAndEncodingMatchTheCpuDefinitions) {
 
   Context context(testing::testOptions());
   Buffer paramBuf(context, sizeof params), idBuf(context, pixels * 16), radBuf(context, pixels * 16),
-      bgBuf(context, bg.size() * 4), rgbaBuf(context, pixels * 4), thresholdBuf(context, 256 * 4),
+      bgBuf(context, bg.size() * 4), rgbaBuf(context, pixels * 4), thresholdBuf(context, sizeof(render::ToneThresholds)),
       edgeBuf(context, pixels * 4), exposureBuf(context, sizeof(ExposureResult));
   // A fixed exposure: in the thresholds, gain 1 (exposure.comp's choice for it).
   ExposureResult fixed{};
@@ -286,7 +286,8 @@ TEST_P(TonemapPass, BackdropAndEncodingMatchTheCpuDefinitions) {
   idBuf.upload(std::span<const glm::uvec4>(ids));
   radBuf.upload(std::span<const glm::vec4>(radiance));
   bgBuf.upload(std::span<const float>(bg));
-  ComputePipeline resolve(context, "resolve.comp", 5, 0), encode(context, "tonemap.comp", 5, 0);
+  ComputePipeline resolve(context, "resolve.comp", shared::kResolveBindings, 0),
+      encode(context, "tonemap.comp", shared::kTonemapBindings, 0);
   resolve.bind({&paramBuf, &idBuf, &radBuf, &bgBuf, &edgeBuf});
   encode.bind({&paramBuf, &radBuf, &rgbaBuf, &thresholdBuf, &exposureBuf});
   context.submit([&](VkCommandBuffer cb) {

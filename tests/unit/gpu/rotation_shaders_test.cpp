@@ -42,10 +42,7 @@ namespace {
 
 // The contract's binding-0 record: gpu::RotationSample (core/shared_layout.h).
 
-struct RotationPush {
-  std::uint32_t first = 0, count = 0, pad0 = 0, pad1 = 0;
-};
-static_assert(sizeof(RotationPush) == 16);
+using shared::RotationPush;
 
 const char* shaderOf(RotationMethod m) {
   switch (m) {
@@ -172,8 +169,9 @@ GpuRun rotateOnGpu(Context& context, RotationMethod method, const std::vector<Br
   sliceBuffer.upload(std::span<const float>(slices));
   dataBuffer.upload(std::span<const std::uint32_t>(methodData));
 
-  ComputePipeline pipeline(context, shaderOf(method), 4, sizeof(RotationPush),
-                           {{0, static_cast<std::uint32_t>(level)}, {1, static_cast<std::uint32_t>(thetaSamples)}});
+  ComputePipeline pipeline(context, shaderOf(method), shared::kRotateBindings, sizeof(RotationPush),
+                           {{shared::kSpecLevel, static_cast<std::uint32_t>(level)},
+                            {shared::kSpecThetaSamples, static_cast<std::uint32_t>(thetaSamples)}});
   pipeline.bind({&sampleBuffer, &sliceBuffer, &dataBuffer, &outBuffer});
   GpuRun run;
   run.rotated.assign(samples.size() * 3 * n, 0.0f);

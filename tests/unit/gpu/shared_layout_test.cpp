@@ -20,6 +20,7 @@
 
 #include "gpu_test_util.h"
 #include "haarcast/core/shared_layout.h"
+#include "haarcast/core/shared_tonemap.h"
 #include "haarcast/gpu/compute.h"
 
 namespace haarcast::gpu {
@@ -64,7 +65,9 @@ const std::vector<Named> kContract = {
       C(kFusedBindings), C(kSplitsumSamplesBinding), C(kSplitsumShadeBinding), C(kSplitsumObjectsBinding),
       C(kSplitsumCounterBinding), C(kSplitsumMasksBinding), C(kSplitsumLobesBinding),
       C(kSplitsumLobeLightTexelsBinding), C(kSplitsumRadianceBinding), C(kSplitsumBindings),
-      C(kGBufferPositionsBinding), C(kGBufferNormalsBinding), C(kGBufferTrianglesBinding), C(kGBufferBindings)};
+      C(kGBufferPositionsBinding), C(kGBufferNormalsBinding), C(kGBufferTrianglesBinding), C(kGBufferBindings),
+      C(kExposureLocalSize), C(kSpecLevel), C(kSpecThetaSamples), C(kSpecLocalSize), C(kSpecInterpolate),
+      C(kSpecPrefilterFinest), C(kToneCodes)};
 #undef C
 
 glm::uvec4 packCase(uint n, uint band, uint l, uint i, uint j) { return {n, band * 256 + l, i, j}; }

@@ -24,16 +24,6 @@
 #ifndef HAARCAST_CORE_SHARED_EXPOSURE_H
 #define HAARCAST_CORE_SHARED_EXPOSURE_H
 
-#ifdef __cplusplus
-// GLSL's floatBitsToUint.
-inline uint floatBitsToUint(float f) { return std::bit_cast<uint>(f); }
-// GLSL's `precise`: no fused multiply-add, so the device rounds as the CPU
-// (whose baseline x86-64 build has no FMA to contract into).
-#define HC_PRECISE
-#else
-#define HC_PRECISE precise
-#endif
-
 HC_CONST uint kMeterObjectWeight = 4u;
 HC_CONST uint kMeterBackdropWeight = 1u;
 HC_CONST uint kMeterHighlightShare = 100u;   // the brightest 1 % of the weight is the highlight
@@ -118,6 +108,65 @@ HC_FUNCTION float exposureStops(uint weight, float target, ExposurePush p) {
   return eased;
 }
 
-#undef HC_PRECISE
+// Per pixel: the weight a pixel of linear colour c adds to the bins of
+// meterBin(meterLuminance(c)) and meterBin(meterPeak(c)), object or not.
+// Black pixels (shadowed, or a black backdrop) carry no exposure
+// information; neither do NaN and ∞: weight 0.
+HC_FUNCTION uint meterWeight(vec3 c, bool object) {
+  const float y = meterLuminance(c);
+  if (!(y > 0.0f) || isinf(y)) return 0u;
+  return object ? kMeterObjectWeight : kMeterBackdropWeight;
+}
+
+// The frame's measure and exposure from its two histograms, read in a
+// fixed order (so the float sum is the same on both sides). The counts are
+// the caller's: in C++ the arrays `luminance` and `peak` of the argument
+// (render::ExposureHistograms); in GLSL the shader defines
+// meterLuminanceCount(bin) and meterPeakCount(bin) (exposure.comp: its
+// shared histograms).
+#ifdef __cplusplus
+template <class Histograms>
+inline ExposureResult meterReadout(const Histograms& h, ExposurePush p) {
+#define HC_LUMINANCE_COUNT(bin) h.luminance[bin]
+#define HC_PEAK_COUNT(bin) h.peak[bin]
+#else
+uint meterLuminanceCount(uint bin);
+uint meterPeakCount(uint bin);
+ExposureResult meterReadout(ExposurePush p) {
+#define HC_LUMINANCE_COUNT(bin) meterLuminanceCount(bin)
+#define HC_PEAK_COUNT(bin) meterPeakCount(bin)
+#endif
+  uint total = 0u;
+  HC_PRECISE float sumLog2 = 0.0f;
+  for (uint b = 0u; b < kMeterBins; ++b) {
+    total += HC_LUMINANCE_COUNT(b);
+    sumLog2 += float(HC_LUMINANCE_COUNT(b)) * meterBinLog2(b);
+  }
+  ExposureResult r;
+  r.logAverage = 0.0f;
+  r.meanLog2 = 0.0f;
+  r.highlightLog2 = 0.0f;
+  float target = 0.0f;
+  if (total != 0u) {
+    r.meanLog2 = sumLog2 / float(total);
+    const uint need = meterHighlightWeight(total);
+    uint above = 0u, bin = kMeterBins - 1u;
+    for (; bin > 0u; --bin) {
+      above += HC_PEAK_COUNT(bin);
+      if (above >= need) break;
+    }
+    r.highlightLog2 = meterBinLog2(bin);
+    r.logAverage = exp2(r.meanLog2);
+    target = meteredStops(r.meanLog2, r.highlightLog2, p);
+  }
+  r.weight = total;
+  r.stops = exposureStops(total, target, p);
+  r.gain = p.automatic != 0u ? exp2(r.stops) : 1.0f;
+  r.pad0 = 0u;
+  r.pad1 = 0u;
+  return r;
+}
+#undef HC_LUMINANCE_COUNT
+#undef HC_PEAK_COUNT
 
 #endif  // HAARCAST_CORE_SHARED_EXPOSURE_H

@@ -1,44 +1,16 @@
 // The numbers and small functions that the CPU and the shaders share, in one
 // header compiled both as C++ (namespace haarcast::shared) and as GLSL
 // (shaders include it with GL_GOOGLE_include_directive, -I server/core/include).
-// Write only what both languages read alike: plain structs of uint, float and
-// vec3/vec4, `const` numbers, and functions built from floor/min/max/clamp,
-// log2, integer bit operations and findMSB (not sin, cos, atan or acos:
-// Vulkan lets a device compute those loosely, sphere.glsl has precise ones). The GPU tests check the shaders'
-// results against the C++ use of the same lines (SharedLayout.*).
+// What may be written here, and the HC_ macros: shared_language.h. The GPU
+// tests check the shaders' results against the C++ use of the same lines
+// (SharedLayout.*).
 #ifndef HAARCAST_CORE_SHARED_LAYOUT_H
 #define HAARCAST_CORE_SHARED_LAYOUT_H
 
+#include "haarcast/core/shared_language.h"
+
 #ifdef __cplusplus
-#include <algorithm>
-#include <bit>
-#include <cmath>
-#include <cstddef>
-#include <cstdint>
-
-#include <glm/mat4x4.hpp>
-#include <glm/vec3.hpp>
-#include <glm/vec4.hpp>
-
 namespace haarcast::shared {
-using uint = std::uint32_t;
-using vec3 = glm::vec3;
-using vec4 = glm::vec4;
-using mat4 = glm::mat4;
-using std::clamp;
-using std::floor;
-using std::log2;
-using std::max;
-using std::min;
-// GLSL's findMSB: the index of the highest set bit, −1 for 0.
-inline constexpr int findMSB(uint x) { return static_cast<int>(std::bit_width(x)) - 1; }
-#define HC_CONST inline constexpr
-#define HC_FUNCTION inline
-#define HC_CONSTEXPR inline constexpr
-#else
-#define HC_CONST const
-#define HC_FUNCTION
-#define HC_CONSTEXPR
 #endif
 
 // π, written once: kPi for the C++ double paths (core/sphere_map.h takes
@@ -482,10 +454,7 @@ static_assert(sizeof(BatchArgsPush) == 16 && offsetof(BatchArgsPush, batches) ==
 
 #ifdef __cplusplus
 }  // namespace haarcast::shared
-#undef HC_CONST
-#undef HC_FUNCTION
-#undef HC_CONSTEXPR
-#undef HC_PI
 #endif
+#undef HC_PI
 
 #endif  // HAARCAST_CORE_SHARED_LAYOUT_H

@@ -15,11 +15,22 @@
 // The local size of the per-pixel and per-batch passes (rotation_input,
 // resolve, tonemap, triple_product, batch_args), which the host's group
 // counts divide by; and the host's pick for the passes that take theirs as
-// specialization constant 2 (rotate_*.comp; splitsum) on a CPU device.
+// specialization constant kSpecLocalSize (rotate_*.comp; splitsum) on a CPU device.
 HC_CONST uint kLocalSize = 64u;
 // The host's pick for those passes and for `fused` on a GPU, and the
 // default of the rotation shaders that declare one.
 HC_CONST uint kGpuLocalSize = 256u;
+// exposure.comp: one workgroup of the least maxComputeWorkGroupInvocations
+// Vulkan guarantees.
+HC_CONST uint kExposureLocalSize = 128u;
+
+// ---- Specialization constants: the ids the shaders declare them at
+// (layout(constant_id = …)) and the host sets them by (gpu::SpecConstant).
+HC_CONST uint kSpecLevel = 0u;            // LEVEL: the maps are 2^LEVEL × 2^LEVEL
+HC_CONST uint kSpecThetaSamples = 1u;     // THETA_SAMPLES: slices per channel per object
+HC_CONST uint kSpecLocalSize = 2u;        // local_size_x_id: the host's workgroup size
+HC_CONST uint kSpecInterpolate = 4u;      // INTERPOLATE: RenderOptions::interpolateSlices
+HC_CONST uint kSpecPrefilterFinest = 5u;  // PREFILTER_FINEST: the prefiltered light's finest level
 
 // ---- Indirect dispatch
 

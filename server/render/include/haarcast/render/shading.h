@@ -39,6 +39,9 @@ class CameraRays {
   // Through the point (px, py) of the image plane in pixels: pixel (x, y)'s
   // centre is (x + ½, y + ½).
   glm::dvec3 directionAt(double px, double py) const;
+  // Through sub-sample k of pixel (x, y) (shared::kSubsamples, the
+  // antialiasing's samples).
+  glm::dvec3 subsampleDirection(int x, int y, unsigned k) const;
   const glm::dvec3& origin() const { return eye_; }
 
  private:

@@ -37,6 +37,7 @@
 #include <string_view>
 #include <vector>
 
+#include "haarcast/core/shared_tonemap.h"
 #include "haarcast/io/image.h"
 
 namespace haarcast::render {
@@ -60,17 +61,20 @@ std::string toneCurveNames();  // "reinhard, aces, agx", for error messages
 // [0, 1]; NaN and negatives → 0.
 double toneCurve(double exposed, ToneCurve curve = ToneCurve::Reinhard);
 
-// The 8-bit code of one linear value. The encoding compares against the 255
-// code boundaries below (so the Vulkan pass, which counts the same float
-// thresholds, gives the same byte for every input).
-std::uint8_t tonemapByte(float linear, const std::array<float, 256>& thresholds);
+// thresholds[k] for the codes k of the display encoding (shared::kToneCodes).
+using ToneThresholds = std::array<float, shared::kToneCodes>;
+
+// The 8-bit code of one linear value: shared::tonemapCode, the count of
+// code boundaries reached, which the Vulkan pass runs on the same float
+// thresholds, so both give the same byte for every input.
+std::uint8_t tonemapByte(float linear, const ToneThresholds& thresholds);
 
 // thresholds[k], k = 1 … 255: the least linear value (before the gain
 // 2^stops) whose code is ≥ k, i.e. the inverse of the transform at the
 // rounding boundary (k − ½)/255 (+∞ for a code the curve never reaches).
 // thresholds[0] = 0 (unused). Counting thresholds works for any curve that
 // treats each channel alone and never decreases: all three do.
-std::array<float, 256> tonemapThresholds(double exposureStops, ToneCurve curve = ToneCurve::Reinhard);
+ToneThresholds tonemapThresholds(double exposureStops, ToneCurve curve = ToneCurve::Reinhard);
 
 // RGBA8 (alpha 255), row 0 at the top, 4 bytes per pixel.
 std::vector<std::uint8_t> tonemapRgba8(const io::RgbImage& image, double exposureStops,
