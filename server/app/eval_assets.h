@@ -12,7 +12,7 @@
 #include "eval.h"
 #include "haarcast/core/metrics.h"
 #include "haarcast/core/mesh.h"
-#include "haarcast/render/cpu_renderer.h"
+#include "haarcast/cpu/cpu_renderer.h"
 #include "haarcast/render/scene.h"
 
 namespace haarcast::app {

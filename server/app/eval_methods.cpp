@@ -10,7 +10,8 @@
 #include <sstream>
 
 #include "haarcast/assets/procedural_mesh.h"
-#include "haarcast/render/reference.h"
+#include "haarcast/cpu/cpu_renderer.h"
+#include "haarcast/cpu/reference.h"
 #include "haarcast/render/renderer.h"
 #include "loadtest_storage.h"
 #include "number_format.h"

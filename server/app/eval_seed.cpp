@@ -8,6 +8,7 @@
 #include <glm/trigonometric.hpp>
 
 #include "haarcast/core/rotation.h"
+#include "haarcast/cpu/cpu_renderer.h"
 #include "haarcast/io/image.h"
 #include "haarcast/render/exposure_meter.h"
 #include "haarcast/render/renderer.h"

@@ -18,7 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "eval_assets.h"
-#include "haarcast/render/cpu_renderer.h"
+#include "haarcast/cpu/cpu_renderer.h"
 #include "progress.h"
 
 namespace haarcast::app {

@@ -11,8 +11,9 @@
 
 #include "haarcast/assets/procedural_mesh.h"
 #include "haarcast/core/metrics.h"
+#include "haarcast/cpu/cpu_renderer.h"
 #include "haarcast/io/mesh_io.h"
-#include "haarcast/render/reference.h"
+#include "haarcast/cpu/reference.h"
 #include "number_format.h"
 #include "truth_metrics.h"
 

@@ -25,8 +25,8 @@
 #include <nlohmann/json.hpp>
 
 #include "eval.h"
-#include "haarcast/render/cpu_renderer.h"
-#include "haarcast/render/reference.h"
+#include "haarcast/cpu/cpu_renderer.h"
+#include "haarcast/cpu/reference.h"
 #include "haarcast/render/scene.h"
 #include "progress.h"
 

@@ -20,6 +20,7 @@
 
 #include "app_paths.h"
 #include "haarcast/client/client_options.h"
+#include "haarcast/cpu/cpu_renderer.h"
 #include "haarcast/render/renderer.h"
 #include "list_flags.h"
 #include "loadtest_progress.h"

@@ -7,7 +7,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "haarcast/render/reference.h"
+#include "haarcast/cpu/reference.h"
 #include "haarcast/render/scene.h"
 #include "progress.h"
 #include "scene_flags.h"

@@ -1,3 +1,4 @@
+#include "haarcast/cpu/cpu_renderer.h"
 #include "haarcast/gpu/backend.h"
 
 #include <stdexcept>

@@ -13,6 +13,7 @@
 
 #include "frame_compare.h"
 #include "gpu_test_util.h"
+#include "haarcast/cpu/cpu_renderer.h"
 #include "haarcast/gpu/vulkan_renderer.h"
 #include "haarcast/render/embree_scene.h"
 #include "haarcast/render/exposure_meter.h"

@@ -13,6 +13,7 @@
 #include "gpu_test_util.h"
 #include "haarcast/assets/procedural_mesh.h"
 #include "haarcast/core/splitsum.h"
+#include "haarcast/cpu/cpu_renderer.h"
 #include "haarcast/gpu/vulkan_renderer.h"
 #include "haarcast/render/renderer.h"
 

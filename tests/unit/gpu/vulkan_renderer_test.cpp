@@ -15,6 +15,7 @@
 
 #include "frame_compare.h"
 #include "gpu_test_util.h"
+#include "haarcast/cpu/cpu_renderer.h"
 #include "haarcast/gpu/vulkan_renderer.h"
 #include "haarcast/render/exposure_meter.h"
 #include "haarcast/render/renderer.h"

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "haarcast/core/shared_layout.h"
+#include "haarcast/cpu/cpu_renderer.h"
 #include "haarcast/render/renderer.h"
 
 namespace haarcast::render {

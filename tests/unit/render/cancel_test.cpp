@@ -1,5 +1,6 @@
 // The CPU backend under a server's load: frames cancelled at the next row,
 // and concurrent frames on one prepared renderer.
+#include "haarcast/cpu/cpu_renderer.h"
 #include "haarcast/render/renderer.h"
 
 #include <atomic>

@@ -1,5 +1,5 @@
 // The CPU renderer against analytic answers.
-#include "haarcast/render/cpu_renderer.h"
+#include "haarcast/cpu/cpu_renderer.h"
 
 #include <gtest/gtest.h>
 

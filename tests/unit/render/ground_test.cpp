@@ -8,6 +8,7 @@
 #include "haarcast/assets/procedural_mesh.h"
 #include "haarcast/core/brdf.h"
 #include "haarcast/core/brdf_slices.h"
+#include "haarcast/cpu/cpu_renderer.h"
 #include "haarcast/render/renderer.h"
 
 namespace haarcast::render {

@@ -2,6 +2,7 @@
 // which level each object gets, the flags' level choices, and that a frame
 // with objects at several levels draws each object exactly as a frame at
 // that object's level alone would.
+#include "haarcast/cpu/cpu_renderer.h"
 #include "haarcast/render/object_levels.h"
 
 #include <gtest/gtest.h>

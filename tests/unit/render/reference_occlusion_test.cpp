@@ -22,7 +22,7 @@
 
 #include "haarcast/assets/procedural_mesh.h"
 #include "haarcast/render/embree_scene.h"
-#include "haarcast/render/reference.h"
+#include "haarcast/cpu/reference.h"
 #include "haarcast/render/shading.h"
 
 namespace haarcast::render {

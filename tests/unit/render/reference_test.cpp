@@ -8,7 +8,7 @@
 // means over P pixel channels by about sqrt(σ_a² + σ_b²)/√P. Where a
 // per-sample bound is known analytically (Lambert under a constant light),
 // the bound is used instead (Popoviciu: σ ≤ range/2).
-#include "haarcast/render/reference.h"
+#include "haarcast/cpu/reference.h"
 
 #include <cmath>
 #include <iostream>
@@ -20,7 +20,7 @@
 
 #include "haarcast/assets/procedural_mesh.h"
 #include "haarcast/core/metrics.h"
-#include "haarcast/render/cpu_renderer.h"
+#include "haarcast/cpu/cpu_renderer.h"
 #include "haarcast/render/embree_scene.h"
 
 namespace haarcast::render {

@@ -1,5 +1,5 @@
 // The Renderer interface's CPU backend and the steps every backend shares.
-#include "haarcast/render/cpu_renderer.h"
+#include "haarcast/cpu/cpu_renderer.h"
 #include "haarcast/render/exposure_meter.h"
 #include "haarcast/render/renderer.h"
 #include "haarcast/render/shading.h"

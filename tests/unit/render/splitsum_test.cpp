@@ -9,6 +9,7 @@
 #include "haarcast/assets/procedural_mesh.h"
 #include "haarcast/core/lobe.h"
 #include "haarcast/core/splitsum.h"
+#include "haarcast/cpu/cpu_renderer.h"
 #include "haarcast/render/renderer.h"
 
 namespace haarcast::render {

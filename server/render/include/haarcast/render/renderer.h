@@ -288,9 +288,4 @@ struct ResolvedFrame {
 };
 ResolvedFrame resolveFrame(const PreparedScene& prepared, const RenderOptions& options, const FrameRequest& request);
 
-// The CPU reference backend (cpu_renderer.h) behind the interface. The scene
-// is copied; precomputation (slice tables, rotators, visibility) happens here.
-std::unique_ptr<Renderer> makeCpuRenderer(const Scene& scene, const RenderOptions& options,
-                                          const RenderProgress& progress = {});
-
 }  // namespace haarcast::render

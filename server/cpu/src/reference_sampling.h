@@ -1,7 +1,7 @@
 // The reference's sampling primitives (reference.h "Sampling"): PCG32
 // random streams, piecewise-constant distributions on the sphere in the
 // haarcast direction convention, and the cell maxima that feed them.
-// Internal to haarcast_render; header-only so that reference.cpp stays one
+// Internal to haarcast_cpu; header-only so that reference.cpp stays one
 // idea (the estimator) and these stay another.
 #pragma once
 

@@ -1,6 +1,6 @@
 // The Monte Carlo reference renderer (see reference.h for what it computes,
 // how it samples and when it stops).
-#include "haarcast/render/reference.h"
+#include "haarcast/cpu/reference.h"
 
 #include <algorithm>
 #include <array>

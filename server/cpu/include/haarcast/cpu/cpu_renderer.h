@@ -24,10 +24,12 @@
 
 #include <cstddef>
 #include <functional>
+#include <memory>
 #include <string>
 
 #include "haarcast/io/image.h"
 #include "haarcast/render/render_options.h"
+#include "haarcast/render/renderer.h"
 #include "haarcast/render/scene.h"
 
 namespace haarcast::render {
@@ -46,5 +48,11 @@ struct RenderResult {
 };
 
 RenderResult renderCpu(const Scene& scene, const RenderOptions& options, const RenderProgress& progress = {});
+
+// The CPU backend behind the renderer interface (render/renderer.h). The
+// scene is copied; precomputation (slice tables, rotators, visibility)
+// happens here.
+std::unique_ptr<Renderer> makeCpuRenderer(const Scene& scene, const RenderOptions& options,
+                                          const RenderProgress& progress = {});
 
 }  // namespace haarcast::render

@@ -20,7 +20,7 @@
 #include "haarcast/core/rotate_haar.h"
 #include "haarcast/core/splitsum.h"
 #include "haarcast/core/triple_product.h"
-#include "haarcast/render/cpu_renderer.h"
+#include "haarcast/cpu/cpu_renderer.h"
 #include "haarcast/render/embree_scene.h"
 #include "haarcast/render/exposure_meter.h"
 #include "haarcast/render/point_lights.h"
