@@ -10,9 +10,9 @@
 #include <utility>
 #include <vector>
 
-#include "haarcast/wire/encoding_name.h"
-
 #include <google/protobuf/descriptor.h>
+
+#include "haarcast/wire/encoding_name.h"
 
 
 namespace haarcast::client {
