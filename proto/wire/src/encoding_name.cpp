@@ -10,7 +10,7 @@ namespace {
 
 // Names the enum's value names do not give: the ones printed before the
 // names came from the descriptor, kept so that flags, logs and reports read
-// as they did. Keyed by the enum; tests/unit/wire checks each key is a value.
+// as they did. Keyed by the enum; tests/unit/wire checks the names they give.
 constexpr std::pair<v1::Encoding, std::string_view> kNameExceptions[] = {
     {v1::ENCODING_RAW_RGBA8, "raw"},
 };
