@@ -236,7 +236,7 @@ esac
 # The fast unit tests under AddressSanitizer and UBSan (undefined behaviour
 # fatal), in a build folder of their own; the GPU and end-to-end tests are
 # left to the ordinary build.
-SANITIZE_TESTS=(haarcast_core_tests haarcast_io_tests haarcast_render_tests haarcast_net_tests)
+SANITIZE_TESTS=(haarcast_core_tests haarcast_io_tests haarcast_render_tests haarcast_wire_tests haarcast_net_tests)
 sanitized_tests() {
   local dir="${HAARCAST_SANITIZE_DIR:-build-sanitize}" failed=0 t
   deploy/sanitize_build.sh "${SANITIZE_TESTS[@]}"

@@ -12,6 +12,8 @@
 
 #include <google/protobuf/descriptor.h>
 
+#include "haarcast/wire/encoding_name.h"
+
 
 namespace haarcast::client {
 
@@ -103,23 +105,14 @@ Size parseSize(const std::string& text) {
 }
 
 v1::Encoding parseEncoding(const std::string& name) {
-  if (name == "jpeg" || name == "jpg") return v1::ENCODING_JPEG;
-  if (name == "png") return v1::ENCODING_PNG;
-  if (name == "raw" || name == "rgba8") return v1::ENCODING_RAW_RGBA8;
-  if (name == "exr") return v1::ENCODING_EXR;
-  if (name == "h264" || name == "h.264") return v1::ENCODING_H264;
-  throw std::invalid_argument("--encoding must be jpeg, png, raw, exr or h264 (got \"" + name + "\")");
-}
-
-std::string encodingName(v1::Encoding encoding) {
-  switch (encoding) {
-    case v1::ENCODING_JPEG: return "jpeg";
-    case v1::ENCODING_PNG: return "png";
-    case v1::ENCODING_RAW_RGBA8: return "raw";
-    case v1::ENCODING_EXR: return "exr";
-    case v1::ENCODING_H264: return "h264";
-    default: return "unspecified";
+  // The wire names (wire::encodingName), and the spellings people also type.
+  if (name == "jpg") return v1::ENCODING_JPEG;
+  if (name == "rgba8") return v1::ENCODING_RAW_RGBA8;
+  if (name == "h.264") return v1::ENCODING_H264;
+  if (const auto encoding = wire::encodingFromName(name); encoding && *encoding != v1::ENCODING_UNSPECIFIED) {
+    return *encoding;
   }
+  throw std::invalid_argument("--encoding must be jpeg, png, raw, exr or h264 (got \"" + name + "\")");
 }
 
 std::string encodingFileExtension(v1::Encoding encoding) {
@@ -141,7 +134,7 @@ void checkH264Options(v1::Encoding encoding, const Size& size, const H264Options
     const char* flag = options.bitrateKbps != 0 ? "--bitrate" : options.keyframeInterval != 0 ? "--keyframe-interval" : nullptr;
     if (flag) {
       throw std::invalid_argument(std::string(flag) + " applies to --encoding h264 only (got --encoding " +
-                                  encodingName(encoding) + ")");
+                                  std::string(wire::encodingName(encoding)) + ")");
     }
     return;
   }

@@ -59,7 +59,7 @@ H264Decoder::H264Decoder() : codec_(std::make_unique<Codec>()) {
 
 H264Decoder::~H264Decoder() = default;
 
-Rgba8Image H264Decoder::decode(std::span<const std::uint8_t> annexB, std::uint32_t width, std::uint32_t height) {
+wire::Rgba8Image H264Decoder::decode(std::span<const std::uint8_t> annexB, std::uint32_t width, std::uint32_t height) {
   const std::string which = "frame " + std::to_string(frames_ + 1);
   if (annexB.empty()) throw std::runtime_error("H.264 " + which + " is empty");
   Codec& c = *codec_;
@@ -103,7 +103,7 @@ Rgba8Image H264Decoder::decode(std::span<const std::uint8_t> annexB, std::uint32
     av_frame_unref(c.frame);
     throwAv("sws_setColorspaceDetails", e);
   }
-  Rgba8Image out{width, height, std::vector<std::uint8_t>(std::size_t{width} * height * 4)};
+  wire::Rgba8Image out{width, height, std::vector<std::uint8_t>(std::size_t{width} * height * 4)};
   std::uint8_t* dst[1] = {out.pixels.data()};
   const int dstStride[1] = {static_cast<int>(width * 4)};
   const int rows = sws_scale(c.toRgba, f.data, f.linesize, 0, f.height, dst, dstStride);

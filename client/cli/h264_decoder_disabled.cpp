@@ -13,7 +13,7 @@ H264Decoder::H264Decoder() {
   throw std::runtime_error("h264: this build has no libavcodec (-DHAARCAST_H264=OFF); choose jpeg, png, raw or exr");
 }
 H264Decoder::~H264Decoder() = default;
-Rgba8Image H264Decoder::decode(std::span<const std::uint8_t>, std::uint32_t, std::uint32_t) {
+wire::Rgba8Image H264Decoder::decode(std::span<const std::uint8_t>, std::uint32_t, std::uint32_t) {
   throw std::runtime_error("h264: this build has no libavcodec (-DHAARCAST_H264=OFF)");
 }
 

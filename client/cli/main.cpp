@@ -21,6 +21,7 @@
 #include "haarcast/client/pose_path.h"
 #include "haarcast/client/run_stats.h"
 #include "haarcast/client/session.h"
+#include "haarcast/wire/encoding_name.h"
 
 namespace {
 
@@ -306,7 +307,7 @@ int run(int argc, char** argv) {
   boost::asio::io_context io;
   Progress progress(duration > 0.0 ? 0 : frames * clients, quiet, perFrame);
   RunSummary summary;
-  summary.encoding = encodingName(base.hello.encoding());
+  summary.encoding = haarcast::wire::encodingName(base.hello.encoding());
   summary.width = base.hello.width();
   summary.height = base.hello.height();
   summary.sessions.resize(clients);
@@ -349,7 +350,7 @@ int run(int argc, char** argv) {
     const auto& w = sessions.front().welcome();
     if (!w.session_id().empty()) {
       std::fprintf(stderr, "haarcast-client: server %s, device \"%s\", %ux%u %s\n", w.server_version().c_str(),
-                   w.device().c_str(), w.width(), w.height(), encodingName(w.encoding()).c_str());
+                   w.device().c_str(), w.width(), w.height(), std::string(haarcast::wire::encodingName(w.encoding())).c_str());
     }
   }
   const nlohmann::json j = summaryJson(summary);

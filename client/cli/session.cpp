@@ -17,6 +17,8 @@
 
 #include "haarcast/client/build_progress.h"
 #include "haarcast/client/frame_image.h"
+#include "haarcast/wire/frame_codec.h"
+#include "haarcast/wire/frame_decode.h"
 
 namespace haarcast::client {
 
@@ -310,11 +312,11 @@ struct Session::Impl : std::enable_shared_from_this<Session::Impl> {
   // counted, and the next pose asks for a keyframe: unless a request is
   // already on its way, i.e. the failing frame answers a pose sent before
   // the one that asked (the keyframe answers that one or a later pose).
-  std::optional<Rgba8Image> decodeInOrder(const v1::Frame& frame) {
+  std::optional<wire::Rgba8Image> decodeInOrder(const v1::Frame& frame) {
     const std::span<const std::uint8_t> data(reinterpret_cast<const std::uint8_t*>(frame.data().data()),
                                              frame.data().size());
     try {
-      Rgba8Image image = decoder.decode(frame.encoding(), data, frame.width(), frame.height());
+      wire::Rgba8Image image = decoder.decode(frame.encoding(), data, frame.width(), frame.height());
       keyframeAskedAt = 0;
       return image;
     } catch (const std::runtime_error& e) {
@@ -331,7 +333,7 @@ struct Session::Impl : std::enable_shared_from_this<Session::Impl> {
   void onFrameMessage(const v1::Frame& frame, std::size_t wireBytes) {
     // Decoded before anything else, so that warm-up and extra frames reach
     // the decoder too; only when a frame is inspected or recorded at all.
-    std::optional<Rgba8Image> h264;
+    std::optional<wire::Rgba8Image> h264;
     bool undecoded = false;
     if (frame.encoding() == v1::ENCODING_H264 && (inspects() || !config.outDir.empty())) {
       h264 = decodeInOrder(frame);
@@ -370,10 +372,8 @@ struct Session::Impl : std::enable_shared_from_this<Session::Impl> {
 
   // Writes the frame under --out and checks it is not blank; false when the
   // session failed doing so. `decoded`: the H.264 picture, decoded in order.
-  bool recordAndCheck(const v1::Frame& frame, std::optional<Rgba8Image> decoded) {
+  bool recordAndCheck(const v1::Frame& frame, std::optional<wire::Rgba8Image> decoded) {
     const auto encoding = frame.encoding();
-    const std::span<const std::uint8_t> data(reinterpret_cast<const std::uint8_t*>(frame.data().data()),
-                                             frame.data().size());
     // Raw and H.264 frames are written decoded (PAM, PNG): their bytes alone are no viewable file.
     const bool raw = encoding == v1::ENCODING_RAW_RGBA8;
     const bool h264 = encoding == v1::ENCODING_H264;
@@ -381,11 +381,11 @@ struct Session::Impl : std::enable_shared_from_this<Session::Impl> {
     const bool inspect = inspects();
     if (!inspect && config.outDir.empty()) return true;
     try {
-      Rgba8Image image;
+      wire::Rgba8Image image;
       if (decoded) {
         image = std::move(*decoded);
       } else if (inspect || raw) {
-        image = decodeFrame(encoding, data, frame.width(), frame.height());
+        image = wire::decodeFrame(encoding, frame.data(), frame.width(), frame.height());
       }
       if (inspect) {
         const PixelStats px = pixelStats(image);
@@ -413,9 +413,12 @@ struct Session::Impl : std::enable_shared_from_this<Session::Impl> {
         std::snprintf(name, sizeof name, "frame-%06llu", static_cast<unsigned long long>(stats.frames));
         const auto path = std::filesystem::path(config.outDir) / (name + encodingFileExtension(encoding));
         std::ofstream out(path, std::ios::binary);
-        if (raw || h264) {
-          const auto file = raw ? encodePam(image) : encodePng(image);
-          out.write(reinterpret_cast<const char*>(file.data()), static_cast<std::streamsize>(file.size()));
+        if (raw) {
+          const auto pam = encodePam(image);
+          out.write(reinterpret_cast<const char*>(pam.data()), static_cast<std::streamsize>(pam.size()));
+        } else if (h264) {
+          const std::string png = wire::encodePng(image.pixels, image.width, image.height);
+          out.write(png.data(), static_cast<std::streamsize>(png.size()));
         } else {
           out.write(frame.data().data(), static_cast<std::streamsize>(frame.data().size()));
         }

@@ -31,6 +31,7 @@
 #include "progress.h"
 #include "report_figures.h"
 #include "haarcast/client/session.h"
+#include "haarcast/wire/encoding_name.h"
 
 namespace haarcast::app {
 namespace {
@@ -96,7 +97,7 @@ Plan plan(const LoadtestArgs& a) {
   // for haarcast-client --encoding and this report.
   for (const auto& e : splitList(a.encodings, "--encodings")) {
     const v1::Encoding encoding = client::parseEncoding(e);
-    p.encodings.emplace_back(client::encodingName(encoding), encoding);
+    p.encodings.emplace_back(wire::encodingName(encoding), encoding);
   }
   if (a.level < render::kMinRenderLevel || a.level > render::kMaxRenderLevel ||
       a.storageLevel < render::kMinRenderLevel || a.storageLevel > render::kMaxRenderLevel) {

@@ -18,9 +18,10 @@
 #include <gtest/gtest.h>
 
 #include "haarcast/client/frame_image.h"
-#include "haarcast/net/encode.h"
 #include "haarcast/net/h264_encoder.h"
 #include "haarcast/net/protocol.h"
+#include "haarcast/wire/frame_codec.h"
+#include "haarcast/wire/frame_decode.h"
 
 namespace haarcast::client {
 namespace {
@@ -106,14 +107,14 @@ TEST(H264Client, DecodesEveryFrameOfTheOrbitCloseToItsSource) {
   std::size_t h264Bytes = 0, jpegBytes = 0;
   double worstPsnr = 99.0;
   for (int t = 0; t < kFrames; ++t) {
-    const Rgba8Image image = decoder.decode(v1::ENCODING_H264, bytesOf(s.units[t].annexB), kSide, kSide);
+    const wire::Rgba8Image image = decoder.decode(v1::ENCODING_H264, bytesOf(s.units[t].annexB), kSide, kSide);
     ASSERT_EQ(image.pixels.size(), s.sources[t].size());
     EXPECT_FALSE(isBlank(pixelStats(image))) << "frame " << t;
     const double psnr = psnrDb(image.pixels, s.sources[t]);
     EXPECT_GE(psnr, kMinPsnrDb) << "frame " << t;
     worstPsnr = std::min(worstPsnr, psnr);
     h264Bytes += s.units[t].annexB.size();
-    jpegBytes += net::encodeJpeg(s.sources[t], kSide, kSide, kJpegQuality).size();
+    jpegBytes += wire::encodeJpeg(s.sources[t], kSide, kSide, kJpegQuality).size();
   }
   const double ratio = static_cast<double>(h264Bytes) / static_cast<double>(jpegBytes);
   std::printf("H.264 %.0f B/frame, JPEG q%d %.0f B/frame: ratio %.3f; worst PSNR %.1f dB\n",
@@ -127,7 +128,7 @@ TEST(H264Client, AClientJoiningAtARequestedKeyframeDecodesFromThere) {
   ASSERT_TRUE(s.units[30].keyframe);
   FrameDecoder late;
   for (int t = 30; t < kFrames; ++t) {
-    const Rgba8Image image = late.decode(v1::ENCODING_H264, bytesOf(s.units[t].annexB), kSide, kSide);
+    const wire::Rgba8Image image = late.decode(v1::ENCODING_H264, bytesOf(s.units[t].annexB), kSide, kSide);
     EXPECT_GE(psnrDb(image.pixels, s.sources[t]), kMinPsnrDb) << "frame " << t;
   }
 
@@ -144,7 +145,7 @@ TEST(H264Client, AClientJoiningAtARequestedKeyframeDecodesFromThere) {
 
 TEST(H264Client, RefusesH264OutsideASessionAndFramesOfAnotherSize) {
   const Stream s = encodeOrbit(-1);
-  EXPECT_THROW(decodeFrame(v1::ENCODING_H264, bytesOf(s.units[0].annexB), kSide, kSide), std::runtime_error);
+  EXPECT_THROW(wire::decodeFrame(v1::ENCODING_H264, s.units[0].annexB, kSide, kSide), std::runtime_error);
   FrameDecoder decoder;
   EXPECT_THROW(decoder.decode(v1::ENCODING_H264, bytesOf(s.units[0].annexB), kSide, kSide / 2), std::runtime_error);
   const std::vector<std::uint8_t> junk(100, 0x42);
@@ -153,9 +154,9 @@ TEST(H264Client, RefusesH264OutsideASessionAndFramesOfAnotherSize) {
 }
 
 TEST(H264Client, DecodedFramesAreWrittenAsPng) {
-  const Rgba8Image image{kSide, kSide, orbitFrame(7)};
-  const std::vector<std::uint8_t> png = encodePng(image);
-  const Rgba8Image back = decodeFrame(v1::ENCODING_PNG, png, kSide, kSide);
+  const wire::Rgba8Image image{kSide, kSide, orbitFrame(7)};
+  const std::string png = wire::encodePng(image.pixels, image.width, image.height);
+  const wire::Rgba8Image back = wire::decodeFrame(v1::ENCODING_PNG, png, kSide, kSide);
   EXPECT_EQ(back.pixels, image.pixels);
 }
 

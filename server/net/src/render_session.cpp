@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <utility>
 
+#include "haarcast/wire/encoding_name.h"
+
 namespace haarcast::net {
 namespace {
 
@@ -133,7 +135,7 @@ void RenderSession::onHello(const v1::Hello& hello, Clock::time_point now) {
     requested_ = now;
   }
   log(format("hello from \"%s\": %dx%d %s, %.1f fps, level %s%d, %s, %s, scene \"%s\"", clientName_.c_str(),
-             config_.width, config_.height, std::string(encodingName(config_.encoding)).c_str(), config_.fps,
+             config_.width, config_.height, std::string(wire::encodingName(toWire(config_.encoding))).c_str(), config_.fps,
              config_.automaticLevel ? "auto:" : "", config_.level, std::string(methodName(config_.method)).c_str(),
              std::string(backendName(config_.backend)).c_str(), sanitizeForLog(config_.scene).c_str()));
   prepareRenderer();

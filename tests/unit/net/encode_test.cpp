@@ -1,90 +1,61 @@
+// The server's encodeFrame: the renderer's output handed to the wire
+// library's encoders (their own tests: tests/unit/wire). Each 8-bit encoding
+// gives the wire encoder's bytes for the RGBA8 image, EXR encodes the linear
+// image, H.264 is refused (a session's H264Encoder encodes it), and bad
+// sizes throw naming the codec.
 #include "haarcast/net/encode.h"
 
-#include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
+
+#include "haarcast/wire/exr_codec.h"
+#include "haarcast/wire/frame_codec.h"
 
 namespace haarcast::net {
 namespace {
 
-// A smooth colour gradient with a sharp square: JPEG keeps the first well
-// and the test sees whether rows or channels are swapped.
 std::vector<std::uint8_t> testRgba(int w, int h) {
   std::vector<std::uint8_t> rgba(static_cast<std::size_t>(w) * h * 4);
-  for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) {
-      auto* p = &rgba[(static_cast<std::size_t>(y) * w + x) * 4];
-      p[0] = static_cast<std::uint8_t>(255 * x / (w - 1));
-      p[1] = static_cast<std::uint8_t>(255 * y / (h - 1));
-      p[2] = (x > w / 4 && x < w / 2 && y > h / 4 && y < h / 2) ? 255 : 40;
-      p[3] = 255;
-    }
-  }
+  for (std::size_t i = 0; i < rgba.size(); ++i) rgba[i] = static_cast<std::uint8_t>((i * 37) % 251);
   return rgba;
 }
 
-TEST(Encode, RawIsTheBytes) {
-  const auto rgba = testRgba(32, 16);
-  const std::string raw = encodeRaw(rgba, 32, 16);
-  ASSERT_EQ(raw.size(), rgba.size());
-  EXPECT_EQ(0, std::memcmp(raw.data(), rgba.data(), raw.size()));
+io::RgbImage testLinear(int w, int h) {
+  io::RgbImage image = io::makeImage(w, h);
+  for (std::size_t i = 0; i < image.rgb.size(); ++i) image.rgb[i] = 0.01f * static_cast<float>(i) + 0.25f;
+  return image;
 }
 
-TEST(Encode, PngRoundTripIsExact) {
-  const auto rgba = testRgba(48, 32);
-  const std::string png = encodePng(rgba, 48, 32);
-  ASSERT_GT(png.size(), 8u);
-  EXPECT_EQ(png.substr(1, 3), "PNG");
-  const Rgba8Image back = decodePng(png);
-  EXPECT_EQ(back.width, 48);
-  EXPECT_EQ(back.height, 32);
-  EXPECT_EQ(back.rgba, rgba);
+TEST(EncodeFrame, EachEncodingIsTheWireEncodersBytes) {
+  const auto rgba = testRgba(24, 16);
+  const io::RgbImage linear = testLinear(24, 16);
+  const io::RgbImage none;  // what an 8-bit encoding's frame may carry
+  EXPECT_EQ(encodeFrame(FrameEncoding::Jpeg, rgba, 24, 16, none, 70), wire::encodeJpeg(rgba, 24, 16, 70));
+  EXPECT_EQ(encodeFrame(FrameEncoding::Png, rgba, 24, 16, none, 70), wire::encodePng(rgba, 24, 16));
+  EXPECT_EQ(encodeFrame(FrameEncoding::RawRgba8, rgba, 24, 16, none, 70), wire::encodeRaw(rgba, 24, 16));
+  // EXR encodes the linear image, whatever the RGBA8 one holds.
+  const std::string exr = encodeFrame(FrameEncoding::Exr, {}, 0, 0, linear, 70);
+  EXPECT_EQ(exr, wire::encodeExr(linear.rgb, 24, 16));
+  const wire::LinearImage back = wire::decodeExr(exr);
+  EXPECT_EQ(back.width, 24u);
+  EXPECT_EQ(back.height, 16u);
 }
 
-TEST(Encode, JpegRoundTripIsClose) {
-  const auto rgba = testRgba(64, 64);
-  const std::string jpeg = encodeJpeg(rgba, 64, 64, 95);
-  const Rgba8Image back = decodeJpeg(jpeg);
-  ASSERT_EQ(back.width, 64);
-  ASSERT_EQ(back.height, 64);
-  double sumAbs = 0;
-  for (std::size_t i = 0; i < rgba.size(); ++i) sumAbs += std::abs(int(rgba[i]) - int(back.rgba[i]));
-  EXPECT_LT(sumAbs / static_cast<double>(rgba.size()), 4.0);  // mean error in 8-bit levels at quality 95
-  // Lower quality → fewer bytes (the quality setting reaches the codec).
-  EXPECT_LT(encodeJpeg(rgba, 64, 64, 20).size(), jpeg.size());
-}
-
-TEST(Encode, ExrRoundTripIsExactToHalf) {
-  io::RgbImage image = io::makeImage(17, 9);
-  for (std::size_t i = 0; i < image.rgb.size(); ++i) image.rgb[i] = 0.001f * static_cast<float>(i * i) + 0.5f;
-  image.rgb[5] = 1000.0f;  // HDR values survive
-  const io::RgbImage back = decodeExr(encodeExr(image));
-  ASSERT_EQ(back.width, 17);
-  ASSERT_EQ(back.height, 9);
-  for (std::size_t i = 0; i < image.rgb.size(); ++i) {
-    // Half has an 11-bit significand: relative error ≤ 2^-11.
-    EXPECT_NEAR(back.rgb[i], image.rgb[i], std::abs(image.rgb[i]) * 0.00049f) << "at " << i;
-  }
-  EXPECT_EQ(back.rgb[5], 1000.0f);
-}
-
-TEST(Encode, BadInputThrowsNamingTheCodec) {
+TEST(EncodeFrame, H264AndBadSizesAreRefused) {
   const auto rgba = testRgba(8, 8);
-  EXPECT_THROW(encodePng(rgba, 8, 9), std::runtime_error);
-  EXPECT_THROW(encodeJpeg(rgba, 0, 8, 80), std::runtime_error);
+  EXPECT_THROW(encodeFrame(FrameEncoding::H264, rgba, 8, 8, {}, 85), std::logic_error);
+  EXPECT_THROW(encodeFrame(FrameEncoding::Png, rgba, 8, 9, {}, 85), std::runtime_error);
+  EXPECT_THROW(encodeFrame(FrameEncoding::Jpeg, rgba, -8, -8, {}, 85), std::runtime_error);
   try {
-    decodeJpeg("definitely not a jpeg");
-    FAIL() << "no throw";
+    encodeFrame(FrameEncoding::Exr, rgba, 8, 8, {}, 85);  // no linear image
+    FAIL() << "EXR encoded without a linear image";
   } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("jpeg"), std::string::npos) << e.what();
+    EXPECT_EQ(std::string(e.what()).rfind("exr: ", 0), 0u) << e.what();
   }
-  EXPECT_THROW(decodePng("\x89PNG garbage"), std::runtime_error);
-  EXPECT_THROW(decodeExr("v/1\x01 garbage"), std::runtime_error);
-  const std::string png = encodePng(rgba, 8, 8);
-  EXPECT_THROW(decodePng(png.substr(0, png.size() / 2)), std::runtime_error);
 }
 
 }  // namespace

@@ -50,7 +50,7 @@ TEST(ServerH264, FramesDecodeInOrderAndAKeyframePoseGetsAKeyframe) {
       EXPECT_EQ(frame.encoding(), v1::ENCODING_H264);
       EXPECT_EQ(frame.settings().h264_keyframe_interval(), 1000u);
       const std::string& data = frame.data();
-      const client::Rgba8Image image = decoder.decode(
+      const wire::Rgba8Image image = decoder.decode(
           v1::ENCODING_H264, std::span(reinterpret_cast<const std::uint8_t*>(data.data()), data.size()), frame.width(),
           frame.height());
       EXPECT_EQ(image.width, 64u);

@@ -6,7 +6,8 @@
 
 #include <sys/socket.h>
 
-#include "haarcast/net/encode.h"
+#include "haarcast/wire/exr_codec.h"
+#include "haarcast/wire/frame_codec.h"
 #include "server_fixture.h"
 
 namespace haarcast::net::test {
@@ -44,9 +45,9 @@ TEST(Server, HelloWelcomePoseFrame) {
   EXPECT_EQ(f->frame().height(), 32u);
   EXPECT_GE(f->frame().sequence(), 1u);
   EXPECT_GE(f->frame().server_ms(), 0.0);
-  const auto image = decodeJpeg(f->frame().data());
-  EXPECT_EQ(image.width, 48);
-  EXPECT_EQ(image.height, 32);
+  const auto image = wire::decodeJpeg(f->frame().data());
+  EXPECT_EQ(image.width, 48u);
+  EXPECT_EQ(image.height, 32u);
   std::vector<std::string> stages;
   for (const auto& t : f->frame().timings()) stages.push_back(t.name());
   EXPECT_NE(std::find(stages.begin(), stages.end(), "encode"), stages.end());
@@ -130,13 +131,14 @@ TEST(Server, EncodingsAgree) {
   const std::string& raw = data[v1::ENCODING_RAW_RGBA8];
   ASSERT_EQ(raw.size(), 32u * 32u * 4u);
   const std::vector<std::uint8_t> rgba(raw.begin(), raw.end());
-  EXPECT_EQ(decodePng(data[v1::ENCODING_PNG]).rgba, rgba);
-  const auto jpeg = decodeJpeg(data[v1::ENCODING_JPEG]);
-  ASSERT_EQ(jpeg.rgba.size(), rgba.size());
+  EXPECT_EQ(wire::decodePng(data[v1::ENCODING_PNG]).pixels, rgba);
+  const auto jpeg = wire::decodeJpeg(data[v1::ENCODING_JPEG]);
+  ASSERT_EQ(jpeg.pixels.size(), rgba.size());
   double error = 0;
-  for (std::size_t i = 0; i < rgba.size(); ++i) error += std::abs(int(jpeg.rgba[i]) - int(rgba[i]));
+  for (std::size_t i = 0; i < rgba.size(); ++i) error += std::abs(int(jpeg.pixels[i]) - int(rgba[i]));
   EXPECT_LT(error / static_cast<double>(rgba.size()), 12.0);
-  const auto linear = decodeExr(data[v1::ENCODING_EXR]);
+  wire::LinearImage exr = wire::decodeExr(data[v1::ENCODING_EXR]);
+  const io::RgbImage linear{static_cast<int>(exr.width), static_cast<int>(exr.height), std::move(exr.rgb)};
   for (const auto& [e, stops] : exposure) EXPECT_EQ(stops, -1.5) << v1::Encoding_Name(e);
   const auto fromExr = render::tonemapRgba8(linear, -1.5);
   ASSERT_EQ(fromExr.size(), rgba.size());

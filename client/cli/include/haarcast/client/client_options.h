@@ -34,9 +34,9 @@ struct Size {
 };
 Size parseSize(const std::string& text);
 
-// "jpeg" | "png" | "raw" | "exr" | "h264" (and "rgba8" for raw).
+// "jpeg" | "png" | "raw" | "exr" | "h264", the names wire::encodingName gives
+// (and "jpg", "rgba8" for raw, "h.264").
 v1::Encoding parseEncoding(const std::string& name);
-std::string encodingName(v1::Encoding encoding);
 // The extension of a frame written under --out. H.264 frames are written as
 // PNG: one access unit depends on the ones before it and is no file of its own.
 std::string encodingFileExtension(v1::Encoding encoding);

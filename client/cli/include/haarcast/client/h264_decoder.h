@@ -16,7 +16,7 @@
 #include <memory>
 #include <span>
 
-#include "haarcast/client/frame_image.h"
+#include "haarcast/wire/image.h"
 
 namespace haarcast::client {
 
@@ -30,7 +30,7 @@ class H264Decoder {
   // Decodes one access unit. `width`/`height` are what the Frame message
   // claims; a picture of another size is an error. Throws std::runtime_error
   // naming the libavcodec call and its AVERROR text.
-  Rgba8Image decode(std::span<const std::uint8_t> annexB, std::uint32_t width, std::uint32_t height);
+  wire::Rgba8Image decode(std::span<const std::uint8_t> annexB, std::uint32_t width, std::uint32_t height);
 
   std::uint64_t framesDecoded() const { return frames_; }
 
