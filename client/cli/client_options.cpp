@@ -26,9 +26,9 @@ std::uint32_t parseDimension(std::string_view text, const std::string& whole) {
   if (text.empty() || ec != std::errc() || ptr != end) {
     throw std::invalid_argument("--size must be WIDTHxHEIGHT, e.g. 256x256 (got \"" + whole + "\")");
   }
-  if (value == 0 || value > 8192) {
-    throw std::invalid_argument("--size: each side must be in 1..8192 (got \"" + whole + "\")");
-  }
+  // The largest side is the server's (Welcome.limits; its refusal names the
+  // range), so here only the form is checked.
+  if (value == 0) throw std::invalid_argument("--size: each side must be at least 1 (got \"" + whole + "\")");
   return value;
 }
 

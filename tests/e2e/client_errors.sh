@@ -52,6 +52,8 @@ expect "server Error (level over the server's --max-level)" 1 "is outside 2..6" 
   "$client_bin" "$url" "${common[@]}" --token sekret --level 7
 expect "server Error (a level no renderer takes)" 1 "level 12 is outside 2..6" -- \
   "$client_bin" "$url" "${common[@]}" --token sekret --level 12
+expect "server Error (a side over the server's)" 1 "resolution 9000x64 is outside 1x1.." -- \
+  "$client_bin" "$url" --frames 2 --size 9000x64 --quiet --timeout 60 --token sekret
 expect "good run, auto exposure, not blown out" 0 "" -- \
   "$client_bin" "$url" "${common[@]}" --token sekret --check-not-blank --max-clipped 0.02
 expect "server Error (unknown material)" 1 "ERROR_CODE_UNKNOWN_MATERIAL" -- \

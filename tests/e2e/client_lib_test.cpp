@@ -58,7 +58,7 @@ TEST(Flags, SizeEncodingAndMethod) {
   const Size s = parseSize("320x200");
   EXPECT_EQ(s.width, 320u);
   EXPECT_EQ(s.height, 200u);
-  for (const char* bad : {"320", "x200", "320x", "0x10", "10x8193", "-1x5", "3.5x4", "12x12x"}) {
+  for (const char* bad : {"320", "x200", "320x", "0x10", "-1x5", "3.5x4", "12x12x"}) {
     EXPECT_THROW(parseSize(bad), std::invalid_argument) << bad;
   }
   EXPECT_EQ(parseEncoding("jpeg"), v1::ENCODING_JPEG);

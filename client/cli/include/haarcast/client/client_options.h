@@ -27,7 +27,8 @@ WsUrl parseWsUrl(const std::string& url);
 std::string withTokenQuery(const std::string& target, const std::string& token);
 
 // "256x256" → {256, 256}; throws std::invalid_argument on anything else,
-// including zero or > 8192 (the renderer's limit).
+// including a zero side. The largest side is the server's to say
+// (Welcome.limits.max_width, max_height; its refusal names the range).
 struct Size {
   std::uint32_t width = 0;
   std::uint32_t height = 0;
