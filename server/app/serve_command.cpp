@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <map>
 #include <set>
 #include <stdexcept>
@@ -17,10 +18,12 @@
 
 #include "haarcast/gpu/backend.h"
 #include "haarcast/net/host_check.h"
+#include "haarcast/net/protocol.h"
 #include "haarcast/net/server.h"
 #include "haarcast/render/object_levels.h"
 #include "haarcast/render/renderer.h"
 #include "haarcast/render/scene.h"
+#include "haarcast/wire/encoding_name.h"
 #include "app_paths.h"
 #include "progress.h"
 #include "scene_flags.h"
@@ -92,12 +95,12 @@ int run(ServeArgs& a) {
   d.automaticLevel = level->automatic;
   d.lightCoefficients = a.lightCoefficients;
   d.backend = defaultBackend;
-  if (a.encoding == "jpeg") d.encoding = net::FrameEncoding::Jpeg;
-  else if (a.encoding == "png") d.encoding = net::FrameEncoding::Png;
-  else if (a.encoding == "raw") d.encoding = net::FrameEncoding::RawRgba8;
-  else if (a.encoding == "exr") d.encoding = net::FrameEncoding::Exr;
-  else if (a.encoding == "h264") d.encoding = net::FrameEncoding::H264;
-  else throw std::invalid_argument("--encoding must be jpeg, png, raw, exr or h264 (got \"" + a.encoding + "\")");
+  // The names are the wire's (wire::encodingName), so a new encoding in the
+  // .proto is a flag value here once the server can send it.
+  const std::optional<v1::Encoding> wireEncoding = wire::encodingFromName(a.encoding);
+  const std::optional<net::FrameEncoding> encoding = wireEncoding ? net::fromWire(*wireEncoding) : std::nullopt;
+  if (!encoding) throw std::invalid_argument("--encoding must be jpeg, png, raw, exr or h264 (got \"" + a.encoding + "\")");
+  d.encoding = *encoding;
   a.server.port = static_cast<std::uint16_t>(a.port);
   if (a.grpcPort != 0) {
     if (a.grpcPort == a.port) throw std::invalid_argument("--grpc-port must differ from --port (both " + std::to_string(a.port) + ")");

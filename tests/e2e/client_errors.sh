@@ -42,6 +42,12 @@ expect "bad --exposure" 2 "--exposure must be auto or a number of stops" -- "$cl
 expect "misspelt flag" 2 "unknown flag --frmes; did you mean --frames?" -- "$client_bin" ws://127.0.0.1:1 --frmes 3
 expect "connection refused" 1 "Connection refused" -- "$client_bin" ws://127.0.0.1:1 --frames 1 --quiet
 
+# The server's --encoding takes the wire's names (wire::encodingName) of
+# what it can send: not the enum's UNSPECIFIED.
+expect "serve: bad --encoding" 2 "--encoding must be jpeg, png, raw, exr or h264 (got \"webp\")" -- \
+  "$server_bin" serve --port 0 --encoding webp
+expect "serve: --encoding unspecified" 2 "(got \"unspecified\")" -- "$server_bin" serve --port 0 --encoding unspecified
+
 source "$(dirname "${BASH_SOURCE[0]}")/start_server.sh"
 start_server "$server_bin" serve --port 0 --token sekret --backend "${HAARCAST_SMOKE_BACKEND:-cpu}"
 url="ws://127.0.0.1:$port"

@@ -40,17 +40,6 @@ std::string wireMethodNames() {
   return out;
 }
 
-std::optional<FrameEncoding> fromWire(v1::Encoding e) {
-  switch (e) {
-    case v1::ENCODING_JPEG: return FrameEncoding::Jpeg;
-    case v1::ENCODING_PNG: return FrameEncoding::Png;
-    case v1::ENCODING_RAW_RGBA8: return FrameEncoding::RawRgba8;
-    case v1::ENCODING_EXR: return FrameEncoding::Exr;
-    case v1::ENCODING_H264: return FrameEncoding::H264;
-    default: return std::nullopt;
-  }
-}
-
 std::optional<RotationMethod> methodFromWire(v1::RotationMethod m) {
   switch (m) {
     case v1::ROTATION_METHOD_HAAR: return RotationMethod::Haar;
@@ -249,6 +238,17 @@ std::optional<ProtocolError> mergeScene(SessionConfig& config, const v1::SceneCh
 }
 
 }  // namespace
+
+std::optional<FrameEncoding> fromWire(v1::Encoding e) {
+  switch (e) {
+    case v1::ENCODING_JPEG: return FrameEncoding::Jpeg;
+    case v1::ENCODING_PNG: return FrameEncoding::Png;
+    case v1::ENCODING_RAW_RGBA8: return FrameEncoding::RawRgba8;
+    case v1::ENCODING_EXR: return FrameEncoding::Exr;
+    case v1::ENCODING_H264: return FrameEncoding::H264;
+    default: return std::nullopt;
+  }
+}
 
 const Catalog::SceneEntry* Catalog::findScene(std::string_view name) const {
   if (scenes.empty()) return nullptr;

@@ -161,6 +161,7 @@ render::FrameRequest frameRequest(const PoseState& pose, const SessionConfig& co
 
 // Wire enums ↔ ours.
 v1::Encoding toWire(FrameEncoding encoding);
+std::optional<FrameEncoding> fromWire(v1::Encoding encoding);  // nullopt: UNSPECIFIED or unknown
 v1::RotationMethod toWire(RotationMethod method);
 v1::Backend toWire(Backend backend);
 v1::ToneCurve toWire(render::ToneCurve tone);
