@@ -15,6 +15,7 @@
 #extension GL_GOOGLE_include_directive : require
 
 #include "rotate_common.glsl"
+#include "haarcast/core/shared_frame.h"
 
 layout(local_size_x = kGpuLocalSize, local_size_x_id = kSpecLocalSize) in;  // the renderer picks the size per device
 
@@ -35,23 +36,11 @@ void main() {
   const int elevations = int(methodData[rs.methodBase + 1u]);
   const int spins = int(methodData[rs.methodBase + 2u]);
 
-  // eulerFromMatrix(rotationMatrix(r)) (core/rotation.cpp): every Euler
-  // triple of one rotation finds the same copy. m·ŷ = (sin β sin α, cos β,
-  // sin β cos α); at the gimbal pole the whole turn goes to α.
-  const mat3 m = rotationYXY(rs.alpha, rs.beta, rs.gamma);
-  const vec3 ny = m[1];
-  const float beta = acosPrecise(clamp(ny.y, -1.0, 1.0));
-  float alpha, gamma;
-  if (sinPrecise(beta) > 1e-12) {
-    alpha = atan2Precise(ny.x, ny.z);
-    // R_y(γ) = R_x(β)ᵀ R_y(α)ᵀ m; its column 0 is (cos γ, 0, −sin γ).
-    const mat3 ry = transpose(rotX(beta)) * transpose(rotY(alpha)) * m;
-    gamma = atan2Precise(-ry[0][2], ry[0][0]);
-  } else {
-    const vec3 nx = m[0];
-    alpha = atan2Precise(-nx.z, nx.x);
-    gamma = 0.0;
-  }
+  // eulerFromMatrix(rotationMatrix(r)) (core/rotation.cpp; eulerYXYOf,
+  // core/shared_frame.h): every Euler triple of one rotation finds the same
+  // copy; at the gimbal pole the whole turn goes to α.
+  const vec3 euler = eulerYXYOf(rotationYXY(rs.alpha, rs.beta, rs.gamma));
+  const float alpha = euler.x, beta = euler.y, gamma = euler.z;
 
   // The nearest copy: β_k by rounding, γ_j by rounding around the circle.
   const int k = clamp(roundHalfAway(beta / kPiF * float(elevations - 1)), 0, elevations - 1);

@@ -2,9 +2,9 @@
 // The "rotation-input" pass: per covered pixel, what the rotation needs (the
 // nearest θₒ slice and the Y-X-Y Euler angles of the local shading frame) and
 // what the triple product needs (object, vertices, barycentrics). The same
-// math as render::rotationInput: the shading frame of core/shared_frame.h,
-// the nearest slice of shared_layout.h's sliceBlendAt, and rotation.cpp's
-// eulerFromMatrix, in float. Covered pixels
+// math as render::rotationInput: the shading frame and its Euler angles of
+// core/shared_frame.h and the nearest slice of shared_layout.h's
+// sliceBlendAt, in float. Covered pixels
 // are compacted through an atomic counter, so their order is arbitrary;
 // every record carries its radiance slot. Local size kLocalSize, one invocation per
 // pixel.
@@ -42,20 +42,7 @@ void emit(uvec4 id, vec3 normal, vec3 direction, uint slot) {
   vec3 wo = transpose(toWorld) * -direction;  // toward the eye, object frame
 
   float thetaOut;
-  mat3 m = shadingFrame(n, wo, thetaOut);
-  vec3 xAxis = m[0];
-
-  // eulerFromMatrix: m·ŷ = n = (sin β sin α, cos β, sin β cos α).
-  float beta = acosPrecise(clamp(n.y, -1.0, 1.0));
-  float alpha, gamma;
-  if (sinPrecise(beta) > 1e-12) {
-    alpha = atan2Precise(n.x, n.z);
-    mat3 ry = transpose(rotX(beta)) * transpose(rotY(alpha)) * m;  // = R_y(γ)
-    gamma = atan2Precise(-ry[0][2], ry[0][0]);
-  } else {
-    alpha = atan2Precise(-xAxis.z, xAxis.x);  // the whole turn in α at the gimbal pole
-    gamma = 0.0;
-  }
+  const vec3 euler = eulerYXYOf(shadingFrame(n, wo, thetaOut));  // (α, β, γ)
 
   // The nearest slice: BrdfSliceTable::nearestSlice in float.
   uint t = sliceBlendAt(thetaOut, o.thetaSamples, 0u).first;
@@ -70,7 +57,7 @@ void emit(uvec4 id, vec3 normal, vec3 direction, uint slot) {
       atomicMax(counter.groups[2], 1u);
     }
   }
-  samples[k] = RotationSample(o.sliceBase + t, o.methodBase, alpha, beta, gamma, slot, thetaOut, 0u);
+  samples[k] = RotationSample(o.sliceBase + t, o.methodBase, euler.x, euler.y, euler.z, slot, thetaOut, 0u);
   uint tri = o.triangleBase + id.y;
   float b1 = uintBitsToFloat(id.z), b2 = uintBitsToFloat(id.w);
   shade[k] = ShadeSample(id.x - 1u, uint[3](triangles[3u * tri], triangles[3u * tri + 1u], triangles[3u * tri + 2u]),

@@ -4,13 +4,14 @@
 // them with their C++ reading (tests/unit/gpu/shared_functions_test.cpp).
 // Not part of any frame.
 //
-// Per case k (FrameCase), four results:
-//   [4k]     cameraDirectionAt(basis, tanHalf, aspect, width, height, px, py), and
+// Per case k (FrameCase), five results:
+//   [5k]     cameraDirectionAt(basis, tanHalf, aspect, width, height, px, py), and
 //            subsampleCoordinate(pixel, sub, axisBit)
-//   [4k + 1] shadingFrame(n, wo)'s column x, and θₒ
-//   [4k + 2] its column z, and the bits of the nearest slice
+//   [5k + 1] shadingFrame(n, wo)'s column x, and θₒ
+//   [5k + 2] its column z, and the bits of the nearest slice
 //            (sliceBlendAt(θₒ, thetaSamples, 0).first)
-//   [4k + 3] the bits of tonemapCode(tone) and of meterWeight(colour, object)
+//   [5k + 3] the bits of tonemapCode(tone) and of meterWeight(colour, object)
+//   [5k + 4] eulerYXYOf(the frame): (α, β, γ)
 // and, from invocation 0, meterReadout of the histograms and the push
 // block's ExposurePush.
 #extension GL_GOOGLE_include_directive : require
@@ -55,11 +56,12 @@ void main() {
   const FrameCase c = cases[k];
   const vec3 ray = cameraDirectionAt(forward.xyz, right.xyz, up.xyz, pc.tanHalf, pc.aspect, c.point.z, c.point.w,
                                      c.point.x, c.point.y);
-  results[4u * k] = vec4(ray, subsampleCoordinate(c.sub.x, c.sub.y, c.sub.z));
+  results[5u * k] = vec4(ray, subsampleCoordinate(c.sub.x, c.sub.y, c.sub.z));
   float thetaOut;
   const mat3 frame = shadingFrame(c.n.xyz, c.wo.xyz, thetaOut);
-  results[4u * k + 1u] = vec4(frame[0], thetaOut);
-  results[4u * k + 2u] = vec4(frame[2], uintBitsToFloat(sliceBlendAt(thetaOut, pc.thetaSamples, 0u).first));
-  results[4u * k + 3u] = vec4(uintBitsToFloat(tonemapCode(c.n.w)), uintBitsToFloat(meterWeight(c.colour.rgb, c.wo.w != 0.0)),
+  results[5u * k + 1u] = vec4(frame[0], thetaOut);
+  results[5u * k + 2u] = vec4(frame[2], uintBitsToFloat(sliceBlendAt(thetaOut, pc.thetaSamples, 0u).first));
+  results[5u * k + 3u] = vec4(uintBitsToFloat(tonemapCode(c.n.w)), uintBitsToFloat(meterWeight(c.colour.rgb, c.wo.w != 0.0)),
                               0.0, 0.0);
+  results[5u * k + 4u] = vec4(eulerYXYOf(frame), 0.0);
 }

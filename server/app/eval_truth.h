@@ -1,5 +1,5 @@
 // `haarcast eval`'s truth sections: renders against converged Monte Carlo
-// references (render/reference.h), written into report.json and report.md.
+// references (cpu/reference.h), written into report.json and report.md.
 //
 //   truth          one glossy sphere (eval's first environment, its second
 //                  table material), every rotation method at levels 5 and 6

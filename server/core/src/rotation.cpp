@@ -7,42 +7,22 @@
 #include <algorithm>
 #include <random>
 
+#include "haarcast/core/shared_frame.h"
 #include "rotators.h"
 
 namespace haarcast {
 
-static glm::dmat3 rotY(double a) {
-  const double c = std::cos(a), s = std::sin(a);
-  // Columns: R_y(a) sends x̂ → (c, 0, −s), ŷ → ŷ, ẑ → (s, 0, c); it adds a to φ.
-  return glm::dmat3(glm::dvec3(c, 0, -s), glm::dvec3(0, 1, 0), glm::dvec3(s, 0, c));
+glm::dmat3 rotationMatrix(const EulerYXY& r) {
+  return shared::rotY(r.alpha) * shared::rotX(r.beta) * shared::rotY(r.gamma);
 }
-
-static glm::dmat3 rotX(double b) {
-  const double c = std::cos(b), s = std::sin(b);
-  // ŷ → (0, c, s): tilts +Y toward +Z by b.
-  return glm::dmat3(glm::dvec3(1, 0, 0), glm::dvec3(0, c, s), glm::dvec3(0, -s, c));
-}
-
-glm::dmat3 rotationMatrix(const EulerYXY& r) { return rotY(r.alpha) * rotX(r.beta) * rotY(r.gamma); }
 
 EulerYXY eulerFromMatrix(const glm::dmat3& m) {
-  // m·ŷ = R_y(α)R_x(β)ŷ = (sin β sin α, cos β, sin β cos α) is column 1 of m.
-  const glm::dvec3 ny = m[1];
-  EulerYXY e;
-  e.beta = std::acos(std::clamp(ny.y, -1.0, 1.0));
-  if (std::sin(e.beta) > 1e-12) {
-    e.alpha = std::atan2(ny.x, ny.z);
-    // R_y(γ) = R_x(β)ᵀ R_y(α)ᵀ m; its column 0 is (cos γ, 0, −sin γ).
-    const glm::dmat3 ry = glm::transpose(rotX(e.beta)) * glm::transpose(rotY(e.alpha)) * m;
-    e.gamma = std::atan2(-ry[0][2], ry[0][0]);
-  } else {
-    // Gimbal pole. β = 0: m = R_y(α+γ). β = π: R_x(π)R_y(γ) = R_y(−γ)R_x(π), so
-    // m = R_y(α−γ)R_x(π). Either way put the whole turn in α; m·x̂ = R_y(α)x̂.
-    const glm::dvec3 nx = m[0];
-    e.alpha = std::atan2(-nx.z, nx.x);
-    e.gamma = 0.0;
-  }
-  return e;
+  const glm::dvec3 e = shared::eulerYXYOf(m);
+  EulerYXY out;
+  out.alpha = e.x;
+  out.beta = e.y;
+  out.gamma = e.z;
+  return out;
 }
 
 std::vector<EulerYXY> randomRotations(int count, std::uint32_t seed) {

@@ -1,8 +1,8 @@
 // The functions the CPU and the shaders share (core/shared_frame.h,
 // core/shared_tonemap.h, core/shared_exposure.h) read as GLSL
 // (shaders/shared_functions_check.comp) against the same lines read as C++
-// in float: the camera ray and a sub-sample's coordinate, the shading frame
-// and θₒ, the nearest slice, the display code, the meter's per-pixel weight
+// in float: the camera ray and a sub-sample's coordinate, the shading frame,
+// θₒ and the frame's Euler angles, the nearest slice, the display code, the meter's per-pixel weight
 // and its read-out. Integer results are compared exactly; float ones to a
 // few ulps, which Vulkan lets a device's division, square root and acos
 // differ by.
@@ -64,7 +64,9 @@ std::vector<FrameCase> makeCases(const render::ToneThresholds& thresholds) {
     // Near the normal (θₒ of 1e-4 … 1e-1), where acos is ill-conditioned:
     // the centre of every sphere in view.
     if (k % 5 == 2) wo = glm::normalize(n + std::pow(10.0f, -4.0f + 3.0f * unit(rng)) * direction());
-    const glm::vec3 normal = k % 50 == 1 ? wo : n;
+    glm::vec3 normal = k % 50 == 1 ? wo : n;
+    if (k % 50 == 3) normal = glm::vec3(0.0f, 1.0f, 0.0f);   // the Euler angles' gimbal pole, β = 0
+    if (k % 50 == 4) normal = glm::vec3(0.0f, -1.0f, 0.0f);  // … and β = π
     // The display code: thresholds themselves, values between them, and
     // what must give 0 (NaN, negatives) or 255 (∞).
     float tone = thresholds[1 + k % (shared::kToneCodes - 1)];
@@ -116,7 +118,7 @@ TEST(SharedFunctions, ShaderAndCppAgreeOnTheFrameTheDisplayCodeAndTheMeter) {
   Context context(testing::testOptions());
   Buffer caseBuf(context, cases.size() * sizeof(FrameCase)), basisBuf(context, sizeof basis),
       thresholdBuf(context, sizeof thresholds), histogramBuf(context, sizeof histograms),
-      resultBuf(context, 4 * cases.size() * sizeof(glm::vec4)), readoutBuf(context, sizeof(shared::ExposureResult));
+      resultBuf(context, 5 * cases.size() * sizeof(glm::vec4)), readoutBuf(context, sizeof(shared::ExposureResult));
   caseBuf.upload(std::span<const FrameCase>(cases));
   basisBuf.write(basis, sizeof basis);
   thresholdBuf.write(thresholds.data(), sizeof thresholds);
@@ -127,7 +129,7 @@ TEST(SharedFunctions, ShaderAndCppAgreeOnTheFrameTheDisplayCodeAndTheMeter) {
     check.dispatch(cb, {(push.count + shared::kLocalSize - 1) / shared::kLocalSize, 1, 1}, &push, sizeof push);
     computeBarrier(cb);
   });
-  std::vector<glm::vec4> got(4 * cases.size());
+  std::vector<glm::vec4> got(5 * cases.size());
   resultBuf.download(std::span<glm::vec4>(got));
   shared::ExposureResult readout{};
   readoutBuf.read(&readout, sizeof readout);
@@ -143,28 +145,47 @@ TEST(SharedFunctions, ShaderAndCppAgreeOnTheFrameTheDisplayCodeAndTheMeter) {
     const glm::vec3 ray = shared::cameraDirectionAt<float>(glm::vec3(basis[0]), glm::vec3(basis[1]), glm::vec3(basis[2]),
                                                            push.tanHalf, push.aspect, c.point.z, c.point.w, c.point.x,
                                                            c.point.y);
-    for (int e = 0; e < 3; ++e) expect(near(got[4 * k][e], ray[e], kTolerance), k, "camera ray", got[4 * k][e], ray[e]);
+    for (int e = 0; e < 3; ++e) expect(near(got[5 * k][e], ray[e], kTolerance), k, "camera ray", got[5 * k][e], ray[e]);
     const float coordinate = shared::subsampleCoordinate<float>(c.sub.x, c.sub.y, c.sub.z);
-    expect(got[4 * k].w == coordinate, k, "sub-sample coordinate", got[4 * k].w, coordinate);
+    expect(got[5 * k].w == coordinate, k, "sub-sample coordinate", got[5 * k].w, coordinate);
 
     float thetaOut = 0.0f;
     const glm::mat3 frame = shared::shadingFrame<float>(glm::vec3(c.n), glm::vec3(c.wo), thetaOut);
     for (int e = 0; e < 3; ++e) {
-      expect(near(got[4 * k + 1][e], frame[0][e], kTolerance), k, "frame x", got[4 * k + 1][e], frame[0][e]);
-      expect(near(got[4 * k + 2][e], frame[2][e], kTolerance), k, "frame z", got[4 * k + 2][e], frame[2][e]);
+      expect(near(got[5 * k + 1][e], frame[0][e], kTolerance), k, "frame x", got[5 * k + 1][e], frame[0][e]);
+      expect(near(got[5 * k + 2][e], frame[2][e], kTolerance), k, "frame z", got[5 * k + 2][e], frame[2][e]);
     }
-    const float deviceTheta = got[4 * k + 1].w;
+    const float deviceTheta = got[5 * k + 1].w;
     expect(near(deviceTheta, thetaOut, kTolerance), k, "θₒ", deviceTheta, thetaOut);
     // The slice from the device's own θₒ: the same float in, the same cell out.
     const uint slice = shared::sliceBlendAt(deviceTheta, push.thetaSamples, 0u).first;
-    const uint deviceSlice = std::bit_cast<uint>(got[4 * k + 2].w);
+    const uint deviceSlice = std::bit_cast<uint>(got[5 * k + 2].w);
     expect(deviceSlice == slice, k, "nearest slice", static_cast<float>(deviceSlice), static_cast<float>(slice));
 
     const uint code = shared::tonemapCode(c.n.w, thresholds);
-    const uint deviceCode = std::bit_cast<uint>(got[4 * k + 3].x);
+    const uint deviceCode = std::bit_cast<uint>(got[5 * k + 3].x);
     expect(deviceCode == code, k, "display code", static_cast<float>(deviceCode), static_cast<float>(code));
+    // The Euler angles: β directly; α and γ through the rotation they make
+    // (at the poles only their sum or difference is fixed), each side's
+    // angles of its own frame. (Not against the frame itself: with θₒ near 0
+    // its z axis, wo − (n·wo)n normalised, is n's orthogonal only to float
+    // rounding over |wo − (n·wo)n|, in both languages alike.)
+    const glm::vec3 euler(got[5 * k + 4]);
+    const glm::vec3 want = shared::eulerYXYOf(frame);
+    expect(near(euler.y, want.y, kTolerance), k, "Euler β", euler.y, want.y);
+    const auto rotation = [](const glm::vec3& e) {
+      return shared::rotY(static_cast<double>(e.x)) * shared::rotX(static_cast<double>(e.y)) *
+             shared::rotY(static_cast<double>(e.z));
+    };
+    const glm::dmat3 fromDevice = rotation(euler), fromCpp = rotation(want);
+    for (int col = 0; col < 3; ++col) {
+      for (int row = 0; row < 3; ++row) {
+        expect(std::abs(fromDevice[col][row] - fromCpp[col][row]) <= 2e-5, k, "R_y(α)R_x(β)R_y(γ)",
+               static_cast<float>(fromDevice[col][row]), static_cast<float>(fromCpp[col][row]));
+      }
+    }
     const uint weight = shared::meterWeight(glm::vec3(c.colour), c.wo.w != 0.0f);
-    const uint deviceWeight = std::bit_cast<uint>(got[4 * k + 3].y);
+    const uint deviceWeight = std::bit_cast<uint>(got[5 * k + 3].y);
     expect(deviceWeight == weight, k, "meter weight", static_cast<float>(deviceWeight), static_cast<float>(weight));
   }
   EXPECT_EQ(wrong, 0u) << "of " << cases.size() << " cases";

@@ -1,7 +1,8 @@
-// A pixel's camera ray and its shading frame, one definition for the CPU
-// (render::CameraRays and render::shadingFrame, in double, which the Monte
-// Carlo reference shares exactly) and the shaders (common/frame.glsl and
-// rotation_input.comp, in float). Each function is a template over the real
+// A pixel's camera ray, its shading frame and the frame's Euler angles, one
+// definition for the CPU (render::CameraRays, render::shadingFrame and
+// eulerFromMatrix, in double, which the Monte Carlo reference shares
+// exactly) and the shaders (common/frame.glsl, rotation_input.comp and
+// rotate_table.comp, in float). Each function is a template over the real
 // type in C++ and a float function in GLSL (HC_REAL_FUNCTION,
 // shared_language.h); the two round alike because every operation is
 // written once, in one order.
@@ -47,6 +48,30 @@ HC_REAL_FUNCTION HC_MAT3 shadingFrame(HC_VEC3 n, HC_VEC3 wo, HC_OUT(HC_REAL) the
   }
   z = normalize(z);
   return HC_MAT3(cross(n, z), n, z);
+}
+
+// The Y-X-Y Euler angles (α, β, γ) of a rotation m = R_y(α) R_x(β) R_y(γ)
+// (core/rotation.h eulerFromMatrix), β in [0, π]. m·ŷ = (sin β sin α, cos β,
+// sin β cos α) is column 1 of m.
+HC_REAL_FUNCTION HC_VEC3 eulerYXYOf(HC_MAT3 m) {
+  const HC_VEC3 ny = m[1];
+  const HC_REAL beta = HC_ACOS(clamp(ny.y, HC_REAL(-1), HC_REAL(1)));
+  HC_REAL alpha;
+  HC_REAL gamma;
+  if (HC_SIN(beta) > HC_REAL(1e-12)) {
+    alpha = HC_ATAN2(ny.x, ny.z);
+    // R_y(γ) = R_x(β)ᵀ R_y(α)ᵀ m; its column 0 is (cos γ, 0, −sin γ).
+    const HC_MAT3 ry = transpose(rotX(beta)) * transpose(rotY(alpha)) * m;
+    gamma = HC_ATAN2(-ry[0][2], ry[0][0]);
+  } else {
+    // The gimbal pole. β = 0: m = R_y(α+γ). β = π: R_x(π)R_y(γ) =
+    // R_y(−γ)R_x(π), so m = R_y(α−γ)R_x(π). Either way the whole turn goes
+    // to α: m·x̂ = R_y(α)x̂.
+    const HC_VEC3 nx = m[0];
+    alpha = HC_ATAN2(-nx.z, nx.x);
+    gamma = HC_REAL(0);
+  }
+  return HC_VEC3(alpha, beta, gamma);
 }
 
 #ifdef __cplusplus

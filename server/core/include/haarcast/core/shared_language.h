@@ -7,9 +7,10 @@
 // structs of uint, float and vec3/vec4, `const` numbers, and functions built
 // from floor/min/max/clamp, log2, dot/cross/normalize, integer bit
 // operations and findMSB. sin, cos, atan and acos are loose on a Vulkan
-// device: a shared function that needs acos calls HC_ACOS, std::acos in C++
-// and acosPrecise in GLSL (shaders/common/sphere.glsl, which the shader
-// includes).
+// device: a shared function that needs them calls HC_ACOS, HC_SIN, HC_ATAN2
+// and the axis rotations rotX, rotY, which are std:: (and the templates
+// below) in C++ and the precise ones of shaders/common/sphere.glsl in GLSL
+// (the shader that calls such a function includes it).
 //
 // The HC_ macros stay defined after this header: every shared header uses
 // them, and their prefix keeps them apart from everything else.
@@ -46,6 +47,18 @@ using std::min;
 inline constexpr int findMSB(uint x) { return static_cast<int>(std::bit_width(x)) - 1; }
 // GLSL's floatBitsToUint.
 inline uint floatBitsToUint(float f) { return std::bit_cast<uint>(f); }
+// R_y(a) adds a to φ: x̂ → (c, 0, −s), ẑ → (s, 0, c); R_x(b) tilts +Y toward
+// +Z: ŷ → (0, c, s) (core/rotation.h; GLSL: common/sphere.glsl's).
+template <class T>
+inline glm::mat<3, 3, T> rotY(T a) {
+  const T c = std::cos(a), s = std::sin(a);
+  return glm::mat<3, 3, T>(glm::vec<3, T>(c, 0, -s), glm::vec<3, T>(0, 1, 0), glm::vec<3, T>(s, 0, c));
+}
+template <class T>
+inline glm::mat<3, 3, T> rotX(T b) {
+  const T c = std::cos(b), s = std::sin(b);
+  return glm::mat<3, 3, T>(glm::vec<3, T>(1, 0, 0), glm::vec<3, T>(0, c, s), glm::vec<3, T>(0, -s, c));
+}
 }  // namespace haarcast::shared
 
 #define HC_CONST inline constexpr
@@ -56,6 +69,8 @@ inline uint floatBitsToUint(float f) { return std::bit_cast<uint>(f); }
 #define HC_PRECISE
 #define HC_OUT(type) type&
 #define HC_ACOS std::acos
+#define HC_SIN std::sin
+#define HC_ATAN2 std::atan2
 // A function of the real type: a template over it in C++ (the CPU calls the
 // double paths with double and the float kernels with float, and both round
 // as written), float in GLSL. Write literals as HC_REAL(2).
@@ -70,7 +85,14 @@ inline uint floatBitsToUint(float f) { return std::bit_cast<uint>(f); }
 #define HC_PRECISE precise
 #define HC_OUT(type) out type
 #define HC_ACOS acosPrecise
-float acosPrecise(float x);  // common/sphere.glsl
+#define HC_SIN sinPrecise
+#define HC_ATAN2 atan2Precise
+// common/sphere.glsl
+float acosPrecise(float x);
+float sinPrecise(float x);
+float atan2Precise(float y, float x);
+mat3 rotY(float a);
+mat3 rotX(float b);
 #define HC_REAL_FUNCTION
 #define HC_REAL float
 #define HC_VEC3 vec3
