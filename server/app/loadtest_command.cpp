@@ -207,19 +207,21 @@ int run(const LoadtestArgs& a) {
     client::SessionConfig base;
     if (a.url.empty()) {
       // Every client comes from 127.0.0.1: the per-address caps must fit
-      // the largest run, or its clients past the pre-Hello cap are refused.
-      const std::string most = std::to_string(*std::max_element(p.clients.begin(), p.clients.end()));
-      const std::string sessions = std::to_string(std::max(64, std::stoi(most)));
+      // the largest run, or its clients past the pre-Hello cap are refused;
+      // and the previous run's clients may still be closing when the next
+      // run's connect (a busy machine closes them late), so room for both.
+      const std::string perAddress = std::to_string(2 * *std::max_element(p.clients.begin(), p.clients.end()));
+      const std::string sessions = std::to_string(std::max(64, std::stoi(perAddress)));
       std::vector<std::string> extra = {"--max-level",
                                         std::to_string(std::max(a.level, 6)),
                                         "--max-sessions",
                                         sessions,
                                         "--max-sessions-per-address",
-                                        most,
+                                        perAddress,
                                         "--max-connections-per-address",
-                                        most,
+                                        perAddress,
                                         "--max-pending-per-address",
-                                        most,
+                                        perAddress,
                                         "--max-pending",
                                         sessions};
       if (!a.cacheDir.empty()) extra.insert(extra.end(), {"--cache-dir", a.cacheDir});
