@@ -35,9 +35,10 @@ void main() {
   uint pixels = frame.width * frame.height;
   for (uint p = lid; p < pixels; p += kExposureLocalSize) {
     vec3 c = radiance[p].rgb;
-    uint w = meterWeight(c, ids[p].x != 0u);
+    float y = meterLuminance(c);
+    uint w = meterWeight(y, ids[p].x != 0u);
     if (w == 0u) continue;
-    atomicAdd(luminance[meterBin(meterLuminance(c))], w);
+    atomicAdd(luminance[meterBin(y)], w);
     atomicAdd(peak[meterBin(meterPeak(c))], w);
   }
   barrier();

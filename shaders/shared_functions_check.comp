@@ -10,7 +10,7 @@
 //   [5k + 1] shadingFrame(n, wo)'s column x, and θₒ
 //   [5k + 2] its column z, and the bits of the nearest slice
 //            (sliceBlendAt(θₒ, thetaSamples, 0).first)
-//   [5k + 3] the bits of tonemapCode(tone) and of meterWeight(colour, object)
+//   [5k + 3] the bits of tonemapCode(tone) and of meterWeight(meterLuminance(colour), object)
 //   [5k + 4] eulerYXYOf(the frame): (α, β, γ)
 // and, from invocation 0, meterReadout of the histograms and the push
 // block's ExposurePush.
@@ -61,7 +61,7 @@ void main() {
   const mat3 frame = shadingFrame(c.n.xyz, c.wo.xyz, thetaOut);
   results[5u * k + 1u] = vec4(frame[0], thetaOut);
   results[5u * k + 2u] = vec4(frame[2], uintBitsToFloat(sliceBlendAt(thetaOut, pc.thetaSamples, 0u).first));
-  results[5u * k + 3u] = vec4(uintBitsToFloat(tonemapCode(c.n.w)), uintBitsToFloat(meterWeight(c.colour.rgb, c.wo.w != 0.0)),
+  results[5u * k + 3u] = vec4(uintBitsToFloat(tonemapCode(c.n.w)), uintBitsToFloat(meterWeight(meterLuminance(c.colour.rgb), c.wo.w != 0.0)),
                               0.0, 0.0);
   results[5u * k + 4u] = vec4(eulerYXYOf(frame), 0.0);
 }

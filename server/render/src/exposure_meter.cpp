@@ -9,9 +9,10 @@ ExposureHistograms meterHistograms(const io::RgbImage& image, const std::vector<
   const std::size_t pixels = image.rgb.size() / 3;
   for (std::size_t p = 0; p < pixels; ++p) {
     const glm::vec3 c(image.rgb[3 * p], image.rgb[3 * p + 1], image.rgb[3 * p + 2]);
-    const std::uint32_t w = shared::meterWeight(c, p < objectMask.size() && objectMask[p] != 0);
+    const float y = shared::meterLuminance(c);
+    const std::uint32_t w = shared::meterWeight(y, p < objectMask.size() && objectMask[p] != 0);
     if (w == 0) continue;
-    h.luminance[shared::meterBin(shared::meterLuminance(c))] += w;
+    h.luminance[shared::meterBin(y)] += w;
     h.peak[shared::meterBin(shared::meterPeak(c))] += w;
   }
   return h;

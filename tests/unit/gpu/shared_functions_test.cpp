@@ -184,7 +184,7 @@ TEST(SharedFunctions, ShaderAndCppAgreeOnTheFrameTheDisplayCodeAndTheMeter) {
                static_cast<float>(fromDevice[col][row]), static_cast<float>(fromCpp[col][row]));
       }
     }
-    const uint weight = shared::meterWeight(glm::vec3(c.colour), c.wo.w != 0.0f);
+    const uint weight = shared::meterWeight(shared::meterLuminance(glm::vec3(c.colour)), c.wo.w != 0.0f);
     const uint deviceWeight = std::bit_cast<uint>(got[5 * k + 3].y);
     expect(deviceWeight == weight, k, "meter weight", static_cast<float>(deviceWeight), static_cast<float>(weight));
   }

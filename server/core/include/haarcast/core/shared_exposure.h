@@ -108,12 +108,11 @@ HC_FUNCTION float exposureStops(uint weight, float target, ExposurePush p) {
   return eased;
 }
 
-// Per pixel: the weight a pixel of linear colour c adds to the bins of
-// meterBin(meterLuminance(c)) and meterBin(meterPeak(c)), object or not.
-// Black pixels (shadowed, or a black backdrop) carry no exposure
-// information; neither do NaN and ∞: weight 0.
-HC_FUNCTION uint meterWeight(vec3 c, bool object) {
-  const float y = meterLuminance(c);
+// Per pixel: the weight a pixel of luminance y = meterLuminance(c) adds to
+// the bins of meterBin(y) and meterBin(meterPeak(c)), object or not. Black
+// pixels (shadowed, or a black backdrop) carry no exposure information;
+// neither do NaN and ∞: weight 0.
+HC_FUNCTION uint meterWeight(float y, bool object) {
   if (!(y > 0.0f) || isinf(y)) return 0u;
   return object ? kMeterObjectWeight : kMeterBackdropWeight;
 }
