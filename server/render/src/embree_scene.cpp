@@ -246,18 +246,6 @@ RTCRay toEmbree(const Ray& r) {
 
 }  // namespace
 
-namespace {
-
-// Under ASan rtcOccluded16 was seen never to return (after other tests had
-// run in the process); the sanitized tests trace packets' rays one by one.
-#if defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define HAARCAST_ONE_RAY_AT_A_TIME 1
-#endif
-#endif
-
-}  // namespace
-
 Hit RayScene::hitOf(unsigned object, unsigned triangle, float u, float v, float t, const glm::vec3& ng) const {
   Hit hit;
   hit.object = object;
@@ -318,15 +306,6 @@ void RayScene::intersectFrom(const glm::vec3& origin, float tnear, std::span<con
       packet.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
       packet.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
     }
-#ifdef HAARCAST_ONE_RAY_AT_A_TIME
-    for (std::size_t k = 0; k < n; ++k) {
-      Ray ray;
-      ray.origin = origin;
-      ray.direction = directions[first + k];
-      ray.tnear = tnear;
-      out[first + k] = intersect(ray);
-    }
-#else
     rtcIntersect16(valid, impl_->top.get(), &context, &packet);
     for (std::size_t k = 0; k < n; ++k) {
       if (packet.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID) {
@@ -336,7 +315,6 @@ void RayScene::intersectFrom(const glm::vec3& origin, float tnear, std::span<con
       out[first + k] = hitOf(packet.hit.instID[0][k], packet.hit.primID[k], packet.hit.u[k], packet.hit.v[k],
                              packet.ray.tfar[k], glm::vec3(packet.hit.Ng_x[k], packet.hit.Ng_y[k], packet.hit.Ng_z[k]));
     }
-#endif
   }
 }
 
@@ -374,18 +352,35 @@ void RayScene::occludedBatch(std::span<const Ray> rays, std::span<std::uint8_t> 
 namespace {
 
 // Rays 0 … count−1, ray i from origin(i) along direction(i), t ∈ [tnear, ∞),
-// traced as Embree packets of 16, its widest, with the coherent hint:
-// out[i] = 1 if blocked. Neighbouring rays (a 4×4 block of map pixels from
-// one point, or a row of points toward one light) share most of their
-// traversal; on the bunny at level 7 packets of 16 took 15–20 % off the
-// rays' time against packets of 8 along a pixel row (AVX-512; about the same
-// either way where Embree runs a packet of 16 as two of 8).
+// traced as Embree packets of 16, its widest: out[i] = 1 if blocked.
+// Neighbouring rays (a 4×4 block of map pixels from one point, or a row of
+// points toward one light) share most of their traversal; on the bunny at
+// level 7 packets of 16 took 15–20 % off the rays' time against packets of 8
+// along a pixel row (AVX-512; about the same either way where Embree runs a
+// packet of 16 as two of 8).
+//
+// Never with the coherent hint (RTC_INTERSECT_CONTEXT_FLAG_COHERENT): with it
+// rtcOccluded16 takes Embree's frustum path (occludedCoherent), which in
+// Debian's libembree3 3.13.5 (GCC 12, AVX-512 kernels) can loop for ever.
+// There the 64-bit mask of rays still to trace, `valid_bits`, is initialised
+// by a 16-bit store (`kmovw %k6, 0x640(%rsp)`) and then read and cleared as
+// 64 bits (`cmpq`, `tzcnt`, `andn`), so its upper 48 bits are whatever the
+// thread's stack held there. Once the 16 real rays are done, a stale bit
+// remains: `tzcnt` names a lane past the 16th, its octant is read from beyond
+// the vector, no ray matches it, the bit is never cleared and the do-while
+// spins. It only happens on CPUs where Embree runs packets of 16 natively
+// (AVX-512), only for scenes with instances (our world scenes), and only
+// when earlier calls on that thread left a non-zero byte in that slot, which
+// depends on what ran there before: the Vulkan backend's host stage (not the
+// CPU backend) on one machine, the sanitized build on another.
+// RayPackets.OcclusionReturnsWhateverTheStackHolds forces it. The incoherent
+// packet path keeps the mask in registers and gives the same answers.
 template <class Origin, class Direction>
 void occludedPackets(RTCScene scene, std::size_t count, float tnear, const Origin& origin, const Direction& direction,
                      std::span<std::uint8_t> out) {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
-  context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
   constexpr std::size_t kWidth = 16;
   alignas(64) RTCRay16 packet;
   alignas(64) int valid[kWidth];
@@ -412,16 +407,7 @@ void occludedPackets(RTCScene scene, std::size_t count, float tnear, const Origi
       // Embree marks a blocked ray by setting tfar to −∞, so it is reset.
       packet.tfar[k] = std::numeric_limits<float>::infinity();
     }
-#ifdef HAARCAST_ONE_RAY_AT_A_TIME
-    for (std::size_t k = 0; k < n; ++k) {
-      RTCRay ray{packet.org_x[k], packet.org_y[k], packet.org_z[k], tnear, packet.dir_x[k], packet.dir_y[k],
-                 packet.dir_z[k], 0.0f, std::numeric_limits<float>::infinity(), ~0u, 0u, 0u};
-      rtcOccluded1(scene, &context, &ray);
-      packet.tfar[k] = ray.tfar;
-    }
-#else
     rtcOccluded16(valid, scene, &context, &packet);
-#endif
     for (std::size_t k = 0; k < n; ++k) out[first + k] = packet.tfar[k] == -std::numeric_limits<float>::infinity() ? 1 : 0;
   }
 }

@@ -92,16 +92,15 @@ class RayScene {
   void occludedBatch(std::span<const Ray> rays, std::span<std::uint8_t> out, bool coherent = false) const;
 
   // occluded() for rays that share an origin (one point's directions), as
-  // Embree packets of 16 consecutive directions with the coherent hint:
-  // out[i] = 1 if the ray origin + t·directions[i], t ∈ [tnear, ∞), is
+  // Embree packets of 16 consecutive directions (without the coherent hint:
+  // embree_scene.cpp says why): out[i] = 1 if the ray origin + t·directions[i], t ∈ [tnear, ∞), is
   // blocked. Fastest when each 16 are neighbours (a 4×4 block of map
   // pixels). Thread-safe. Throws std::invalid_argument if the spans differ
   // in size.
   void occludedFrom(const glm::vec3& origin, float tnear, std::span<const glm::vec3> directions,
                     std::span<std::uint8_t> out) const;
   // occluded() for rays that share a direction (many points toward one
-  // light), as Embree packets of 16 consecutive origins with the coherent
-  // hint: out[i] = 1 if origins[i] + t·direction, t ∈ [tnear, ∞), is
+  // light), as Embree packets of 16 consecutive origins: out[i] = 1 if origins[i] + t·direction, t ∈ [tnear, ∞), is
   // blocked. Fastest when each 16 are neighbours (a pixel row's points).
   // Thread-safe. Throws std::invalid_argument if the spans differ in size.
   void occludedToward(std::span<const glm::vec3> origins, const glm::vec3& direction, float tnear,
