@@ -259,14 +259,35 @@ fi
 configure_and_build
 vendor_web_client
 
+# Runs one named step of a job under a wall-clock limit: `step NAME SECONDS
+# cmd...`. A step that fails or runs past its limit ends the job with an
+# error naming the step (timeout(1) sends TERM, then KILL 10 s later).
+step() {
+  local name="$1" limit="$2" rc=0
+  shift 2
+  timeout --kill-after=10 "$limit" "$@" || rc=$?
+  if ((rc == 124 || rc == 137)); then
+    echo "error: step '$name' did not finish within $limit s" >&2
+    exit 1
+  elif ((rc != 0)); then
+    echo "error: step '$name' failed (exit status $rc)" >&2
+    exit "$rc"
+  fi
+}
+
 case "$command" in
   demo)
     # The main job on the built-in default scene: render it on both backends
-    # (EXR + PNG in build/demo/), then serve it and drive it with the CLI client.
+    # (EXR + PNG in build/demo/), then serve it and drive it with the CLI
+    # client. Every step has a wall-clock limit (HAARCAST_DEMO_STEP_SECONDS,
+    # default 600: a first Vulkan frame on lavapipe compiles its shaders,
+    # about a minute on two cores) and a failure names its step.
+    step_limit="${HAARCAST_DEMO_STEP_SECONDS:-600}"
     mkdir -p "$BUILD_DIR/demo"
     for backend in cpu vulkan; do
       log "rendering the default scene with --backend $backend into $BUILD_DIR/demo/default-$backend.exr (+ .png)"
-      "$BUILD_DIR/bin/haarcast" render --backend "$backend" --width 192 --height 128 --level 5 \
+      step "render --backend $backend" "$step_limit" \
+        "$BUILD_DIR/bin/haarcast" render --backend "$backend" --width 192 --height 128 --level 5 \
         --cache-dir "$BUILD_DIR/cache" --out "$BUILD_DIR/demo/default-$backend.exr" "$@" </dev/null
     done
     port="${HAARCAST_PORT:-8080}"
@@ -275,29 +296,45 @@ case "$command" in
     "$BUILD_DIR/bin/haarcast" serve --port "$port" --backend "${HAARCAST_BACKEND:-vulkan}" \
       --cache-dir "$BUILD_DIR/cache" </dev/null >"$server_log" 2>&1 &
     server=$!
-    trap 'kill -TERM "$server" 2>/dev/null || true' EXIT
+    trap 'kill -KILL "$server" 2>/dev/null || true' EXIT
     url=""
     for _ in $(seq 1 600); do
       url="$(sed -n 's/^listening on \(http:[^ ]*\)$/\1/p' "$server_log" | head -n 1)"
       [[ -n "$url" ]] && break
-      kill -0 "$server" 2>/dev/null || { cat "$server_log" >&2; echo "error: the server exited" >&2; exit 1; }
+      kill -0 "$server" 2>/dev/null || { cat "$server_log" >&2; echo "error: step 'serve' failed: the server exited" >&2; exit 1; }
       sleep 0.1
     done
-    [[ -n "$url" ]] || { cat "$server_log" >&2; echo "error: the server did not start within 60 s" >&2; exit 1; }
+    [[ -n "$url" ]] || { cat "$server_log" >&2; echo "error: step 'serve' did not start listening within 60 s" >&2; exit 1; }
     log "browser client: $url"
     ws="ws://${url#http://}ws"
     # The client plays a 36-pose orbit for at most 10 s at 256² with the
-    # server's default method (fused).
+    # server's default method (fused). The first frame may wait for the
+    # server's renderer build and, on lavapipe, for its shaders' compilation
+    # at the server's level (a minute or more on two busy cores): up to 300 s
+    # a frame, within the step's limit.
     log "running haarcast-client $ws for 10 s (frames in $BUILD_DIR/demo/frames/)"
-    "$BUILD_DIR/bin/haarcast-client" "$ws" --duration 10 --frames 36 --size 256x256 --encoding jpeg \
-      --out "$BUILD_DIR/demo/frames" --json </dev/null
+    step "haarcast-client" "$step_limit" \
+      "$BUILD_DIR/bin/haarcast-client" "$ws" --duration 10 --frames 36 --size 256x256 --encoding jpeg \
+      --timeout 300 --out "$BUILD_DIR/demo/frames" --json </dev/null
     if [[ -t 0 ]]; then
       log "the server keeps running at $url (log: $server_log); Ctrl-C stops it"
       wait "$server"
     else
+      # SIGTERM, then at most 10 s for a clean exit.
       kill -TERM "$server"
-      wait "$server"
+      for _ in $(seq 1 100); do
+        kill -0 "$server" 2>/dev/null || break
+        sleep 0.1
+      done
+      if kill -0 "$server" 2>/dev/null; then
+        cat "$server_log" >&2
+        echo "error: step 'stop server' did not finish within 10 s of SIGTERM" >&2
+        exit 1
+      fi
+      rc=0
+      wait "$server" || rc=$?
       trap - EXIT
+      ((rc == 0)) || { cat "$server_log" >&2; echo "error: step 'stop server' failed: serve exited with status $rc" >&2; exit 1; }
       log "server stopped cleanly"
     fi
     ;;

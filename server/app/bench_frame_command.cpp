@@ -20,7 +20,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "haarcast/gpu/backend.h"
+#include "haarcast/backends/backends.h"
 #include "list_flags.h"
 #include "progress.h"
 #include "haarcast/render/object_levels.h"
@@ -94,9 +94,8 @@ std::pair<double, std::size_t> agreement(const render::Frame& reference, const r
 }
 
 int run(const BenchArgs& a) {
-  if (a.backend != "cpu" && a.backend != "vulkan" && a.backend != "both") {
-    throw std::invalid_argument("--backend must be cpu, vulkan or both (got \"" + a.backend + "\")");
-  }
+  if (a.backend != "both") backends::checkBuilt(a.backend, "--backend");
+  else backends::checkBuilt(render::kVulkanBackend, "--backend both: backend");
   if (a.frames < 1 || a.frames > 1000) throw std::invalid_argument("--frames must be in 1..1000");
   if (a.warmup < 0 || a.warmup > 100) throw std::invalid_argument("--warmup must be in 0..100");
   const std::vector<std::pair<int, int>> sizes = parseSizeList(a.sizes, "--sizes");
@@ -110,7 +109,8 @@ int run(const BenchArgs& a) {
     levels.push_back(*choice);
   }
   const std::vector<RotationMethod> methods = parseMethodList(a.methods, "--method", true);
-  const bool cpu = a.backend != "vulkan", vulkan = a.backend != "cpu";
+  const std::string cpuName(render::kCpuBackend), vulkanName(render::kVulkanBackend);
+  const bool cpu = a.backend != vulkanName, vulkan = a.backend != cpuName;
   if (a.antialias != "on" && a.antialias != "off") {
     throw std::invalid_argument("--antialias must be on or off (got \"" + a.antialias + "\")");
   }
@@ -124,9 +124,8 @@ int run(const BenchArgs& a) {
   out["runs"] = nlohmann::json::array();
   if (vulkan) {
     nlohmann::json devices = nlohmann::json::array();
-    for (const auto& d : gpu::listDevices()) {
-      devices.push_back({{"index", d.index}, {"name", d.name}, {"type", d.type}, {"api", d.apiVersionText},
-                         {"rejected", d.rejected}});
+    for (const auto& d : backends::vulkanDevices()) {
+      devices.push_back({{"index", d.index}, {"name", d.name}, {"type", d.type}, {"api", d.api}, {"rejected", d.rejected}});
     }
     out["vulkan_devices"] = devices;
   }
@@ -166,12 +165,10 @@ int run(const BenchArgs& a) {
       progress.message("level " + level + ", " + std::string(methodName(method)) + ": preparing");
       std::unique_ptr<render::Renderer> cpuRenderer, gpuRenderer;
       // Slice tables, visibility, rotators: the same progress lines as `render`.
-      if (cpu) cpuRenderer = gpu::makeRenderer("cpu", scene, options, {}, progress.callback());
+      if (cpu) cpuRenderer = backends::makeRenderer(render::kCpuBackend, scene, options, {}, progress.callback());
       if (vulkan) {
-        gpu::VulkanOptions v;
-        v.device = a.device;
-        v.validation = false;  // timing: validation layers would dominate
-        gpuRenderer = gpu::makeRenderer("vulkan", scene, options, v, progress.callback());
+        // Timing: validation layers would dominate.
+        gpuRenderer = backends::makeRenderer(render::kVulkanBackend, scene, options, {a.device, false}, progress.callback());
         out["vulkan_device"] = gpuRenderer->deviceName();
       }
       if (cpuRenderer) out["cpu_device"] = cpuRenderer->deviceName();
@@ -194,7 +191,7 @@ int run(const BenchArgs& a) {
           results[r->backend()] = measure(*r, request, a.frames, a.warmup);
         }
         std::optional<std::pair<double, std::size_t>> agree;
-        if (results.count("cpu") && results.count("vulkan")) agree = agreement(results["cpu"].first, results["vulkan"].first);
+        if (results.count(cpuName) && results.count(vulkanName)) agree = agreement(results[cpuName].first, results[vulkanName].first);
         for (const auto& [backend, m] : results) {
           nlohmann::json run{{"backend", backend},       {"level", level}, {"object_levels", objectLevels},
                              {"method", methodName(method)}, {"width", width},
@@ -205,12 +202,12 @@ int run(const BenchArgs& a) {
           for (const auto& [name, seconds] : m.stages) stages[name] = seconds;
           run["stages"] = stages;
           std::string ratio = "";
-          if (backend == "vulkan" && results.count("cpu")) {
-            const double r = results["cpu"].frameSeconds / m.frameSeconds;
+          if (backend == vulkanName && results.count(cpuName)) {
+            const double r = results[cpuName].frameSeconds / m.frameSeconds;
             run["cpu_over_vulkan"] = r;
             nlohmann::json perStage = nlohmann::json::object();
             for (const auto& [name, seconds] : m.stages) {
-              for (const auto& [cname, cseconds] : results["cpu"].stages) {
+              for (const auto& [cname, cseconds] : results[cpuName].stages) {
                 if (cname == name && seconds > 0.0) perStage[name] = cseconds / seconds;
               }
             }
@@ -259,7 +256,7 @@ std::function<int()> addBenchFrameCommand(CLI::App& app) {
   auto args = std::make_shared<BenchArgs>();
   auto* c = app.add_subcommand("bench-frame",
                                "Per-pass and frame times of the CPU and Vulkan backends against resolution and level");
-  c->add_option("--backend", args->backend, "cpu|vulkan|both (both: ratios from one run)")->capture_default_str();
+  c->add_option("--backend", args->backend, backends::availableText() + " or both (both: ratios from one run)")->capture_default_str();
   c->add_option("--sizes", args->sizes, "Frame sizes, comma-separated: N for N×N, or WxH (e.g. 128,256,1920x1080)")
       ->capture_default_str();
   c->add_option("--levels", args->levels,

@@ -19,6 +19,7 @@
 #include <boost/asio/io_context.hpp>
 
 #include "app_paths.h"
+#include "haarcast/backends/backends.h"
 #include "haarcast/client/client_options.h"
 #include "haarcast/cpu/cpu_renderer.h"
 #include "haarcast/render/renderer.h"
@@ -105,9 +106,7 @@ Plan plan(const LoadtestArgs& a) {
                                 ".." + std::to_string(render::kMaxRenderLevel));
   }
   if (!(a.seconds > 0.0)) throw std::invalid_argument("--seconds must be positive");
-  if (!a.backend.empty() && a.backend != "cpu" && a.backend != "vulkan") {
-    throw std::invalid_argument("--backend must be cpu or vulkan (got \"" + a.backend + "\")");
-  }
+  if (!a.backend.empty()) backends::checkBuilt(a.backend, "--backend");
   return p;
 }
 
@@ -245,7 +244,7 @@ int run(const LoadtestArgs& a) {
     hello.set_fps_cap(a.fpsCap);
     hello.mutable_settings()->set_method(client::parseMethod(mname));
     hello.mutable_settings()->set_level(static_cast<std::uint32_t>(a.level));
-    if (!a.backend.empty()) hello.mutable_settings()->set_backend(a.backend == "cpu" ? v1::BACKEND_CPU : v1::BACKEND_VULKAN);
+    if (!a.backend.empty()) hello.mutable_settings()->set_backend(a.backend == render::kCpuBackend ? v1::BACKEND_CPU : v1::BACKEND_VULKAN);
     for (const int clients : p.clients) {
       for (const auto& [w, h] : p.sizes) {
         for (const auto& [ename, encoding] : p.encodings) {
@@ -332,7 +331,7 @@ std::function<int()> addLoadtestCommand(CLI::App& app) {
       ->capture_default_str();
   c->add_option("--fps-cap", a->fpsCap, "Frames per second each session asks for")->capture_default_str();
   c->add_option("--timeout", a->timeout, "Seconds to wait for a Welcome or any one frame")->capture_default_str();
-  c->add_option("--backend", a->backend, "cpu|vulkan (default: the server's)");
+  c->add_option("--backend", a->backend, backends::availableText() + " (default: the server's)");
   c->add_option("--cache-dir", a->cacheDir, "Slice-table and visibility cache, shared with the local server");
   c->add_option("--out", a->out, "Folder for report.json, report.md and the figures")->capture_default_str();
   char quick[200];

@@ -10,6 +10,7 @@
 
 #include "bench_frame_command.h"
 #include "compare_command.h"
+#include "haarcast/backends/backends.h"
 #include "eval.h"
 #include "haarcast/client/flag_suggest.h"
 #include "loadtest_command.h"
@@ -71,6 +72,7 @@ int runReport(const haarcast::app::RotationReportOptions& options, bool json) {
 int main(int argc, char** argv) {
   CLI::App app{"haarcast: all-frequency relighting by run-time rotation in the Haar domain"};
   app.require_subcommand(1);
+  app.footer(haarcast::backends::buildDescription());
 
   haarcast::app::RotationReportOptions report;
   bool json = false;

@@ -6,7 +6,7 @@
 #include <memory>
 #include <string>
 
-#include "haarcast/gpu/backend.h"
+#include "haarcast/backends/backends.h"
 #include "haarcast/render/object_levels.h"
 #include "haarcast/render/renderer.h"
 #include "haarcast/render/scene.h"
@@ -21,17 +21,15 @@ namespace fs = std::filesystem;
 
 struct RenderArgs {
   SceneFlags scene;
-  std::string method = "fused", variant = "refined", backend = "cpu", device, cacheDir, antialias = "auto";
+  std::string method = "fused", variant = "refined", backend{render::kCpuBackend}, device, cacheDir, antialias = "auto";
   std::string level = "auto";  // render::parseLevelChoice
-  bool validation = gpu::kValidationByDefault;
+  bool validation = backends::kValidationByDefault;
   render::RenderOptions options;
 };
 
 int run(RenderArgs& a) {
-  if (a.backend != "cpu" && a.backend != "vulkan") {
-    throw std::invalid_argument("--backend must be cpu or vulkan (got \"" + a.backend + "\")");
-  }
-  if (a.backend == "cpu" && !a.device.empty()) throw std::invalid_argument("--device applies to --backend vulkan only");
+  backends::checkBuilt(a.backend, "--backend");
+  if (a.backend == render::kCpuBackend && !a.device.empty()) throw std::invalid_argument("--device applies to --backend vulkan only");
   const auto method = parseRotationMethod(a.method);
   if (!method) throw std::invalid_argument("--method must be one of " + pixelMethodNames() + " (got \"" + a.method + "\")");
   const auto variant = parseHaarVariant(a.variant);
@@ -58,10 +56,8 @@ int run(RenderArgs& a) {
   // outputs whichever backend draws them.
   const auto t0 = std::chrono::steady_clock::now();
   StderrProgress progress;  // slice tables and visibility: percentage and time left
-  gpu::VulkanOptions vulkan;
-  vulkan.device = a.device;
-  vulkan.validation = a.validation;
-  const std::unique_ptr<render::Renderer> renderer = gpu::makeRenderer(a.backend, scene, a.options, vulkan, progress.callback());
+  const std::unique_ptr<render::Renderer> renderer =
+      backends::makeRenderer(a.backend, scene, a.options, {a.device, a.validation}, progress.callback());
   const double prepare = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   render::FrameRequest request;
   request.width = a.options.width;
@@ -110,7 +106,7 @@ std::function<int()> addRenderCommand(CLI::App& app) {
                 "fused: rounds of refining the mesh where its vertices' visibility disagrees (0 = off)")
       ->capture_default_str()
       ->check(CLI::Range(0, 16));
-  c->add_option("--backend", args->backend, "cpu|vulkan")->capture_default_str();
+  c->add_option("--backend", args->backend, "The backend: " + backends::availableText())->capture_default_str();
   c->add_option("--antialias", args->antialias, "auto|on|off: edge pixels as the mean of 4 sub-samples (auto: on)")
       ->capture_default_str();
   c->add_option("--device", args->device, "Vulkan device: an index or a name substring (default: discrete > integrated > CPU)");

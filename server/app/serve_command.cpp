@@ -16,7 +16,8 @@
 #include <unistd.h>
 #include <vector>
 
-#include "haarcast/gpu/backend.h"
+#include "haarcast/backends/backends.h"
+#include "haarcast/core/check.h"
 #include "haarcast/net/host_check.h"
 #include "haarcast/net/protocol.h"
 #include "haarcast/net/server.h"
@@ -40,7 +41,7 @@ struct ServeArgs {
   int port = 8080;  // checked, then narrowed into server.port
   int grpcPort = 0;  // 0: no gRPC listener
   std::string antialias = "auto";
-  std::string backend = "cpu", method = "fused", encoding = "jpeg";
+  std::string backend{render::kCpuBackend}, method = "fused", encoding = "jpeg";
   std::vector<std::string> backends;  // enabled for clients; empty: just --backend
   std::string level = "auto";  // render::parseLevelChoice; auto: its cap at most --max-level
   std::size_t lightCoefficients = 256;
@@ -70,14 +71,10 @@ int run(ServeArgs& a) {
   auto materialFiles = std::make_shared<std::map<std::string, std::string>>(std::move(served.materialFiles));
   // Backends: those built into this binary; clients may use only the ones
   // the operator enabled (--backends, else just --backend).
-  const std::vector<std::string> built = gpu::availableBackends();
-  std::string builtNames;
-  for (const auto& b : built) builtNames += (builtNames.empty() ? "" : ", ") + b;
   const auto enable = [&](const std::string& flag, const std::string& name) {
+    backends::checkBuilt(name, flag);
     const auto backend = net::parseBackend(name);
-    if (!backend || std::find(built.begin(), built.end(), name) == built.end()) {
-      throw std::invalid_argument(flag + " " + name + " is not one this server offers (valid: " + builtNames + ")");
-    }
+    HC_CHECK_EQ(backend.has_value(), true);  // every built backend has a wire name
     if (!catalog.offersBackend(*backend)) catalog.backends.push_back(*backend);
     return *backend;
   };
@@ -172,7 +169,7 @@ int run(ServeArgs& a) {
   base.cacheDir = cacheDirFromFlag(a.cacheDir);
   base.sceneLimits = a.sceneLimits;
   base.threads = a.renderThreads;
-  const gpu::VulkanOptions vulkanOptions{a.vulkanDevice, a.vulkanValidation};
+  const backends::DeviceOptions vulkanOptions{a.vulkanDevice, a.vulkanValidation};
   auto sharedScenes = std::make_shared<std::vector<SceneSource>>(std::move(scenes));
   const bool quiet = a.quiet;
   const std::string antialias = a.antialias;
@@ -211,7 +208,7 @@ int run(ServeArgs& a) {
       if (shown) shown(stage, done, total);
       if (toClients) toClients(stage, done, total);
     };
-    prepared->renderer = gpu::makeRenderer(backend, scene, options, vulkanOptions, stages);
+    prepared->renderer = backends::makeRenderer(backend, scene, options, vulkanOptions, stages);
     if (!quiet) {
       std::fprintf(stderr, "[serve] renderer ready: %s on %s\n", prepared->renderer->backend().c_str(),
                    prepared->renderer->deviceName().c_str());
@@ -263,7 +260,7 @@ std::function<int()> addServeCommand(CLI::App& app) {
         return "--allow-host " + value + " is not a host name (a name like render.example.com, optionally :PORT)";
       });
   c->add_option("--token", a->token, "Required token (?token=T or Authorization: Bearer T); default $HAARCAST_TOKEN");
-  c->add_option("--backend", a->backend, "Default backend: cpu|vulkan")->capture_default_str();
+  c->add_option("--backend", a->backend, "Default backend: " + backends::availableText())->capture_default_str();
   c->add_option("--backends", a->backends, "Backends clients may choose (default: only --backend)")->delimiter(',');
   c->add_option("--antialias", a->antialias, "auto|on|off: edge pixels as the mean of 4 sub-samples (auto: on)")
       ->capture_default_str();

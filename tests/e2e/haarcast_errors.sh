@@ -34,7 +34,7 @@ expect "misspelt flag with =" "unknown flag --levle; did you mean --levels?" -- 
 expect "two misspelt flags" "unknown flag --heigth; did you mean --height?" -- \
   "$bin" render --widht 64 --heigth 32 --out "$work/x.exr"
 expect "port out of range" "--port: Value 99999 not in range 0 to 65535" -- "$bin" serve --port 99999
-expect "backend not offered" "--backend gpu is not one this server offers (valid: cpu" -- "$bin" serve --backend gpu
+expect "backend not offered" '--backend "gpu" is not a backend (valid: cpu' -- "$bin" serve --backend gpu
 expect "missing web root" "--web-root $work/none: no such folder" -- "$bin" serve --web-root "$work/none"
 expect "max level outside the range" "--max-level 9 is outside 2..7" -- "$bin" serve --max-level 9
 expect "serve level over --max-level" "--level 7 is outside 2..6 (see --max-level)" -- "$bin" serve --level 7

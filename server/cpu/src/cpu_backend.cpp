@@ -21,6 +21,7 @@
 #include "haarcast/core/splitsum.h"
 #include "haarcast/core/triple_product.h"
 #include "haarcast/cpu/cpu_renderer.h"
+#include "haarcast/render/backend_names.h"
 #include "haarcast/render/embree_scene.h"
 #include "haarcast/render/exposure_meter.h"
 #include "haarcast/render/point_lights.h"
@@ -85,7 +86,7 @@ class CpuRenderer final : public Renderer {
     idleRays_.push_back(makeRays());
   }
 
-  std::string backend() const override { return "cpu"; }
+  std::string backend() const override { return std::string(kCpuBackend); }
   std::string deviceName() const override {
     // The SIMD target the fused pass dispatched to on this machine, for reports.
     return "cpu reference (" + std::to_string(hardwareThreads(options_.threads)) + " threads" +

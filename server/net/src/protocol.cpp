@@ -1,3 +1,4 @@
+#include "haarcast/render/backend_names.h"
 #include "haarcast/net/protocol.h"
 
 #include <algorithm>
@@ -281,8 +282,8 @@ std::vector<std::string> Catalog::backendNames() const {
 
 std::string_view backendName(Backend backend) {
   switch (backend) {
-    case Backend::Cpu: return "cpu";
-    case Backend::Vulkan: return "vulkan";
+    case Backend::Cpu: return render::kCpuBackend;
+    case Backend::Vulkan: return render::kVulkanBackend;
   }
   return "?";
 }

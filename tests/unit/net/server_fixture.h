@@ -16,7 +16,7 @@
 #include <boost/beast/websocket.hpp>
 #include <gtest/gtest.h>
 
-#include "haarcast/gpu/backend.h"
+#include "haarcast/backends/backends.h"
 #include "haarcast/net/server.h"
 
 namespace haarcast::net::test {
@@ -58,7 +58,7 @@ inline RendererBuilder testBuilder() {
     options.lightCoefficients = c.lightCoefficients;
     options.cacheDir = HAARCAST_TEST_CACHE_DIR;
     auto p = std::make_shared<PreparedRenderer>();
-    p->renderer = gpu::makeRenderer(std::string(backendName(c.backend)), scene, options);
+    p->renderer = backends::makeRenderer(std::string(backendName(c.backend)), scene, options);
     return p;
   };
 }

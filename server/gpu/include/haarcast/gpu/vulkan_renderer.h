@@ -43,6 +43,7 @@
 
 #include "haarcast/gpu/context.h"
 #include "haarcast/gpu/passes.h"
+#include "haarcast/render/backend_names.h"
 #include "haarcast/render/renderer.h"
 
 namespace haarcast::gpu {
@@ -71,7 +72,7 @@ class VulkanRenderer final : public render::Renderer {
                  const render::RenderProgress& progress = {}, const VulkanRendererLimits& limits = {});
   ~VulkanRenderer() override;
 
-  std::string backend() const override { return "vulkan"; }
+  std::string backend() const override { return std::string(render::kVulkanBackend); }
   std::string deviceName() const override;
   const render::RenderOptions& options() const override;
   std::size_t objectCount() const override;

@@ -26,8 +26,9 @@ namespace haarcast::net {
 inline constexpr std::uint32_t kProtocolVersion = 1;
 inline constexpr const char* kServerVersion = "haarcast 0.1.0";
 
-// The renderer backends a session may run on (haarcast/gpu/backend.h builds
-// them); the operator enables a subset (Catalog::backends).
+// The renderer backends a session may run on (haarcast/backends/backends.h
+// builds them, render/backend_names.h names them); the operator enables a
+// subset of those the build has (Catalog::backends).
 enum class Backend { Cpu, Vulkan };
 inline constexpr Backend kAllBackends[] = {Backend::Cpu, Backend::Vulkan};
 std::string_view backendName(Backend backend);                 // "cpu", "vulkan"
