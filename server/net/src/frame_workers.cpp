@@ -340,12 +340,14 @@ std::vector<StuckRender> FrameWorkers::stuckRenders() const {
   for (const auto& w : left_) {
     const char* stage = w->stage.current();
     StuckRender s;
-    if (w->device) {
+    if (w->rendering) {
       s.backend = w->device->backend;
       s.device = w->device->name;
+      s.stage = stage ? stage : "unknown";
+      s.seconds = secondsSince(w->started);
+    } else {
+      s.stage = "between frames";  // stop() did not wait for it to take its next job
     }
-    s.stage = !w->rendering ? "(between frames)" : stage ? stage : "unknown";
-    s.seconds = w->rendering ? secondsSince(w->started) : 0.0;
     out.push_back(std::move(s));
   }
   return out;
