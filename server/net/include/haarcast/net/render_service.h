@@ -174,7 +174,7 @@ class RenderService {
     // A frame rendering longer than this is abandoned (see above); 0 = no
     // deadline. Far above any legitimate frame (docs/service.md, "Frame
     // deadline"): it is there to catch a render that never returns.
-    double frameDeadlineSeconds = 120.0;
+    double frameDeadlineSeconds = 300.0;
     // stop() waits this long for the render threads (and a running build)
     // to end; those still inside a render then are left behind.
     double stopGraceSeconds = 1.5;
