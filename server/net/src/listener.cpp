@@ -205,7 +205,7 @@ void Server::Impl::stopRenderService() {
   renderService->stop((stopping.load() ? stopRequested : Clock::now()) + grace);
   for (const StuckRender& r : renderService->stuckRenders()) {
     if (r.device.empty()) {
-      log("a render thread is still busy %s: exiting without it", r.stage.c_str());
+      log("a render service thread is still busy (%s): exiting without it", r.stage.c_str());
     } else {
       log("a render thread is still rendering after %.1f s, in stage %s on device %s (%s): exiting without it",
           r.seconds, r.stage.c_str(), r.device.c_str(), r.backend.c_str());

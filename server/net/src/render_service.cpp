@@ -90,6 +90,7 @@ struct RenderService::Impl {
 
   // Set when the builder thread's loop has ended (stop() may join it).
   std::promise<void> builderExitedPromise;
+  std::atomic<bool> builderLeft{false};  // stop() did not wait for it: reported with stuckRenders()
   std::future<void> builderExited = builderExitedPromise.get_future();
 
   // The frames: queue, render threads, devices, deadline (frame_workers.h).
@@ -377,7 +378,11 @@ bool RenderService::atPixelBudget() const { return impl_->frames->atPixelBudget(
 
 std::vector<DeviceStatus> RenderService::devices() const { return impl_->frames->devices(); }
 
-std::vector<StuckRender> RenderService::stuckRenders() const { return impl_->frames->stuckRenders(); }
+std::vector<StuckRender> RenderService::stuckRenders() const {
+  std::vector<StuckRender> stuck = impl_->frames->stuckRenders();
+  if (impl_->builderLeft) stuck.push_back({"", "", "a renderer build", 0.0});
+  return stuck;
+}
 
 void RenderService::stop() {
   if (!impl_) return;
@@ -408,6 +413,7 @@ void RenderService::stop(Clock::time_point graceUntil) {
       s.builderThread.join();
     } else {
       s.builderThread.detach();
+      s.builderLeft = true;
       if (s.options.log) s.options.log("a renderer build was still running after the stop grace: left behind");
     }
   }

@@ -141,7 +141,9 @@ struct DeviceStatus {
 };
 
 // A render thread left behind: a frame abandoned at its deadline, or still
-// rendering when stop()'s grace ran out, that has not returned.
+// rendering when stop()'s grace ran out, that has not returned (or, with no
+// device, a service thread stop() did not wait for: "between frames", "a
+// renderer build").
 struct StuckRender {
   std::string backend;
   std::string device;
