@@ -159,6 +159,7 @@ int run(int argc, char** argv) {
   unsigned quality = 0;
   H264Options h264;
   std::string method;
+  std::string backend;
   std::string level;
   unsigned coefficients = 0;
   std::string scene;
@@ -195,6 +196,8 @@ int run(int argc, char** argv) {
                  "H.264 frames from one keyframe to the next (0 = the server's default)")
       ->check(CLI::Range(0u, 100000u));
   app.add_option("--method", method, "Per-pixel method: fused | haar | spatial | matrix | table | splitsum (default: the server's)");
+  app.add_option("--backend", backend, "Backend: cpu | vulkan, one the server enables (default: the server's)")
+      ->check(CLI::IsMember({"cpu", "vulkan"}));
   app.add_option("--level", level,
                  "Map level n, 2^n x 2^n, in the server's range (its Welcome.limits; a level outside it is "
                  "refused by name), every object at it; auto or auto:N: each "
@@ -266,6 +269,7 @@ int run(int argc, char** argv) {
     base.hello.set_jpeg_quality(quality);
     auto* settings = base.hello.mutable_settings();
     settings->set_method(parseMethod(method));
+    if (!backend.empty()) settings->set_backend(backend == "vulkan" ? haarcast::v1::BACKEND_VULKAN : haarcast::v1::BACKEND_CPU);
     const LevelRequest levelRequest = parseLevel(level);
     settings->set_level(levelRequest.level);
     settings->set_level_mode(levelRequest.mode);

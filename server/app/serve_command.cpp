@@ -128,6 +128,10 @@ int run(ServeArgs& a) {
   limits.defaultFps = std::min(limits.defaultFps, limits.maxFps);
 
   auto& render = a.server.render;
+  if (!(render.frameDeadlineSeconds >= 0.0)) {
+    throw std::invalid_argument("--frame-deadline must be at least 0 seconds (0: none; got " +
+                                std::to_string(render.frameDeadlineSeconds) + ")");
+  }
   for (const auto& [flag, value] : {std::pair{"--render-workers", static_cast<std::size_t>(std::max(0, render.workers))},
                                     {"--max-session-pixels", render.maxSessionPixels},
                                     {"--max-queued-builds", render.maxQueuedBuilds}}) {
@@ -209,6 +213,21 @@ int run(ServeArgs& a) {
       if (toClients) toClients(stage, done, total);
     };
     prepared->renderer = backends::makeRenderer(backend, scene, options, vulkanOptions, stages);
+    if (backend == render::kVulkanBackend) {
+      // The build's last stage: a tiny frame. A Vulkan driver may compile
+      // its shaders at their first dispatch (Mesa's lavapipe: up to ~45 s),
+      // which then shows as build progress instead of a first frame that
+      // runs into the frame deadline. It stops with the build when nobody
+      // waits for it any more.
+      stages("warm-up", 0, 1);
+      render::FrameRequest warmUp;
+      warmUp.width = warmUp.height = 16;
+      warmUp.camera = scene.camera;
+      warmUp.linearImage = false;
+      warmUp.cancelled = abandoned;
+      prepared->renderer->render(warmUp);
+      stages("warm-up", 1, 1);
+    }
     if (!quiet) {
       std::fprintf(stderr, "[serve] renderer ready: %s on %s\n", prepared->renderer->backend().c_str(),
                    prepared->renderer->deviceName().c_str());
@@ -228,6 +247,15 @@ int run(ServeArgs& a) {
                  a.server.webRoot.empty() ? "not found" : a.server.webRoot.c_str());
   }
   server.run();  // until SIGINT/SIGTERM, then drains
+  if (server.renderThreadsLeft() > 0) {
+    // A render thread stuck inside a library call (logged above, with its
+    // stage) is not waited for, and neither are destructors that could wait
+    // on it (the renderer's, the driver's at exit): leave now, the log
+    // flushed, with the status of a clean stop.
+    std::fflush(stdout);
+    std::fflush(stderr);
+    std::_Exit(0);
+  }
   return 0;
 }
 
@@ -315,6 +343,11 @@ std::function<int()> addServeCommand(CLI::App& app) {
   c->add_option("--server-pixel-budget", a->serverPixelBudget,
                 "Pixels rendering at once across the server; a frame waits for its share, /readyz is 503 while one "
                 "waits (default 2 × --max-session-pixels; 0 = none)");
+  c->add_option("--frame-deadline", o.render.frameDeadlineSeconds,
+                "Seconds a frame may render; a longer one is abandoned: its client gets an error naming the stage it "
+                "was stuck in, its device turns unhealthy (its frames fail at once, /readyz 503 when it is the "
+                "default backend's) until the frame returns. Far above any real frame; 0 = none")
+      ->capture_default_str();
   c->add_option("--max-queued-builds", o.render.maxQueuedBuilds,
                 "Renderer builds waiting across the server; one more is refused with Error OVERLOADED")
       ->capture_default_str();

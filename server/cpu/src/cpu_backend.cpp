@@ -388,6 +388,7 @@ Frame CpuRenderer::renderFrame(const FrameRequest& request, const CancelPoint& c
 
   // ---- light: world → each object's frame, once per frame -----------------
   auto t0 = Clock::now();
+  enterFrameStage(request, "light");
   const ResolvedFrame resolved = resolveFrame(prepared_, options_, request);
   std::size_t bytes = resolved.lightBytes;
   frame.stages.push_back({"light", since(t0)});
@@ -403,14 +404,21 @@ Frame CpuRenderer::renderFrame(const FrameRequest& request, const CancelPoint& c
   const std::size_t pixels = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
   GBuffer g;
   t0 = Clock::now();
+  enterFrameStage(request, "gbuffer");
   traceGBuffer(*rays, camera, w, h, g, cancelPoint);
   frame.stages.push_back({"gbuffer", since(t0)});
   t0 = Clock::now();
+  enterFrameStage(request, "rotation-input");
   fillInputs(resolved, g, cancelPoint);
   frame.stages.push_back({"rotation-input", since(t0)});
 
   frame.image = io::makeImage(w, h);
   frame.objectMask.assign(pixels, 0);
+  // The rotating methods rotate and multiply pixel by pixel: one stage
+  // entered, "rotation", for both.
+  enterFrameStage(request, options_.method == RotationMethod::Fused      ? "fused"
+                           : options_.method == RotationMethod::Splitsum ? "splitsum"
+                                                                         : "rotation");
   switch (options_.method) {
     case RotationMethod::Fused: bytes += shadeFused(resolved, *rays, g, request, camera, frame, cancelPoint); break;
     case RotationMethod::Splitsum: bytes += shadeSplitsum(resolved, *rays, g, request, camera, frame, cancelPoint); break;
@@ -419,6 +427,7 @@ Frame CpuRenderer::renderFrame(const FrameRequest& request, const CancelPoint& c
 
   // ---- tonemap: backdrop, RGBA8 --------------------------------------------
   t0 = Clock::now();
+  enterFrameStage(request, "tonemap");
   if (options_.environmentBackground) {
     parallelFor(static_cast<std::size_t>(h), [&](std::size_t y) {
       cancelPoint();

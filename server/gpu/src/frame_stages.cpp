@@ -23,7 +23,8 @@ void VulkanRenderer::Impl::ensureQueries(std::uint32_t count) {
   queryCapacity = count;
 }
 
-void VulkanRenderer::Impl::runStages(const std::vector<FrameStage>& stages, render::Frame& frame) {
+void VulkanRenderer::Impl::runStages(const std::vector<FrameStage>& stages, const render::FrameRequest& request,
+                                     render::Frame& frame) {
   const std::size_t first = frame.stages.size();
   auto add = [&](const char* name, double seconds) {
     for (std::size_t i = first; i < frame.stages.size(); ++i) {
@@ -41,6 +42,7 @@ void VulkanRenderer::Impl::runStages(const std::vector<FrameStage>& stages, rend
       const auto& record = stage.second;
       frame.cancelled = cancelRequested();
       if (frame.cancelled) return;
+      render::enterFrameStage(request, stage.first);
       const auto t = RendererClock::now();
       context.submit([&](VkCommandBuffer cb) {
         record(cb);
@@ -51,7 +53,8 @@ void VulkanRenderer::Impl::runStages(const std::vector<FrameStage>& stages, rend
     return;
   }
   frame.cancelled = cancelRequested();  // one submission: the frame is the batch
-  if (frame.cancelled) return;
+  if (frame.cancelled || stages.empty()) return;
+  render::enterFrameStage(request, stages.front().first);
   const auto count = static_cast<std::uint32_t>(stages.size());
   ensureQueries(count + 1);
   context.submit([&](VkCommandBuffer cb) {

@@ -121,6 +121,7 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
   // ---- light (host): resolveFrame, as the CPU backend; its pixel form and
   // point lights uploaded, the ground's closed form in its ObjectInfo
   auto t0 = RendererClock::now();
+  render::enterFrameStage(request, "light");
   const render::ResolvedFrame resolved = render::resolveFrame(prepared, options, request);
   ensureResolution(request.width, request.height);
   const std::size_t objectCount = prepared.objects.size();
@@ -161,13 +162,14 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
                 vkCmdFillBuffer(cb, counter.handle(), 0, VK_WHOLE_SIZE, 0u);
                 rotationInput->dispatch(cb, {groupsOf(pixels, shared::kLocalSize), 1, 1});
               }}},
-            frame);
+            request, frame);
   if (frame.cancelled) return frame;  // stopped between stages: no images
 
   // ---- shadow-rays (host): each covered sample's point-light bits
   frame.cancelled = cancelRequested();
   if (frame.cancelled) return frame;
   t0 = RendererClock::now();
+  render::enterFrameStage(request, "shadow-rays");
   const std::uint32_t covered =
       computeShadowMasks(resolved, glm::vec3(render::CameraRays(request.camera, request.width, request.height).origin()));
   frame.stages.push_back({"shadow-rays", secondsSince(t0)});
@@ -185,7 +187,7 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
                 fusedPass->dispatchIndirect(cb, counter, offsetof(CoverageCounter, groups));
               }},
              {"tonemap", [&](VkCommandBuffer cb) { recordTonemap(cb, request); }}},
-            frame);
+            request, frame);
   if (frame.cancelled) return frame;
 
   // ---- Results: RGBA8 always, the linear image only when asked for ----------

@@ -18,6 +18,7 @@ render::Frame VulkanRenderer::Impl::renderRotating(const render::FrameRequest& r
   const auto start = RendererClock::now();
   // ---- light (host): resolveFrame, as the CPU backend (it checks the request).
   auto t0 = RendererClock::now();
+  render::enterFrameStage(request, "light");
   render::ResolvedFrame resolved = render::resolveFrame(prepared, options, request);
   ensureResolution(request.width, request.height);
   const std::size_t objectCount = prepared.objects.size();
@@ -72,7 +73,7 @@ render::Frame VulkanRenderer::Impl::renderRotating(const render::FrameRequest& r
     });
   }
   stages.emplace_back("tonemap", [&](VkCommandBuffer cb) { recordTonemap(cb, request); });
-  runStages(stages, frame);
+  runStages(stages, request, frame);
   if (frame.cancelled) return frame;  // stopped between batches: no images
 
   std::uint32_t covered = 0;

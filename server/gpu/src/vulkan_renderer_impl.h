@@ -196,8 +196,10 @@ struct VulkanRenderer::Impl {
   // (a CPU device) one submission per stage, timed on the host. Stages of
   // one name (the batches of rotation and triple-product) add up to one
   // entry of frame.stages, at the place of the first. Stops before a
-  // submission once cancelRequested(), with frame.cancelled set.
-  void runStages(const std::vector<FrameStage>& stages, render::Frame& frame);
+  // submission once cancelRequested(), with frame.cancelled set. Each
+  // stage is entered (render::enterFrameStage) as it is submitted; one
+  // submission of every stage is the first stage's, for a watcher.
+  void runStages(const std::vector<FrameStage>& stages, const render::FrameRequest& request, render::Frame& frame);
   void ensureQueries(std::uint32_t count);
 
   // fused_frame.cpp

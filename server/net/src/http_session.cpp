@@ -144,9 +144,8 @@ void HttpSession::serve(const Request& request) {
     return;
   }
   if (path == "/readyz") {
-    if (server_.atCapacity()) {
-      respond(request, http::status::service_unavailable,
-              server_.stopping.load() ? "draining\n" : "at capacity\n", "text/plain", keepAlive);
+    if (const auto reason = server_.notReadyReason()) {
+      respond(request, http::status::service_unavailable, *reason + "\n", "text/plain", keepAlive);
     } else {
       respond(request, http::status::ok, "ready\n", "text/plain", keepAlive);
     }

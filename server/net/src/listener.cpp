@@ -41,6 +41,12 @@ Admission::Limits checkedAdmission(Admission::Limits l) {
 
 }  // namespace
 
+// The render service's log lines go to the server's log.
+RenderService::Options Server::Impl::withLog(RenderService::Options o) {
+  if (!o.log) o.log = [this](const std::string& line) { log("%s", line.c_str()); };
+  return o;
+}
+
 std::string peerAddress(const tcp::socket& socket) {
   beast::error_code ec;
   const auto remote = socket.remote_endpoint(ec);
@@ -64,7 +70,7 @@ Server::Impl::Impl(ServerOptions o, Catalog c, AbandonableRendererBuilder builde
       acceptPause(acceptor.get_executor()),
       drainTimer(ioc),
       refusalSummaryTimer(ioc),
-      renderService(std::make_unique<RenderService>(std::move(builder), options.render, metrics)) {
+      renderService(std::make_unique<RenderService>(std::move(builder), withLog(options.render), metrics)) {
   if (!options.webRoot.empty()) webRoot = WebRoot::load(options.webRoot);
   metrics.sessionCapacity.store(options.admission.sessions);
 }
@@ -164,8 +170,20 @@ std::size_t Server::Impl::sessionCount() {
   return sessions.size() + (grpc ? grpc->sessionCount() : 0);
 }
 
-bool Server::Impl::atCapacity() const {
-  return stopping.load() || admission.fullForNewAddress() || renderService->atPixelBudget();
+bool Server::Impl::atCapacity() const { return notReadyReason().has_value(); }
+
+std::optional<std::string> Server::Impl::notReadyReason() const {
+  if (stopping.load()) return "draining";
+  if (admission.fullForNewAddress() || renderService->atPixelBudget()) return "at capacity";
+  // The default backend's device: a new session that asks for nothing in
+  // particular renders there. Another backend's unhealthy device fails only
+  // the sessions that chose it (their frames name it), so it alone does not
+  // take the server out of rotation.
+  const std::string_view backend = backendName(options.defaults.backend);
+  for (const DeviceStatus& d : renderService->devices()) {
+    if (!d.healthy && d.backend == backend) return "device unhealthy: " + d.device + " (" + d.backend + "): " + d.reason;
+  }
+  return std::nullopt;
 }
 
 std::string Server::Impl::metricsText() {
@@ -173,11 +191,32 @@ std::string Server::Impl::metricsText() {
   metrics.pixelBudget.store(options.render.serverPixelBudget);
   metrics.queuedBuilds.store(renderService->queuedBuilds());
   metrics.maxQueuedBuilds.store(options.render.maxQueuedBuilds);
+  metrics.renderThreadsStuck.store(renderService->stuckRenders().size());
+  metrics.frameDeadlineSeconds.store(options.render.frameDeadlineSeconds);
+  std::vector<Metrics::DeviceHealth> devices;
+  for (const DeviceStatus& d : renderService->devices()) devices.push_back({d.backend, d.device, d.healthy});
+  metrics.setDevices(std::move(devices));
   return metrics.prometheusText();
 }
 
+void Server::Impl::stopRenderService() {
+  const auto grace = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options.render.stopGraceSeconds));
+  // Not stopped (a Server destroyed without stop()): the grace counts from now.
+  renderService->stop((stopping.load() ? stopRequested : Clock::now()) + grace);
+  for (const StuckRender& r : renderService->stuckRenders()) {
+    if (r.device.empty()) {
+      log("a render service thread is still busy (%s): exiting without it", r.stage.c_str());
+    } else {
+      log("a render thread is still rendering after %.1f s, in stage %s on device %s (%s): exiting without it",
+          r.seconds, r.stage.c_str(), r.device.c_str(), r.backend.c_str());
+    }
+  }
+}
+
 void Server::Impl::stop() {
+  const auto now = Clock::now();
   if (stopping.exchange(true)) return;
+  stopRequested = now;
   metrics.draining.store(true);
   log("stopping: draining %zu sessions", sessionCount());
   std::vector<std::shared_ptr<WsSession>> open;
@@ -257,7 +296,7 @@ Server::Server(ServerOptions options, Catalog catalog, AbandonableRendererBuilde
 Server::~Server() {
   stop();
   wait();
-  impl_->renderService->stop();
+  impl_->stopRenderService();
 }
 
 std::uint16_t Server::port() const { return impl_->boundPort; }
@@ -276,7 +315,7 @@ void Server::run() {
   }
   impl_->ioc.run();
   wait();
-  impl_->renderService->stop();
+  impl_->stopRenderService();
 }
 
 void Server::stop() { impl_->stop(); }
@@ -290,6 +329,10 @@ void Server::wait() {
 }
 
 bool Server::atCapacity() const { return impl_->atCapacity(); }
+
+std::optional<std::string> Server::notReadyReason() const { return impl_->notReadyReason(); }
+
+std::size_t Server::renderThreadsLeft() const { return impl_->renderService->stuckRenders().size(); }
 
 const Metrics& Server::metrics() const { return impl_->metrics; }
 

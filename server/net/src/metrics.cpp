@@ -46,7 +46,29 @@ long long processResidentBytes() {
   return residentPages * static_cast<long long>(sysconf(_SC_PAGESIZE));
 }
 
+// A label value as the text format wants it: backslash, double quote and
+// newline escaped (device names come from drivers).
+std::string labelValue(std::string_view value) {
+  std::string out;
+  for (const char c : value) {
+    if (c == '\\' || c == '"') {
+      out += '\\';
+      out += c;
+    } else if (c == '\n') {
+      out += "\\n";
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
+
 }  // namespace
+
+void Metrics::setDevices(std::vector<DeviceHealth> devices) {
+  std::lock_guard lock(mutex_);
+  devices_ = std::move(devices);
+}
 
 void Metrics::addLabelled(std::string_view family, std::string_view label) {
   std::lock_guard lock(mutex_);
@@ -147,6 +169,15 @@ std::string Metrics::prometheusText() const {
   metric("haarcast_frames_cancelled_total", "counter",
          "Frame jobs ended without a frame: the session had gone, its request was replaced, or the server stopped.");
   out << "haarcast_frames_cancelled_total " << framesCancelled.load() << '\n';
+  metric("haarcast_frames_abandoned_total", "counter",
+         "Frames abandoned at the frame deadline: their session got an error naming the stage, their device turned "
+         "unhealthy.");
+  out << "haarcast_frames_abandoned_total " << framesAbandoned.load() << '\n';
+  metric("haarcast_render_threads_stuck", "gauge",
+         "Render threads left behind inside a render that has not returned (abandoned frames).");
+  out << "haarcast_render_threads_stuck " << renderThreadsStuck.load() << '\n';
+  metric("haarcast_frame_deadline_seconds", "gauge", "A frame rendering longer than this is abandoned (0 = none).");
+  out << "haarcast_frame_deadline_seconds " << frameDeadlineSeconds.load() << '\n';
 
   std::lock_guard lock(mutex_);
   metric("haarcast_stage_seconds", "summary", "Time per frame stage, summed over frames.");
@@ -155,6 +186,12 @@ std::string Metrics::prometheusText() const {
     std::snprintf(sum, sizeof sum, "%.9g", sc.first);
     out << "haarcast_stage_seconds_sum{stage=\"" << name << "\"} " << sum << '\n';
     out << "haarcast_stage_seconds_count{stage=\"" << name << "\"} " << sc.second << '\n';
+  }
+  metric("haarcast_device_healthy", "gauge",
+         "1 while a device rendered on is healthy, 0 while a frame abandoned on it has not returned (its frames fail).");
+  for (const DeviceHealth& d : devices_) {
+    out << "haarcast_device_healthy{backend=\"" << labelValue(d.backend) << "\",device=\"" << labelValue(d.device)
+        << "\"} " << (d.healthy ? 1 : 0) << '\n';
   }
   metric("haarcast_errors_total", "counter", "Protocol errors sent to clients, by code.");
   for (const auto& [code, n] : errors_) out << "haarcast_errors_total{code=\"" << code << "\"} " << n << '\n';

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <deque>
+#include <future>
 #include <list>
 #include <limits>
 #include <map>
@@ -14,8 +15,7 @@
 #include <thread>
 #include <utility>
 
-#include "haarcast/net/encode.h"
-#include "task_queue.h"
+#include "frame_workers.h"
 
 namespace haarcast::net {
 namespace {
@@ -31,6 +31,8 @@ void checkOptions(const RenderService::Options& o) {
   if (o.maxSessionPixels < 1) bad("maxSessionPixels must be at least 1");
   if (o.maxQueuedBuilds < 1) bad("maxQueuedBuilds must be at least 1");
   if (!(o.progressIntervalSeconds >= 0.0)) bad("progressIntervalSeconds must be at least 0");
+  if (!(o.frameDeadlineSeconds >= 0.0)) bad("frameDeadlineSeconds must be at least 0 (0: none)");
+  if (!(o.stopGraceSeconds >= 0.0)) bad("stopGraceSeconds must be at least 0");
 }
 
 // A prepare's answer, made under the cache lock and given outside it.
@@ -86,27 +88,16 @@ struct RenderService::Impl {
   std::shared_ptr<Build> runningBuild;  // taken from the queue by the builder thread
   std::thread builderThread;
 
-  // ---- Frames --------------------------------------------------------------
-  // A worker takes the oldest job whose renderer is free (a renderer that
-  // cannot render concurrently is busy while one of its frames renders) and
-  // whose pixels fit the budget; no job passes one waiting for the budget,
-  // so a large frame is not starved by small ones.
-  struct Queued {
-    RenderJob job;
-    Clock::time_point submitted;
-  };
-  mutable std::mutex queueMutex;
-  std::condition_variable queueCv;
-  std::deque<Queued> queue;
-  std::set<const PreparedRenderer*> busy;
-  std::size_t pixelsInFlight = 0;
-  bool budgetWait = false;  // the oldest startable job waits for the budget
-  std::atomic<bool> stopping{false};
-  std::vector<std::thread> workers;
+  // Set when the builder thread's loop has ended (stop() may join it).
+  std::promise<void> builderExitedPromise;
+  std::atomic<bool> builderLeft{false};  // stop() did not wait for it: reported with stuckRenders()
+  std::future<void> builderExited = builderExitedPromise.get_future();
 
-  TaskQueue encodeQueue;
+  // The frames: queue, render threads, devices, deadline (frame_workers.h).
+  std::shared_ptr<FrameWorkers> frames;
 
-  Impl(AbandonableRendererBuilder b, Options o, Metrics& m) : builder(std::move(b)), options(o), metrics(m) {}
+  Impl(AbandonableRendererBuilder b, Options o, Metrics& m)
+      : builder(std::move(b)), options(o), metrics(m), frames(std::make_shared<FrameWorkers>(options, m)) {}
 
   // -------------------------------------------------------------- builds
 
@@ -279,6 +270,7 @@ struct RenderService::Impl {
     std::vector<ProgressSink> sinks;
     {
       std::lock_guard lock(cacheMutex);
+      if (buildsStopping) return;  // the sinks may belong to sessions that have gone
       for (const Waiter& w : build.waiters) {
         if (w.progress) sinks.push_back(w.progress);
       }
@@ -300,6 +292,10 @@ struct RenderService::Impl {
       std::lock_guard lock(cacheMutex);
       runningBuild.reset();
       if (const auto b = builds.find(build->key); b != builds.end() && b->second == build) builds.erase(b);
+      // Stopping: the waiters are dropped unanswered, and nothing of the
+      // server's is touched (a build left behind by stop() may end after the
+      // server has gone).
+      if (buildsStopping) return;
       if (renderer && built) {
         // Cached even when abandoned: another session may want it next.
         renderer->key = build->key;
@@ -307,7 +303,6 @@ struct RenderService::Impl {
         ready.push_front(renderer);
         while (ready.size() > options.maxRenderers) ready.pop_back();  // sessions keep theirs alive
       }
-      if (buildsStopping) return;  // the waiters are dropped unanswered
       for (Waiter& w : build->waiters) {
         if (const auto o = ownerWaits.find(w.owner); o != ownerWaits.end() && o->second == build) ownerWaits.erase(o);
         answers.push_back({std::move(w.done), renderer ? PrepareOutcome{PrepareStatus::Ready, renderer, {}}
@@ -316,129 +311,6 @@ struct RenderService::Impl {
       build->waiters.clear();
     }
     for (auto& [done, outcome] : answers) done(std::move(outcome));
-  }
-
-  // -------------------------------------------------------------- frames
-
-  static bool isCancelled(const RenderJob& job) { return job.cancelled && job.cancelled(); }
-
-  // The next job a worker may start, or none (then `dropped` may hold jobs
-  // found cancelled). Under queueMutex.
-  std::optional<Queued> pickLocked(std::vector<RenderJob>& dropped) {
-    budgetWait = false;
-    for (auto it = queue.begin(); it != queue.end();) {
-      if (isCancelled(it->job)) {
-        dropped.push_back(std::move(it->job));
-        it = queue.erase(it);
-        continue;
-      }
-      const PreparedRenderer* renderer = it->job.renderer.get();
-      if (!renderer->renderer->concurrentRenders() && busy.count(renderer)) {
-        ++it;
-        continue;
-      }
-      const std::size_t p = chargeOf(it->job);
-      if (options.serverPixelBudget && pixelsInFlight > 0 && pixelsInFlight + p > options.serverPixelBudget) {
-        budgetWait = true;  // and nobody passes it
-        return std::nullopt;
-      }
-      Queued next = std::move(*it);
-      queue.erase(it);
-      return next;
-    }
-    return std::nullopt;
-  }
-
-  // What a job holds of the budget from its start: its declared pixels (a
-  // job over the session limit fails before rendering and holds nothing).
-  std::size_t chargeOf(const RenderJob& job) const {
-    return job.pixels > options.maxSessionPixels ? 0 : job.pixels;
-  }
-
-  void workerLoop() {
-    for (;;) {
-      std::optional<Queued> next;
-      std::vector<RenderJob> dropped;
-      std::size_t charge = 0;
-      {
-        std::unique_lock lock(queueMutex);
-        for (;;) {
-          if (stopping) return;
-          next = pickLocked(dropped);
-          if (next || !dropped.empty()) break;
-          queueCv.wait(lock);
-        }
-        if (next) {
-          if (!next->job.renderer->renderer->concurrentRenders()) busy.insert(next->job.renderer.get());
-          charge = chargeOf(next->job);
-          pixelsInFlight += charge;
-        }
-      }
-      for (RenderJob& job : dropped) {
-        if (job.onCancelled) job.onCancelled();
-      }
-      if (!next) continue;
-      const PreparedRenderer* renderer = next->job.renderer.get();  // render() may move the job on
-      render(next->job, next->submitted, charge);
-      {
-        std::lock_guard lock(queueMutex);
-        busy.erase(renderer);
-        pixelsInFlight -= charge;
-      }
-      queueCv.notify_all();
-    }
-  }
-
-  // Holds `charge` pixels of the budget; resizes it to the request's.
-  void render(RenderJob& job, Clock::time_point submitted, std::size_t& charge) {
-    const double queuedSeconds = secondsSince(submitted);
-    auto cancel = [&job] {
-      if (job.onCancelled) job.onCancelled();
-    };
-    std::optional<render::FrameRequest> request = job.take();
-    if (!request || isCancelled(job)) return cancel();
-    const std::size_t pixels = static_cast<std::size_t>(std::max(0, request->width)) *
-                               static_cast<std::size_t>(std::max(0, request->height));
-    if (pixels > options.maxSessionPixels) {
-      job.done(std::nullopt, "a frame of " + std::to_string(request->width) + "×" + std::to_string(request->height) +
-                                 " (" + std::to_string(pixels) + " pixels) is over the server's limit of " +
-                                 std::to_string(options.maxSessionPixels) + " pixels per session (max-session-pixels)");
-      return;
-    }
-    if (pixels != charge) {  // the session's size changed since submit
-      std::lock_guard lock(queueMutex);
-      pixelsInFlight = pixelsInFlight - charge + pixels;
-      charge = pixels;
-    }
-    // Only EXR encodes the linear image; every other encoding needs RGBA8
-    // alone, and a GPU backend then skips reading the linear image back.
-    request->linearImage = job.encoding == FrameEncoding::Exr;
-    request->cancelled = [this, &job, own = std::move(request->cancelled)] {
-      return stopping.load() || isCancelled(job) || (own && own());
-    };
-    RenderedFrame out;
-    out.queuedSeconds = queuedSeconds;
-    try {
-      out.frame = job.renderer->renderer->render(*request);
-    } catch (const std::exception& e) {
-      job.done(std::nullopt, std::string("render failed: ") + e.what());
-      return;
-    }
-    if (out.frame.cancelled || stopping) return cancel();
-    // Encoding goes to its own threads: the next frame can render meanwhile.
-    encodeQueue.push([job = std::move(job), out = std::move(out)]() mutable {
-      try {
-        const auto t0 = Clock::now();
-        out.encoded = job.encode ? job.encode(out.frame)
-                                 : encodeFrame(job.encoding, out.frame.rgba8, out.frame.width, out.frame.height,
-                                               out.frame.image, job.jpegQuality);
-        out.encodeSeconds = secondsSince(t0);
-      } catch (const std::exception& e) {
-        job.done(std::nullopt, std::string("encode failed: ") + e.what());
-        return;
-      }
-      job.done(std::move(out), {});
-    });
   }
 };
 
@@ -456,12 +328,12 @@ RenderService::RenderService(RendererBuilder builder, Options options, Metrics& 
 RenderService::RenderService(AbandonableRendererBuilder builder, Options options, Metrics& metrics) {
   checkOptions(options);
   if (!builder) throw std::invalid_argument("RenderService: no renderer builder");
-  impl_ = std::make_unique<Impl>(std::move(builder), options, metrics);
-  impl_->builderThread = std::thread([impl = impl_.get()] { impl->builderLoop(); });
-  for (int i = 0; i < options.workers; ++i) {
-    impl_->workers.emplace_back([impl = impl_.get()] { impl->workerLoop(); });
-  }
-  impl_->encodeQueue.start(options.encoders);
+  impl_ = std::make_shared<Impl>(std::move(builder), options, metrics);
+  impl_->builderThread = std::thread([impl = impl_] {
+    impl->builderLoop();
+    impl->builderExitedPromise.set_value();
+  });
+  impl_->frames->start();
 }
 
 RenderService::~RenderService() { stop(); }
@@ -490,42 +362,40 @@ void RenderService::withdraw(const std::string& owner) {
 
 void RenderService::submit(RenderJob job) {
   if (!job.renderer || !job.renderer->renderer) throw std::invalid_argument("RenderService::submit: a job without a renderer");
-  {
-    std::lock_guard lock(impl_->queueMutex);
-    if (impl_->stopping) return;
-    impl_->queue.push_back({std::move(job), Clock::now()});
-  }
-  impl_->queueCv.notify_all();
+  impl_->frames->submit(std::move(job));
 }
 
-std::size_t RenderService::queued() const {
-  std::lock_guard lock(impl_->queueMutex);
-  return impl_->queue.size();
-}
+std::size_t RenderService::queued() const { return impl_->frames->queued(); }
 
 std::size_t RenderService::queuedBuilds() const {
   std::lock_guard lock(impl_->cacheMutex);
   return impl_->buildQueue.size();
 }
 
-std::size_t RenderService::pixelsInFlight() const {
-  std::lock_guard lock(impl_->queueMutex);
-  return impl_->pixelsInFlight;
-}
+std::size_t RenderService::pixelsInFlight() const { return impl_->frames->pixelsInFlight(); }
 
-bool RenderService::atPixelBudget() const {
-  std::lock_guard lock(impl_->queueMutex);
-  const std::size_t budget = impl_->options.serverPixelBudget;
-  return impl_->budgetWait || (budget && impl_->pixelsInFlight >= budget);
+bool RenderService::atPixelBudget() const { return impl_->frames->atPixelBudget(); }
+
+std::vector<DeviceStatus> RenderService::devices() const { return impl_->frames->devices(); }
+
+std::vector<StuckRender> RenderService::stuckRenders() const {
+  std::vector<StuckRender> stuck = impl_->frames->stuckRenders();
+  if (impl_->builderLeft) stuck.push_back({"", "", "a renderer build", 0.0});
+  return stuck;
 }
 
 void RenderService::stop() {
+  if (!impl_) return;
+  stop(Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                         std::chrono::duration<double>(impl_->options.stopGraceSeconds)));
+}
+
+void RenderService::stop(Clock::time_point graceUntil) {
   if (!impl_) return;
   Impl& s = *impl_;
   // Flags first, then joins: a running build and the running frames stop
   // together, at their next stage, tile or batch.
   std::deque<std::shared_ptr<Impl::Build>> droppedBuilds;  // callbacks destroyed outside the locks
-  std::deque<Impl::Queued> droppedJobs;
   {
     std::lock_guard lock(s.cacheMutex);
     s.buildsStopping = true;
@@ -535,18 +405,18 @@ void RenderService::stop() {
     s.ownerWaits.clear();
   }
   s.buildCv.notify_all();
-  {
-    std::lock_guard lock(s.queueMutex);
-    s.stopping = true;
-    droppedJobs.swap(s.queue);
+  s.frames->stop(graceUntil);
+  // A build stuck past the grace (a renderer's warm-up frame inside a
+  // library call) is left behind like a render: it holds the Impl.
+  if (s.builderThread.joinable()) {
+    if (s.builderExited.wait_until(graceUntil) == std::future_status::ready) {
+      s.builderThread.join();
+    } else {
+      s.builderThread.detach();
+      s.builderLeft = true;
+      if (s.options.log) s.options.log("a renderer build was still running after the stop grace: left behind");
+    }
   }
-  s.queueCv.notify_all();
-  if (s.builderThread.joinable()) s.builderThread.join();
-  for (auto& t : s.workers) {
-    if (t.joinable()) t.join();
-  }
-  s.workers.clear();
-  s.encodeQueue.stop();
 }
 
 }  // namespace haarcast::net

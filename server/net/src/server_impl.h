@@ -54,6 +54,9 @@ struct Server::Impl {
   boost::asio::steady_timer drainTimer;
   boost::asio::steady_timer refusalSummaryTimer;
   Clock::time_point drainDeadline;
+  // When stop() was first called: the render service's stop grace counts
+  // from here, so SIGTERM's exit is bounded whatever the drain takes.
+  Clock::time_point stopRequested;
   std::uint16_t boundPort = 0;
   std::unique_ptr<RenderService> renderService;
 
@@ -61,6 +64,7 @@ struct Server::Impl {
   ~Impl();
 
   void log(const char* format, ...) __attribute__((format(printf, 2, 3)));
+  RenderService::Options withLog(RenderService::Options o);
   // A refused request from `address`: `line` is written if it is the
   // address's first this period (refusal_log.h); "" counts it only.
   void logRefusal(const std::string& address, const std::string& line);
@@ -73,6 +77,10 @@ struct Server::Impl {
   void watchDrain();
   std::size_t sessionCount();
   bool atCapacity() const;
+  std::optional<std::string> notReadyReason() const;
+  // The render service stopped, its stop grace counted from stop(), and the
+  // threads it left behind logged. After the I/O threads have been joined.
+  void stopRenderService();
   // /metrics: the render service's gauges copied into `metrics`, then the text.
   std::string metricsText();
 };

@@ -36,12 +36,23 @@ class Metrics {
   std::atomic<std::uint64_t> renderersBuilt{0};
   std::atomic<std::uint64_t> renderFailures{0};    // frames that failed to render (each one, said or folded)
   std::atomic<std::uint64_t> framesCancelled{0};   // frame jobs ended without a frame (session gone, request replaced, stop)
+  std::atomic<std::uint64_t> framesAbandoned{0};   // frames past the frame deadline (render_service.h)
   // Gauges of the render service, copied in just before each exposition
   // (Server: the service owns the numbers).
   std::atomic<std::uint64_t> pixelsInFlight{0};    // width × height of the frames rendering now
   std::atomic<std::uint64_t> pixelBudget{0};       // --server-pixel-budget (0 = none)
   std::atomic<std::uint64_t> queuedBuilds{0};      // renderer builds waiting
   std::atomic<std::uint64_t> maxQueuedBuilds{0};   // --max-queued-builds
+  std::atomic<std::uint64_t> renderThreadsStuck{0};  // render threads left behind, not returned
+  std::atomic<double> frameDeadlineSeconds{0.0};   // --frame-deadline (0 = none)
+  // Each device rendered on and whether it is healthy (render_service.h
+  // DeviceStatus), copied in like the gauges above.
+  struct DeviceHealth {
+    std::string backend;
+    std::string device;
+    bool healthy = true;
+  };
+  void setDevices(std::vector<DeviceHealth> devices);
 
   // One frame's stage times (seconds), "encode" included.
   void addStages(const std::vector<render::StageTime>& stages);
@@ -62,6 +73,7 @@ class Metrics {
   mutable std::mutex mutex_;
   std::map<std::string, std::pair<double, std::uint64_t>> stages_;  // name → (sum seconds, count)
   std::map<std::string, std::uint64_t> errors_;
+  std::vector<DeviceHealth> devices_;
   // family name → label value → count
   std::map<std::string, std::map<std::string, std::uint64_t>, std::less<>> labelled_;
   void addLabelled(std::string_view family, std::string_view label);

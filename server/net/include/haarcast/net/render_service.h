@@ -21,8 +21,17 @@
 //              job queued or running, so the queue is a round robin over the
 //              sessions that want a frame: a fast client cannot starve a slow
 //              one. Frames of different sessions render at once, up to the
-//              workers and the server's pixel budget; a renderer that cannot
-//              render concurrently (Vulkan) renders one frame at a time.
+//              workers and the server's pixel budget. Renderers that cannot
+//              render concurrently (Vulkan) take turns per device: one frame
+//              at a time on a device, and a job whose device is busy leaves
+//              its worker free for another session's job.
+//
+// A frame past Options::frameDeadlineSeconds is abandoned (frame_workers.h):
+// its session's `done` gets an error naming the stage it was stuck in and
+// its device, its pixels leave the budget, its worker is replaced (the
+// stuck thread is left behind, detached) and its device turns unhealthy:
+// later jobs for it fail at once, naming the device and why, until every
+// frame abandoned on it has returned.
 //
 // A job asks its session for the request when the worker starts it (not when
 // it was queued), so the frame answers the latest pose. A job is cancelled
@@ -32,6 +41,7 @@
 // frame is compressed.
 #pragma once
 
+#include <chrono>
 #include <cstddef>
 #include <functional>
 #include <memory>
@@ -120,6 +130,27 @@ struct PrepareOutcome {
   std::string error;
 };
 
+// A device the service has rendered on, named by its renderers' backend()
+// and deviceName(): renderers of one backend on one device share its busy
+// flag and its health.
+struct DeviceStatus {
+  std::string backend;  // "cpu" | "vulkan"
+  std::string device;   // Renderer::deviceName()
+  bool healthy = true;  // no frame abandoned on it is still stuck
+  std::string reason;   // unhealthy: the last abandoned frame ("a frame abandoned after 30 s in stage …")
+};
+
+// A render thread left behind: a frame abandoned at its deadline, or still
+// rendering when stop()'s grace ran out, that has not returned (or, with no
+// device, a service thread stop() did not wait for: "between frames", "a
+// renderer build").
+struct StuckRender {
+  std::string backend;
+  std::string device;
+  std::string stage;     // the stage it entered last ("unknown" when its backend named none)
+  double seconds = 0.0;  // since its frame started
+};
+
 class RenderService {
  public:
   struct Options {
@@ -142,6 +173,17 @@ class RenderService {
     // besides one update at each new stage (build_progress.h): about 4 a
     // second, enough for a moving display, few enough for any link.
     double progressIntervalSeconds = 0.25;
+    // A frame rendering longer than this is abandoned (see above); 0 = no
+    // deadline. Far above any legitimate frame (docs/service.md, "Frame
+    // deadline"): it is there to catch a render that never returns.
+    double frameDeadlineSeconds = 300.0;
+    // stop() waits this long for the render threads (and a running build)
+    // to end; those still inside a render then are left behind.
+    double stopGraceSeconds = 1.5;
+    // Lines for the server's log (a frame abandoned, a device healthy
+    // again); empty = none. Called on service threads, never under a lock
+    // the caller could take.
+    std::function<void(const std::string&)> log;
   };
 
   // Throws std::invalid_argument naming an option out of range.
@@ -183,16 +225,23 @@ class RenderService {
   std::size_t queuedBuilds() const;
   std::size_t pixelsInFlight() const;
   bool atPixelBudget() const;
+  // Every device rendered on so far, and the render threads left behind.
+  std::vector<DeviceStatus> devices() const;
+  std::vector<StuckRender> stuckRenders() const;
 
   // Cancels the renders in progress (they end at their next tile or batch
   // boundary, as cancelled) and abandons a running build, drops the queued
   // jobs and prepares (their callbacks destroyed uncalled), joins the
-  // threads. Idempotent.
-  void stop();
+  // threads. A thread still inside a render (or a build) at `graceUntil`
+  // is not waited for: it is left behind, detached (stuckRenders()), and
+  // what it uses stays alive. Idempotent.
+  void stop();  // graceUntil: now + Options::stopGraceSeconds
+  void stop(std::chrono::steady_clock::time_point graceUntil);
 
  private:
   struct Impl;
-  std::unique_ptr<Impl> impl_;
+  // Shared with the service's threads: one left behind keeps what it uses.
+  std::shared_ptr<Impl> impl_;
 };
 
 }  // namespace haarcast::net

@@ -4,7 +4,8 @@
 //                         served_files.txt names, index.html first)
 //   GET /haarcast.proto   the wire contract, for the browser client
 //   GET /healthz          200 "ok" while the process serves (liveness)
-//   GET /readyz           200 "ready", or 503 at capacity or draining (readiness)
+//   GET /readyz           200 "ready", or 503 at capacity, draining, or while
+//                         the default backend's device is unhealthy (readiness)
 //   GET /metrics          Prometheus text (metrics.h)
 //   /ws                   WebSocket: one protobuf message per binary message,
 //                         ClientMessage in, ServerMessage out (proto/haarcast.proto)
@@ -103,7 +104,9 @@ class Server {
   std::uint16_t grpcPort() const;  // the bound gRPC port; 0 without one
 
   // Runs the I/O threads in the background / blocks until stopped and
-  // drained (and the render threads have finished).
+  // drained, and the render threads have finished or, past the render
+  // service's stop grace (counted from stop()), been left behind: each is
+  // logged with its stage (renderThreadsLeft()).
   void start();
   void run();
   // Graceful shutdown, from any thread (a signal handler's strand included):
@@ -114,11 +117,21 @@ class Server {
   // Joins the background threads (after start()).
   void wait();
 
-  // True when a load balancer should send no new clients here (/readyz 503):
-  // the session budget is full, the render service is at its pixel budget
-  // (RenderService::atPixelBudget: a job waits for pixels), or the server is
-  // draining.
+  // True when a load balancer should send no new clients here (/readyz 503,
+  // gRPC health NOT_SERVING): the session budget is full, the render
+  // service is at its pixel budget (RenderService::atPixelBudget: a job
+  // waits for pixels), the server is draining, or a device of the default
+  // backend is unhealthy (a frame abandoned on it has not returned: the
+  // sessions that ask for nothing in particular would get errors).
   bool atCapacity() const;
+  // Why atCapacity(), as /readyz says it ("at capacity", "draining",
+  // "device unhealthy: …"); nullopt when ready.
+  std::optional<std::string> notReadyReason() const;
+
+  // Render threads left behind, inside renders that never returned: after
+  // run(), the process should leave without destructors (they could wait on
+  // those threads inside a driver): `haarcast serve` does.
+  std::size_t renderThreadsLeft() const;
 
   const Metrics& metrics() const;
 

@@ -43,6 +43,7 @@
 #include "haarcast/core/shared_layout.h"
 #include "haarcast/core/sphere_map.h"
 #include "haarcast/io/image.h"
+#include "haarcast/render/frame_stage.h"
 #include "haarcast/render/render_options.h"
 #include "haarcast/render/point_lights.h"
 #include "haarcast/render/scene.h"
@@ -73,6 +74,10 @@ struct FrameRequest {
   // returns a Frame with `cancelled` set. Empty = never cancelled. Called on
   // the render's own threads, so it must be cheap and thread-safe.
   std::function<bool()> cancelled;
+  // Where the frame is, for a watcher on another thread (frame_stage.h):
+  // the backend enters each stage of the table above through
+  // enterFrameStage(request, name). Null = nobody watches.
+  StageMark* stage = nullptr;
 };
 
 struct StageTime {
