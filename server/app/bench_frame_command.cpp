@@ -21,6 +21,7 @@
 #include <nlohmann/json.hpp>
 
 #include "haarcast/gpu/backend.h"
+#include "haarcast/gpu/engine.h"
 #include "list_flags.h"
 #include "progress.h"
 #include "haarcast/render/object_levels.h"
@@ -123,6 +124,9 @@ int run(const BenchArgs& a) {
   out["warmup"] = a.warmup;
   out["runs"] = nlohmann::json::array();
   if (vulkan) {
+    // The process's one instance (gpu/engine.h), made here without
+    // validation: timing, and the layers would dominate (below too).
+    gpu::Engine::get(gpu::EngineOptions{false});
     nlohmann::json devices = nlohmann::json::array();
     for (const auto& d : gpu::listDevices()) {
       devices.push_back({{"index", d.index}, {"name", d.name}, {"type", d.type}, {"api", d.apiVersionText},
