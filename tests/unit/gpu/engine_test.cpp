@@ -70,10 +70,11 @@ GPU_TEST(Engine, QueriesAndContextsBorrowOneInstanceAndOneDevice) {
 // Contexts on the shared device, one per thread, submit at once (the queue
 // is locked around vkQueueSubmit only): each thread's buffer holds its own
 // value after every round. Validation's thread checker reports a queue used
-// from two threads at once, which the fixture turns into a failure.
+// from two threads at once, which the fixture turns into a failure (without
+// the lock: in every one of 10 runs on lavapipe; the race is the checker's to see).
 GPU_TEST(Engine, ContextsSubmitFromManyThreadsAtOnce) {
   HAARCAST_REQUIRE_VULKAN();
-  constexpr int kThreads = 4, kRounds = 40;
+  constexpr int kThreads = 4, kRounds = 200;
   constexpr std::size_t kWords = 4096;
   std::vector<std::string> failures(kThreads);
   std::vector<std::thread> threads;
