@@ -6,6 +6,7 @@
 #include "haarcast/cpu/cpu_renderer.h"
 #if HAARCAST_HAS_VULKAN
 #include "haarcast/gpu/context.h"
+#include "haarcast/gpu/engine.h"
 #include "haarcast/gpu/vulkan_renderer.h"
 #endif
 
@@ -63,10 +64,13 @@ std::unique_ptr<render::Renderer> makeRenderer(std::string_view backend, const r
 #endif
 }
 
-std::vector<DeviceSummary> vulkanDevices() {
+std::vector<DeviceSummary> vulkanDevices(bool validation) {
   std::vector<DeviceSummary> out;
 #if HAARCAST_HAS_VULKAN
-  for (const gpu::DeviceInfo& d : gpu::listDevices()) out.push_back({d.index, d.name, d.type, d.apiVersionText, d.rejected});
+  for (const gpu::DeviceInfo& d : gpu::Engine::get(gpu::EngineOptions{validation}).devices())
+    out.push_back({d.index, d.name, d.type, d.apiVersionText, d.rejected});
+#else
+  static_cast<void>(validation);
 #endif
   return out;
 }

@@ -45,7 +45,9 @@ VulkanRenderer::Impl::Impl(const render::Scene& scene, const render::RenderOptio
 
 VulkanRenderer::Impl::~Impl() {
   VkDevice device = context.device();
-  vkDeviceWaitIdle(device);  // best effort in a destructor
+  // This renderer's own work only (the device is shared with every other
+  // renderer, engine.h): every submission is waited for, unless its wait threw.
+  context.waitIdle();
   releaseResolution();
   if (queries) vkDestroyQueryPool(device, queries, nullptr);
   if (gbufferPool) vkDestroyDescriptorPool(device, gbufferPool, nullptr);

@@ -1,10 +1,11 @@
 // RayScene on Embree 3: one child scene per distinct Mesh, placed by instance
 // geometries in a top-level scene, so that moving an object rebuilds only the
-// (tiny) top level.
+// (tiny) top level; every scene on the process's one Embree device.
 #include "haarcast/render/embree_scene.h"
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -73,6 +74,32 @@ struct SceneDeleter {
 };
 using DeviceHandle = std::unique_ptr<RTCDeviceTy, DeviceDeleter>;
 using SceneHandle = std::unique_ptr<RTCSceneTy, SceneDeleter>;
+
+std::atomic<std::uint64_t> gDevicesCreated{0};  // constant-initialised: counts from the first static on
+
+// The process's Embree device, made on the first RayScene and shared by
+// every one after it. A device is thread-safe (scenes may be built and
+// traced from many threads at once), and each device brings its own task
+// scheduler and memory accounting, so one per scene cost a device per
+// renderer. Error codes stay per thread (Embree keeps one per thread and
+// device) and the callback runs on the failing thread, so tEmbreeMessage
+// still pairs with the code check() reads. Each RayScene retains the device
+// (Embree counts references): this static's release at exit destroys it only
+// once the last scene is gone.
+RTCDevice sharedDevice() {
+  static const DeviceHandle device = [] {
+    // A failed rtcNewDevice reports its error on the null device; the
+    // static is then tried again by the next scene.
+    DeviceHandle d(rtcNewDevice(nullptr));
+    check(nullptr, "rtcNewDevice");
+    if (!d) throw std::runtime_error("Embree: rtcNewDevice returned null");
+    ++gDevicesCreated;
+    rtcSetDeviceErrorFunction(d.get(), recordEmbreeError, nullptr);
+    check(d.get(), "rtcSetDeviceErrorFunction");
+    return d;
+  }();
+  return device.get();
+}
 
 void checkTransform(const glm::mat4& m, std::size_t object) {
   const std::string who = "RayScene: object " + std::to_string(object) + ": ";
@@ -195,12 +222,10 @@ RayScene::RayScene(std::vector<Instance> instances) : impl_(std::make_unique<Imp
   if (instances.size() > RTC_INVALID_GEOMETRY_ID) throw std::invalid_argument("RayScene: too many instances");
 
   Impl& s = *impl_;
-  // A failed rtcNewDevice reports its error on the null device.
-  s.device.reset(rtcNewDevice(nullptr));
-  check(nullptr, "rtcNewDevice");
-  if (!s.device) throw std::runtime_error("Embree: rtcNewDevice returned null");
-  rtcSetDeviceErrorFunction(s.device.get(), recordEmbreeError, nullptr);
-  check(s.device.get(), "rtcSetDeviceErrorFunction");
+  RTCDevice device = sharedDevice();
+  rtcRetainDevice(device);
+  s.device.reset(device);  // released with the scene
+  check(device, "rtcRetainDevice");
 
   s.top.reset(checked(s.device.get(), rtcNewScene(s.device.get()), "rtcNewScene"));
   rtcSetSceneFlags(s.top.get(), RTC_SCENE_FLAG_ROBUST);
@@ -218,6 +243,8 @@ RayScene::RayScene(std::vector<Instance> instances) : impl_(std::make_unique<Imp
   check(s.device.get(), "rtcCommitScene(top)");
   s.chooseOcclusionScene(instances.front().objectToWorld);
 }
+
+std::uint64_t RayScene::devicesCreated() { return gDevicesCreated.load(); }
 
 RayScene::~RayScene() = default;
 RayScene::RayScene(RayScene&&) noexcept = default;

@@ -88,7 +88,7 @@ TracedEdges traceEdges(const render::PreparedScene& prepared, const render::Fram
 // sub-samples (up to a few where the rasteriser and Embree split a
 // silhouette differently), and the same image on the pixels whose samples
 // agree, at the floor of the one-sample frames.
-TEST(Antialias, VulkanMatchesTheCpuBackend) {
+GPU_TEST(Antialias, VulkanMatchesTheCpuBackend) {
   HAARCAST_REQUIRE_VULKAN();
   const render::Scene scene = render::defaultScene();
   render::RenderOptions o = frameOptions(RotationMethod::Fused, true);
@@ -130,7 +130,7 @@ TEST(Antialias, VulkanMatchesTheCpuBackend) {
 // ground's are counted apart: it is flat-shaded (its closed form is the same
 // at every lit point), so an edge pixel whose centre and sub-samples all
 // fall on it in the same light keeps its value exactly.
-TEST(Antialias, ChangesEdgePixelsOnly) {
+GPU_TEST(Antialias, ChangesEdgePixelsOnly) {
   HAARCAST_REQUIRE_VULKAN();
   const render::Scene scene = render::defaultScene();
   render::RenderOptions o = frameOptions(RotationMethod::Fused, true);
@@ -174,7 +174,7 @@ TEST(Antialias, ChangesEdgePixelsOnly) {
 // The exposure chosen on the device (exposure.comp) is the CPU's on the
 // same antialiased frame, for a rotating method (batched, split passes);
 // the bytes are the frame's own linear image encoded at that exposure.
-TEST(Antialias, DeviceAutoExposureMatchesTheCpuOnARotatingMethod) {
+GPU_TEST(Antialias, DeviceAutoExposureMatchesTheCpuOnARotatingMethod) {
   HAARCAST_REQUIRE_VULKAN();
   const render::Scene scene = render::defaultScene();
   render::RenderOptions o = frameOptions(RotationMethod::Haar, true);

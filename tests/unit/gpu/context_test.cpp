@@ -18,7 +18,7 @@
 namespace haarcast::gpu {
 namespace {
 
-TEST(VulkanContext, ErrorsNameTheCallAndTheCode) {
+GPU_TEST(VulkanContext, ErrorsNameTheCallAndTheCode) {
   try {
     vkCheck(VK_ERROR_OUT_OF_DEVICE_MEMORY, "vkAllocateMemory");
     FAIL() << "vkCheck did not throw";
@@ -28,7 +28,7 @@ TEST(VulkanContext, ErrorsNameTheCallAndTheCode) {
   EXPECT_NO_THROW(vkCheck(VK_SUCCESS, "vkCreateDevice"));
 }
 
-TEST(VulkanContext, EveryShaderIsEmbedded) {
+GPU_TEST(VulkanContext, EveryShaderIsEmbedded) {
   for (const char* name : {"rotate_spatial.comp", "rotation_input.comp", "triple_product.comp", "resolve.comp",
                            "exposure.comp", "tonemap.comp", "fused.comp", "splitsum.comp", "shared_layout_check.comp",
                            "shared_functions_check.comp",
@@ -40,7 +40,7 @@ TEST(VulkanContext, EveryShaderIsEmbedded) {
   EXPECT_TRUE(embeddedShader("no_such.comp").empty());
 }
 
-TEST(VulkanContext, ListsDevicesAndSelectsOne) {
+GPU_TEST(VulkanContext, ListsDevicesAndSelectsOne) {
   HAARCAST_REQUIRE_VULKAN();
   const auto devices = listDevices();
   ASSERT_FALSE(devices.empty());
@@ -57,7 +57,7 @@ TEST(VulkanContext, ListsDevicesAndSelectsOne) {
   testing::expectNoValidationMessages(context);
 }
 
-TEST(VulkanContext, UnknownDeviceListsEveryDeviceAndWhy) {
+GPU_TEST(VulkanContext, UnknownDeviceListsEveryDeviceAndWhy) {
   HAARCAST_REQUIRE_VULKAN();
   try {
     Context context(VulkanOptions{"no-such-gpu-xyz", false});
@@ -70,7 +70,7 @@ TEST(VulkanContext, UnknownDeviceListsEveryDeviceAndWhy) {
   }
 }
 
-TEST(VulkanContext, BufferRoundTripAndBoundsCheck) {
+GPU_TEST(VulkanContext, BufferRoundTripAndBoundsCheck) {
   HAARCAST_REQUIRE_VULKAN();
   Context context(testing::testOptions());
   Buffer b(context, 64);
@@ -87,7 +87,7 @@ TEST(VulkanContext, BufferRoundTripAndBoundsCheck) {
 // Device inputs (buffer.h): mapped where the host sees all of device-local
 // memory (lavapipe does), else staged; the staged path, forced on any device,
 // delivers what was written, piece by piece, and refuses host access.
-TEST(VulkanContext, DeviceInputsMappedOrStaged) {
+GPU_TEST(VulkanContext, DeviceInputsMappedOrStaged) {
   HAARCAST_REQUIRE_VULKAN();
   Context direct(testing::testOptions());
   const std::optional<MemoryPlacement> where =

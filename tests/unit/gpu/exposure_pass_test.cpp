@@ -67,7 +67,7 @@ TestFrame testFrame() {
   return f;
 }
 
-TEST(ExposurePass, MetersAsTheCpuForEveryCurveAndControl) {
+GPU_TEST(ExposurePass, MetersAsTheCpuForEveryCurveAndControl) {
   HAARCAST_REQUIRE_VULKAN();
   const TestFrame f = testFrame();
   const std::size_t pixels = f.ids.size();

@@ -58,7 +58,7 @@ struct PassCase {
   int other = 0;  // object 2's level; 0: `level` too
 };
 
-class FusedPass : public ::testing::TestWithParam<PassCase> {};
+class FusedPass : public testing::GpuTestWithParam<PassCase> {};
 
 TEST_P(FusedPass, MatchesCoreFusedShade) {
   HAARCAST_REQUIRE_VULKAN();

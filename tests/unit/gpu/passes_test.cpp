@@ -52,7 +52,7 @@ double maxAbs(std::span<const float> v) {
   return m;
 }
 
-class SpatialRotationPass : public ::testing::TestWithParam<int> {};
+class SpatialRotationPass : public testing::GpuTestWithParam<int> {};
 
 TEST_P(SpatialRotationPass, MatchesTheCpuRotatorCoefficientByCoefficient) {
   HAARCAST_REQUIRE_VULKAN();
@@ -119,7 +119,7 @@ TEST_P(SpatialRotationPass, MatchesTheCpuRotatorCoefficientByCoefficient) {
 
 INSTANTIATE_TEST_SUITE_P(Levels, SpatialRotationPass, ::testing::Values(4, 5));
 
-TEST(TripleProductPass, MatchesCoreTripleProductOnRandomSparseInputs) {
+GPU_TEST(TripleProductPass, MatchesCoreTripleProductOnRandomSparseInputs) {
   HAARCAST_REQUIRE_VULKAN();
   for (const int level : {4, 5}) {
     const std::size_t n = static_cast<std::size_t>(mapSize(level)) * static_cast<std::size_t>(mapSize(level));
@@ -208,7 +208,7 @@ TEST(TripleProductPass, MatchesCoreTripleProductOnRandomSparseInputs) {
 
 // batch_args.comp: every batch's indirect arguments from the covered count,
 // a partial last batch and empty batches after it included.
-TEST(BatchArgsPass, SizesEveryBatchFromTheCoveredCount) {
+GPU_TEST(BatchArgsPass, SizesEveryBatchFromTheCoveredCount) {
   HAARCAST_REQUIRE_VULKAN();
   constexpr std::uint32_t kBatch = 97, kBatches = 7;
   Context context(testing::testOptions());
@@ -240,7 +240,7 @@ TEST(BatchArgsPass, SizesEveryBatchFromTheCoveredCount) {
 }
 
 // Per tone curve (the curve lives in the thresholds the host computes).
-class TonemapPass : public ::testing::TestWithParam<render::ToneCurve> {};
+class TonemapPass : public testing::GpuTestWithParam<render::ToneCurve> {};
 
 TEST_P(TonemapPass, BackdropAndEncodingMatchTheCpuDefinitions) {
   HAARCAST_REQUIRE_VULKAN();
@@ -369,7 +369,7 @@ render::RenderOptions tinyOptions() {
 // G-buffer's point lies on its triangle at its own barycentrics, its
 // normal is the mesh's at them, and it is seen through the pixel's centre
 // to within a small fraction of a pixel; Embree's barycentrics are printed.
-TEST(GBufferPass, CoverageAndSurfacePointsMatchEmbreeAtPixelCentres) {
+GPU_TEST(GBufferPass, CoverageAndSurfacePointsMatchEmbreeAtPixelCentres) {
   HAARCAST_REQUIRE_VULKAN();
   const render::Scene scene = testScene();
   const render::RenderOptions o = tinyOptions();
@@ -440,7 +440,7 @@ TEST(GBufferPass, CoverageAndSurfacePointsMatchEmbreeAtPixelCentres) {
   testing::expectNoValidationMessages(gpu.context());
 }
 
-TEST(RotationInputPass, MatchesRenderRotationInputPerCoveredPixel) {
+GPU_TEST(RotationInputPass, MatchesRenderRotationInputPerCoveredPixel) {
   HAARCAST_REQUIRE_VULKAN();
   const render::Scene scene = testScene();
   VulkanRenderer gpu(scene, tinyOptions(), testing::testOptions());

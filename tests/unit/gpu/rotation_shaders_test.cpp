@@ -267,14 +267,17 @@ MethodRun runMethod(Context& context, RotationMethod method, int level, int thet
 
 constexpr double kBound = 1e-5;  // max|gpu − cpu| / max|c|; see the note above the tests
 
-class RotationShaders : public ::testing::Test {
+class RotationShaders : public testing::GpuTest {
  protected:
   void SetUp() override {
+    testing::GpuTest::SetUp();
     HAARCAST_REQUIRE_VULKAN();
     context_ = std::make_unique<Context>(testing::testOptions());
   }
   void TearDown() override {
     if (context_) testing::expectNoValidationMessages(*context_);
+    context_.reset();  // inside the test: the fixture sees what its destruction reports
+    testing::GpuTest::TearDown();
   }
   void expectEqualsCpu(RotationMethod method, int level, int thetaSamples, int randomCount, double bound,
                        const RotatorOptions& options = {}) {
@@ -359,7 +362,7 @@ std::vector<BrdfSliceTable> smallTables() { return sliceTables(3, 2); }
 
 float wordAsFloat(std::uint32_t w) { return std::bit_cast<float>(w); }
 
-TEST(RotationData, HaarBlockHoldsTheSliceBaseAndEveryPixelDifference) {
+GPU_TEST(RotationData, HaarBlockHoldsTheSliceBaseAndEveryPixelDifference) {
   const BrdfSliceTable table = smallTables().front();
   const int m = mapSize(3);
   std::vector<std::uint32_t> data(5, 7u);  // an earlier object's block
@@ -386,7 +389,7 @@ TEST(RotationData, HaarBlockHoldsTheSliceBaseAndEveryPixelDifference) {
     }
 }
 
-TEST(RotationData, TableBlockHoldsTheCpuRotatorsCopies) {
+GPU_TEST(RotationData, TableBlockHoldsTheCpuRotatorsCopies) {
   const BrdfSliceTable table = smallTables().back();
   RotatorOptions o;
   o.tableElevations = 3;
@@ -404,7 +407,7 @@ TEST(RotationData, TableBlockHoldsTheCpuRotatorsCopies) {
   for (std::size_t k = 0; k < 64; ++k) EXPECT_EQ(wordAsFloat(data[at + k]), copy[k]) << k;
 }
 
-TEST(RotationData, MatrixBlockHoldsTheCpuRotatorsMatrices) {
+GPU_TEST(RotationData, MatrixBlockHoldsTheCpuRotatorsMatrices) {
   const BrdfSliceTable table = smallTables().front();
   RotatorOptions o;
   o.matrixElevations = 3;
@@ -437,7 +440,7 @@ void expectInvalid(F f, const std::string& expected) {
   }
 }
 
-TEST(RotationData, RefusesWhatTheShadersDoNotImplement) {
+GPU_TEST(RotationData, RefusesWhatTheShadersDoNotImplement) {
   const BrdfSliceTable table = smallTables().front();
   std::vector<std::uint32_t> data;
   RotatorOptions local;

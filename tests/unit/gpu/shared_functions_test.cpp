@@ -90,7 +90,7 @@ std::vector<FrameCase> makeCases(const render::ToneThresholds& thresholds) {
   return cases;
 }
 
-TEST(SharedFunctions, ShaderAndCppAgreeOnTheFrameTheDisplayCodeAndTheMeter) {
+GPU_TEST(SharedFunctions, ShaderAndCppAgreeOnTheFrameTheDisplayCodeAndTheMeter) {
   HAARCAST_REQUIRE_VULKAN();
   const render::ToneThresholds thresholds = render::tonemapThresholds(0.7, render::ToneCurve::Reinhard);
   const std::vector<FrameCase> cases = makeCases(thresholds);

@@ -97,7 +97,7 @@ std::array<glm::uvec4, 3> expected(const glm::uvec4& c) {
           glm::uvec4(index, p.band, p.level, (p.i << 16) | p.j)};
 }
 
-TEST(SharedLayout, ShaderAndCppAgreeOnTheHaarNumbersAndTheLookup) {
+GPU_TEST(SharedLayout, ShaderAndCppAgreeOnTheHaarNumbersAndTheLookup) {
   HAARCAST_REQUIRE_VULKAN();
   std::vector<glm::uvec4> cases;
   for (uint n = 1; n <= shared::kFusedMaxLevel; ++n) {

@@ -51,7 +51,7 @@ void expectBackendsAgree(const render::Scene& scene, render::RenderOptions o, re
   testing::expectNoValidationMessages(gpu.context());
 }
 
-class SplitsumFrame : public ::testing::TestWithParam<bool> {};
+class SplitsumFrame : public testing::GpuTestWithParam<bool> {};
 
 TEST_P(SplitsumFrame, VulkanMatchesTheCpuBackendOnTheDefaultScene) {
   HAARCAST_REQUIRE_VULKAN();
@@ -68,7 +68,7 @@ TEST_P(SplitsumFrame, VulkanMatchesTheCpuBackendOnTheDefaultScene) {
 INSTANTIATE_TEST_SUITE_P(Antialias, SplitsumFrame, ::testing::Values(false, true),
                          [](const auto& param) { return std::string(param.param ? "On" : "Off"); });
 
-TEST(SplitsumFrame, VulkanMatchesTheCpuBackendOnANearMirror) {
+GPU_TEST(SplitsumFrame, VulkanMatchesTheCpuBackendOnANearMirror) {
   HAARCAST_REQUIRE_VULKAN();
   render::Scene scene;
   scene.environment = render::builtinEnvironment();

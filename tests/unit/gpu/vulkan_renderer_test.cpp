@@ -80,7 +80,7 @@ void expectBackendsAgree(RotationMethod method, bool background) {
 
 // Every method, with the environment behind the objects (objects and
 // backdrop both compared).
-class WholeFrame : public ::testing::TestWithParam<RotationMethod> {};
+class WholeFrame : public testing::GpuTestWithParam<RotationMethod> {};
 
 TEST_P(WholeFrame, VulkanMatchesTheCpuBackendAbove60dB) {
   HAARCAST_REQUIRE_VULKAN();
@@ -88,7 +88,7 @@ TEST_P(WholeFrame, VulkanMatchesTheCpuBackendAbove60dB) {
 }
 
 // A black background: only the objects' pixels carry light.
-TEST(WholeFrameBlack, VulkanMatchesTheCpuBackendAbove60dB) {
+GPU_TEST(WholeFrameBlack, VulkanMatchesTheCpuBackendAbove60dB) {
   HAARCAST_REQUIRE_VULKAN();
   expectBackendsAgree(RotationMethod::Haar, false);
 }
@@ -112,7 +112,7 @@ render::FrameRequest turnedRequest(const render::Scene& scene, const render::Ren
 // backend's fused frame, levels 4–7, 64×64, environment backdrop. The floor
 // is set below the measured PSNR (docs/gpu.md) with room for device
 // differences; every object pixel must be covered alike.
-class FusedFrame : public ::testing::TestWithParam<int> {};
+class FusedFrame : public testing::GpuTestWithParam<int> {};
 
 TEST_P(FusedFrame, VulkanMatchesTheCpuBackend) {
   HAARCAST_REQUIRE_VULKAN();
@@ -141,7 +141,7 @@ INSTANTIATE_TEST_SUITE_P(Levels, FusedFrame, ::testing::Values(4, 5, 6, 7));
 // Each object at its own level (RenderOptions::automaticLevel): the default
 // scene with a Lambert sphere (the floor, 5) beside its GGX torus (6) and
 // the ground (the floor), in one frame on both backends.
-TEST(FusedFrame, ObjectsAtTheirOwnLevelsMatchTheCpuBackend) {
+GPU_TEST(FusedFrame, ObjectsAtTheirOwnLevelsMatchTheCpuBackend) {
   HAARCAST_REQUIRE_VULKAN();
   render::Scene scene = render::defaultScene();
   scene.objects[0].material = render::materialFromSpec("lambert");
@@ -172,7 +172,7 @@ TEST(FusedFrame, ObjectsAtTheirOwnLevelsMatchTheCpuBackend) {
 // The same with the lobe path (core/lobe.h chooseLobeCore): the sphere a
 // near-mirror the path takes whole, the torus a mirror over a diffuse base
 // it takes the core of, the pass the rest.
-class FusedMirrorFrame : public ::testing::TestWithParam<int> {};
+class FusedMirrorFrame : public testing::GpuTestWithParam<int> {};
 
 TEST_P(FusedMirrorFrame, VulkanMatchesTheCpuBackend) {
   HAARCAST_REQUIRE_VULKAN();
@@ -201,7 +201,7 @@ INSTANTIATE_TEST_SUITE_P(Levels, FusedMirrorFrame, ::testing::Values(4, 5));
 // Auto exposure: the device's frame is metered and exposed as the CPU's
 // (core/shared_exposure.h's rule on its own linear image, the same
 // transform), and eases from a previous exposure by the fraction asked for.
-TEST(VulkanRenderer, AutoExposureMatchesTheCpuBackend) {
+GPU_TEST(VulkanRenderer, AutoExposureMatchesTheCpuBackend) {
   HAARCAST_REQUIRE_VULKAN();
   const render::Scene scene = render::defaultScene();
   const render::RenderOptions o = frameOptions(RotationMethod::Fused, true);
@@ -226,7 +226,7 @@ TEST(VulkanRenderer, AutoExposureMatchesTheCpuBackend) {
 
 // Each tone curve: the device's bytes are its own linear image encoded by
 // the CPU's transform with that curve, at a fixed and at the auto exposure.
-TEST(VulkanRenderer, EveryToneCurveEncodesAsTheCpu) {
+GPU_TEST(VulkanRenderer, EveryToneCurveEncodesAsTheCpu) {
   HAARCAST_REQUIRE_VULKAN();
   const render::Scene scene = render::defaultScene();
   const render::RenderOptions o = frameOptions(RotationMethod::Fused, true);
@@ -256,7 +256,7 @@ TEST(VulkanRenderer, EveryToneCurveEncodesAsTheCpu) {
 // workgroups as samples or 3 that loop over them all, 64 invocations or
 // the default. A frame asked for RGBA8 only reads back no linear image and
 // encodes the same bytes; frames allocate no device memory.
-TEST(VulkanRenderer, FusedDispatchShapeAndReadback) {
+GPU_TEST(VulkanRenderer, FusedDispatchShapeAndReadback) {
   HAARCAST_REQUIRE_VULKAN();
   const render::Scene scene = render::defaultScene();
   const render::RenderOptions o = frameOptions(RotationMethod::Fused, true);
@@ -299,7 +299,7 @@ TEST(VulkanRenderer, FusedDispatchShapeAndReadback) {
 // A fused frame polls the request's cancel before each submission and
 // before the host's shadow rays: cancelled at any of those points it stops
 // with no images, and the next frame is whole.
-TEST(VulkanRenderer, FusedFrameCancelsBetweenItsSubmissions) {
+GPU_TEST(VulkanRenderer, FusedFrameCancelsBetweenItsSubmissions) {
   HAARCAST_REQUIRE_VULKAN();
   const render::Scene scene = render::defaultScene();
   const render::RenderOptions o = frameOptions(RotationMethod::Fused, true);
@@ -355,17 +355,17 @@ void expectStagedInputsChangeNothing(RotationMethod method) {
   testing::expectNoValidationMessages(staged.context());
 }
 
-TEST(VulkanRenderer, StagedInputsChangeNothingFused) {
+GPU_TEST(VulkanRenderer, StagedInputsChangeNothingFused) {
   HAARCAST_REQUIRE_VULKAN();
   expectStagedInputsChangeNothing(RotationMethod::Fused);
 }
 
-TEST(VulkanRenderer, StagedInputsChangeNothingHaar) {
+GPU_TEST(VulkanRenderer, StagedInputsChangeNothingHaar) {
   HAARCAST_REQUIRE_VULKAN();
   expectStagedInputsChangeNothing(RotationMethod::Haar);
 }
 
-TEST(VulkanRenderer, AllocatesDeviceMemoryOncePerResolution) {
+GPU_TEST(VulkanRenderer, AllocatesDeviceMemoryOncePerResolution) {
   HAARCAST_REQUIRE_VULKAN();
   const render::Scene scene = render::defaultScene();
   const render::RenderOptions o = frameOptions(RotationMethod::Spatial, true);
@@ -387,7 +387,7 @@ TEST(VulkanRenderer, AllocatesDeviceMemoryOncePerResolution) {
   testing::expectNoValidationMessages(gpu.context());
 }
 
-TEST(VulkanRenderer, BatchingTheRotationDoesNotChangeTheImage) {
+GPU_TEST(VulkanRenderer, BatchingTheRotationDoesNotChangeTheImage) {
   HAARCAST_REQUIRE_VULKAN();
   const render::Scene scene = render::defaultScene();
   const render::RenderOptions o = frameOptions(RotationMethod::Spatial, false);
@@ -413,7 +413,7 @@ TEST(VulkanRenderer, BatchingTheRotationDoesNotChangeTheImage) {
   testing::expectNoValidationMessages(batched.context());
 }
 
-TEST(VulkanRenderer, RejectsWhatTheGpuCannotDoByName) {
+GPU_TEST(VulkanRenderer, RejectsWhatTheGpuCannotDoByName) {
   HAARCAST_REQUIRE_VULKAN();
   const render::Scene scene = render::defaultScene();
   render::RenderOptions o = frameOptions(RotationMethod::Spatial, false);

@@ -61,8 +61,10 @@ struct DeviceSummary {
   std::string name, type, api;
   std::string rejected;  // empty when usable, else why not
 };
-// The Vulkan devices (empty in a build without Vulkan). Throws when the
-// Vulkan loader cannot list them.
-std::vector<DeviceSummary> vulkanDevices();
+// The Vulkan devices (empty in a build without Vulkan). The first Vulkan
+// use in the process makes its one engine (gpu/engine.h), with the
+// validation layer as `validation` asks; later calls list the same devices.
+// Throws when the Vulkan loader cannot list them.
+std::vector<DeviceSummary> vulkanDevices(bool validation = kValidationByDefault);
 
 }  // namespace haarcast::backends

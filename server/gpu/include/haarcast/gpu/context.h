@@ -1,5 +1,14 @@
-// The Vulkan device every GPU pass runs on: instance, device selection,
-// one queue, memory and one-shot command submission (buffers: buffer.h).
+// A renderer's handle on the Vulkan device every GPU pass runs on: device
+// selection, the device's one queue, memory and one-shot command submission
+// (buffers: buffer.h).
+//
+// The instance and the VkDevice are the process's (engine.h): made once,
+// the device on the first Context that selects it, and lent to every
+// Context. What a Context owns is its own: a command pool, a fence, the
+// count of its allocations and its stageInputs choice. Contexts on one
+// device may submit from different threads at once (the shared queue's
+// submissions are serialised in the engine; each Context waits on its own
+// fence).
 //
 // Selection (no --device): the first usable device in the order discrete GPU,
 // integrated GPU, virtual GPU, CPU device (Mesa's lavapipe), other. A device
@@ -8,6 +17,13 @@
 // substring or an index ("--device 0", "--device llvmpipe") overrides the
 // order; when nothing fits, the error lists each device and why it was
 // rejected.
+//
+// Validation is a property of the process's instance (engine.h): on when
+// the first Vulkan use of the process asked for it (VulkanOptions::validation
+// of the first Context, or EngineOptions) or HAARCAST_VULKAN_VALIDATION=1 is
+// set, and the validation layer is installed. A Context's validation
+// messages are the instance's messages since the Context was made (or last
+// cleared): with several Contexts alive at once, each also sees the others'.
 //
 // Every VkResult is checked where it is returned: vkCheck throws
 // std::runtime_error("vkCreateDevice failed: VK_ERROR_…"), naming the call.
@@ -26,7 +42,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
-#include <mutex>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -46,8 +62,9 @@ struct VulkanOptions {
   // substring of its name; empty = the automatic order above.
   std::string device;
   // VK_LAYER_KHRONOS_validation, when installed (silently off otherwise;
-  // Context::validationEnabled() tells). Any message of severity warning or
-  // error is recorded (Context::validationMessages()).
+  // Context::validationEnabled() tells). It counts only for the first Vulkan
+  // use of the process, which creates the instance (above). Any message of
+  // severity warning or error is recorded (Context::validationMessages()).
   bool validation = kValidationByDefault;
   // Upload MemoryUse::DeviceInput buffers through a staging buffer even
   // where their memory could be mapped (buffer.h): the path of a discrete
@@ -73,9 +90,12 @@ struct DeviceInfo {
 };
 
 // True when a Vulkan loader and at least one physical device exist (what
-// tests use to decide whether to skip).
+// tests use to decide whether to skip). Creates the process's instance
+// (engine.h) if there is none yet, with validation only where
+// kValidationByDefault or the environment asks for it.
 bool vulkanAvailable();
-// Every physical device, usable or not, with the reason it is not.
+// Every physical device, usable or not, with the reason it is not, from the
+// process's instance (created as vulkanAvailable() does).
 // Throws std::runtime_error when no Vulkan instance can be created.
 std::vector<DeviceInfo> listDevices();
 // One line per device: "0: llvmpipe (…) [cpu, Vulkan 1.3.230]" plus the
@@ -83,39 +103,47 @@ std::vector<DeviceInfo> listDevices();
 std::string describeDevices(const std::vector<DeviceInfo>& devices);
 bool validationLayerInstalled();
 
+class SharedDevice;
+
 class Context {
  public:
   // Throws std::runtime_error naming the problem (no device, a failed call).
   explicit Context(const VulkanOptions& options = {});
-  ~Context();
+  ~Context();  // waits for this Context's submission, if one is still in flight
   Context(const Context&) = delete;
   Context& operator=(const Context&) = delete;
 
-  VkInstance instance() const { return instance_; }
-  VkPhysicalDevice physicalDevice() const { return physical_; }
+  VkInstance instance() const;
+  VkPhysicalDevice physicalDevice() const;
   VkDevice device() const { return device_; }
-  VkQueue queue() const { return queue_; }
-  std::uint32_t queueFamily() const { return queueFamily_; }
-  const DeviceInfo& info() const { return info_; }
-  const VkPhysicalDeviceProperties& properties() const { return properties_; }
+  // The device's one queue, shared with every other Context on it: submit
+  // through submit() only (the engine serialises submissions).
+  VkQueue queue() const;
+  std::uint32_t queueFamily() const;
+  const DeviceInfo& info() const;
+  const VkPhysicalDeviceProperties& properties() const;
   // Invocations a subgroup runs together (VkPhysicalDeviceSubgroupProperties):
   // the SIMD width on a CPU device (8 on lavapipe with AVX2).
-  std::uint32_t subgroupSize() const { return subgroupSize_; }
+  std::uint32_t subgroupSize() const;
 
   // Timestamp queries: supported on the queue, and nanoseconds per tick.
-  bool timestampsSupported() const { return timestampValidBits_ > 0 && properties_.limits.timestampPeriod > 0; }
-  double timestampPeriodNs() const { return properties_.limits.timestampPeriod; }
-  std::uint32_t timestampValidBits() const { return timestampValidBits_; }
+  bool timestampsSupported() const { return timestampValidBits() > 0 && properties().limits.timestampPeriod > 0; }
+  double timestampPeriodNs() const { return properties().limits.timestampPeriod; }
+  std::uint32_t timestampValidBits() const;
 
   // Records with `record` into a fresh primary command buffer, submits it and
-  // waits for the queue to finish it.
+  // waits for this Context's fence (not for other Contexts' work).
   void submit(const std::function<void(VkCommandBuffer)>& record);
+  // Waits for a submission of this Context still in flight (one whose wait
+  // threw); what destructors call in place of vkDeviceWaitIdle, which would
+  // wait for every renderer on the device.
+  void waitIdle();
 
   // Memory: the type index for the requirement bits and property flags
   // (preferring `preferred` on top of `required`); throws when none fits.
   std::uint32_t memoryType(std::uint32_t typeBits, VkMemoryPropertyFlags required,
                            VkMemoryPropertyFlags preferred = 0) const;
-  const VkPhysicalDeviceMemoryProperties& memoryProperties() const { return memory_; }
+  const VkPhysicalDeviceMemoryProperties& memoryProperties() const;
   // False when VulkanOptions::stageInputs asks for staged uploads everywhere.
   bool directInputs() const { return directInputs_; }
   // vkAllocateMemory through the context, so that allocations can be counted
@@ -124,31 +152,23 @@ class Context {
   void free(VkDeviceMemory memory);
   std::uint64_t allocationCount() const { return allocations_.load(); }
 
-  bool validationEnabled() const { return messenger_ != VK_NULL_HANDLE; }
-  // Validation warnings and errors seen so far (empty without validation).
+  // Whether the process's instance runs the validation layer.
+  bool validationEnabled() const;
+  // The instance's validation warnings and errors since this Context was
+  // made or last cleared (empty without validation).
   std::vector<std::string> validationMessages() const;
   void clearValidationMessages();
-  void addValidationMessage(std::string message);  // for the debug callback
 
  private:
   void destroy();
-  VkInstance instance_ = VK_NULL_HANDLE;
-  VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
-  VkPhysicalDevice physical_ = VK_NULL_HANDLE;
+  std::shared_ptr<SharedDevice> shared_;  // the process's device: outlives this Context
   VkDevice device_ = VK_NULL_HANDLE;
-  VkQueue queue_ = VK_NULL_HANDLE;
   VkCommandPool pool_ = VK_NULL_HANDLE;
   VkFence fence_ = VK_NULL_HANDLE;
-  std::uint32_t queueFamily_ = 0;
-  std::uint32_t timestampValidBits_ = 0;
-  std::uint32_t subgroupSize_ = 1;
+  bool inFlight_ = false;  // submitted, not yet waited for
   bool directInputs_ = true;
-  DeviceInfo info_;
-  VkPhysicalDeviceProperties properties_{};
-  VkPhysicalDeviceMemoryProperties memory_{};
   std::atomic<std::uint64_t> allocations_{0};
-  mutable std::mutex messagesMutex_;
-  std::vector<std::string> messages_;
+  std::atomic<std::uint64_t> validationMark_{0};  // ValidationLog::count() when made or cleared
 };
 
 }  // namespace haarcast::gpu

@@ -1,5 +1,7 @@
 // Ray casting against one or more meshes, each placed by an object-to-world
-// transform: an RAII wrapper of an Embree 3 device and scene. Used for the
+// transform: an RAII wrapper of an Embree 3 scene. Every RayScene of the
+// process shares one Embree device, made by the first (as the Vulkan
+// backend shares its instance and device, gpu/engine.h). Used for the
 // per-vertex visibility of one object (in its own frame: identity transform)
 // and, later, by the CPU reference renderer and the Monte Carlo reference for
 // scenes of several objects.
@@ -72,6 +74,9 @@ class RayScene {
   RayScene& operator=(const RayScene&) = delete;
 
   std::size_t objectCount() const;
+  // Embree devices this process has made (rtcNewDevice): 1 once any scene
+  // exists, however many; what a test checks.
+  static std::uint64_t devicesCreated();
 
   // Closest hit in [tnear, tfar], or none. Thread-safe.
   std::optional<Hit> intersect(const Ray& ray) const;
