@@ -21,6 +21,7 @@
 #include <nlohmann/json.hpp>
 
 #include "haarcast/backends/backends.h"
+#include "haarcast/core/check.h"
 #include "list_flags.h"
 #include "progress.h"
 #include "haarcast/render/object_levels.h"
@@ -175,7 +176,9 @@ int run(const BenchArgs& a) {
       }
       if (cpuRenderer) out["cpu_device"] = cpuRenderer->deviceName();
       // Each object's level: the choice's, or under `auto` each one's own.
-      const render::Renderer& any = cpuRenderer ? *cpuRenderer : *gpuRenderer;
+      const render::Renderer* first = cpuRenderer ? cpuRenderer.get() : gpuRenderer.get();
+      HC_CHECK_EQ(first != nullptr, true);  // --backend names at least one
+      const render::Renderer& any = *first;
       std::vector<int> objectLevels = any.objectLevels();
       if (objectLevels.empty()) objectLevels.assign(any.objectCount(), options.level);
       const std::string levelCell = choice.automatic ? level + " (" + render::describeLevels(objectLevels) + ")" : level;

@@ -19,7 +19,7 @@
 #include "frame_compare.h"
 #include "gpu_test_util.h"
 #include "haarcast/cpu/cpu_renderer.h"
-#include "haarcast/gpu/backend.h"
+#include "haarcast/gpu/vulkan_renderer.h"
 #include "haarcast/gpu/buffer.h"
 #include "haarcast/gpu/compute.h"
 #include "haarcast/gpu/engine.h"
@@ -141,7 +141,7 @@ GPU_TEST(Engine, TwoHundredRenderersMakeOneInstanceAndOneDevice) {
   double worst = 1e300;
   constexpr int kRenderers = 200;
   for (int i = 0; i < kRenderers; ++i) {
-    const auto renderer = makeRenderer("vulkan", scene, o, testing::testOptions());
+    const auto renderer = makeVulkanRenderer(scene, o, testing::testOptions());
     const testing::Comparison c = testing::compare(reference, renderer->render(request));
     worst = std::min(worst, c.psnr);
     ASSERT_GE(c.psnr, 60.0) << "renderer " << i;
