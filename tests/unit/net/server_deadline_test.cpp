@@ -2,6 +2,7 @@
 // Error names the stage, /readyz turns 503 naming the default backend's
 // device, /metrics counts it, and the server stops within 2 s without
 // joining the stuck thread (frame_workers.h).
+#include <atomic>
 #include <condition_variable>
 #include <memory>
 #include <mutex>
@@ -11,6 +12,10 @@
 
 namespace haarcast::net::test {
 namespace {
+
+// Renders that have reached their hang: a test that needs one stuck waits
+// for this to grow (the pixels are reserved before the render starts).
+std::atomic<int> hangingRenders{0};
 
 // Blocks for ever in stage gbuffer, deaf to cancellation: a hung driver call.
 class HangingRenderer final : public render::Renderer {
@@ -25,6 +30,7 @@ class HangingRenderer final : public render::Renderer {
     render::enterFrameStage(request, "light");
     render::enterFrameStage(request, "gbuffer");
     std::unique_lock lock(mutex_);
+    ++hangingRenders;
     never_.wait(lock, [] { return false; });
     return {};
   }
@@ -85,11 +91,13 @@ TEST(ServerFrameDeadline, StopReturnsWithinTwoSecondsWithARenderStuck) {
   auto server = std::make_unique<Server>(options, testCatalog(render::defaultScene()), hangingBuilder());
   server->start();
   const auto port = server->port();
+  const int before = hangingRenders.load();
   Client c(port);
   c.handshake();
   c.send(pose(1));
   const auto deadline = Clock::now() + 10s;
-  while (metric(port, "haarcast_pixels_in_flight") <= 0 && Clock::now() < deadline) std::this_thread::sleep_for(10ms);
+  while (hangingRenders.load() == before && Clock::now() < deadline) std::this_thread::sleep_for(10ms);
+  ASSERT_GT(hangingRenders.load(), before);  // the render is inside its hang, not about to start
   ASSERT_GT(metric(port, "haarcast_pixels_in_flight"), 0);
   const auto t0 = Clock::now();
   server->stop();
