@@ -19,12 +19,8 @@
 
 namespace haarcast::backends {
 
-// Validation layers by default in debug builds (VulkanOptions::validation).
-#ifdef NDEBUG
-inline constexpr bool kValidationByDefault = false;
-#else
-inline constexpr bool kValidationByDefault = true;
-#endif
+// Validation layers by default in debug builds (render/backend_names.h).
+inline constexpr bool kValidationByDefault = render::kValidationByDefault;
 
 // Which device a device backend (Vulkan) runs on; the CPU backend has none.
 struct DeviceOptions {

@@ -48,14 +48,12 @@
 
 #include <vulkan/vulkan.h>
 
+#include "haarcast/render/backend_names.h"
+
 namespace haarcast::gpu {
 
-// Validation layers by default in debug builds; tests turn them on always.
-#ifdef NDEBUG
-inline constexpr bool kValidationByDefault = false;
-#else
-inline constexpr bool kValidationByDefault = true;
-#endif
+// Validation layers by default in debug builds (render/backend_names.h).
+inline constexpr bool kValidationByDefault = render::kValidationByDefault;
 
 struct VulkanOptions {
   // A device index (as listDevices numbers them) or a case-insensitive
