@@ -1,14 +1,24 @@
 #!/usr/bin/env bash
 # The GPU check (docs/gpu.md, "On a real GPU") on a machine with an NVIDIA
 # driver and none of haarcast's packages: unpacks a bundle made by
-# deploy/gpu_bundle.sh, then runs the GPU unit tests with validation on and
-# bench-frame on the GPU. Each step has its own time limit, so one that
-# hangs still leaves the others' figures.
+# deploy/gpu_bundle.sh (haarcast, haarcast_gpu_tests and vulkaninfo), then
+# runs, each step under its own time limit so that one that hangs still
+# leaves the others' figures:
+#   the device and whether it offers ray queries (vulkaninfo);
+#   every GPU test, validation on, in one process (one engine per process);
+#   bench-frame, Vulkan, fused at 1280×720 and 1920×1080, levels auto and 6;
+#   serve --backend vulkan with 1, 4 and 16 load-test clients at 1280×720;
+#   H.264 at 1920×1080 (libx264 on the CPU: the H100/H200 have no NVENC),
+#   its encode time per frame read from the server's /metrics;
+#   bench-frame with both backends (Vulkan = CPU in dB, and the ratio).
+# A bundle that also holds bin/haarcast.old (an earlier build) runs its
+# bench-frame and load test too, in the same run: ratios against a baseline
+# measured on the same machine.
 #
 #   deploy/gpu_check.sh BUNDLE.tar.xz OUT_DIR [quick]
 #
-# OUT_DIR receives device.txt, gpu_tests.log, bench.log, one JSON file per
-# bench-frame run and the load test's report (at most 8 files).
+# OUT_DIR receives device.txt, vulkaninfo.txt, gpu_tests.log, one JSON file
+# per bench-frame run with bench.log, loadtest logs and reports, metrics.txt.
 set -uo pipefail
 bundle="${1:?usage: deploy/gpu_check.sh BUNDLE.tar.xz OUT_DIR [quick]}"
 out="${2:?usage: deploy/gpu_check.sh BUNDLE.tar.xz OUT_DIR [quick]}"
@@ -16,6 +26,7 @@ mode="${3:-full}"
 mkdir -p "$out" /tmp/hcgpu
 tar -C /tmp/hcgpu -xJf "$bundle" || exit 1
 hc=/tmp/hcgpu/hc
+cache=/tmp/hcgpu/cache
 export LD_LIBRARY_PATH="$hc/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
 export VK_LAYER_PATH="$hc/layers"
 # NVIDIA's Vulkan driver manifest: where the container runtime mounts it, or
@@ -33,61 +44,91 @@ fi
 glx="$(ldconfig -p | awk '/libGLX_nvidia.so.0/ { print $NF; exit }')"
 [[ -n "$glx" ]] || glx="$(find / -xdev -name 'libGLX_nvidia.so.0' -not -path '/proc/*' 2>/dev/null | head -1)"
 [[ -n "$glx" ]] && export LD_LIBRARY_PATH="$LD_LIBRARY_PATH:$(dirname "$glx")"
-step() { echo "==> $*"; }
+step() { echo "==> [$(date +%T), ${SECONDS}s] $*"; }
 
 {
   step "device"
   nvidia-smi --query-gpu=name,driver_version,memory.total,clocks.max.sm --format=csv
   echo "ICD: ${VK_DRIVER_FILES:-none found}; libGLX_nvidia: ${glx:-none found}"
-  [[ -n "${VK_DRIVER_FILES:-}" ]] && cat "$VK_DRIVER_FILES"
-  nproc; uname -r
+  nproc; uname -r; grep -m1 'model name' /proc/cpuinfo
 } 2>&1 | tee "$out/device.txt"
 
-# On the H200 every vkCreateInstance after about 40 in one process failed
-# (VK_ERROR_INCOMPATIBLE_DRIVER; gpu.md, "On a real GPU"), and the tests
-# make one per test: each suite runs in its own process, so all of them
-# run; the suites share HAARCAST_GPU_TEST_SECONDS. Each process's thread
-# count is sampled every 2 s (one suspect of that limit).
-step "GPU unit tests, validation on, a process per suite"
-suites=$("$hc/bin/haarcast_gpu_tests" --gtest_list_tests | awk '/^[^ ]/ && /\.$/ { print $1 }')
-deadline=$((SECONDS + ${HAARCAST_GPU_TEST_SECONDS:-140}))
-: >"$out/gpu_tests.log"
-for suite in $suites; do
-  left=$((deadline - SECONDS))
-  if ((left <= 0)); then echo "out of time before $suite" | tee -a "$out/gpu_tests.log"; break; fi
-  "$hc/bin/haarcast_gpu_tests" --gtest_brief=1 --gtest_filter="${suite}*" >>"$out/gpu_tests.log" 2>&1 &
-  pid=$!
-  ( while kill -0 "$pid" 2>/dev/null; do
-      printf '%s %s\n' "$suite" "$(ls /proc/"$pid"/task 2>/dev/null | wc -l)"; sleep 2
-    done ) >>/tmp/hcgpu/threads.txt &
-  ( sleep "$left"; kill "$pid" 2>/dev/null ) &
-  killer=$!
-  wait "$pid"
-  echo "$suite rc=$?"
-  kill "$killer" 2>/dev/null
-done
-echo "threads per suite process (most seen):" \
-  $(sort -k1,1 -k2,2n /tmp/hcgpu/threads.txt 2>/dev/null | awk '{ m[$1] = $2 } END { for (s in m) printf "%s%s ", s, "=" m[s] }')
-grep -E '^\[  (PASSED|FAILED|SKIPPED)|validation:|G-buffer|PSNR' "$out/gpu_tests.log" | head -80
+step "vulkaninfo: the device and its ray-query support"
+if [[ -x "$hc/bin/vulkaninfo" ]]; then
+  timeout 30 "$hc/bin/vulkaninfo" --summary >"$out/vulkaninfo.txt" 2>&1
+  timeout 30 "$hc/bin/vulkaninfo" 2>/dev/null |
+    grep -iE 'ray_query|rayQuery|acceleration_structure|accelerationStructure +=|ray_tracing|rayTracingPipeline +=' |
+    sort -u | tee -a "$out/vulkaninfo.txt"
+  grep -E 'apiVersion|driverVersion|deviceName|driverName' "$out/vulkaninfo.txt" | head -8
+else
+  echo "no vulkaninfo in the bundle"
+fi
+
+# One process, as CI runs them: step 14 made one VkInstance per process, so
+# every test starts (on the H200 the 41st instance used to fail).
+step "GPU unit tests, validation on, one process"
+timeout "${HAARCAST_GPU_TEST_SECONDS:-150}" "$hc/bin/haarcast_gpu_tests" --gtest_brief=1 >"$out/gpu_tests.log" 2>&1
+echo "rc=$?"
+grep -E '^\[  (PASSED|FAILED|SKIPPED)|^\[==========\]|validation:|Failure|PSNR|dB' "$out/gpu_tests.log" | head -60
 
 bench() {
-  local name="$1" limit="$2"; shift 2
-  step "bench-frame $*"
-  timeout "$limit" "$hc/bin/haarcast" bench-frame --cache-dir /tmp/hcgpu/cache --json "$@" >"$out/$name.json" 2>/tmp/hcgpu/bench.err
+  local name="$1" limit="$2" bin="${BIN:-$hc/bin/haarcast}"; shift 2
+  step "bench-frame $* ($(basename "$bin"))"
+  timeout "$limit" "$bin" bench-frame --cache-dir "$cache" --json "$@" >"$out/$name.json" 2>/tmp/hcgpu/bench.err
   echo "rc=$?"
-  grep -E 'row|error' /tmp/hcgpu/bench.err | tail -12
+  grep -E 'row|error|fps' /tmp/hcgpu/bench.err | tail -12
   cat /tmp/hcgpu/bench.err >>"$out/bench.log"
 }
-frames="${HAARCAST_GPU_FRAMES:-10}"
-bench fused_grid 90 --backend vulkan --method fused --sizes 256,1280x720,1920x1080 --levels 5,6,auto --frames "$frames"
-if [[ "$mode" != quick ]]; then
-  bench both 50 --backend both --method fused --sizes 256,1280x720 --levels 5 --frames "$frames"
-  bench all_720 40 --backend vulkan --method all --sizes 1280x720 --levels 5 --frames 5
-  step "loadtest: serve --backend vulkan, 1 and 4 clients at 1280x720"
-  timeout 40 "$hc/bin/haarcast" loadtest --backend vulkan --methods fused --clients 1,4 --sizes 1280x720 \
-    --encodings jpeg --seconds 4 --cache-dir /tmp/hcgpu/cache --out /tmp/hcgpu/loadtest >"$out/loadtest.log" 2>&1
+frames="${HAARCAST_GPU_FRAMES:-20}"
+bench fused_vulkan 120 --backend vulkan --method fused --sizes 1280x720,1920x1080 --levels auto,6 --frames "$frames"
+old="$hc/bin/haarcast.old"
+[[ -x "$old" ]] && BIN="$old" bench fused_vulkan_old 120 --backend vulkan --method fused --sizes 1280x720,1920x1080 \
+  --levels auto,6 --frames "$frames"
+[[ "$mode" == quick ]] && { ls -la "$out"; exit 0; }
+
+# The service: one server, whose /metrics gives the stage times (the encode
+# stage included) over every frame it served.
+metrics() {
+  exec 3<>/dev/tcp/127.0.0.1/18080 || return 1
+  printf 'GET /metrics HTTP/1.1\r\nHost: localhost\r\nConnection: close\r\n\r\n' >&3
+  timeout 5 cat <&3 | grep -E '^haarcast_(stage_seconds|frames|device)'
+  exec 3<&-
+}
+# Every load-test client comes from 127.0.0.1: the per-address limits
+# admit 16 at once.
+serve() {
+  step "serve --backend vulkan ($(basename "$1"))"
+  "$1" serve --backend vulkan --port 18080 --io-threads 4 --cache-dir "$cache" --quiet --max-pending-per-address 32 \
+    --max-sessions-per-address 32 --max-connections-per-address 64 >"$out/serve$2.log" 2>&1 &
+  server=$!
+  for _ in $(seq 60); do
+    (exec 3<>/dev/tcp/127.0.0.1/18080) 2>/dev/null && break
+    sleep 0.5
+  done
+}
+stop_server() { kill -TERM "$server"; wait "$server"; echo "serve rc=$?"; }
+loadtest() {
+  local name="$1" limit="$2"; shift 2
+  step "loadtest $*"
+  timeout "$limit" "$hc/bin/haarcast" loadtest --url ws://127.0.0.1:18080 --backend vulkan --methods fused \
+    --storage-level 4 --fps-cap 60 --seconds 4 --cache-dir "$cache" --out "/tmp/hcgpu/$name" "$@" \
+    >"$out/$name.log" 2>&1
   echo "rc=$?"
-  cp /tmp/hcgpu/loadtest/report.json "$out/loadtest.json" 2>/dev/null
-  grep -v 's in, about' "$out/loadtest.log" | tail -8
+  cp "/tmp/hcgpu/$name/report.md" "$out/$name.md" 2>/dev/null
+  grep -v 's in, about' "$out/$name.log" | tail -8
+}
+serve "$hc/bin/haarcast" ""
+loadtest loadtest_720 100 --clients 1,4,16 --sizes 1280x720 --encodings jpeg
+metrics >"$out/metrics_720.txt"
+loadtest loadtest_1080_h264 45 --clients 1 --sizes 1920x1080 --encodings h264
+metrics >"$out/metrics.txt"
+grep stage_seconds "$out/metrics.txt"
+stop_server
+if [[ -x "$old" ]]; then
+  serve "$old" _old
+  loadtest loadtest_720_old 100 --clients 1,4,16 --sizes 1280x720 --encodings jpeg
+  stop_server
 fi
+
+bench fused_both 120 --backend both --method fused --sizes 1280x720,1920x1080 --levels 6 --frames 5
 ls -la "$out"

@@ -76,6 +76,11 @@ layout(std430, set = 0, binding = kFusedLobesBinding) readonly buffer Lobes { Sl
 layout(set = 0, binding = kFusedLobeLightTexelsBinding) uniform samplerBuffer lobeLight;
 // The slices as point values at the texel centres (core PixelSlices::pointSlice), laid out as `texels`.
 layout(set = 0, binding = kFusedPointSliceTexelsBinding) uniform samplerBuffer pointTexels;
+// Per object: its samples shaded from one slice (2·object; the ground's
+// samples, which read none, too) and from two (2·object + 1), cleared before
+// the pass; the host counts the coefficient bytes read from them (core
+// fusedPixelBytes) without reading any sample back.
+layout(std430, set = 0, binding = kFusedSliceCountsBinding) buffer SliceCounts { uint sliceCounts[]; };
 
 shared vec3 partial[LOCAL];
 shared vec3 partialSum[LOCAL];  // Σ ΔΩ·ρ_c: the lobe's energy as the directions sample it
@@ -244,6 +249,7 @@ void shadePixel(uint s) {
   // point lights' shadow bits vary.
   if ((o.flags & kObjectGround) != 0u) {
     if (lid == 0u) {
+      atomicAdd(sliceCounts[2u * sh.object], 1u);  // read no slice: counted so that every sample is
       vec3 sum = groundSkyKept(seen) * o.groundRadiance.rgb;
       for (uint k = 0u; k < o.pointLights; ++k) {
         if (((seen >> k) & 1u) != 0u) sum += pointLights[sh.object * kMaxPointLights + k].power.rgb;
@@ -256,6 +262,7 @@ void shadePixel(uint s) {
   const RotationSample rs = samples[s];
   const SliceBlend blend = sliceBlendAt(rs.thetaOut, o.thetaSamples, INTERPOLATE);
   const bool blended = blend.weight != 0.0 && blend.second != blend.first;
+  if (lid == 0u) atomicAdd(sliceCounts[2u * sh.object + (blended ? 1u : 0u)], 1u);
 
   // The lobe path (fused.h LobePath): all of the lobe, with no pass, or
   // its core, with the pass over the rest.

@@ -52,22 +52,29 @@ struct Measured {
   double frameSeconds = 0.0;
   std::size_t coefficientBytes = 0;
   std::size_t covered = 0;
-  render::Frame first;  // the first timed frame, for the comparison
+  render::Frame first;  // an untimed frame with its linear image, for the comparison
 };
 
+// The timed frames are the service's: RGBA8 only (FrameRequest::linearImage
+// false), so the linear image's readback is not in the figures; one
+// untimed frame first brings the linear image and the object mask.
 Measured measure(render::Renderer& r, const render::FrameRequest& request, int frames, int warmup) {
   // Warm-up: first-use allocation and shader variants are not the steady state.
   for (int i = 0; i < warmup; ++i) r.render(request);
   Measured m;
+  render::FrameRequest linear = request;
+  linear.linearImage = true;
+  m.first = r.render(linear);
+  render::FrameRequest timed = request;
+  timed.linearImage = false;
   for (int i = 0; i < frames; ++i) {
-    render::Frame f = r.render(request);
+    render::Frame f = r.render(timed);
     if (m.stages.empty()) {
       for (const auto& s : f.stages) m.stages.emplace_back(s.name, 0.0);
     }
     for (std::size_t k = 0; k < f.stages.size() && k < m.stages.size(); ++k) m.stages[k].second += f.stages[k].seconds / frames;
     m.frameSeconds += f.seconds / frames;
     m.coefficientBytes = f.coefficientBytes;
-    if (i == 0) m.first = std::move(f);
   }
   for (std::uint8_t b : m.first.objectMask) m.covered += b;
   return m;

@@ -1,4 +1,5 @@
 #include "haarcast/gpu/buffer.h"
+#include "haarcast/gpu/compute.h"
 
 #include <algorithm>
 #include <cstring>
@@ -104,6 +105,25 @@ void Buffer::read(void* data, std::size_t bytes, std::size_t offset) const {
   checkRange("Buffer::read", bytes, offset, size_);
   if (!mapped_ && bytes) throw std::logic_error("Buffer::read: the buffer is not host-visible");
   if (bytes) std::memcpy(data, static_cast<const char*>(mapped_) + offset, bytes);
+}
+
+void readBack(Context& context, const Buffer& source, void* data, std::size_t bytes, std::size_t offset) {
+  if (source.mapped() || bytes == 0) {
+    source.read(data, bytes, offset);
+    return;
+  }
+  if (offset > source.size() || bytes > source.size() - offset) {
+    throw std::out_of_range("readBack: " + std::to_string(bytes) + " bytes at " + std::to_string(offset) +
+                            " pass the end of a buffer of " + std::to_string(source.size()));
+  }
+  Buffer copy(context, bytes, kStorageUsage, MemoryUse::Readback);
+  context.submit([&](VkCommandBuffer cb) {
+    computeBarrier(cb);  // after whatever wrote the source, in this queue
+    const VkBufferCopy region{offset, 0, bytes};
+    vkCmdCopyBuffer(cb, source.handle(), copy.handle(), 1, &region);
+    computeBarrier(cb);  // before the host reads
+  });
+  copy.read(data, bytes);
 }
 
 // ---- TexelView ---------------------------------------------------------

@@ -87,8 +87,8 @@ void VulkanRenderer::Impl::releaseResolution() {
   destroyTarget(target);
   destroyTarget(subTarget);
   maskUpload = BufferUpload();
-  for (Buffer* b : {&gbufIds, &gbufNormals, &gbufPositions, &samples, &shade, &counter, &radiance, &rgba8, &rotated,
-                    &radianceOut, &batchArgs, &subIds, &subNormals, &edges, &masks}) {
+  for (Buffer* b : {&gbufIds, &gbufNormals, &gbufPositions, &samples, &shade, &counter, &counterOut, &shadeOut, &radiance,
+                    &rgba8, &rotated, &radianceOut, &idsOut, &batchArgs, &subIds, &subNormals, &edges, &masks}) {
     *b = Buffer();
   }
   width = height = 0;
@@ -103,13 +103,13 @@ void VulkanRenderer::Impl::ensureResolution(int w, int h) {
   const std::size_t pixels = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
   const auto uw = static_cast<std::uint32_t>(w), uh = static_cast<std::uint32_t>(h);
   target = createTarget(uw, uh);
-  // What the host reads back each frame is Readback (cached system memory,
-  // gpu/memory.h): the ids (the object mask), the samples and shading
-  // points the host traces shadow rays from, the counter, the RGBA8 image.
-  gbufIds = Buffer(context, pixels * sizeof(glm::uvec4), kStorageUsage, MemoryUse::Readback);
-  gbufNormals = Buffer(context, pixels * sizeof(glm::vec4));
-  gbufPositions = Buffer(context, pixels * sizeof(glm::vec4));
-  edges = Buffer(context, pixels * sizeof(std::uint32_t));
+  // The passes' own buffers are device-local (DeviceOnly); what the host
+  // reads is a Readback copy (cached system memory, gpu/memory.h): the RGBA8
+  // image, the counter, and on request the linear image and the ids.
+  gbufIds = Buffer(context, pixels * sizeof(glm::uvec4), kStorageUsage, MemoryUse::DeviceOnly);
+  gbufNormals = Buffer(context, pixels * sizeof(glm::vec4), kStorageUsage, MemoryUse::DeviceOnly);
+  gbufPositions = Buffer(context, pixels * sizeof(glm::vec4), kStorageUsage, MemoryUse::DeviceOnly);
+  edges = Buffer(context, pixels * sizeof(std::uint32_t), kStorageUsage, MemoryUse::DeviceOnly);
   if (options.antialias) {
     // The sub-samples: the pixel centres of the frame at twice the resolution (shared_layout.h).
     subTarget = createTarget(2 * uw, 2 * uh);
@@ -121,17 +121,21 @@ void VulkanRenderer::Impl::ensureResolution(int w, int h) {
     subNormals = Buffer(context, sizeof(std::uint32_t), kStorageUsage, MemoryUse::DeviceOnly);
     sampleCapacity = pixels;
   }
-  samples = Buffer(context, sampleCapacity * sizeof(RotationSample), kStorageUsage, MemoryUse::Readback);
-  shade = Buffer(context, sampleCapacity * sizeof(ShadeSample), kStorageUsage, MemoryUse::Readback);
+  samples = Buffer(context, sampleCapacity * sizeof(RotationSample), kStorageUsage, MemoryUse::DeviceOnly);
+  shade = Buffer(context, sampleCapacity * sizeof(ShadeSample), kStorageUsage, MemoryUse::DeviceOnly);
+  // Where the host reads samples: copies of the covered ones (readShadeSamples).
+  shadeOut = Buffer(context, sampleCapacity * sizeof(ShadeSample), kStorageUsage, MemoryUse::Readback);
   // The covered-pixel count and `fused`'s indirect dispatch arguments.
-  counter = Buffer(context, sizeof(CoverageCounter),
-                   VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
-                       VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT,
-                   MemoryUse::Readback);
+  counter = Buffer(context, sizeof(CoverageCounter), kStorageUsage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT,
+                   MemoryUse::DeviceOnly);
+  counterOut = Buffer(context, sizeof(CoverageCounter), kStorageUsage, MemoryUse::Readback);
   // Per pixel, then (antialiasing) per sub-sample slot (shared_layout.h subsampleSlot).
-  radiance = Buffer(context, (options.antialias ? 1 + shared::kSubsamples : 1) * pixels * sizeof(glm::vec4));
+  radiance = Buffer(context, (options.antialias ? 1 + shared::kSubsamples : 1) * pixels * sizeof(glm::vec4),
+                    kStorageUsage, MemoryUse::DeviceOnly);
+  // The one image every frame reads back, written once by the tonemap pass.
   rgba8 = Buffer(context, pixels * sizeof(std::uint32_t), kStorageUsage, MemoryUse::Readback);
   radianceOut = Buffer(context, pixels * sizeof(glm::vec4), kStorageUsage, MemoryUse::Readback);
+  idsOut = Buffer(context, pixels * sizeof(glm::uvec4), kStorageUsage, MemoryUse::Readback);
 
   using namespace shared;  // the passes' binding names (shared_passes.h)
   rotationInput->bind({{kRotationInputFrameBinding, &frameParams},
@@ -150,10 +154,13 @@ void VulkanRenderer::Impl::ensureResolution(int w, int h) {
                  {kResolveRadianceBinding, &radiance},
                  {kResolveBackgroundBinding, &background},
                  {kResolveEdgesBinding, &edges}});
-  exposure->bind({{kExposureFrameBinding, &frameParams},
-                  {kExposureIdsBinding, &gbufIds},
-                  {kExposureRadianceBinding, &radiance},
-                  {kExposureResultBinding, &exposureResult}});
+  for (ComputePipeline* pass : {exposure.get(), exposureReadout.get()}) {
+    pass->bind({{kExposureFrameBinding, &frameParams},
+                {kExposureIdsBinding, &gbufIds},
+                {kExposureRadianceBinding, &radiance},
+                {kExposureResultBinding, &exposureResult},
+                {kExposureHistogramsBinding, &exposureHistograms}});
+  }
   tonemap->bind({{kTonemapFrameBinding, &frameParams},
                  {kTonemapRadianceBinding, &radiance},
                  {kTonemapRgba8Binding, &rgba8},
@@ -189,7 +196,8 @@ void VulkanRenderer::Impl::ensureResolution(int w, int h) {
                      {kFusedSliceEnergyBinding, &sliceEnergy},
                      {kFusedLobesBinding, &lobes},
                      {kFusedLobeLightTexelsBinding, &lobeLightTexels},
-                     {kFusedPointSliceTexelsBinding, &pointSliceTexels}});
+                     {kFusedPointSliceTexelsBinding, &pointSliceTexels},
+                     {kFusedSliceCountsBinding, &sliceCounts}});
     return;
   }
 

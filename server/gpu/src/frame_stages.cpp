@@ -4,6 +4,8 @@
 #include <array>
 #include <vector>
 
+#include "haarcast/core/check.h"
+#include "haarcast/io/image.h"
 #include "haarcast/render/exposure_meter.h"
 #include "haarcast/render/tonemap.h"
 #include "vulkan_renderer_impl.h"
@@ -96,22 +98,69 @@ void VulkanRenderer::Impl::recordTonemap(VkCommandBuffer cb, const render::Frame
   const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
   resolve->dispatch(cb, {groupsOf(pixels, shared::kLocalSize), 1, 1});
   computeBarrier(cb);
+  // The meter: histograms over many workgroups, then one invocation's read-out.
+  vkCmdFillBuffer(cb, exposureHistograms.handle(), 0, VK_WHOLE_SIZE, 0u);
+  computeBarrier(cb);
+  exposure->dispatch(cb, {groupsOf(pixels, shared::kExposureLocalSize * shared::kExposurePixelsPerInvocation), 1, 1});
+  computeBarrier(cb);
   const ExposurePush push = render::exposurePush(request.exposure, request.tone);
-  exposure->dispatch(cb, {1, 1, 1}, &push, sizeof push);  // one workgroup reduces the frame
+  exposureReadout->dispatch(cb, {1, 1, 1}, &push, sizeof push);
   computeBarrier(cb);
   tonemap->dispatch(cb, {groupsOf(pixels, shared::kLocalSize), 1, 1});
+  computeBarrier(cb);
+  // What the host reads: the exposure's outcome, and on request the
+  // pixels' radiance (the first `pixels` entries) and ids (the object mask).
+  const VkBufferCopy result{0, 0, sizeof(ExposureResult)};
+  vkCmdCopyBuffer(cb, exposureResult.handle(), exposureOut.handle(), 1, &result);
   if (request.linearImage) {
-    // The pixels' radiance (the first `pixels` entries) into host memory.
-    computeBarrier(cb);
-    const VkBufferCopy region{0, 0, pixels * sizeof(glm::vec4)};
-    vkCmdCopyBuffer(cb, radiance.handle(), radianceOut.handle(), 1, &region);
-    computeBarrier(cb);
+    const VkBufferCopy image{0, 0, pixels * sizeof(glm::vec4)};
+    vkCmdCopyBuffer(cb, radiance.handle(), radianceOut.handle(), 1, &image);
+    const VkBufferCopy ids{0, 0, pixels * sizeof(glm::uvec4)};
+    vkCmdCopyBuffer(cb, gbufIds.handle(), idsOut.handle(), 1, &ids);
   }
+  computeBarrier(cb);
+}
+
+void VulkanRenderer::Impl::readLinearImage(render::Frame& frame) const {
+  const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  frame.image = io::makeImage(width, height);
+  frame.objectMask.assign(pixels, 0);
+  const auto* rad = static_cast<const glm::vec4*>(radianceOut.mapped());
+  const auto* ids = static_cast<const glm::uvec4*>(idsOut.mapped());
+  for (std::size_t p = 0; p < pixels; ++p) {
+    for (std::size_t c = 0; c < 3; ++c) frame.image.rgb[3 * p + c] = rad[p][static_cast<int>(c)];
+    frame.objectMask[p] = ids[p].x != 0 ? 1 : 0;
+  }
+}
+
+void VulkanRenderer::Impl::recordCounterCopy(VkCommandBuffer cb) {
+  computeBarrier(cb);
+  const VkBufferCopy region{0, 0, sizeof(CoverageCounter)};
+  vkCmdCopyBuffer(cb, counter.handle(), counterOut.handle(), 1, &region);
+}
+
+std::uint32_t VulkanRenderer::Impl::coveredSamples() const {
+  CoverageCounter count{};
+  counterOut.read(&count, sizeof count);
+  HC_CHECK_LE(count.covered, sampleCapacity);  // rotation-input emits at most one sample per slot
+  return count.covered;
+}
+
+const ShadeSample* VulkanRenderer::Impl::readShadeSamples(std::uint32_t covered) {
+  if (covered != 0) {
+    context.submit([&](VkCommandBuffer cb) {
+      computeBarrier(cb);
+      const VkBufferCopy region{0, 0, covered * sizeof(ShadeSample)};
+      vkCmdCopyBuffer(cb, shade.handle(), shadeOut.handle(), 1, &region);
+      computeBarrier(cb);
+    });
+  }
+  return static_cast<const ShadeSample*>(shadeOut.mapped());
 }
 
 void VulkanRenderer::Impl::finishExposure(const render::FrameRequest& request, render::Frame& frame) const {
   ExposureResult r{};
-  exposureResult.read(&r, sizeof r);
+  exposureOut.read(&r, sizeof r);
   frame.logAverageLuminance = r.logAverage;
   // A fixed exposure is reported as asked (the device holds it in float).
   frame.exposureStops = request.exposure.automatic ? static_cast<double>(r.stops) : request.exposure.stops;

@@ -24,12 +24,7 @@
 namespace haarcast::gpu {
 
 std::uint32_t VulkanRenderer::Impl::computeShadowMasks(const render::ResolvedFrame& resolved, const glm::vec3& eye) {
-  CoverageCounter count{};
-  counter.read(&count, sizeof count);
-  if (count.covered > sampleCapacity) {
-    throw std::logic_error("rotation-input reported " + std::to_string(count.covered) + " samples, more than the " +
-                           std::to_string(sampleCapacity) + " the frame can have");
-  }
+  const std::uint32_t covered = coveredSamples();
   const std::size_t objectCount = prepared.objects.size();
   for (std::size_t i = 0; i < objectCount; ++i) rays->setTransform(i, glm::mat4(resolved.objects[i].objectToWorld));
   std::vector<glm::mat4> toWorld;
@@ -38,12 +33,11 @@ std::uint32_t VulkanRenderer::Impl::computeShadowMasks(const render::ResolvedFra
     toWorld.emplace_back(o.objectToWorld);
     rotations.emplace_back(o.rotation);
   }
-  // The samples as rotation-input wrote them (host-visible: `shade` is a
-  // Host buffer), in chunks of samples (parallelFor hands out one index at
-  // a time, under a lock).
-  const auto* sh = static_cast<const ShadeSample*>(shade.mapped());
+  // The samples as rotation-input wrote them, copied to the host, in chunks
+  // of samples (parallelFor hands out one index at a time, under a lock).
+  const ShadeSample* sh = readShadeSamples(covered);
   std::vector<std::uint32_t>& out = maskData;
-  out.resize(count.covered);
+  out.resize(covered);
   constexpr std::size_t kChunk = 256;
   const std::span<const glm::vec3> lightDirections = resolved.pointLightDirections;
   auto pointOf = [&](const ShadeSample& sample) {
@@ -63,7 +57,7 @@ std::uint32_t VulkanRenderer::Impl::computeShadowMasks(const render::ResolvedFra
   const bool groundSky = fused && prepared.ground;
   if (groundSky) {
     std::vector<std::uint32_t> centreOf(pixels, ~0u);
-    for (std::size_t s = 0; s < count.covered; ++s)
+    for (std::size_t s = 0; s < covered; ++s)
       if (sh[s].pixel < pixels && sh[s].object < objectCount) centreOf[sh[s].pixel] = static_cast<std::uint32_t>(s);
     auto ground = [&](std::size_t pixel) {
       const std::uint32_t s = centreOf[pixel];
@@ -78,9 +72,9 @@ std::uint32_t VulkanRenderer::Impl::computeShadowMasks(const render::ResolvedFra
       return pointOf(sh[centreOf[pixel]]);
     }, options.threads);
   }
-  parallelFor((count.covered + kChunk - 1) / kChunk, [&](std::size_t chunk) {
+  parallelFor((covered + kChunk - 1) / kChunk, [&](std::size_t chunk) {
     const std::size_t begin = chunk * kChunk;
-    const std::size_t end = std::min<std::size_t>(count.covered, (chunk + 1) * kChunk);
+    const std::size_t end = std::min<std::size_t>(covered, (chunk + 1) * kChunk);
     // The point lights' rays for the chunk's samples at once, in packets
     // (render::pointLightMasks); samples off every object (a zero normal
     // faces no light) cast none.
@@ -109,7 +103,7 @@ std::uint32_t VulkanRenderer::Impl::computeShadowMasks(const render::ResolvedFra
     }
   }, {}, options.threads);
   if (!out.empty()) maskUpload.write(out.data(), out.size() * sizeof(std::uint32_t));
-  return count.covered;
+  return covered;
 }
 
 render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& request) {
@@ -160,7 +154,10 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
              {"rotation-input",
               [&](VkCommandBuffer cb) {
                 vkCmdFillBuffer(cb, counter.handle(), 0, VK_WHOLE_SIZE, 0u);
+                if (fused) vkCmdFillBuffer(cb, sliceCounts.handle(), 0, VK_WHOLE_SIZE, 0u);
+                computeBarrier(cb);
                 rotationInput->dispatch(cb, {groupsOf(pixels, shared::kLocalSize), 1, 1});
+                recordCounterCopy(cb);
               }}},
             request, frame);
   if (frame.cancelled) return frame;  // stopped between stages: no images
@@ -185,29 +182,26 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
                 maskUpload.record(cb);
                 computeBarrier(cb);
                 fusedPass->dispatchIndirect(cb, counter, offsetof(CoverageCounter, groups));
+                if (fused) {
+                  computeBarrier(cb);
+                  const VkBufferCopy counts{0, 0, sliceCounts.size()};
+                  vkCmdCopyBuffer(cb, sliceCounts.handle(), sliceCountsOut.handle(), 1, &counts);
+                }
               }},
              {"tonemap", [&](VkCommandBuffer cb) { recordTonemap(cb, request); }}},
             request, frame);
   if (frame.cancelled) return frame;
 
-  // ---- Results: RGBA8 always, the linear image only when asked for ----------
+  // ---- Results: RGBA8 always, the linear image and mask only when asked for
   frame.rgba8.resize(pixels * 4);
   rgba8.read(frame.rgba8.data(), frame.rgba8.size());
-  frame.objectMask.assign(pixels, 0);
-  const auto* ids = static_cast<const glm::uvec4*>(gbufIds.mapped());
-  for (std::size_t p = 0; p < pixels; ++p) frame.objectMask[p] = ids[p].x != 0 ? 1 : 0;
-  if (request.linearImage) {
-    frame.image = io::makeImage(width, height);
-    const auto* rad = static_cast<const glm::vec4*>(radianceOut.mapped());
-    for (std::size_t p = 0; p < pixels; ++p) {
-      for (std::size_t c = 0; c < 3; ++c) frame.image.rgb[3 * p + c] = rad[p][static_cast<int>(c)];
-    }
-  }
+  if (request.linearImage) readLinearImage(frame);
   finishExposure(request, frame);
 
   // Coefficient bytes read, counted as the CPU backend counts them: the
   // light, and per shaded sample core fusedPixelBytes (one slice or two, the
   // light planes, the three vertices' visibility words); the ground reads none.
+  // The device counted each object's samples of one slice and of two.
   // splitsum: core splitsumPixelBytes per sample, the ground's too.
   std::size_t bytes = resolved.lightBytes;
   if (splitsum) {
@@ -215,16 +209,18 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
     frame.seconds = secondsSince(start);
     return frame;
   }
-  const auto* rs = static_cast<const RotationSample*>(samples.mapped());
-  const auto* sh = static_cast<const ShadeSample*>(shade.mapped());
-  for (std::uint32_t i = 0; i < covered; ++i) {
-    if (sh[i].object >= objectCount || prepared.objects[sh[i].object].ground) continue;
-    const int objectLevel = prepared.objects[sh[i].object].level;
+  std::vector<std::uint32_t> counts(2 * objectCount);
+  sliceCountsOut.read(counts.data(), counts.size() * sizeof(std::uint32_t));
+  std::size_t counted = 0;
+  for (std::size_t i = 0; i < objectCount; ++i) {
+    counted += std::size_t{counts[2 * i]} + counts[2 * i + 1];
+    if (prepared.objects[i].ground) continue;
+    const int objectLevel = prepared.objects[i].level;
     const std::size_t visibilityBytes = 3 * shared::visibilityWords(static_cast<shared::uint>(objectLevel)) * sizeof(std::uint32_t);
-    const shared::SliceBlend blend =
-        shared::sliceBlendAt(rs[i].thetaOut, static_cast<shared::uint>(options.thetaSamples), options.interpolateSlices ? 1u : 0u);
-    bytes += fusedPixelBytes(objectLevel, blend.weight != 0.0f && blend.second != blend.first, visibilityBytes);
+    bytes += counts[2 * i] * fusedPixelBytes(objectLevel, false, visibilityBytes) +
+             counts[2 * i + 1] * fusedPixelBytes(objectLevel, true, visibilityBytes);
   }
+  HC_CHECK_EQ(counted, std::size_t{covered});  // the pass shaded every covered sample once
   frame.coefficientBytes = bytes;
   frame.seconds = secondsSince(start);
   return frame;

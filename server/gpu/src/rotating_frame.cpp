@@ -53,6 +53,7 @@ render::Frame VulkanRenderer::Impl::renderRotating(const render::FrameRequest& r
     lightUpload.record(cb);  // where the light is staged: its copy into device memory
     computeBarrier(cb);
     rotationInput->dispatch(cb, {groupsOf(pixels, shared::kLocalSize), 1, 1});
+    recordCounterCopy(cb);
     computeBarrier(cb);
     shared::BatchArgsPush sizes{};
     sizes.batch = static_cast<std::uint32_t>(batch);
@@ -76,36 +77,22 @@ render::Frame VulkanRenderer::Impl::renderRotating(const render::FrameRequest& r
   runStages(stages, request, frame);
   if (frame.cancelled) return frame;  // stopped between batches: no images
 
-  std::uint32_t covered = 0;
-  counter.read(&covered, sizeof covered);
-  if (covered > sampleCapacity) {
-    throw std::logic_error("rotation-input reported " + std::to_string(covered) + " samples, more than the " +
-                           std::to_string(sampleCapacity) + " the frame can have");
-  }
+  const std::uint32_t covered = coveredSamples();
   lastBatches = (covered + batch - 1) / batch;
 
   // ---- Results ---------------------------------------------------------------
-  frame.objectMask.assign(pixels, 0);
   frame.rgba8.resize(pixels * 4);
-  {
-    const auto* ids = static_cast<const glm::uvec4*>(gbufIds.mapped());
-    for (std::size_t p = 0; p < pixels; ++p) frame.objectMask[p] = ids[p].x != 0 ? 1 : 0;
-    rgba8.read(frame.rgba8.data(), frame.rgba8.size());
-  }
-  if (request.linearImage) {
-    frame.image = io::makeImage(width, height);
-    const auto* rad = static_cast<const glm::vec4*>(radianceOut.mapped());
-    for (std::size_t p = 0; p < pixels; ++p) {
-      for (std::size_t c = 0; c < 3; ++c) frame.image.rgb[3 * p + c] = rad[p][static_cast<int>(c)];
-    }
-  }
+  rgba8.read(frame.rgba8.data(), frame.rgba8.size());
+  if (request.linearImage) readLinearImage(frame);
   finishExposure(request, frame);
 
   // Coefficient bytes read: the light lists (above), and per covered pixel and
   // channel the rotation's data and the three vertices' visibility lists, in
-  // the GPU's own formats (16-byte blocks).
+  // the GPU's own formats (16-byte blocks). These methods are the
+  // comparisons' (not the service's default), so the samples are copied
+  // back to count them; `fused` counts its bytes on the device.
   {
-    const auto* sh = static_cast<const ShadeSample*>(shade.mapped());
+    const ShadeSample* sh = readShadeSamples(covered);
     for (std::uint32_t i = 0; i < covered; ++i) {
       std::size_t visBlocks = 0;
       for (std::uint32_t v : sh[i].vertex) visBlocks += v < visibilityBlocks.size() ? visibilityBlocks[v] : 0;

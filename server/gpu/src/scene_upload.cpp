@@ -222,6 +222,9 @@ void VulkanRenderer::Impl::uploadScene() {
     pointLightData.assign(objectCount * shared::kMaxPointLights, PointLight{});
     pointLights = Buffer(context, pointLightData.size() * sizeof(PointLight), kStorageUsage, MemoryUse::DeviceInput);
     pointLightUpload = BufferUpload(context, pointLights);
+    // Per object, its samples shaded from one slice and from two (fused.comp).
+    sliceCounts = Buffer(context, 2 * objectCount * sizeof(std::uint32_t), kStorageUsage, MemoryUse::DeviceOnly);
+    sliceCountsOut = Buffer(context, 2 * objectCount * sizeof(std::uint32_t), kStorageUsage, MemoryUse::Readback);
     // The shadow rays' scene: every object (the ground included) at its
     // scene pose, posed per frame (CpuRenderer::makeRays).
     std::vector<Instance> instances;
@@ -232,7 +235,9 @@ void VulkanRenderer::Impl::uploadScene() {
   }
   frameParams = Buffer(context, sizeof(FrameParams));
   thresholds = Buffer(context, sizeof(render::ToneThresholds));
-  exposureResult = Buffer(context, sizeof(ExposureResult), kStorageUsage, MemoryUse::Readback);
+  exposureHistograms = Buffer(context, 2 * shared::kMeterBins * sizeof(std::uint32_t), kStorageUsage, MemoryUse::DeviceOnly);
+  exposureResult = Buffer(context, sizeof(ExposureResult), kStorageUsage, MemoryUse::DeviceOnly);
+  exposureOut = Buffer(context, sizeof(ExposureResult), kStorageUsage, MemoryUse::Readback);
 
   const auto lvl = static_cast<std::uint32_t>(level);
   // Constant 2 is rotate_spatial.comp's local size (the other methods'
@@ -242,8 +247,9 @@ void VulkanRenderer::Impl::uploadScene() {
   if (limits.spatialLocalSize) local = limits.spatialLocalSize;
   rotationInput = std::make_unique<ComputePipeline>(context, "rotation_input.comp", shared::kRotationInputBindings, 0);
   resolve = std::make_unique<ComputePipeline>(context, "resolve.comp", shared::kResolveBindings, 0);
-  exposure =
-      std::make_unique<ComputePipeline>(context, "exposure.comp", shared::kExposureBindings, sizeof(ExposurePush));
+  exposure = std::make_unique<ComputePipeline>(context, "exposure.comp", shared::kExposureBindings, 0);
+  exposureReadout = std::make_unique<ComputePipeline>(context, "exposure_readout.comp", shared::kExposureBindings,
+                                                      sizeof(ExposurePush));
   tonemap = std::make_unique<ComputePipeline>(context, "tonemap.comp", shared::kTonemapBindings, 0);
   if (splitsum) {
     createSplitsumPipeline();

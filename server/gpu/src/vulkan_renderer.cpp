@@ -87,35 +87,33 @@ std::size_t VulkanRenderer::batchesLastFrame() const { return impl_->lastBatches
 
 namespace {
 template <class T>
-std::vector<T> readAll(const Buffer& b, std::size_t count) {
+std::vector<T> readAll(Context& context, const Buffer& b, std::size_t count) {
   std::vector<T> out(count);
-  if (count) b.read(out.data(), count * sizeof(T));
+  readBack(context, b, out.data(), count * sizeof(T));
   return out;
 }
 }  // namespace
 
 std::vector<glm::uvec4> VulkanRenderer::gbufferIds() const {
-  return readAll<glm::uvec4>(impl_->gbufIds, static_cast<std::size_t>(impl_->width) * static_cast<std::size_t>(impl_->height));
+  return readAll<glm::uvec4>(impl_->context, impl_->gbufIds, static_cast<std::size_t>(impl_->width) * static_cast<std::size_t>(impl_->height));
 }
 std::vector<glm::vec4> VulkanRenderer::gbufferNormals() const {
-  return readAll<glm::vec4>(impl_->gbufNormals, static_cast<std::size_t>(impl_->width) * static_cast<std::size_t>(impl_->height));
+  return readAll<glm::vec4>(impl_->context, impl_->gbufNormals, static_cast<std::size_t>(impl_->width) * static_cast<std::size_t>(impl_->height));
 }
 std::vector<glm::vec4> VulkanRenderer::gbufferPositions() const {
-  return readAll<glm::vec4>(impl_->gbufPositions, static_cast<std::size_t>(impl_->width) * static_cast<std::size_t>(impl_->height));
+  return readAll<glm::vec4>(impl_->context, impl_->gbufPositions, static_cast<std::size_t>(impl_->width) * static_cast<std::size_t>(impl_->height));
 }
 std::vector<RotationSample> VulkanRenderer::rotationSamples() const {
-  std::uint32_t covered = 0;
-  if (impl_->counter.handle()) impl_->counter.read(&covered, sizeof covered);
-  return readAll<RotationSample>(impl_->samples, covered);
+  const std::uint32_t covered = impl_->counterOut.handle() ? impl_->coveredSamples() : 0;
+  return readAll<RotationSample>(impl_->context, impl_->samples, covered);
 }
 std::vector<ShadeSample> VulkanRenderer::shadeSamples() const {
-  std::uint32_t covered = 0;
-  if (impl_->counter.handle()) impl_->counter.read(&covered, sizeof covered);
-  return readAll<ShadeSample>(impl_->shade, covered);
+  const std::uint32_t covered = impl_->counterOut.handle() ? impl_->coveredSamples() : 0;
+  return readAll<ShadeSample>(impl_->context, impl_->shade, covered);
 }
 std::vector<std::uint32_t> VulkanRenderer::edgeWords() const {
   if (!impl_->options.antialias) return {};
-  return readAll<std::uint32_t>(impl_->edges, static_cast<std::size_t>(impl_->width) * static_cast<std::size_t>(impl_->height));
+  return readAll<std::uint32_t>(impl_->context, impl_->edges, static_cast<std::size_t>(impl_->width) * static_cast<std::size_t>(impl_->height));
 }
 
 std::unique_ptr<render::Renderer> makeVulkanRenderer(const render::Scene& scene, const render::RenderOptions& options,

@@ -69,8 +69,10 @@ struct VulkanRenderer::Impl {
   std::vector<std::size_t> methodBytesPerChannel;  // per object: method data one rotation reads
   Buffer slices, methodData, positions, normals, triangles, visibility, background;
   Buffer objects, light, frameParams, thresholds;
-  // Auto exposure's outcome (exposure.comp), read by the tonemap pass and the host.
-  Buffer exposureResult;
+  // Auto exposure: the frame's two histograms (exposure.comp, cleared each
+  // frame) and their read-out (exposure_readout.comp), which the tonemap
+  // pass reads on the device and the host from its copy in `exposureOut`.
+  Buffer exposureHistograms, exposureResult, exposureOut;
   // The light is device-local (buffer.h); each frame writes it here and
   // records the copy, where it is staged, ahead of the pass that reads it.
   BufferUpload lightUpload;
@@ -102,8 +104,8 @@ struct VulkanRenderer::Impl {
   std::unique_ptr<RayScene> rays;
 
   // ---- Pipelines ---------------------------------------------------------------
-  std::unique_ptr<ComputePipeline> rotate, rotationInput, tripleProduct, resolve, exposure, tonemap, fusedPass,
-      batchArgsPass;
+  std::unique_ptr<ComputePipeline> rotate, rotationInput, tripleProduct, resolve, exposure, exposureReadout, tonemap,
+      fusedPass, batchArgsPass;
   VkRenderPass renderPass = VK_NULL_HANDLE;
   VkDescriptorSetLayout gbufferSetLayout = VK_NULL_HANDLE;
   VkPipelineLayout gbufferLayout = VK_NULL_HANDLE;
@@ -125,10 +127,22 @@ struct VulkanRenderer::Impl {
   };
   GBufferTarget target;     // the pixel centres
   GBufferTarget subTarget;  // antialiasing: the sub-samples, at twice the resolution
+  // What the passes write and read stays in device-local memory: a GPU's
+  // passes never touch system memory over the bus (on an H100 the counter's
+  // atomics and the samples in system memory made rotation-input 37 ms at
+  // 1080p). The host reads only copies (Readback):
   Buffer gbufIds, gbufNormals, gbufPositions, samples, shade, counter, radiance, rgba8, rotated;
-  // The frame's linear image for the host (Readback), copied from `radiance`
-  // (which the passes keep on the device) only when a request asks for it.
-  Buffer radianceOut;
+  // the covered count and indirect arguments, copied after rotation-input;
+  Buffer counterOut;
+  // the covered samples' ShadeSamples where the host traces their rays or
+  // counts their bytes, copied on demand (readShadeSamples);
+  Buffer shadeOut;
+  // the frame's linear image and G-buffer ids (the object mask), copied
+  // from `radiance` and `gbufIds` only when a request asks for the linear image;
+  Buffer radianceOut, idsOut;
+  // `fused`: per object its samples shaded from one slice and from two
+  // (fused.comp), cleared each frame, and their copy for the bytes-read count.
+  Buffer sliceCounts, sliceCountsOut;
   // `fused`: per covered sample its point-light shadow bits (bit k: sees
   // light k), computed on the host between the frame's two submissions.
   Buffer masks;
@@ -191,6 +205,9 @@ struct VulkanRenderer::Impl {
   void recordTonemap(VkCommandBuffer cb, const render::FrameRequest& request);
   // The exposure the device measured and used (Frame::logAverageLuminance, exposureStops).
   void finishExposure(const render::FrameRequest& request, render::Frame& frame) const;
+  // With the linear image asked for: the image and the object mask from
+  // their copies (recordTonemap).
+  void readLinearImage(render::Frame& frame) const;
   // The stages of a frame, in order: with timestamps, recorded into one
   // command buffer (a timestamp after each) and submitted once; otherwise
   // (a CPU device) one submission per stage, timed on the host. Stages of
@@ -210,6 +227,12 @@ struct VulkanRenderer::Impl {
   // point-light mask (render::pointLightMask against `rays`, posed for this
   // frame) written for the upload. Returns the covered count.
   std::uint32_t computeShadowMasks(const render::ResolvedFrame& resolved, const glm::vec3& eye);
+  // The covered count rotation-input left (counterOut), checked against the capacity.
+  std::uint32_t coveredSamples() const;
+  // The first `covered` ShadeSamples, copied from the device into shadeOut.
+  const ShadeSample* readShadeSamples(std::uint32_t covered);
+  // Records the copy of the counter into counterOut (after rotation-input).
+  void recordCounterCopy(VkCommandBuffer cb);
 
   // rotating_frame.cpp
   render::Frame renderRotating(const render::FrameRequest& request);

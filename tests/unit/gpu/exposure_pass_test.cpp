@@ -1,8 +1,9 @@
-// exposure.comp driven alone against render::meterExposure on the same
-// linear frame: auto exposure's metering (core/shared_exposure.h) counts the
-// same integer histograms on the device as on the CPU, so the highlight bin
-// and the weight agree exactly and the exposure to float rounding, for every
-// tone curve, with and without easing, and for a fixed exposure.
+// exposure.comp and exposure_readout.comp driven alone against
+// render::meterExposure on the same linear frame: auto exposure's metering
+// (core/shared_exposure.h) counts the same integer histograms on the device
+// as on the CPU, so the highlight bin and the weight agree exactly and the
+// exposure to float rounding, for every tone curve, with and without easing,
+// for a fixed exposure, and however many workgroups share the frame.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -76,12 +77,20 @@ GPU_TEST(ExposurePass, MetersAsTheCpuForEveryCurveAndControl) {
   params.width = static_cast<std::uint32_t>(f.width);
   params.height = static_cast<std::uint32_t>(f.height);
   Buffer paramBuf(context, sizeof params), idBuf(context, pixels * 16), radBuf(context, pixels * 16),
-      resultBuf(context, sizeof(ExposureResult));
+      resultBuf(context, sizeof(ExposureResult)), histogramBuf(context, 2 * shared::kMeterBins * sizeof(std::uint32_t));
   paramBuf.write(&params, sizeof params);
   idBuf.upload(std::span<const glm::uvec4>(f.ids));
   radBuf.upload(std::span<const glm::vec4>(f.radiance));
-  ComputePipeline exposure(context, "exposure.comp", shared::kExposureBindings, sizeof(ExposurePush));
-  exposure.bind({&paramBuf, &idBuf, &radBuf, &resultBuf});
+  ComputePipeline exposure(context, "exposure.comp", shared::kExposureBindings, 0);
+  ComputePipeline readout(context, "exposure_readout.comp", shared::kExposureBindings, sizeof(ExposurePush));
+  exposure.bind({&paramBuf, &idBuf, &radBuf, &resultBuf, &histogramBuf});
+  readout.bind({&paramBuf, &idBuf, &radBuf, &resultBuf, &histogramBuf});
+  // The renderer's split (gpu frame_stages.cpp) and others: one workgroup,
+  // and more workgroups than the frame has pixels per invocation.
+  const std::uint32_t natural = static_cast<std::uint32_t>(
+      (pixels + shared::kExposureLocalSize * shared::kExposurePixelsPerInvocation - 1) /
+      (shared::kExposureLocalSize * shared::kExposurePixelsPerInvocation));
+  ASSERT_GE(natural, 2u);  // the frame is split by the renderer's rule
 
   render::ExposureControl eased;
   eased.previousStops = 1.5;
@@ -92,21 +101,30 @@ GPU_TEST(ExposurePass, MetersAsTheCpuForEveryCurveAndControl) {
   const std::vector<MeterCase> cases = {{"auto", {}}, {"eased", eased}, {"fixed", fixed}};
   for (const render::ToneCurve tone : render::kToneCurves) {
     for (const MeterCase& c : cases) {
-      const ExposurePush push = render::exposurePush(c.control, tone);
-      context.submit([&](VkCommandBuffer cb) { exposure.dispatch(cb, {1, 1, 1}, &push, sizeof push); });
-      ExposureResult got{};
-      resultBuf.read(&got, sizeof got);
-      const ExposureResult want = render::meterExposure(f.image, f.mask, c.control, tone);
-      const std::string what = std::string(render::toneCurveName(tone)) + ", " + c.name;
-      ASSERT_GT(want.weight, 0u);
-      EXPECT_EQ(got.weight, want.weight) << what;
-      EXPECT_EQ(got.highlightLog2, want.highlightLog2) << what;
-      // One pixel in a neighbouring bin would move the mean by 1/16 · its
-      // weight / the total weight, ≥ 1e-5 here.
-      EXPECT_NEAR(got.meanLog2, want.meanLog2, 1e-6) << what;
-      EXPECT_NEAR(got.logAverage, want.logAverage, 1e-5 * want.logAverage) << what;
-      EXPECT_NEAR(got.stops, want.stops, 1e-5) << what;
-      EXPECT_NEAR(got.gain, want.gain, 1e-5 * want.gain) << what;
+      for (const std::uint32_t groups : {1u, natural, 7u, 29u}) {
+        const ExposurePush push = render::exposurePush(c.control, tone);
+        context.submit([&](VkCommandBuffer cb) {
+          vkCmdFillBuffer(cb, histogramBuf.handle(), 0, VK_WHOLE_SIZE, 0u);
+          computeBarrier(cb);
+          exposure.dispatch(cb, {groups, 1, 1});
+          computeBarrier(cb);
+          readout.dispatch(cb, {1, 1, 1}, &push, sizeof push);
+        });
+        ExposureResult got{};
+        resultBuf.read(&got, sizeof got);
+        const ExposureResult want = render::meterExposure(f.image, f.mask, c.control, tone);
+        const std::string what =
+            std::string(render::toneCurveName(tone)) + ", " + c.name + ", " + std::to_string(groups) + " workgroups";
+        ASSERT_GT(want.weight, 0u);
+        EXPECT_EQ(got.weight, want.weight) << what;
+        EXPECT_EQ(got.highlightLog2, want.highlightLog2) << what;
+        // One pixel in a neighbouring bin would move the mean by 1/16 · its
+        // weight / the total weight, ≥ 1e-5 here.
+        EXPECT_NEAR(got.meanLog2, want.meanLog2, 1e-6) << what;
+        EXPECT_NEAR(got.logAverage, want.logAverage, 1e-5 * want.logAverage) << what;
+        EXPECT_NEAR(got.stops, want.stops, 1e-5) << what;
+        EXPECT_NEAR(got.gain, want.gain, 1e-5 * want.gain) << what;
+      }
     }
   }
   // The frame is one where the guard acts: the key alone would clip the sky.

@@ -232,11 +232,15 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
                     {{shared::kSpecLocalSize, shared::kLocalSize},
                      {shared::kSpecInterpolate, pc.interpolate ? 1u : 0u},
                      {shared::kSpecPrefilterFinest, static_cast<std::uint32_t>(kPrefilterFinest)}});
+  std::vector<std::uint32_t> sliceCounts(2 * objects.size(), 0u);
+  Buffer sliceCountBuf = upload(sliceCounts.data(), sliceCounts.size() * sizeof(std::uint32_t));
   p.bind({&sampleBuf, &shadeBuf, &objectBuf, &texelView, &lightView, &bitsView, &dirView, &pointBuf, &radiance,
-          &counterBuf, &maskBuf, &energyBuf, &lobeBuf, &prefilterView, &pointTexelView});
+          &counterBuf, &maskBuf, &energyBuf, &lobeBuf, &prefilterView, &pointTexelView, &sliceCountBuf});
   context.submit([&](VkCommandBuffer cb) { p.dispatch(cb, {kGroups, 1, 1}); });
   std::vector<glm::vec4> got(kPixels);
   radiance.read(got.data(), got.size() * sizeof(glm::vec4));
+  sliceCountBuf.read(sliceCounts.data(), sliceCounts.size() * sizeof(std::uint32_t));
+  std::vector<std::uint32_t> wantCounts(2 * objects.size(), 0u);  // per object: samples of one slice, of two
 
   double worst = 0.0, scale = 0.0, lightShare = 0.0;
   std::array<int, 2> lobeSamples{};  // samples all on the path, in part
@@ -250,9 +254,11 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
       for (std::size_t k = 0; k < kLights; ++k)
         if ((masks[i] >> k) & 1u)
           for (std::size_t c = 0; c < 3; ++c) expected[i][c] += pointLights[o][k].power[c];
+      ++wantCounts[2 * o];  // the ground reads no slice: counted as one
       continue;
     }
     const shared::SliceBlend blend = shared::sliceBlendAt(samples[i].thetaOut, kThetaSamples, pc.interpolate ? 1u : 0u);
+    ++wantCounts[2 * o + (blend.weight != 0.0f && blend.second != blend.first ? 1 : 0)];
     const std::array<WeightedBits, 3> vis = {WeightedBits{bits[o].point(3 * i).data(), shade[i].b[0]},
                                              WeightedBits{bits[o].point(3 * i + 1).data(), shade[i].b[1]},
                                              WeightedBits{bits[o].point(3 * i + 2).data(), shade[i].b[2]}};
@@ -288,6 +294,8 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
     }
   }
   EXPECT_GT(groundSamples, 3u);
+  // What the host counts the bytes read from (VulkanRenderer: core fusedPixelBytes).
+  EXPECT_EQ(sliceCounts, wantCounts) << "samples per object of one slice and of two";
   std::printf("lobe path: %d samples all on it, %d in part\n", lobeSamples[0], lobeSamples[1]);
   EXPECT_GT(lobeSamples[0], 3);
   EXPECT_GT(lobeSamples[1], 3);

@@ -5,14 +5,22 @@
 // θₒ and the frame's Euler angles, the nearest slice, the display code, the meter's per-pixel weight
 // and its read-out. Integer results are compared exactly; float ones to a
 // few ulps, which Vulkan lets a device's division, square root and acos
-// differ by.
+// differ by (and a driver may contract a·b + c into one fma). Where θₒ is
+// small the frame's z axis, (wo − (n·wo)n)/|wo − (n·wo)n|, and θₒ itself
+// carry those ulps divided by sin θₒ in either language: there the bound
+// grows as 1/sin θₒ (on an H100, 3.6·10⁻⁴ where lavapipe matches C++ to the bit).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstdio>
 #include <limits>
+#include <map>
 #include <random>
 #include <span>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -135,13 +143,25 @@ GPU_TEST(SharedFunctions, ShaderAndCppAgreeOnTheFrameTheDisplayCodeAndTheMeter) 
   readoutBuf.read(&readout, sizeof readout);
 
   constexpr float kTolerance = 4e-6f;
+  // The ill-conditioned part: 16 float ulps of 1 (2⁻²⁴ each) of error in
+  // wo − (n·wo)n, over its length sin θₒ.
+  constexpr double kConditionedUlps = 16.0 * 0x1p-24;
   std::size_t wrong = 0;
+  std::map<std::string, std::size_t> wrongByKind;
+  double worstFrameShare = 0.0;  // the largest |GLSL − C++| of a frame axis, as a share of its bound
   auto expect = [&](bool ok, std::size_t k, const char* what, float glsl, float cpp) {
-    if (ok || ++wrong > 10) return;
+    if (ok) return;
+    ++wrong;
+    if (++wrongByKind[what] > 3) return;
     ADD_FAILURE() << "case " << k << " " << what << ": GLSL " << glsl << ", C++ " << cpp;
   };
   for (std::size_t k = 0; k < cases.size(); ++k) {
     const FrameCase& c = cases[k];
+    // sin θₒ of the case, in double; the tangent branch (|z| < 10⁻⁸) is exact.
+    const glm::dvec3 dn(c.n), dwo(c.wo);
+    const double sinTheta = glm::length(dwo - glm::dot(dn, dwo) * dn);
+    const float conditioned = sinTheta > 1e-8 ? static_cast<float>(kConditionedUlps / sinTheta) : 0.0f;
+    const float frameTolerance = kTolerance + conditioned;
     const glm::vec3 ray = shared::cameraDirectionAt<float>(glm::vec3(basis[0]), glm::vec3(basis[1]), glm::vec3(basis[2]),
                                                            push.tanHalf, push.aspect, c.point.z, c.point.w, c.point.x,
                                                            c.point.y);
@@ -152,11 +172,15 @@ GPU_TEST(SharedFunctions, ShaderAndCppAgreeOnTheFrameTheDisplayCodeAndTheMeter) 
     float thetaOut = 0.0f;
     const glm::mat3 frame = shared::shadingFrame<float>(glm::vec3(c.n), glm::vec3(c.wo), thetaOut);
     for (int e = 0; e < 3; ++e) {
-      expect(near(got[5 * k + 1][e], frame[0][e], kTolerance), k, "frame x", got[5 * k + 1][e], frame[0][e]);
-      expect(near(got[5 * k + 2][e], frame[2][e], kTolerance), k, "frame z", got[5 * k + 2][e], frame[2][e]);
+      expect(near(got[5 * k + 1][e], frame[0][e], frameTolerance), k, "frame x", got[5 * k + 1][e], frame[0][e]);
+      expect(near(got[5 * k + 2][e], frame[2][e], frameTolerance), k, "frame z", got[5 * k + 2][e], frame[2][e]);
+      for (const auto& [glsl, cpp] : {std::pair(got[5 * k + 1][e], frame[0][e]), std::pair(got[5 * k + 2][e], frame[2][e])}) {
+        const double bound = frameTolerance * (1.0 + std::abs(cpp));
+        worstFrameShare = std::max(worstFrameShare, std::abs(static_cast<double>(glsl) - cpp) / bound);
+      }
     }
     const float deviceTheta = got[5 * k + 1].w;
-    expect(near(deviceTheta, thetaOut, kTolerance), k, "θₒ", deviceTheta, thetaOut);
+    expect(near(deviceTheta, thetaOut, frameTolerance), k, "θₒ", deviceTheta, thetaOut);
     // The slice from the device's own θₒ: the same float in, the same cell out.
     const uint slice = shared::sliceBlendAt(deviceTheta, push.thetaSamples, 0u).first;
     const uint deviceSlice = std::bit_cast<uint>(got[5 * k + 2].w);
@@ -180,7 +204,7 @@ GPU_TEST(SharedFunctions, ShaderAndCppAgreeOnTheFrameTheDisplayCodeAndTheMeter) 
     const glm::dmat3 fromDevice = rotation(euler), fromCpp = rotation(want);
     for (int col = 0; col < 3; ++col) {
       for (int row = 0; row < 3; ++row) {
-        expect(std::abs(fromDevice[col][row] - fromCpp[col][row]) <= 2e-5, k, "R_y(α)R_x(β)R_y(γ)",
+        expect(std::abs(fromDevice[col][row] - fromCpp[col][row]) <= 2e-5 + 2.0 * conditioned, k, "R_y(α)R_x(β)R_y(γ)",
                static_cast<float>(fromDevice[col][row]), static_cast<float>(fromCpp[col][row]));
       }
     }
@@ -188,7 +212,10 @@ GPU_TEST(SharedFunctions, ShaderAndCppAgreeOnTheFrameTheDisplayCodeAndTheMeter) 
     const uint deviceWeight = std::bit_cast<uint>(got[5 * k + 3].y);
     expect(deviceWeight == weight, k, "meter weight", static_cast<float>(deviceWeight), static_cast<float>(weight));
   }
-  EXPECT_EQ(wrong, 0u) << "of " << cases.size() << " cases";
+  std::string kinds;
+  for (const auto& [what, n] : wrongByKind) kinds += " " + what + ": " + std::to_string(n) + ";";
+  EXPECT_EQ(wrong, 0u) << "of " << cases.size() << " cases, by kind:" << kinds;
+  std::printf("shared frame: the frame axes' worst |GLSL − C++| is %.3f of its bound\n", worstFrameShare);
 
   const shared::ExposureResult want = shared::meterReadout(histograms, push.exposure);
   ASSERT_GT(want.weight, 0u);

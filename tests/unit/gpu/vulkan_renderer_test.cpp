@@ -10,11 +10,14 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <glm/geometric.hpp>
 
 #include "frame_compare.h"
 #include "gpu_test_util.h"
+#include "haarcast/core/fused.h"
+#include "haarcast/core/shared_layout.h"
 #include "haarcast/cpu/cpu_renderer.h"
 #include "haarcast/gpu/vulkan_renderer.h"
 #include "haarcast/render/exposure_meter.h"
@@ -166,6 +169,25 @@ GPU_TEST(FusedFrame, ObjectsAtTheirOwnLevelsMatchTheCpuBackend) {
   EXPECT_EQ(c.mismatched, 0u);
   EXPECT_GT(c.objectPixels, 500u);
   expectStagesAndRgba8(b, kFusedStages, request.exposure.stops);
+  // The bytes read, which the device counts per object (one slice or two),
+  // as the host counts them from the frame's own samples: the light, and per
+  // sample of an object (not the ground) core fusedPixelBytes.
+  const std::vector<RotationSample> rs = gpu.rotationSamples();
+  const std::vector<ShadeSample> sh = gpu.shadeSamples();
+  ASSERT_EQ(rs.size(), sh.size());
+  std::size_t bytes = render::resolveFrame(gpu.prepared(), o, request).lightBytes, ground = 0;
+  for (std::size_t i = 0; i < sh.size(); ++i) {
+    const render::PreparedObject& p = gpu.prepared().objects.at(sh[i].object);
+    if (p.ground) {
+      ++ground;
+      continue;
+    }
+    const shared::SliceBlend blend = shared::sliceBlendAt(rs[i].thetaOut, static_cast<shared::uint>(o.thetaSamples), 1u);
+    const std::size_t visibilityBytes = 3 * shared::visibilityWords(static_cast<shared::uint>(p.level)) * sizeof(std::uint32_t);
+    bytes += fusedPixelBytes(p.level, blend.weight != 0.0f && blend.second != blend.first, visibilityBytes);
+  }
+  EXPECT_GT(ground, 0u);
+  EXPECT_EQ(b.coefficientBytes, bytes);
   testing::expectNoValidationMessages(gpu.context());
 }
 
@@ -255,7 +277,8 @@ GPU_TEST(VulkanRenderer, EveryToneCurveEncodesAsTheCpu) {
 // The fused dispatch's shape does not change a bit of the image: as many
 // workgroups as samples or 3 that loop over them all, 64 invocations or
 // the default. A frame asked for RGBA8 only reads back no linear image and
-// encodes the same bytes; frames allocate no device memory.
+// no mask, and encodes the same bytes at the same exposure; frames allocate
+// no device memory.
 GPU_TEST(VulkanRenderer, FusedDispatchShapeAndReadback) {
   HAARCAST_REQUIRE_VULKAN();
   const render::Scene scene = render::defaultScene();
@@ -285,10 +308,13 @@ GPU_TEST(VulkanRenderer, FusedDispatchShapeAndReadback) {
   request.linearImage = false;
   const render::Frame c = whole.render(request);
   EXPECT_TRUE(c.image.rgb.empty());
+  EXPECT_TRUE(c.objectMask.empty()) << "the mask comes back with the linear image only";
   EXPECT_EQ(c.rgba8, a.rgba8);
-  EXPECT_EQ(c.objectMask, a.objectMask);
+  EXPECT_EQ(c.exposureStops, a.exposureStops);
+  EXPECT_EQ(c.coefficientBytes, a.coefficientBytes);
   EXPECT_EQ(whole.context().allocationCount(), allocations) << "a fused frame allocated device memory";
   // An empty frame (the camera looks away): the indirect dispatch has no groups.
+  request.linearImage = true;
   request.camera.target = lookingAway(scene.camera);
   const render::Frame d = whole.render(request);
   EXPECT_EQ(std::count(d.objectMask.begin(), d.objectMask.end(), 1), 0);

@@ -20,9 +20,12 @@ HC_CONST uint kLocalSize = 64u;
 // The host's pick for those passes and for `fused` on a GPU, and the
 // default of the rotation shaders that declare one.
 HC_CONST uint kGpuLocalSize = 256u;
-// exposure.comp: one workgroup of the least maxComputeWorkGroupInvocations
-// Vulkan guarantees.
+// exposure.comp: workgroups of the least maxComputeWorkGroupInvocations
+// Vulkan guarantees, each invocation metering about
+// kExposurePixelsPerInvocation pixels (a 1920×1080 frame: 1013 workgroups,
+// each adding its shared histograms' non-empty bins to the frame's once).
 HC_CONST uint kExposureLocalSize = 128u;
+HC_CONST uint kExposurePixelsPerInvocation = 16u;
 
 // ---- Specialization constants: the ids the shaders declare them at
 // (layout(constant_id = …)) and the host sets them by (gpu::SpecConstant).
@@ -105,12 +108,14 @@ HC_CONST uint kResolveBackgroundBinding = 3u;
 HC_CONST uint kResolveEdgesBinding = 4u;
 HC_CONST uint kResolveBindings = 5u;
 
-// exposure.comp
+// exposure.comp (the histograms, many workgroups) and exposure_readout.comp
+// (one invocation: the histograms read out into the result)
 HC_CONST uint kExposureFrameBinding = 0u;
 HC_CONST uint kExposureIdsBinding = 1u;
 HC_CONST uint kExposureRadianceBinding = 2u;
 HC_CONST uint kExposureResultBinding = 3u;
-HC_CONST uint kExposureBindings = 4u;
+HC_CONST uint kExposureHistogramsBinding = 4u;
+HC_CONST uint kExposureBindings = 5u;
 
 // tonemap.comp
 HC_CONST uint kTonemapFrameBinding = 0u;
@@ -158,7 +163,8 @@ HC_CONST uint kFusedSliceEnergyBinding = 11u;
 HC_CONST uint kFusedLobesBinding = 12u;
 HC_CONST uint kFusedLobeLightTexelsBinding = 13u;
 HC_CONST uint kFusedPointSliceTexelsBinding = 14u;
-HC_CONST uint kFusedBindings = 15u;
+HC_CONST uint kFusedSliceCountsBinding = 15u;
+HC_CONST uint kFusedBindings = 16u;
 
 // splitsum.comp; kSplitsumLobeLightTexelsBinding is a uniform texel
 // buffer, the rest storage buffers (gpu::splitsumBindings).

@@ -71,6 +71,12 @@ class Buffer {
   bool staged_ = false;
 };
 
+// Bytes of any buffer to the host: from its mapping where it has one, else
+// copied through a temporary Readback buffer in one submission of its own.
+// For tests and inspection, not for a frame's path (which keeps its
+// Readback copies and records their copies in the frame's own submission).
+void readBack(Context& context, const Buffer& source, void* data, std::size_t bytes, std::size_t offset = 0);
+
 // Host data into a buffer: straight into its mapping where it has one, else
 // into a staging buffer (host-visible, the target's size, allocated once
 // here) whose written range record() copies over. Keep one for the life of

@@ -67,7 +67,8 @@ struct FrameRequest {
   // The RGBA8 image's tone curve (tonemap.h).
   ToneCurve tone = ToneCurve::Reinhard;
   // false: the caller needs only rgba8 (an encoder), so a backend may skip
-  // reading the linear image back (Frame::image is then empty).
+  // reading the linear image and the object mask back (Frame::image and
+  // Frame::objectMask may then be empty).
   bool linearImage = true;
   // Polled at every tile (CPU: a row of a pass) or batch (Vulkan: a
   // submission) boundary; once it returns true the render stops there and
@@ -90,7 +91,7 @@ struct Frame {
   int height = 0;
   io::RgbImage image;                 // linear radiance, for EXR and exact checks (empty if not requested)
   std::vector<std::uint8_t> rgba8;    // tonemapped, row 0 at the top, 4 bytes per pixel
-  std::vector<std::uint8_t> objectMask;  // 1 where an object was hit
+  std::vector<std::uint8_t> objectMask;  // 1 where an object was hit (with the linear image; may be empty without)
   std::vector<StageTime> stages;      // in pipeline order
   double seconds = 0.0;               // wall time of render()
   std::size_t coefficientBytes = 0;   // coefficient data read this frame (slices, light, visibility, method tables)
