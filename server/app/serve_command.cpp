@@ -49,6 +49,7 @@ struct ServeArgs {
   std::string materialsDir, webRoot, protoFile, cacheDir, vulkanDevice;
   render::SceneLimits sceneLimits;
   bool vulkanValidation = false, quiet = false;
+  std::size_t framesInFlight = 0;
   unsigned renderThreads = 0;
   long long serverPixelBudget = -1;  // -1: 2 × --max-session-pixels
 };
@@ -173,7 +174,7 @@ int run(ServeArgs& a) {
   base.cacheDir = cacheDirFromFlag(a.cacheDir);
   base.sceneLimits = a.sceneLimits;
   base.threads = a.renderThreads;
-  const backends::DeviceOptions vulkanOptions{a.vulkanDevice, a.vulkanValidation};
+  const backends::DeviceOptions vulkanOptions{a.vulkanDevice, a.vulkanValidation, a.framesInFlight};
   auto sharedScenes = std::make_shared<std::vector<SceneSource>>(std::move(scenes));
   const bool quiet = a.quiet;
   const std::string antialias = a.antialias;
@@ -353,6 +354,12 @@ std::function<int()> addServeCommand(CLI::App& app) {
       ->capture_default_str();
   c->add_option("--vulkan-device", a->vulkanDevice, "Vulkan device name substring");
   c->add_flag("--vulkan-validation", a->vulkanValidation, "Enable the Vulkan validation layers");
+  c->add_option("--frames-in-flight", a->framesInFlight,
+                "Frames a Vulkan renderer may render at once, each with its own device buffers (the scene uploaded once "
+                "per frame in flight): while one frame's host stages run, another's passes run on the device. "
+                "0 = 1 on a CPU device (lavapipe), 2 on a GPU")
+      ->check(CLI::Range(0, 16))
+      ->capture_default_str();
   c->add_flag("--quiet", a->quiet, "No per-session log lines on stderr");
   return [c, a]() { return c->parsed() ? run(*a) : -1; };
 }

@@ -57,7 +57,9 @@ std::unique_ptr<render::Renderer> makeRenderer(std::string_view backend, const r
   gpu::VulkanOptions vulkan;
   vulkan.device = device.device;
   vulkan.validation = device.validation;
-  return gpu::makeVulkanRenderer(scene, options, vulkan, progress);
+  gpu::VulkanRendererLimits limits;
+  limits.framesInFlight = device.framesInFlight;
+  return gpu::makeVulkanRenderer(scene, options, vulkan, progress, limits);
 #else
   static_cast<void>(device);
   throw std::logic_error("backend " + std::string(backend) + " passed checkBuilt but has no factory");

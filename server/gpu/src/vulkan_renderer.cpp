@@ -3,6 +3,7 @@
 
 #include "haarcast/gpu/vulkan_renderer.h"
 
+#include <algorithm>
 #include <stdexcept>
 #include <string>
 
@@ -70,20 +71,62 @@ render::Frame VulkanRenderer::Impl::render(const render::FrameRequest& request) 
 
 VulkanRenderer::VulkanRenderer(const render::Scene& scene, const render::RenderOptions& options,
                                const VulkanOptions& vulkan, const render::RenderProgress& progress,
-                               const VulkanRendererLimits& limits)
-    : impl_(std::make_unique<Impl>(scene, options, vulkan, progress, limits)) {}
+                               const VulkanRendererLimits& limits) {
+  slots_.push_back(std::make_unique<Impl>(scene, options, vulkan, progress, limits));
+  std::size_t slots = limits.framesInFlight;
+  if (slots == 0) slots = slots_.front()->context.info().type == "cpu" ? 1 : 2;
+  // Every further slot prepares the same scene (from the cache the first
+  // one filled, where there is one) and compiles the same pipelines (the
+  // driver's cache), then uploads its own copy.
+  while (slots_.size() < slots) slots_.push_back(std::make_unique<Impl>(scene, options, vulkan, progress, limits));
+  busy_.assign(slots_.size(), false);
+}
 
 VulkanRenderer::~VulkanRenderer() = default;
 
-std::string VulkanRenderer::deviceName() const { return impl_->context.info().name; }
-const render::RenderOptions& VulkanRenderer::options() const { return impl_->options; }
-std::size_t VulkanRenderer::objectCount() const { return impl_->prepared.objects.size(); }
-std::vector<int> VulkanRenderer::objectLevels() const { return impl_->prepared.objectLevels(); }
-render::Frame VulkanRenderer::render(const render::FrameRequest& request) { return impl_->render(request); }
-Context& VulkanRenderer::context() { return impl_->context; }
-const render::PreparedScene& VulkanRenderer::prepared() const { return impl_->prepared; }
-std::size_t VulkanRenderer::batchSamples() const { return impl_->batch; }
-std::size_t VulkanRenderer::batchesLastFrame() const { return impl_->lastBatches; }
+VulkanRenderer::Impl& VulkanRenderer::last() const {
+  std::lock_guard lock(mutex_);
+  return *slots_[last_];
+}
+
+render::Frame VulkanRenderer::render(const render::FrameRequest& request) {
+  std::size_t slot = 0;
+  {
+    std::unique_lock lock(mutex_);
+    freed_.wait(lock, [&] { return std::find(busy_.begin(), busy_.end(), false) != busy_.end(); });
+    slot = static_cast<std::size_t>(std::find(busy_.begin(), busy_.end(), false) - busy_.begin());
+    busy_[slot] = true;
+    peak_ = std::max(peak_, ++inFlight_);
+  }
+  struct Release {
+    VulkanRenderer& r;
+    std::size_t slot;
+    ~Release() {
+      {
+        std::lock_guard lock(r.mutex_);
+        r.busy_[slot] = false;
+        --r.inFlight_;
+        r.last_ = slot;
+      }
+      r.freed_.notify_one();
+    }
+  } release{*this, slot};
+  return slots_[slot]->render(request);
+}
+
+std::size_t VulkanRenderer::peakFramesInFlight() const {
+  std::lock_guard lock(mutex_);
+  return peak_;
+}
+
+std::string VulkanRenderer::deviceName() const { return slots_.front()->context.info().name; }
+const render::RenderOptions& VulkanRenderer::options() const { return slots_.front()->options; }
+std::size_t VulkanRenderer::objectCount() const { return slots_.front()->prepared.objects.size(); }
+std::vector<int> VulkanRenderer::objectLevels() const { return slots_.front()->prepared.objectLevels(); }
+Context& VulkanRenderer::context() { return last().context; }
+const render::PreparedScene& VulkanRenderer::prepared() const { return slots_.front()->prepared; }
+std::size_t VulkanRenderer::batchSamples() const { return last().batch; }
+std::size_t VulkanRenderer::batchesLastFrame() const { return last().lastBatches; }
 
 namespace {
 template <class T>
@@ -95,30 +138,33 @@ std::vector<T> readAll(Context& context, const Buffer& b, std::size_t count) {
 }  // namespace
 
 std::vector<glm::uvec4> VulkanRenderer::gbufferIds() const {
-  return readAll<glm::uvec4>(impl_->context, impl_->gbufIds, static_cast<std::size_t>(impl_->width) * static_cast<std::size_t>(impl_->height));
+  return readAll<glm::uvec4>(last().context, last().gbufIds, static_cast<std::size_t>(last().width) * static_cast<std::size_t>(last().height));
 }
 std::vector<glm::vec4> VulkanRenderer::gbufferNormals() const {
-  return readAll<glm::vec4>(impl_->context, impl_->gbufNormals, static_cast<std::size_t>(impl_->width) * static_cast<std::size_t>(impl_->height));
+  return readAll<glm::vec4>(last().context, last().gbufNormals, static_cast<std::size_t>(last().width) * static_cast<std::size_t>(last().height));
 }
 std::vector<glm::vec4> VulkanRenderer::gbufferPositions() const {
-  return readAll<glm::vec4>(impl_->context, impl_->gbufPositions, static_cast<std::size_t>(impl_->width) * static_cast<std::size_t>(impl_->height));
+  return readAll<glm::vec4>(last().context, last().gbufPositions, static_cast<std::size_t>(last().width) * static_cast<std::size_t>(last().height));
 }
 std::vector<RotationSample> VulkanRenderer::rotationSamples() const {
-  const std::uint32_t covered = impl_->counterOut.handle() ? impl_->coveredSamples() : 0;
-  return readAll<RotationSample>(impl_->context, impl_->samples, covered);
+  Impl& impl = last();
+  const std::uint32_t covered = impl.counterOut.handle() ? impl.coveredSamples() : 0;
+  return readAll<RotationSample>(impl.context, impl.samples, covered);
 }
 std::vector<ShadeSample> VulkanRenderer::shadeSamples() const {
-  const std::uint32_t covered = impl_->counterOut.handle() ? impl_->coveredSamples() : 0;
-  return readAll<ShadeSample>(impl_->context, impl_->shade, covered);
+  Impl& impl = last();
+  const std::uint32_t covered = impl.counterOut.handle() ? impl.coveredSamples() : 0;
+  return readAll<ShadeSample>(impl.context, impl.shade, covered);
 }
 std::vector<std::uint32_t> VulkanRenderer::edgeWords() const {
-  if (!impl_->options.antialias) return {};
-  return readAll<std::uint32_t>(impl_->context, impl_->edges, static_cast<std::size_t>(impl_->width) * static_cast<std::size_t>(impl_->height));
+  if (!last().options.antialias) return {};
+  return readAll<std::uint32_t>(last().context, last().edges, static_cast<std::size_t>(last().width) * static_cast<std::size_t>(last().height));
 }
 
 std::unique_ptr<render::Renderer> makeVulkanRenderer(const render::Scene& scene, const render::RenderOptions& options,
-                                                     const VulkanOptions& vulkan, const render::RenderProgress& progress) {
-  return std::make_unique<VulkanRenderer>(scene, options, vulkan, progress);
+                                                     const VulkanOptions& vulkan, const render::RenderProgress& progress,
+                                                     const VulkanRendererLimits& limits) {
+  return std::make_unique<VulkanRenderer>(scene, options, vulkan, progress, limits);
 }
 
 }  // namespace haarcast::gpu

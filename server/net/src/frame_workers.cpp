@@ -98,7 +98,9 @@ std::optional<FrameWorkers::Queued> FrameWorkers::pickLocked(std::vector<RenderJ
       it = queue_.erase(it);
       continue;
     }
-    if (device.busy && !it->job.renderer->renderer->concurrentRenders()) {
+    const render::Renderer& renderer = *it->job.renderer->renderer;
+    const std::size_t slots = renderer.framesInFlight();
+    if ((slots == 1 && device.busy) || (slots > 1 && slotsInUse(renderer) >= slots)) {
       ++it;
       continue;
     }
@@ -112,6 +114,11 @@ std::optional<FrameWorkers::Queued> FrameWorkers::pickLocked(std::vector<RenderJ
     return next;
   }
   return std::nullopt;
+}
+
+std::size_t FrameWorkers::slotsInUse(const render::Renderer& renderer) const {
+  const auto it = rendering_.find(&renderer);
+  return it == rendering_.end() ? 0 : it->second;
 }
 
 // What a job holds of the budget from its start: its declared pixels (a
@@ -139,8 +146,11 @@ void FrameWorkers::workerLoop(const std::shared_ptr<Worker>& w) {
       }
       if (next) {
         w->device = next->device;
-        w->holdsDevice = !next->job.renderer->renderer->concurrentRenders();
+        const render::Renderer& renderer = *next->job.renderer->renderer;
+        w->holdsDevice = renderer.framesInFlight() == 1;
         if (w->holdsDevice) w->device->busy = true;
+        w->slotOf = renderer.framesInFlight() > 1 ? &renderer : nullptr;
+        if (w->slotOf) ++rendering_[w->slotOf];
         w->charge = chargeOf(next->job);
         pixelsInFlight_ += w->charge;
       }
@@ -236,6 +246,8 @@ bool FrameWorkers::release(Worker& w) {
   std::lock_guard lock(mutex_);
   if (w.holdsDevice) w.device->busy = false;
   w.holdsDevice = false;
+  if (w.slotOf && --rendering_[w.slotOf] == 0) rendering_.erase(w.slotOf);
+  w.slotOf = nullptr;
   pixelsInFlight_ -= w.charge;
   w.charge = 0;
   if (!w.abandoned) return true;

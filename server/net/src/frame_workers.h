@@ -2,9 +2,12 @@
 // threads, the server's pixel budget, the devices and the frame deadline.
 //
 //   devices   Renderers are grouped by device (backend() + deviceName()).
-//             Renderers that cannot render concurrently (Vulkan) take turns
-//             on their device's one busy flag; a job whose device is busy is
-//             passed over, so it never holds a worker while it waits.
+//             Renderers of one frame at a time (framesInFlight() 1: Vulkan
+//             on a CPU device) take turns on their device's one busy flag;
+//             a renderer of K frames in flight (Vulkan on a GPU) has up to K
+//             of its frames rendering, whatever else is on its device. A job
+//             that may not start yet is passed over, so it never holds a
+//             worker while it waits, and a stuck device holds at most K workers.
 //   deadline  A watchdog thread abandons a frame rendering longer than
 //             Options::frameDeadlineSeconds: its session's `done` gets an
 //             error naming the stage the frame was in (render::StageMark)
@@ -84,6 +87,7 @@ class FrameWorkers : public std::enable_shared_from_this<FrameWorkers> {
     RenderJob* job = nullptr;               // the job rendering now (on the thread's stack)
     Device* device = nullptr;
     bool holdsDevice = false;               // holds device->busy
+    const void* slotOf = nullptr;           // the renderer whose frame slot it holds (K frames in flight)
     std::size_t charge = 0;                 // its share of the pixel budget
     Clock::time_point started;              // its render's start
   };
@@ -93,6 +97,7 @@ class FrameWorkers : public std::enable_shared_from_this<FrameWorkers> {
   void spawnLocked();
   std::optional<Queued> pickLocked(std::vector<RenderJob>& dropped, std::vector<Failed>& failed);
   std::size_t chargeOf(const RenderJob& job) const;
+  std::size_t slotsInUse(const render::Renderer& renderer) const;  // under mutex_
   void render(Worker& w, RenderJob& job, Clock::time_point submitted);
   bool claim(Worker& w);
   bool release(Worker& w);
@@ -111,6 +116,7 @@ class FrameWorkers : public std::enable_shared_from_this<FrameWorkers> {
   std::condition_variable exitCv_;   // a worker's loop ended, for stop()
   std::deque<Queued> queue_;
   std::map<std::pair<std::string, std::string>, Device> devices_;  // by (backend, name); never erased
+  std::map<const void*, std::size_t> rendering_;  // frames rendering per renderer of K > 1 frames in flight (0: erased)
   std::size_t pixelsInFlight_ = 0;
   bool budgetWait_ = false;          // the oldest startable job waits for the budget
   std::atomic<bool> stopping_{false};

@@ -5,11 +5,15 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <cstdio>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -320,6 +324,52 @@ GPU_TEST(VulkanRenderer, FusedDispatchShapeAndReadback) {
   EXPECT_EQ(std::count(d.objectMask.begin(), d.objectMask.end(), 1), 0);
   testing::expectNoValidationMessages(whole.context());
   testing::expectNoValidationMessages(looped.context());
+}
+
+// Two frames in flight (VulkanRendererLimits::framesInFlight): two threads
+// render at once, each in its own slot, and each frame is the one a renderer
+// of one slot makes of the same request. Each frame's first cancel poll waits
+// (bounded) until the other frame has polled too: were the frames rendered
+// one after the other, the first would wait in vain.
+GPU_TEST(VulkanRenderer, TwoFramesInFlightRenderAtOnceAndAsOne) {
+  HAARCAST_REQUIRE_VULKAN();
+  const render::Scene scene = render::defaultScene();
+  const render::RenderOptions o = frameOptions(RotationMethod::Fused, true);
+  VulkanRenderer one(scene, o, testing::testOptions());
+  VulkanRendererLimits two;
+  two.framesInFlight = 2;
+  VulkanRenderer slotted(scene, o, testing::testOptions(), {}, two);
+  ASSERT_EQ(slotted.framesInFlight(), 2u);
+  ASSERT_TRUE(slotted.concurrentRenders());
+  render::FrameRequest a = requestFor(scene, 40, 40), b = turnedRequest(scene, o);
+  b.width = b.height = 40;
+  std::mutex m;
+  std::condition_variable cv;
+  int started = 0, metTheOther = 0;
+  auto waitForTheOther = [&] {
+    std::unique_lock lock(m);
+    ++started;
+    cv.notify_all();
+    if (cv.wait_for(lock, std::chrono::seconds(10), [&] { return started >= 2; })) ++metTheOther;
+    return false;  // never cancelled
+  };
+  render::FrameRequest ca = a, cb = b;
+  std::once_flag fa, fb;
+  ca.cancelled = [&] { std::call_once(fa, waitForTheOther); return false; };
+  cb.cancelled = [&] { std::call_once(fb, waitForTheOther); return false; };
+  render::Frame ga, gb;
+  std::thread t([&] { ga = slotted.render(ca); });
+  gb = slotted.render(cb);
+  t.join();
+  EXPECT_EQ(metTheOther, 2) << "each frame saw the other inside render() at its first poll";
+  EXPECT_EQ(slotted.peakFramesInFlight(), 2u);
+  const render::Frame wa = one.render(a), wb = one.render(b);
+  EXPECT_EQ(ga.image.rgb, wa.image.rgb);
+  EXPECT_EQ(gb.image.rgb, wb.image.rgb);
+  EXPECT_EQ(ga.rgba8, wa.rgba8);
+  EXPECT_EQ(gb.rgba8, wb.rgba8);
+  EXPECT_NE(ga.rgba8, gb.rgba8) << "the two requests are different views";
+  testing::expectNoValidationMessages(one.context());
 }
 
 // A fused frame polls the request's cancel before each submission and

@@ -67,12 +67,15 @@ SessionConfig config(int level) {
 class ScriptedRenderer final : public render::Renderer {
  public:
   using Body = std::function<void(const render::FrameRequest&, render::Frame&)>;
-  ScriptedRenderer(bool concurrent, Body body) : concurrent_(concurrent), body_(std::move(body)) {}
+  // slots: framesInFlight() (0: the interface's default for `concurrent`).
+  ScriptedRenderer(bool concurrent, Body body, std::size_t slots = 0)
+      : concurrent_(concurrent), body_(std::move(body)), slots_(slots) {}
   std::string backend() const override { return "scripted"; }
   std::string deviceName() const override { return "scripted device"; }
   const render::RenderOptions& options() const override { return options_; }
   std::size_t objectCount() const override { return 1; }
   bool concurrentRenders() const override { return concurrent_; }
+  std::size_t framesInFlight() const override { return slots_ ? slots_ : render::Renderer::framesInFlight(); }
   render::Frame render(const render::FrameRequest& request) override {
     render::Frame f;
     f.width = request.width;
@@ -86,11 +89,12 @@ class ScriptedRenderer final : public render::Renderer {
   render::RenderOptions options_;
   bool concurrent_;
   Body body_;
+  std::size_t slots_;
 };
 
-std::shared_ptr<PreparedRenderer> scripted(bool concurrent, ScriptedRenderer::Body body) {
+std::shared_ptr<PreparedRenderer> scripted(bool concurrent, ScriptedRenderer::Body body, std::size_t slots = 0) {
   auto p = std::make_shared<PreparedRenderer>();
-  p->renderer = std::make_unique<ScriptedRenderer>(concurrent, std::move(body));
+  p->renderer = std::make_unique<ScriptedRenderer>(concurrent, std::move(body), slots);
   return p;
 }
 
@@ -266,6 +270,47 @@ TEST(RenderService, FramesOfTwoSessionsRenderAtOnce) {
   ASSERT_TRUE(waitUntil([&] { return log.get().size() == 2; }, 10s));
   std::lock_guard lock(m);
   EXPECT_EQ(most, 2);
+}
+
+// A renderer of two frames in flight (a Vulkan renderer on a GPU) gets two
+// workers at once, never three: the others' jobs wait without a worker.
+TEST(RenderService, ARendererOfTwoFramesInFlightRendersTwoAtOnceAndNoMore) {
+  Metrics metrics;
+  std::mutex m;
+  std::condition_variable cv;
+  int inside = 0, most = 0;
+  bool open = false;
+  auto slotted = scripted(
+      true,
+      [&](const render::FrameRequest&, render::Frame&) {
+        std::unique_lock lock(m);
+        most = std::max(most, ++inside);
+        cv.notify_all();
+        cv.wait_for(lock, 5s, [&] { return open; });
+        --inside;
+      },
+      2);
+  RenderService::Options options;
+  options.workers = 4;
+  RenderService service([&](const SessionConfig&) { return slotted; }, options, metrics);
+  JobLog log;
+  for (const char* name : {"a", "b", "c", "d"}) service.submit(job(slotted, 8, 8, log, name));
+  ASSERT_TRUE(waitUntil([&] {
+    std::lock_guard lock(m);
+    return inside == 2;
+  }));
+  std::this_thread::sleep_for(50ms);  // a third would have started by now
+  EXPECT_EQ(service.queued(), 2u);    // waiting without a worker
+  {
+    std::lock_guard lock(m);
+    EXPECT_EQ(inside, 2);
+    open = true;
+  }
+  cv.notify_all();
+  ASSERT_TRUE(waitUntil([&] { return log.get().size() == 4; }, 10s));
+  std::lock_guard lock(m);
+  EXPECT_EQ(most, 2);
+  for (const std::string& e : log.get()) EXPECT_NE(e.find("frame"), std::string::npos) << e;
 }
 
 TEST(RenderService, ThePixelBudgetHoldsAJobUntilAnotherFinishes) {

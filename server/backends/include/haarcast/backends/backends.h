@@ -8,6 +8,7 @@
 // The names themselves are render/backend_names.h.
 #pragma once
 
+#include <cstddef>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -29,6 +30,9 @@ struct DeviceOptions {
   std::string device;
   // The Vulkan validation layer, when installed.
   bool validation = kValidationByDefault;
+  // Vulkan: frames one renderer may have in flight at once
+  // (gpu::VulkanRendererLimits::framesInFlight; 0 = 1 on a CPU device, 2 on a GPU).
+  std::size_t framesInFlight = 0;
 };
 
 // True when this build has `name` (one of render::kBackendNames).

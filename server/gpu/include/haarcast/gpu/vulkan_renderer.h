@@ -33,9 +33,11 @@
 // an unchanged resolution allocates no device memory.
 #pragma once
 
+#include <condition_variable>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -61,6 +63,12 @@ struct VulkanRendererLimits {
   // GPUs, at most the device's limit).
   std::uint32_t fusedLocalSize = 0;
   std::uint32_t fusedGroups = 0;
+  // Frames that may render at once, each with its own device buffers,
+  // command buffers and host scratch (the scene's data is uploaded once per
+  // frame in flight too): 0 = 1 on a CPU device (lavapipe's frames share
+  // its cores), 2 on a GPU. While one frame's host stages run (the light,
+  // the shadow rays, the encoding after it), another's passes run on the device.
+  std::size_t framesInFlight = 0;
 };
 
 class VulkanRenderer final : public render::Renderer {
@@ -77,9 +85,15 @@ class VulkanRenderer final : public render::Renderer {
   const render::RenderOptions& options() const override;
   std::size_t objectCount() const override;
   std::vector<int> objectLevels() const override;
+  bool concurrentRenders() const override { return slots_.size() > 1; }
+  std::size_t framesInFlight() const override { return slots_.size(); }
+  // Waits for a free frame slot (one of framesInFlight()), renders in it.
   render::Frame render(const render::FrameRequest& request) override;
+  // The most frames that have rendered at once so far.
+  std::size_t peakFramesInFlight() const;
 
   // ---- For tests and diagnostics: the last frame's intermediate data -----
+  // (of the slot that finished a frame last; call between frames)
   Context& context();
   const render::PreparedScene& prepared() const;
   // G-buffer per pixel: (object + 1 or 0, triangle, u bits, v bits), the
@@ -98,11 +112,18 @@ class VulkanRenderer final : public render::Renderer {
 
  private:
   struct Impl;
-  std::unique_ptr<Impl> impl_;
+  Impl& last() const;
+  // One Impl per frame in flight; `busy_` and `last_` under mutex_.
+  std::vector<std::unique_ptr<Impl>> slots_;
+  mutable std::mutex mutex_;
+  std::condition_variable freed_;
+  std::vector<bool> busy_;
+  std::size_t last_ = 0, inFlight_ = 0, peak_ = 0;
 };
 
 std::unique_ptr<render::Renderer> makeVulkanRenderer(const render::Scene& scene, const render::RenderOptions& options,
                                                      const VulkanOptions& vulkan,
-                                                     const render::RenderProgress& progress = {});
+                                                     const render::RenderProgress& progress = {},
+                                                     const VulkanRendererLimits& limits = {});
 
 }  // namespace haarcast::gpu

@@ -115,9 +115,13 @@ class Renderer {
   virtual std::vector<int> objectLevels() const { return {}; }
   // Whether render() may run on several threads at once. The CPU backend's
   // prepared data is immutable and each call keeps its own scratch, so it
-  // may; a Vulkan renderer owns one set of device buffers and may not (the
-  // server then serialises its frames).
+  // may; a Vulkan renderer owns one set of device buffers per frame in
+  // flight, and may when it has more than one (framesInFlight()).
   virtual bool concurrentRenders() const { return false; }
+  // How many render() calls may run at once: 0 = any number, 1 = one at a
+  // time (the server then makes the frames of the renderer's device take
+  // turns), K = up to K (a caller past K waits inside render()).
+  virtual std::size_t framesInFlight() const { return concurrentRenders() ? 0 : 1; }
   // One frame. Unless concurrentRenders(), one at a time per renderer.
   // Throws std::invalid_argument naming what was wrong (resolution outside
   // 1..8192, pose count ≠ object count, …).
