@@ -18,7 +18,11 @@
 #   deploy/gpu_check.sh BUNDLE.tar.xz OUT_DIR [quick]
 #
 # OUT_DIR receives device.txt, vulkaninfo.txt, gpu_tests.log, one JSON file
-# per bench-frame run with bench.log, loadtest logs and reports, metrics.txt.
+# per bench-frame run with bench.log, loadtest logs and reports, metrics.txt:
+# give it the device tool's $OUT, so that a run cut short still returns what
+# it wrote (and expect at most 8 files back: tar the folder if asked for more).
+# HAARCAST_GPU_SECONDS (default 400) is the whole run's budget: a step whose
+# own limit no longer fits in what is left is skipped and says so.
 set -uo pipefail
 bundle="${1:?usage: deploy/gpu_check.sh BUNDLE.tar.xz OUT_DIR [quick]}"
 out="${2:?usage: deploy/gpu_check.sh BUNDLE.tar.xz OUT_DIR [quick]}"
@@ -45,6 +49,10 @@ glx="$(ldconfig -p | awk '/libGLX_nvidia.so.0/ { print $NF; exit }')"
 [[ -n "$glx" ]] || glx="$(find / -xdev -name 'libGLX_nvidia.so.0' -not -path '/proc/*' 2>/dev/null | head -1)"
 [[ -n "$glx" ]] && export LD_LIBRARY_PATH="$LD_LIBRARY_PATH:$(dirname "$glx")"
 step() { echo "==> [$(date +%T), ${SECONDS}s] $*"; }
+budget="${HAARCAST_GPU_SECONDS:-400}"
+fits() {  # fits LIMIT: whether a step of LIMIT seconds fits in the budget left
+  if ((SECONDS + $1 > budget)); then echo "skipped: ${1}s would pass the ${budget}s budget (${SECONDS}s spent)"; return 1; fi
+}
 
 {
   step "device"
@@ -74,6 +82,7 @@ grep -E '^\[  (PASSED|FAILED|SKIPPED)|^\[==========\]|validation:|Failure|PSNR|d
 bench() {
   local name="$1" limit="$2" bin="${BIN:-$hc/bin/haarcast}"; shift 2
   step "bench-frame $* ($(basename "$bin"))"
+  fits "$limit" || return 0
   timeout "$limit" "$bin" bench-frame --cache-dir "$cache" --json "$@" >"$out/$name.json" 2>/tmp/hcgpu/bench.err
   echo "rc=$?"
   grep -E 'row|error|fps' /tmp/hcgpu/bench.err | tail -12
@@ -82,7 +91,7 @@ bench() {
 frames="${HAARCAST_GPU_FRAMES:-20}"
 bench fused_vulkan 120 --backend vulkan --method fused --sizes 1280x720,1920x1080 --levels auto,6 --frames "$frames"
 old="$hc/bin/haarcast.old"
-[[ -x "$old" ]] && BIN="$old" bench fused_vulkan_old 120 --backend vulkan --method fused --sizes 1280x720,1920x1080 \
+[[ -x "$old" ]] && BIN="$old" bench fused_vulkan_old 60 --backend vulkan --method fused --sizes 1280x720,1920x1080 \
   --levels auto,6 --frames "$frames"
 [[ "$mode" == quick ]] && { ls -la "$out"; exit 0; }
 
@@ -97,8 +106,8 @@ metrics() {
 # Every load-test client comes from 127.0.0.1: the per-address limits
 # admit 16 at once.
 serve() {
-  step "serve --backend vulkan ($(basename "$1"))"
-  "$1" serve --backend vulkan --port 18080 --io-threads 4 --cache-dir "$cache" --quiet --max-pending-per-address 32 \
+  step "serve --backend vulkan ($(basename "$1")) ${3:-}"
+  "$1" serve --backend vulkan ${3:-} --port 18080 --io-threads 4 --cache-dir "$cache" --quiet --max-pending-per-address 32 \
     --max-sessions-per-address 32 --max-connections-per-address 64 >"$out/serve$2.log" 2>&1 &
   server=$!
   for _ in $(seq 60); do
@@ -110,6 +119,7 @@ stop_server() { kill -TERM "$server"; wait "$server"; echo "serve rc=$?"; }
 loadtest() {
   local name="$1" limit="$2"; shift 2
   step "loadtest $*"
+  fits "$limit" || return 0
   timeout "$limit" "$hc/bin/haarcast" loadtest --url ws://127.0.0.1:18080 --backend vulkan --methods fused \
     --storage-level 4 --fps-cap 60 --seconds 4 --cache-dir "$cache" --out "/tmp/hcgpu/$name" "$@" \
     >"$out/$name.log" 2>&1
@@ -124,9 +134,13 @@ loadtest loadtest_1080_h264 45 --clients 1 --sizes 1920x1080 --encodings h264
 metrics >"$out/metrics.txt"
 grep stage_seconds "$out/metrics.txt"
 stop_server
+# One frame in flight against the default (two on a GPU): what the second slot gives.
+serve "$hc/bin/haarcast" _k1 "--frames-in-flight 1"
+loadtest loadtest_720_k1 60 --clients 4,16 --sizes 1280x720 --encodings jpeg
+stop_server
 if [[ -x "$old" ]]; then
   serve "$old" _old
-  loadtest loadtest_720_old 100 --clients 1,4,16 --sizes 1280x720 --encodings jpeg
+  loadtest loadtest_720_old 60 --clients 1,4,16 --sizes 1280x720 --encodings jpeg
   stop_server
 fi
 
