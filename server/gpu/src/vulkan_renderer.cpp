@@ -77,8 +77,13 @@ VulkanRenderer::VulkanRenderer(const render::Scene& scene, const render::RenderO
   if (slots == 0) slots = slots_.front()->context.info().type == "cpu" ? 1 : 2;
   // Every further slot prepares the same scene (from the cache the first
   // one filled, where there is one) and compiles the same pipelines (the
-  // driver's cache), then uploads its own copy.
-  while (slots_.size() < slots) slots_.push_back(std::make_unique<Impl>(scene, options, vulkan, progress, limits));
+  // driver's cache), then uploads its own copy. Its progress is one stage
+  // of its own, so that the build's fractions never go back.
+  while (slots_.size() < slots) {
+    if (progress) progress("frame slots", slots_.size(), slots);
+    slots_.push_back(std::make_unique<Impl>(scene, options, vulkan, render::RenderProgress{}, limits));
+  }
+  if (progress && slots > 1) progress("frame slots", slots, slots);
   busy_.assign(slots_.size(), false);
 }
 

@@ -338,8 +338,16 @@ GPU_TEST(VulkanRenderer, TwoFramesInFlightRenderAtOnceAndAsOne) {
   VulkanRenderer one(scene, o, testing::testOptions());
   VulkanRendererLimits two;
   two.framesInFlight = 2;
-  VulkanRenderer slotted(scene, o, testing::testOptions(), {}, two);
+  std::vector<std::string> reports;  // the build's progress: the second slot is a stage of its own, at the end
+  VulkanRenderer slotted(scene, o, testing::testOptions(),
+                         [&](const std::string& stage, std::size_t done, std::size_t total) {
+                           reports.push_back(stage + " " + std::to_string(done) + "/" + std::to_string(total));
+                         },
+                         two);
   ASSERT_EQ(slotted.framesInFlight(), 2u);
+  ASSERT_GE(reports.size(), 2u);
+  EXPECT_EQ(reports[reports.size() - 2], "frame slots 1/2");
+  EXPECT_EQ(reports.back(), "frame slots 2/2");
   ASSERT_TRUE(slotted.concurrentRenders());
   render::FrameRequest a = requestFor(scene, 40, 40), b = turnedRequest(scene, o);
   b.width = b.height = 40;
