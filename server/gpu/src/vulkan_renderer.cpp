@@ -4,9 +4,11 @@
 #include "haarcast/gpu/vulkan_renderer.h"
 
 #include <algorithm>
+#include <memory>
 #include <stdexcept>
 #include <string>
 
+#include "haarcast/gpu/engine.h"
 #include "haarcast/gpu/shaders.h"
 
 #include "vulkan_renderer_impl.h"
@@ -15,13 +17,10 @@ namespace haarcast::gpu {
 
 // ------------------------------------------------------------------ setup
 
-VulkanRenderer::Impl::Impl(const render::Scene& scene, const render::RenderOptions& o, const VulkanOptions& vulkan,
-                           const render::RenderProgress& progress, const VulkanRendererLimits& l)
-    : options(o), limits(l), prepared(), context(vulkan) {
+void VulkanRenderer::Impl::checkOptions(const render::RenderOptions& options) {
   render::checkRenderOptions(options);
-  fused = options.method == RotationMethod::Fused;
-  splitsum = options.method == RotationMethod::Splitsum;
-  if (fused || splitsum) {
+  const bool fusedPass = options.method == RotationMethod::Fused || options.method == RotationMethod::Splitsum;
+  if (fusedPass) {
     checkFusedLevel(options.level);  // 2–7: its scratch need not fit in shared memory (splitsum reads no maps of it)
   } else if (options.level < kMinGpuLevel || options.level > kMaxGpuLevel) {
     throw std::invalid_argument("the Vulkan backend takes map levels " + std::to_string(kMinGpuLevel) + " to " +
@@ -29,15 +28,22 @@ VulkanRenderer::Impl::Impl(const render::Scene& scene, const render::RenderOptio
                                 "): a rotation workgroup keeps one map in shared memory, and a level-6 map is the "
                                 "16 KiB every Vulkan device guarantees");
   }
-  methodName = std::string(haarcast::methodName(options.method));
-  const std::string shader = fused || splitsum ? methodName + ".comp" : "rotate_" + methodName + ".comp";
+  const std::string name(haarcast::methodName(options.method));
+  const std::string shader = fusedPass ? name + ".comp" : "rotate_" + name + ".comp";
   if (embeddedShader(shader).empty()) {
-    throw std::invalid_argument("rotation method \"" + methodName + "\" has no Vulkan shader in this build (shaders/" +
+    throw std::invalid_argument("rotation method \"" + name + "\" has no Vulkan shader in this build (shaders/" +
                                 shader + " is missing)");
   }
+}
+
+VulkanRenderer::Impl::Impl(std::shared_ptr<const render::PreparedScene> scene, const render::RenderOptions& o,
+                           const VulkanOptions& vulkan, const VulkanRendererLimits& l)
+    : options(o), limits(l), preparedScene(std::move(scene)), prepared(*preparedScene), context(vulkan) {
+  fused = options.method == RotationMethod::Fused;
+  splitsum = options.method == RotationMethod::Splitsum;
+  methodName = std::string(haarcast::methodName(options.method));
   level = options.level;
   coefficients = static_cast<std::size_t>(mapSize(level)) * static_cast<std::size_t>(mapSize(level));
-  prepared = render::prepareScene(scene, options, progress);
   uploadScene();
   createGraphicsPipeline();
   useTimestamps = context.timestampsSupported() && context.properties().limits.timestampComputeAndGraphics &&
@@ -72,16 +78,21 @@ render::Frame VulkanRenderer::Impl::render(const render::FrameRequest& request) 
 VulkanRenderer::VulkanRenderer(const render::Scene& scene, const render::RenderOptions& options,
                                const VulkanOptions& vulkan, const render::RenderProgress& progress,
                                const VulkanRendererLimits& limits) {
-  slots_.push_back(std::make_unique<Impl>(scene, options, vulkan, progress, limits));
+  Impl::checkOptions(options);
+  // The device first (it throws when there is none), then the scene,
+  // prepared once for every slot.
+  const std::shared_ptr<SharedDevice> device = Engine::get(EngineOptions{vulkan.validation}).device(vulkan.device);
+  const auto prepared = std::make_shared<const render::PreparedScene>(render::prepareScene(scene, options, progress));
   std::size_t slots = limits.framesInFlight;
-  if (slots == 0) slots = slots_.front()->context.info().type == "cpu" ? 1 : 2;
-  // Every further slot prepares the same scene (from the cache the first
-  // one filled, where there is one) and compiles the same pipelines (the
-  // driver's cache), then uploads its own copy. Its progress is one stage
-  // of its own, so that the build's fractions never go back.
+  if (slots == 0) slots = device->info().type == "cpu" ? 1 : 2;
+  // Each slot uploads its own copy of the scene's data and compiles the
+  // same pipelines (the driver's cache makes the second compile a lookup).
+  // The further slots' progress is one stage of its own, so that the
+  // build's fractions never go back.
+  slots_.push_back(std::make_unique<Impl>(prepared, options, vulkan, limits));
   while (slots_.size() < slots) {
     if (progress) progress("frame slots", slots_.size(), slots);
-    slots_.push_back(std::make_unique<Impl>(scene, options, vulkan, render::RenderProgress{}, limits));
+    slots_.push_back(std::make_unique<Impl>(prepared, options, vulkan, limits));
   }
   if (progress && slots > 1) progress("frame slots", slots, slots);
   busy_.assign(slots_.size(), false);
@@ -129,7 +140,7 @@ const render::RenderOptions& VulkanRenderer::options() const { return slots_.fro
 std::size_t VulkanRenderer::objectCount() const { return slots_.front()->prepared.objects.size(); }
 std::vector<int> VulkanRenderer::objectLevels() const { return slots_.front()->prepared.objectLevels(); }
 Context& VulkanRenderer::context() { return last().context; }
-const render::PreparedScene& VulkanRenderer::prepared() const { return slots_.front()->prepared; }
+const render::PreparedScene& VulkanRenderer::prepared() const { return *slots_.front()->preparedScene; }
 std::size_t VulkanRenderer::batchSamples() const { return last().batch; }
 std::size_t VulkanRenderer::batchesLastFrame() const { return last().lastBatches; }
 

@@ -54,7 +54,10 @@ using FrameStage = std::pair<const char*, std::function<void(VkCommandBuffer)>>;
 struct VulkanRenderer::Impl {
   render::RenderOptions options;
   VulkanRendererLimits limits;
-  render::PreparedScene prepared;
+  // The scene as both backends prepare it, made once per renderer and
+  // shared (read-only) by its frame slots.
+  std::shared_ptr<const render::PreparedScene> preparedScene;
+  const render::PreparedScene& prepared;
   Context context;
   int level = 0;                 // RenderOptions::level: every object's, or for `fused` the cap (objects at their own: PreparedObject::level)
   std::size_t coefficients = 0;  // N = 4^level
@@ -167,8 +170,11 @@ struct VulkanRenderer::Impl {
   bool cancelRequested() const { return cancelled && *cancelled && (*cancelled)(); }
 
   // vulkan_renderer.cpp
-  Impl(const render::Scene& scene, const render::RenderOptions& o, const VulkanOptions& vulkan,
-       const render::RenderProgress& progress, const VulkanRendererLimits& l);
+  // Throws std::invalid_argument for options the GPU passes cannot take,
+  // before anything is prepared.
+  static void checkOptions(const render::RenderOptions& o);
+  Impl(std::shared_ptr<const render::PreparedScene> scene, const render::RenderOptions& o, const VulkanOptions& vulkan,
+       const VulkanRendererLimits& l);
   ~Impl();
   render::Frame render(const render::FrameRequest& request);
 

@@ -87,7 +87,7 @@ class FrameWorkers : public std::enable_shared_from_this<FrameWorkers> {
     RenderJob* job = nullptr;               // the job rendering now (on the thread's stack)
     Device* device = nullptr;
     bool holdsDevice = false;               // holds device->busy
-    const void* slotOf = nullptr;           // the renderer whose frame slot it holds (K frames in flight)
+    const render::Renderer* slotOf = nullptr;  // the renderer whose frame slot it holds (K frames in flight)
     std::size_t charge = 0;                 // its share of the pixel budget
     Clock::time_point started;              // its render's start
   };
@@ -116,7 +116,7 @@ class FrameWorkers : public std::enable_shared_from_this<FrameWorkers> {
   std::condition_variable exitCv_;   // a worker's loop ended, for stop()
   std::deque<Queued> queue_;
   std::map<std::pair<std::string, std::string>, Device> devices_;  // by (backend, name); never erased
-  std::map<const void*, std::size_t> rendering_;  // frames rendering per renderer of K > 1 frames in flight (0: erased)
+  std::map<const render::Renderer*, std::size_t> rendering_;  // frames rendering per renderer of K > 1 frames in flight (0: erased)
   std::size_t pixelsInFlight_ = 0;
   bool budgetWait_ = false;          // the oldest startable job waits for the budget
   std::atomic<bool> stopping_{false};

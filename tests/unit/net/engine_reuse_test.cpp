@@ -62,11 +62,7 @@ RendererBuilder sharedSceneBuilder(std::shared_ptr<std::atomic<int>> builds) {
   };
   return [scene, builds](const SessionConfig& c) {
     ++*builds;
-    render::RenderOptions options;
-    options.level = c.level;
-    options.method = c.method;
-    options.lightCoefficients = c.lightCoefficients;
-    options.cacheDir = HAARCAST_TEST_CACHE_DIR;
+    const render::RenderOptions options = testRenderOptions(c);
     auto p = std::make_shared<PreparedRenderer>();
     p->renderer = backends::makeRenderer(backendName(c.backend), *scene, options);
     return p;

@@ -46,17 +46,23 @@ inline Catalog testCatalog(const render::Scene& scene) {
   return c;
 }
 
+// A session config's render options, as the test builders make them.
+inline render::RenderOptions testRenderOptions(const SessionConfig& c) {
+  render::RenderOptions options;
+  options.level = c.level;
+  options.method = c.method;
+  options.lightCoefficients = c.lightCoefficients;
+  options.cacheDir = HAARCAST_TEST_CACHE_DIR;
+  return options;
+}
+
 inline RendererBuilder testBuilder() {
   return [](const SessionConfig& c) {
     render::Scene scene = render::defaultScene();
     for (std::size_t i = 0; i < scene.objects.size() && i < c.materials.size(); ++i) {
       if (c.materials[i] != scene.objects[i].material.name) scene.objects[i].material = render::materialFromSpec(c.materials[i]);
     }
-    render::RenderOptions options;
-    options.level = c.level;
-    options.method = c.method;
-    options.lightCoefficients = c.lightCoefficients;
-    options.cacheDir = HAARCAST_TEST_CACHE_DIR;
+    const render::RenderOptions options = testRenderOptions(c);
     auto p = std::make_shared<PreparedRenderer>();
     p->renderer = backends::makeRenderer(std::string(backendName(c.backend)), scene, options);
     return p;

@@ -64,8 +64,8 @@ struct VulkanRendererLimits {
   std::uint32_t fusedLocalSize = 0;
   std::uint32_t fusedGroups = 0;
   // Frames that may render at once, each with its own device buffers,
-  // command buffers and host scratch (the scene's data is uploaded once per
-  // frame in flight too): 0 = 1 on a CPU device (lavapipe's frames share
+  // command buffers and host scratch (the prepared scene is shared; its
+  // device copy is uploaded once per frame in flight): 0 = 1 on a CPU device (lavapipe's frames share
   // its cores), 2 on a GPU. While one frame's host stages run (the light,
   // the shadow rays, the encoding after it), another's passes run on the device.
   std::size_t framesInFlight = 0;
