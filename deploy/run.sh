@@ -158,20 +158,56 @@ install_packages() {
   # npm ships inside NodeSource's nodejs; Debian's own nodejs needs the npm
   # package beside it (installing that over NodeSource's would conflict).
   if grep -qx nodejs <<<"$packages"; then command -v npm >/dev/null 2>&1 || missing+=(npm); fi
-  ((${#missing[@]} == 0)) && return 0
 
-  log "installing ${missing[*]}"
-  local -a as_root=()
-  if ((EUID != 0)); then
-    if ! command -v sudo >/dev/null 2>&1; then
-      echo "error: not root and no sudo; install these packages first: ${missing[*]}" >&2
-      exit 1
-    fi
-    as_root=(sudo)
+  if ((${#missing[@]} > 0)); then
+    log "installing ${missing[*]}"
+    as_root "${missing[*]}" env DEBIAN_FRONTEND=noninteractive apt-get update -q </dev/null
+    as_root "${missing[*]}" env DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends \
+      "${missing[@]}" </dev/null
   fi
-  "${as_root[@]}" env DEBIAN_FRONTEND=noninteractive apt-get update -q </dev/null
-  "${as_root[@]}" env DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends \
-    "${missing[@]}" </dev/null
+  if grep -qx mesa-vulkan-drivers <<<"$packages"; then lavapipe_with_ray_tracing; fi
+}
+
+# Runs a command as root (itself, or through sudo); $1 names what it is for.
+as_root() {
+  local what="$1"
+  shift
+  if ((EUID == 0)); then
+    "$@"
+  elif command -v sudo >/dev/null 2>&1; then
+    sudo "$@"
+  else
+    echo "error: not root and no sudo; install these first: $what" >&2
+    exit 1
+  fi
+}
+
+# Mesa's lavapipe traces rays (VK_KHR_acceleration_structure and
+# VK_KHR_ray_tracing_pipeline: the Vulkan backend's device rays, docs/gpu.md)
+# from Mesa 24.1 on; Debian 12's own Mesa is 22.3.6. On Debian 12 this adds
+# the bookworm-backports suite (/etc/apt/sources.list.d/haarcast-bookworm-backports.list;
+# apt prefers the main suite for everything else, backports only where asked)
+# and takes mesa-vulkan-drivers 25 from it, with the Mesa and libdrm packages
+# it needs (libgl1-mesa-dri, mesa-libgallium, libdrm*; about 5 s). Elsewhere, or
+# where a Mesa ≥ 24.1 is installed already, it changes nothing.
+lavapipe_with_ray_tracing() {
+  local version codename=""
+  version="$(dpkg-query -W -f='${Version}' mesa-vulkan-drivers 2>/dev/null || true)"
+  if [[ -n "$version" ]] && dpkg --compare-versions "$version" ge 24.1; then return 0; fi
+  # shellcheck disable=SC1091
+  [[ -r /etc/os-release ]] && codename="$(. /etc/os-release && echo "${VERSION_CODENAME:-}")"
+  if [[ "$codename" != bookworm ]]; then
+    log "note: mesa-vulkan-drivers ${version:-absent} has no ray tracing on lavapipe; the Vulkan backend traces its rays on the host"
+    return 0
+  fi
+  local list=/etc/apt/sources.list.d/haarcast-bookworm-backports.list
+  log "taking mesa-vulkan-drivers from bookworm-backports (lavapipe with ray tracing; Debian 12 has ${version:-none})"
+  if [[ ! -f "$list" ]]; then
+    echo "deb http://deb.debian.org/debian bookworm-backports main" | as_root "$list" tee "$list" >/dev/null
+  fi
+  as_root "bookworm-backports" env DEBIAN_FRONTEND=noninteractive apt-get update -q </dev/null
+  as_root "mesa-vulkan-drivers from bookworm-backports" env DEBIAN_FRONTEND=noninteractive \
+    apt-get install -y -q --no-install-recommends -t bookworm-backports mesa-vulkan-drivers </dev/null
 }
 
 configure_and_build() {
@@ -343,6 +379,12 @@ case "$command" in
     ;;
   test)
     log "running tests"
+    # The install step gave lavapipe ray tracing where it can (Debian 12):
+    # there the device-ray tests fail rather than skip without it.
+    if [[ -z "${HAARCAST_REQUIRE_RAY_TRACING:-}" ]] &&
+      dpkg --compare-versions "$(dpkg-query -W -f='${Version}' mesa-vulkan-drivers 2>/dev/null || echo 0)" ge 24.1; then
+      export HAARCAST_REQUIRE_RAY_TRACING=1
+    fi
     exec ctest --test-dir "$BUILD_DIR" --output-on-failure "$@" </dev/null
     ;;
   bench)

@@ -20,7 +20,9 @@
 //      triangle's three vertices' visibility bits blended by the
 //      barycentrics, V = b0·bit0 + b1·bit1 + b2·bit2 (core blendVisibility);
 //      accumulated with W_c = L_c·V;
-//   2. the partial sums are reduced in invocation order; invocation 0 puts
+//   2. the partial sums are reduced (subgroupAdd where the workgroup is one
+//      subgroup, SUBGROUP_REDUCE; else in invocation order through shared
+//      memory, with barriers); invocation 0 puts
 //      the lobe's energy back (× ∫ρ / Σ ΔΩ·ρ, the second sum of step 1:
 //      core fused.cpp energyKept), adds the point lights whose bit is set,
 //      in light order, each with ρ read at the light's direction from the
@@ -44,6 +46,9 @@
 // read at a per-invocation index goes lane by lane and component by
 // component, each behind a branch (docs/gpu.md, "fused on lavapipe").
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_samplerless_texture_functions : require
+#extension GL_KHR_shader_subgroup_arithmetic : require
+#extension GL_EXT_control_flow_attributes : require
 #include "haarcast/core/shared_layout.h"
 #include "common/frame.glsl"
 #include "common/sphere.glsl"
@@ -51,6 +56,7 @@
 layout(local_size_x_id = kSpecLocalSize) in;
 layout(constant_id = kSpecInterpolate) const uint INTERPOLATE = 1u;    // RenderOptions::interpolateSlices
 layout(constant_id = kSpecPrefilterFinest) const uint PREFILTER_FINEST = 9u;  // the prefiltered light's finest level
+layout(constant_id = kSpecSubgroupReduce) const uint SUBGROUP_REDUCE = 0u;     // shared_passes.h
 
 const uint LOCAL = gl_WorkGroupSize.x;
 
@@ -58,13 +64,13 @@ layout(std430, set = 0, binding = kFusedSamplesBinding) readonly buffer Samples 
 layout(std430, set = 0, binding = kFusedShadeBinding) readonly buffer Shade { ShadeSample shade[]; };
 layout(std430, set = 0, binding = kFusedObjectsBinding) readonly buffer Objects { ObjectInfo objects[]; };
 // Object o's slice t, direction k at o.texelBase + t·N + k: RGB0.
-layout(set = 0, binding = kFusedSliceTexelsBinding) uniform samplerBuffer texels;
-layout(set = 0, binding = kFusedLightTexelsBinding) uniform samplerBuffer light;        // object o, direction k at o.lightBase + k: (L·ΔΩ) RGB, 0
+layout(set = 0, binding = kFusedSliceTexelsBinding) uniform textureBuffer texels;
+layout(set = 0, binding = kFusedLightTexelsBinding) uniform textureBuffer light;        // object o, direction k at o.lightBase + k: (L·ΔΩ) RGB, 0
 // Global vertex v of object o, direction i: bit i % 32 of word
 // o.visibilityBase + (v − o.vertexBase)·visibilityWords(o.level) + i / 32 (core VisibilityBits).
-layout(set = 0, binding = kFusedVisibilityTexelsBinding) uniform usamplerBuffer visibilityBits;
+layout(set = 0, binding = kFusedVisibilityTexelsBinding) uniform utextureBuffer visibilityBits;
 // Pixel-centre unit vectors (xyz) and ΔΩ (w) of every level in use; level n's direction k at o.directionBase + k.
-layout(set = 0, binding = kFusedDirectionTexelsBinding) uniform samplerBuffer directions;
+layout(set = 0, binding = kFusedDirectionTexelsBinding) uniform textureBuffer directions;
 // Object o, light k at o·kMaxPointLights + k; ObjectInfo::pointLights of them are this frame's.
 layout(std430, set = 0, binding = kFusedPointLightsBinding) readonly buffer PointLights { PointLight pointLights[]; };
 layout(std430, set = 0, binding = kFusedRadianceBinding) buffer Radiance { vec4 radiance[]; };
@@ -73,9 +79,9 @@ layout(std430, set = 0, binding = kFusedMasksBinding) readonly buffer Masks { ui
 layout(std430, set = 0, binding = kFusedSliceEnergyBinding) readonly buffer SliceEnergies { vec4 sliceEnergy[]; };  // global slice: ∫ρ_c (rgb)
 layout(std430, set = 0, binding = kFusedLobesBinding) readonly buffer Lobes { SliceLobe lobes[]; };          // global slice: its lobe
 // Level l of the prefiltered light at prefilterOffset(l), RGB0 (core PrefilteredLight).
-layout(set = 0, binding = kFusedLobeLightTexelsBinding) uniform samplerBuffer lobeLight;
+layout(set = 0, binding = kFusedLobeLightTexelsBinding) uniform textureBuffer lobeLight;
 // The slices as point values at the texel centres (core PixelSlices::pointSlice), laid out as `texels`.
-layout(set = 0, binding = kFusedPointSliceTexelsBinding) uniform samplerBuffer pointTexels;
+layout(set = 0, binding = kFusedPointSliceTexelsBinding) uniform textureBuffer pointTexels;
 // Per object: its samples shaded from one slice (2·object; the ground's
 // samples, which read none, too) and from two (2·object + 1), cleared before
 // the pass; the host counts the coefficient bytes read from them (core
@@ -212,19 +218,26 @@ vec3 sumDirections(const bool blended, PixelSetup p, out vec3 norm) {
 // core times Σ_i w_i·L(ω_i) over the lobe's samples, each read at its level.
 vec3 lobeShade(ObjectInfo o, RotationSample rs, SliceBlend blend, uint seen) {
   if ((seen & kLobeSeenBit) == 0u) return vec3(0.0);
-  const SliceLobe lobe = blendLobes(lobes[o.sliceBase + blend.first], lobes[o.sliceBase + blend.second], blend.weight);
-  const vec2 sc = sinCosPrecise(lobe.energy.w);
+  // blendLobes read field by field and sample by sample in a loop kept
+  // rolled: a SliceLobe copied whole (560 bytes, twice) and the loop
+  // unrolled made lavapipe's compile of this pass take a minute (docs/gpu.md).
+  const uint a = o.sliceBase + blend.first, b = o.sliceBase + blend.second;
+  const float t = blend.weight;
+  const float theta = lobes[a].energy.w + t * (lobes[b].energy.w - lobes[a].energy.w);
+  const vec2 sc = sinCosPrecise(theta);
   const mat3 toLight = mat3(o.toLight[0].xyz, o.toLight[1].xyz, o.toLight[2].xyz) * rotationYXY(rs.alpha, rs.beta, rs.gamma);
   const vec3 axis = toLight * vec3(0.0, sc.y, -sc.x);
   const vec3 u = toLight * vec3(1.0, 0.0, 0.0);
   const vec3 v = toLight * vec3(0.0, -sc.x, -sc.y);
   vec3 sum = vec3(0.0);
-  for (uint i = 0u; i < kLobeSamples; ++i) {
-    const vec4 s = lobe.samples[i];
-    const vec2 a = sinCosPrecise(s.x), b = sinCosPrecise(s.y);
-    sum += s.w * prefilteredAt(s.z, a.y * axis + a.x * (b.y * u + b.x * v));
+  [[dont_unroll]] for (uint i = 0u; i < kLobeSamples; ++i) {
+    const vec4 sa = lobes[a].samples[i];
+    const vec4 s = sa + t * (lobes[b].samples[i] - sa);
+    const vec2 x = sinCosPrecise(s.x), y = sinCosPrecise(s.y);
+    sum += s.w * prefilteredAt(s.z, x.y * axis + x.x * (y.y * u + y.x * v));
   }
-  return lobe.core.rgb * sum;
+  const vec3 core = lobes[a].core.rgb + t * (lobes[b].core.rgb - lobes[a].core.rgb);
+  return core * sum;
 }
 
 // sum + Σ_k bit_k·power_k·ρ(Rᵀd_k) over the lights the sample sees, added
@@ -337,13 +350,20 @@ void shadePixel(uint s) {
 
   // 2. Reduce in invocation order, put the lobe's energy back (fused.cpp
   // energyKept: ×∫ρ / Σ ΔΩ·ρ), then the point lights and the lobe path.
-  partial[lid] = acc;
-  partialSum[lid] = norm;
-  sync();
+  vec3 sum = vec3(0.0), sampled = vec3(0.0);
+  if (SUBGROUP_REDUCE != 0u) {
+    sum = subgroupAdd(acc);
+    sampled = subgroupAdd(norm);
+  } else {
+    partial[lid] = acc;
+    partialSum[lid] = norm;
+    sync();
+    if (lid == 0u) {
+      for (uint k = 0u; k < LOCAL; ++k) sum += partial[k];
+      for (uint k = 0u; k < LOCAL; ++k) sampled += partialSum[k];
+    }
+  }
   if (lid == 0u) {
-    vec3 sum = vec3(0.0), sampled = vec3(0.0);
-    for (uint k = 0u; k < LOCAL; ++k) sum += partial[k];
-    for (uint k = 0u; k < LOCAL; ++k) sampled += partialSum[k];
     for (int c = 0; c < 3; ++c) {
       if (sampled[c] > 0.0) sum[c] *= energy[c] / sampled[c];
     }
@@ -353,7 +373,7 @@ void shadePixel(uint s) {
     if (lobePath) sum += lobeShade(o, rs, blend, seen);
     radiance[sh.pixel] = vec4(sum, 1.0);
   }
-  sync();  // `partial` is reused by the next sample
+  if (SUBGROUP_REDUCE == 0u) sync();  // `partial` is reused by the next sample
 }
 
 void main() {

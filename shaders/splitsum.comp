@@ -15,6 +15,7 @@
 // the dispatch is the rotation-input pass's indirect arguments, as fused's
 // (FrameParams::fusedGroups caps its workgroups).
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_samplerless_texture_functions : require
 #include "haarcast/core/shared_layout.h"
 #include "common/frame.glsl"
 #include "common/sphere.glsl"
@@ -31,7 +32,7 @@ layout(std430, set = 0, binding = kSplitsumMasksBinding) readonly buffer Masks {
 // Object o's lobe t at ObjectInfo::sliceBase + t (core SliceLobe).
 layout(std430, set = 0, binding = kSplitsumLobesBinding) readonly buffer Lobes { SliceLobe lobes[]; };
 // Level l of the prefiltered light at prefilterOffset(l), RGB0 (core PrefilteredLight).
-layout(set = 0, binding = kSplitsumLobeLightTexelsBinding) uniform samplerBuffer lobeLight;
+layout(set = 0, binding = kSplitsumLobeLightTexelsBinding) uniform textureBuffer lobeLight;
 layout(std430, set = 0, binding = kSplitsumRadianceBinding) writeonly buffer Radiance { vec4 radiance[]; };
 
 #include "common/prefiltered.glsl"
@@ -41,11 +42,15 @@ vec3 splitsumShade(uint s) {
   const RotationSample rs = samples[s];
   const ObjectInfo o = objects[shade[s].object];
   const SliceBlend blend = sliceBlendAt(rs.thetaOut, o.thetaSamples, INTERPOLATE);
-  const SliceLobe lobe = blendLobes(lobes[o.sliceBase + blend.first], lobes[o.sliceBase + blend.second], blend.weight);
+  // blendLobes of the two fields read: a SliceLobe copied whole (560 bytes,
+  // twice) made lavapipe's compile of this pass take 22 s (docs/gpu.md).
+  const uint a = o.sliceBase + blend.first, b = o.sliceBase + blend.second;
+  const vec3 energy = lobes[a].energy.rgb + blend.weight * (lobes[b].energy.rgb - lobes[a].energy.rgb);
+  const float median = lobes[a].median.x + blend.weight * (lobes[b].median.x - lobes[a].median.x);
   const vec2 sc = sinCosPrecise(rs.thetaOut);
   const mat3 toLight = mat3(o.toLight[0].xyz, o.toLight[1].xyz, o.toLight[2].xyz);
   const vec3 mirror = toLight * (rotationYXY(rs.alpha, rs.beta, rs.gamma) * vec3(0.0, sc.y, -sc.x));
-  return lobe.energy.rgb * prefilteredAt(splitsumLevel(lobe.median.x), mirror);
+  return energy * prefilteredAt(splitsumLevel(median), mirror);
 }
 
 void main() {

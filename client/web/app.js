@@ -64,7 +64,9 @@ function onWelcome(w) {
   view.pendingScene = null;
   onSceneInfo(w.sceneInfo || { name: w.scenes[0] || '', objects: [] }, true);
   // The frame size is the HUD's to say: it follows the view.
-  setStatus(`connected: ${w.device || 'renderer'}, session ${w.sessionId}`);
+  // Where its shadow rays are traced: on the GPU itself or by the server's CPU.
+  const rays = w.rays === 'device' ? ', rays on the device' : w.rays === 'host' ? ', rays on the host' : '';
+  setStatus(`connected: ${w.device || 'renderer'}${rays}, session ${w.sessionId}`);
   view.poseDirty = true;  // the first pose: the view kept across a reconnect, or none
   // The Hello's size was a guess made before the server's limits were known
   // (or the view changed meanwhile): ask for the one that fits now.

@@ -40,6 +40,7 @@ struct BenchArgs {
   std::string antialias = "off";  // on: the cost of the edge sub-samples, on either backend
   std::string scene;  // scene file; empty = the built-in default
   std::string device;
+  std::string rays = "auto";
   std::string cacheDir;
   int frames = 3;
   int warmup = 1;
@@ -107,6 +108,7 @@ int run(const BenchArgs& a) {
   if (a.frames < 1 || a.frames > 1000) throw std::invalid_argument("--frames must be in 1..1000");
   if (a.warmup < 0 || a.warmup > 100) throw std::invalid_argument("--warmup must be in 0..100");
   const std::vector<std::pair<int, int>> sizes = parseSizeList(a.sizes, "--sizes");
+  const render::RayMode rays = parseRayModeFlag(a.rays);
   if (a.slices != "blend" && a.slices != "nearest") {
     throw std::invalid_argument("--slices must be blend or nearest (got \"" + a.slices + "\")");
   }
@@ -148,8 +150,8 @@ int run(const BenchArgs& a) {
     std::fflush(stdout);
   };
   // "fused / splitsum": the one pass of either, in place of rotation and triple product.
-  line("| level | method | size | backend | light | gbuffer | rotation-input | rotation | triple-product | fused / splitsum | tonemap | frame (s) | fps | coeff. bytes/frame | vs cpu |");
-  line("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+  line("| level | method | size | backend | light | gbuffer | rotation-input | shadow-rays | rotation | triple-product | fused / splitsum | tonemap | frame (s) | fps | coeff. bytes/frame | vs cpu |");
+  line("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
   const std::size_t rows = levels.size() * methods.size() * sizes.size() * ((cpu ? 1 : 0) + (vulkan ? 1 : 0));
   std::size_t rowsDone = 0;
   const auto started = std::chrono::steady_clock::now();
@@ -178,8 +180,10 @@ int run(const BenchArgs& a) {
       if (cpu) cpuRenderer = backends::makeRenderer(render::kCpuBackend, scene, options, {}, progress.callback());
       if (vulkan) {
         // Timing: validation layers would dominate.
-        gpuRenderer = backends::makeRenderer(render::kVulkanBackend, scene, options, {a.device, false}, progress.callback());
+        gpuRenderer = backends::makeRenderer(render::kVulkanBackend, scene, options,
+                                             {a.device, false, 0, rays}, progress.callback());
         out["vulkan_device"] = gpuRenderer->deviceName();
+        out["vulkan_rays"] = gpuRenderer->rays();
       }
       if (cpuRenderer) out["cpu_device"] = cpuRenderer->deviceName();
       // Each object's level: the choice's, or under `auto` each one's own.
@@ -237,8 +241,10 @@ int run(const BenchArgs& a) {
           run["antialias"] = antialias;
           out["runs"].push_back(run);
           std::string row = "| " + levelCell + " | " + std::string(methodName(method)) + " | " +
-                            std::to_string(width) + "×" + std::to_string(height) + " | " + backend + " |";
-          for (const char* name : {"light", "gbuffer", "rotation-input", "rotation", "triple-product", "fused", "tonemap"}) {
+                            std::to_string(width) + "×" + std::to_string(height) + " | " + backend +
+                            (backend == vulkanName && gpuRenderer ? " (rays " + gpuRenderer->rays() + ")" : "") + " |";
+          for (const char* name :
+               {"light", "gbuffer", "rotation-input", "shadow-rays", "rotation", "triple-product", "fused", "tonemap"}) {
             double seconds = 0.0;
             for (const auto& [sname, s] : m.stages) {
               if (sname == name || (sname == "splitsum" && std::string(name) == "fused")) seconds = s;
@@ -286,6 +292,7 @@ std::function<int()> addBenchFrameCommand(CLI::App& app) {
       ->capture_default_str();
   c->add_option("--scene", args->scene, "Scene file (default: the built-in scene)");
   c->add_option("--device", args->device, "Vulkan device: an index or a name substring");
+  c->add_option("--rays", args->rays, rayModeHelp())->capture_default_str();
   c->add_option("--cache-dir", args->cacheDir, "Cache of slice tables and visibility ('none' or empty: no cache)");
   c->add_flag("--json", args->json, "Print JSON instead of a table");
   return [c, args]() { return c->parsed() ? run(*args) : -1; };

@@ -1,6 +1,7 @@
 #include "list_flags.h"
 
 #include <iterator>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -66,6 +67,16 @@ std::vector<RotationMethod> parseMethodList(const std::string& text, const char*
     out.push_back(*m);
   }
   return out;
+}
+
+render::RayMode parseRayModeFlag(const std::string& text) {
+  if (const std::optional<render::RayMode> mode = render::parseRayMode(text)) return *mode;
+  throw std::invalid_argument("--rays must be auto, device or host (got \"" + text + "\")");
+}
+
+std::string rayModeHelp() {
+  return "Vulkan: where the shadow rays are traced: auto (the device on a GPU that traces rays, else the host), "
+         "device (a ray-tracing pipeline; refused where the device has none) or host (Embree)";
 }
 
 }  // namespace haarcast::app

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "haarcast/core/rotation.h"
+#include "haarcast/render/backend_names.h"
 
 namespace haarcast::app {
 
@@ -26,5 +27,10 @@ std::vector<std::pair<int, int>> parseSizeList(const std::string& text, const ch
 // Per-pixel method names (DESIGN.md), comma-separated; "all" (when allowed)
 // stands for every method.
 std::vector<RotationMethod> parseMethodList(const std::string& text, const char* flag, bool allowAll);
+
+// --rays: auto, device or host (render::RayMode).
+render::RayMode parseRayModeFlag(const std::string& text);
+// Its --help text.
+std::string rayModeHelp();
 
 }  // namespace haarcast::app

@@ -1,4 +1,5 @@
 #include "render_command.h"
+#include "list_flags.h"
 
 #include <chrono>
 #include <cstdio>
@@ -22,6 +23,7 @@ namespace fs = std::filesystem;
 struct RenderArgs {
   SceneFlags scene;
   std::string method = "fused", variant = "refined", backend{render::kCpuBackend}, device, cacheDir, antialias = "auto";
+  std::string rays = "auto";
   std::string level = "auto";  // render::parseLevelChoice
   bool validation = backends::kValidationByDefault;
   render::RenderOptions options;
@@ -30,6 +32,9 @@ struct RenderArgs {
 int run(RenderArgs& a) {
   backends::checkBuilt(a.backend, "--backend");
   if (a.backend == render::kCpuBackend && !a.device.empty()) throw std::invalid_argument("--device applies to --backend vulkan only");
+  const render::RayMode rays = parseRayModeFlag(a.rays);
+  if (a.backend == render::kCpuBackend && rays == render::RayMode::Device)
+    throw std::invalid_argument("--rays device applies to --backend vulkan only (the CPU backend traces on the host)");
   const auto method = parseRotationMethod(a.method);
   if (!method) throw std::invalid_argument("--method must be one of " + pixelMethodNames() + " (got \"" + a.method + "\")");
   const auto variant = parseHaarVariant(a.variant);
@@ -57,7 +62,7 @@ int run(RenderArgs& a) {
   const auto t0 = std::chrono::steady_clock::now();
   StderrProgress progress;  // slice tables and visibility: percentage and time left
   const std::unique_ptr<render::Renderer> renderer =
-      backends::makeRenderer(a.backend, scene, a.options, {a.device, a.validation}, progress.callback());
+      backends::makeRenderer(a.backend, scene, a.options, {a.device, a.validation, 0, rays}, progress.callback());
   const double prepare = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   render::FrameRequest request;
   request.width = a.options.width;
@@ -82,9 +87,10 @@ int run(RenderArgs& a) {
     levelText += ")";
   }
   if (a.options.automaticLevel) levelText += " [" + level->name() + "]";
-  std::fprintf(stderr, "%s on %s: %d×%d, %s, %s, k = %zu: precompute %.2f s, frame %.3f s (%s)\n",
+  std::fprintf(stderr, "%s on %s: %d×%d, %s, %s, k = %zu, rays %s: precompute %.2f s, frame %.3f s (%s)\n",
                renderer->backend().c_str(), renderer->deviceName().c_str(), a.options.width, a.options.height,
-               levelText.c_str(), a.method.c_str(), a.options.lightCoefficients, prepare, frame.seconds, stages.c_str());
+               levelText.c_str(), a.method.c_str(), a.options.lightCoefficients, renderer->rays().c_str(), prepare,
+               frame.seconds, stages.c_str());
   return 0;
 }
 
@@ -110,6 +116,7 @@ std::function<int()> addRenderCommand(CLI::App& app) {
   c->add_option("--antialias", args->antialias, "auto|on|off: edge pixels as the mean of 4 sub-samples (auto: on)")
       ->capture_default_str();
   c->add_option("--device", args->device, "Vulkan device: an index or a name substring (default: discrete > integrated > CPU)");
+  c->add_option("--rays", args->rays, rayModeHelp())->capture_default_str();
   c->add_flag("--validation,!--no-validation", args->validation, "Vulkan validation layers (when installed)")
       ->capture_default_str();
   c->add_option("--cache-dir", args->cacheDir, "Cache of slice tables and visibility (default $XDG_CACHE_HOME/haarcast; 'none' disables)");

@@ -2,6 +2,7 @@
 // only turns flags into a catalogue of scenes and materials, a renderer
 // builder (the backend factory) and server options.
 #include "serve_command.h"
+#include "list_flags.h"
 
 #include <algorithm>
 #include <cstdio>
@@ -47,6 +48,7 @@ struct ServeArgs {
   std::size_t lightCoefficients = 256;
   std::vector<std::string> sceneFiles;
   std::string materialsDir, webRoot, protoFile, cacheDir, vulkanDevice;
+  std::string rays = "auto";
   render::SceneLimits sceneLimits;
   bool vulkanValidation = false, quiet = false;
   std::size_t framesInFlight = 0;
@@ -174,7 +176,8 @@ int run(ServeArgs& a) {
   base.cacheDir = cacheDirFromFlag(a.cacheDir);
   base.sceneLimits = a.sceneLimits;
   base.threads = a.renderThreads;
-  const backends::DeviceOptions vulkanOptions{a.vulkanDevice, a.vulkanValidation, a.framesInFlight};
+  const backends::DeviceOptions vulkanOptions{a.vulkanDevice, a.vulkanValidation, a.framesInFlight,
+                                              parseRayModeFlag(a.rays)};
   auto sharedScenes = std::make_shared<std::vector<SceneSource>>(std::move(scenes));
   const bool quiet = a.quiet;
   const std::string antialias = a.antialias;
@@ -230,8 +233,8 @@ int run(ServeArgs& a) {
       stages("warm-up", 1, 1);
     }
     if (!quiet) {
-      std::fprintf(stderr, "[serve] renderer ready: %s on %s\n", prepared->renderer->backend().c_str(),
-                   prepared->renderer->deviceName().c_str());
+      std::fprintf(stderr, "[serve] renderer ready: %s on %s, rays %s\n", prepared->renderer->backend().c_str(),
+                   prepared->renderer->deviceName().c_str(), prepared->renderer->rays().c_str());
     }
     return prepared;
   };
@@ -354,6 +357,7 @@ std::function<int()> addServeCommand(CLI::App& app) {
       ->capture_default_str();
   c->add_option("--vulkan-device", a->vulkanDevice, "Vulkan device name substring");
   c->add_flag("--vulkan-validation", a->vulkanValidation, "Enable the Vulkan validation layers");
+  c->add_option("--rays", a->rays, rayModeHelp())->capture_default_str();
   c->add_option("--frames-in-flight", a->framesInFlight,
                 "Frames a Vulkan renderer may render at once, each with its own device buffers (the scene uploaded once "
                 "per frame in flight): while one frame's host stages run, another's passes run on the device. "

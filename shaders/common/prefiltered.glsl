@@ -1,7 +1,7 @@
 // The prefiltered light (core/prefiltered_light.h) as a shader reads it:
 // level l's texels at prefilterOffset(l), RGB0, in a texel buffer. The
 // includer declares, before this file:
-//   uniform samplerBuffer lobeLight;     the texels
+//   uniform textureBuffer lobeLight;     the texels
 //   const uint PREFILTER_FINEST;         the light's finest level (a spec constant)
 // splitsum.comp and fused.comp's lobe path read it through these.
 #ifndef HAARCAST_PREFILTERED_GLSL

@@ -59,6 +59,7 @@ std::unique_ptr<render::Renderer> makeRenderer(std::string_view backend, const r
   vulkan.validation = device.validation;
   gpu::VulkanRendererLimits limits;
   limits.framesInFlight = device.framesInFlight;
+  limits.rays = device.rays;
   return gpu::makeVulkanRenderer(scene, options, vulkan, progress, limits);
 #else
   static_cast<void>(device);

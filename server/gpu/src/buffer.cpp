@@ -1,6 +1,8 @@
 #include "haarcast/gpu/buffer.h"
 #include "haarcast/gpu/compute.h"
 
+#include "haarcast/core/check.h"
+
 #include <algorithm>
 #include <cstring>
 #include <stdexcept>
@@ -49,7 +51,10 @@ Buffer::Buffer(Context& context, VkDeviceSize bytes, VkBufferUsageFlags usage, M
       throw std::runtime_error(std::string("no Vulkan memory type for a ") + useName(use) + " buffer among type bits " +
                                std::to_string(req.memoryTypeBits) + " on " + context.info().name);
     }
-    memory_ = context.allocate(req.size, placement->type);
+    // A buffer whose address a shader or an acceleration-structure build
+    // reads (ray_tracing.h) needs memory allocated for device addresses.
+    const bool addressed = (usage & VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT) != 0;
+    memory_ = context.allocate(req.size, placement->type, addressed ? VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT : 0);
     staged_ = placement->staged;
     vkCheck(vkBindBufferMemory(device, buffer_, memory_, 0), "vkBindBufferMemory");
     if (placement->mapped) vkCheck(vkMapMemory(device, memory_, 0, VK_WHOLE_SIZE, 0, &mapped_), "vkMapMemory");
@@ -60,6 +65,14 @@ Buffer::Buffer(Context& context, VkDeviceSize bytes, VkBufferUsageFlags usage, M
 }
 
 Buffer::~Buffer() { release(); }
+
+VkDeviceAddress Buffer::deviceAddress() const {
+  HC_CHECK_NE(buffer_, VK_NULL_HANDLE);
+  VkBufferDeviceAddressInfo info{};
+  info.sType = VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO;
+  info.buffer = buffer_;
+  return vkGetBufferDeviceAddress(context_->device(), &info);
+}
 
 Buffer::Buffer(Buffer&& other) noexcept
     : context_(std::exchange(other.context_, nullptr)),

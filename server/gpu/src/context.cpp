@@ -119,6 +119,7 @@ void Context::submit(const std::function<void(VkCommandBuffer)>& record) {
   if (inFlight_) throw std::runtime_error("Context::submit: the previous submission never finished (vkWaitForFences failed)");
   vkCheck(vkResetFences(device_, 1, &fence_), "vkResetFences");
   shared_->submit(s, fence_);  // under the shared queue's lock; the wait below is outside it
+  ++submissions_;
   inFlight_ = true;
   vkCheck(vkWaitForFences(device_, 1, &fence_, VK_TRUE, UINT64_MAX), "vkWaitForFences");
   inFlight_ = false;
@@ -136,9 +137,13 @@ std::uint32_t Context::memoryType(std::uint32_t typeBits, VkMemoryPropertyFlags 
                            std::to_string(typeBits) + " on " + info().name);
 }
 
-VkDeviceMemory Context::allocate(VkDeviceSize bytes, std::uint32_t typeIndex) {
+VkDeviceMemory Context::allocate(VkDeviceSize bytes, std::uint32_t typeIndex, VkMemoryAllocateFlags flags) {
+  VkMemoryAllocateFlagsInfo f{};
+  f.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO;
+  f.flags = flags;
   VkMemoryAllocateInfo a{};
   a.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
+  if (flags) a.pNext = &f;
   a.allocationSize = bytes;
   a.memoryTypeIndex = typeIndex;
   VkDeviceMemory memory = VK_NULL_HANDLE;
@@ -152,6 +157,8 @@ void Context::free(VkDeviceMemory memory) {
 }
 
 bool Context::validationEnabled() const { return shared_->validationEnabled(); }
+const RayTracingSupport& Context::rayTracing() const { return shared_->rayTracing(); }
+bool Context::subgroupArithmetic() const { return shared_->subgroupArithmetic(); }
 
 std::vector<std::string> Context::validationMessages() const {
   return shared_->validationLog().since(validationMark_.load());

@@ -130,6 +130,60 @@ DeviceInfo describe(VkPhysicalDevice device, int index) {
   return info;
 }
 
+bool deviceExtensionAvailable(VkPhysicalDevice device, const char* name) {
+  std::uint32_t count = 0;
+  if (vkEnumerateDeviceExtensionProperties(device, nullptr, &count, nullptr) != VK_SUCCESS) return false;
+  std::vector<VkExtensionProperties> exts(count);
+  if (vkEnumerateDeviceExtensionProperties(device, nullptr, &count, exts.data()) != VK_SUCCESS) return false;
+  return std::any_of(exts.begin(), exts.end(),
+                     [&](const VkExtensionProperties& e) { return std::strcmp(e.extensionName, name) == 0; });
+}
+
+RayTracingSupport rayTracingSupport(VkPhysicalDevice device) {
+  RayTracingSupport support;
+  std::string missing;
+  for (const char* name : {VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME, VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME,
+                           VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME}) {
+    if (!deviceExtensionAvailable(device, name)) missing += std::string(missing.empty() ? "" : ", ") + name;
+  }
+  if (missing.empty()) {
+    VkPhysicalDeviceVulkan12Features v12{};
+    v12.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES;
+    VkPhysicalDeviceAccelerationStructureFeaturesKHR as{};
+    as.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR;
+    VkPhysicalDeviceRayTracingPipelineFeaturesKHR rt{};
+    rt.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_FEATURES_KHR;
+    v12.pNext = &as;
+    as.pNext = &rt;
+    VkPhysicalDeviceFeatures2 features{};
+    features.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
+    features.pNext = &v12;
+    vkGetPhysicalDeviceFeatures2(device, &features);
+    if (!v12.bufferDeviceAddress) missing = "bufferDeviceAddress";
+    if (!as.accelerationStructure) missing += std::string(missing.empty() ? "" : ", ") + "accelerationStructure";
+    if (!rt.rayTracingPipeline) missing += std::string(missing.empty() ? "" : ", ") + "rayTracingPipeline";
+  }
+  if (!missing.empty()) {
+    support.missing = "no " + missing;
+    return support;
+  }
+  VkPhysicalDeviceRayTracingPipelinePropertiesKHR rt{};
+  rt.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_PROPERTIES_KHR;
+  VkPhysicalDeviceAccelerationStructurePropertiesKHR as{};
+  as.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_PROPERTIES_KHR;
+  rt.pNext = &as;
+  VkPhysicalDeviceProperties2 properties{};
+  properties.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2;
+  properties.pNext = &rt;
+  vkGetPhysicalDeviceProperties2(device, &properties);
+  support.supported = true;
+  support.handleSize = rt.shaderGroupHandleSize;
+  support.handleAlignment = std::max<std::uint32_t>(rt.shaderGroupHandleAlignment, 1);
+  support.baseAlignment = std::max<std::uint32_t>(rt.shaderGroupBaseAlignment, 1);
+  support.scratchAlignment = std::max<std::uint32_t>(as.minAccelerationStructureScratchOffsetAlignment, 1);
+  return support;
+}
+
 VKAPI_ATTR VkBool32 VKAPI_CALL debugCallback(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
                                              VkDebugUtilsMessageTypeFlagsEXT,
                                              const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
@@ -243,8 +297,30 @@ SharedDevice::SharedDevice(std::shared_ptr<VulkanInstance> instance, VkPhysicalD
   properties2.pNext = &subgroup;
   vkGetPhysicalDeviceProperties2(physical_, &properties2);
   subgroupSize_ = std::max<std::uint32_t>(subgroup.subgroupSize, 1);
+  subgroupArithmetic_ = (subgroup.supportedOperations & VK_SUBGROUP_FEATURE_ARITHMETIC_BIT) != 0 &&
+                        (subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) != 0;
   vkGetPhysicalDeviceMemoryProperties(physical_, &memory_);
   queueFamily_ = *findQueueFamily(physical_, &timestampValidBits_);  // describe() found one
+
+  // Ray tracing where the device offers all of it (context.h,
+  // RayTracingSupport); the rest of the renderer needs none of it.
+  rayTracing_ = rayTracingSupport(physical_);
+  const std::vector<const char*> rayExtensions = {VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME,
+                                                  VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME,
+                                                  VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME};
+  VkPhysicalDeviceVulkan12Features v12{};
+  v12.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES;
+  VkPhysicalDeviceAccelerationStructureFeaturesKHR asFeatures{};
+  asFeatures.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR;
+  VkPhysicalDeviceRayTracingPipelineFeaturesKHR rtFeatures{};
+  rtFeatures.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_FEATURES_KHR;
+  if (rayTracing_.supported) {
+    v12.bufferDeviceAddress = VK_TRUE;
+    asFeatures.accelerationStructure = VK_TRUE;
+    rtFeatures.rayTracingPipeline = VK_TRUE;
+    v12.pNext = &asFeatures;
+    asFeatures.pNext = &rtFeatures;
+  }
 
   const float priority = 1.0f;
   VkDeviceQueueCreateInfo q{};
@@ -256,6 +332,11 @@ SharedDevice::SharedDevice(std::shared_ptr<VulkanInstance> instance, VkPhysicalD
   d.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO;
   d.queueCreateInfoCount = 1;
   d.pQueueCreateInfos = &q;
+  if (rayTracing_.supported) {
+    d.pNext = &v12;
+    d.enabledExtensionCount = static_cast<std::uint32_t>(rayExtensions.size());
+    d.ppEnabledExtensionNames = rayExtensions.data();
+  }
   vkCheck(vkCreateDevice(physical_, &d, nullptr, &device_), "vkCreateDevice");
   ++gDevicesCreated;
   vkGetDeviceQueue(device_, queueFamily_, 0, &queue_);

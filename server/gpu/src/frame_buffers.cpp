@@ -88,7 +88,7 @@ void VulkanRenderer::Impl::releaseResolution() {
   destroyTarget(subTarget);
   maskUpload = BufferUpload();
   for (Buffer* b : {&gbufIds, &gbufNormals, &gbufPositions, &samples, &shade, &counter, &counterOut, &shadeOut, &radiance,
-                    &rgba8, &rotated, &radianceOut, &idsOut, &batchArgs, &subIds, &subNormals, &edges, &masks}) {
+                    &rgba8, &rotated, &radianceOut, &idsOut, &batchArgs, &subIds, &subNormals, &edges, &masks, &pixelSample, &skyGrid}) {
     *b = Buffer();
   }
   width = height = 0;
@@ -169,8 +169,14 @@ void VulkanRenderer::Impl::ensureResolution(int w, int h) {
   if (fused || splitsum) {
     // Each sample's point-light mask, written by the host every frame (the
     // frame's "shadow-rays" stage) and read by the fused pass.
-    masks = Buffer(context, sampleCapacity * sizeof(std::uint32_t), kStorageUsage, MemoryUse::DeviceInput);
-    maskUpload = BufferUpload(context, masks);
+    // On the device, the ray-generation shader writes them instead (device_rays.cpp).
+    if (deviceRays) {
+      masks = Buffer(context, sampleCapacity * sizeof(std::uint32_t), kStorageUsage, MemoryUse::DeviceOnly);
+      ensureDeviceRayBuffers();
+    } else {
+      masks = Buffer(context, sampleCapacity * sizeof(std::uint32_t), kStorageUsage, MemoryUse::DeviceInput);
+      maskUpload = BufferUpload(context, masks);
+    }
     if (splitsum) {
       fusedPass->bind({{kSplitsumSamplesBinding, &samples},
                        {kSplitsumShadeBinding, &shade},

@@ -1,10 +1,11 @@
-// A `fused` frame: [G-buffer → rotation input (compaction, indirect
-// arguments)] → the host's shadow rays for the covered samples read back →
-// [fused (vkCmdDispatchIndirect) → tonemap]. A `splitsum` frame is the same
-// with splitsum.comp as the pass, its rays the mirror rays alone. Two submissions (each one
-// command buffer on devices with timestamps), because each sample's
-// point-light bits come from Embree on the host (render/point_lights.h),
-// the same rays as the CPU backend's for the same hit.
+// A `fused` frame: G-buffer → rotation input (compaction, indirect
+// arguments) → shadow rays → fused (vkCmdDispatchIndirect) → tonemap. A
+// `splitsum` frame is the same with splitsum.comp as the pass, its rays the
+// mirror rays alone. With the rays on the device (device_rays.cpp) the frame
+// is one submission (on devices with timestamps, or with
+// VulkanRendererLimits::oneSubmission). With the host's (Embree, the CPU
+// backend's rays for the same hit: render/point_lights.h) it is two, around
+// the covered samples read back and their shadow words uploaded.
 
 #include <algorithm>
 #include <cstddef>
@@ -148,49 +149,59 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
   uploadFrameUniforms(request, resolved);
   frame.stages.push_back({"light", secondsSince(t0)});
 
-  // ---- the device's first part: the samples to shade
+  // ---- the samples to shade, their shadow rays, the pass, the image
   const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
-  runStages({{"gbuffer", [&](VkCommandBuffer cb) { recordGBuffer(cb, resolved); }},
-             {"rotation-input",
-              [&](VkCommandBuffer cb) {
-                vkCmdFillBuffer(cb, counter.handle(), 0, VK_WHOLE_SIZE, 0u);
-                if (fused) vkCmdFillBuffer(cb, sliceCounts.handle(), 0, VK_WHOLE_SIZE, 0u);
-                computeBarrier(cb);
-                rotationInput->dispatch(cb, {groupsOf(pixels, shared::kLocalSize), 1, 1});
-                recordCounterCopy(cb);
-              }}},
-            request, frame);
-  if (frame.cancelled) return frame;  // stopped between stages: no images
+  const glm::vec3 eye(render::CameraRays(request.camera, request.width, request.height).origin());
+  const FrameStage gbufferStage{"gbuffer", [&](VkCommandBuffer cb) { recordGBuffer(cb, resolved); }};
+  const FrameStage rotationInputStage{"rotation-input", [&](VkCommandBuffer cb) {
+                                        vkCmdFillBuffer(cb, counter.handle(), 0, VK_WHOLE_SIZE, 0u);
+                                        if (fused) vkCmdFillBuffer(cb, sliceCounts.handle(), 0, VK_WHOLE_SIZE, 0u);
+                                        computeBarrier(cb);
+                                        rotationInput->dispatch(cb, {groupsOf(pixels, shared::kLocalSize), 1, 1});
+                                        recordCounterCopy(cb);
+                                      }};
+  const FrameStage passStage{splitsum ? "splitsum" : "fused", [&](VkCommandBuffer cb) {
+                               // Where the inputs are staged: their copies into device memory.
+                               if (fused) {
+                                 lightUpload.record(cb);
+                                 pointLightUpload.record(cb);
+                               }
+                               if (!deviceRays) maskUpload.record(cb);
+                               computeBarrier(cb);
+                               fusedPass->dispatchIndirect(cb, counter, offsetof(CoverageCounter, groups));
+                               if (fused) {
+                                 computeBarrier(cb);
+                                 const VkBufferCopy counts{0, 0, sliceCounts.size()};
+                                 vkCmdCopyBuffer(cb, sliceCounts.handle(), sliceCountsOut.handle(), 1, &counts);
+                               }
+                             }};
+  const FrameStage tonemapStage{"tonemap", [&](VkCommandBuffer cb) { recordTonemap(cb, request); }};
+  std::uint32_t covered = 0;
+  if (deviceRays) {
+    // One submission: the rays traced on the device between rotation-input and the pass.
+    writeRays(resolved, eye);
+    runStages({gbufferStage,
+               rotationInputStage,
+               {"shadow-rays", [&](VkCommandBuffer cb) { recordDeviceRays(cb); }},
+               passStage,
+               tonemapStage},
+              request, frame);
+    if (frame.cancelled) return frame;
+    covered = coveredSamples();
+  } else {
+    runStages({gbufferStage, rotationInputStage}, request, frame);
+    if (frame.cancelled) return frame;  // stopped between stages: no images
 
-  // ---- shadow-rays (host): each covered sample's point-light bits
-  frame.cancelled = cancelRequested();
-  if (frame.cancelled) return frame;
-  t0 = RendererClock::now();
-  render::enterFrameStage(request, "shadow-rays");
-  const std::uint32_t covered =
-      computeShadowMasks(resolved, glm::vec3(render::CameraRays(request.camera, request.width, request.height).origin()));
-  frame.stages.push_back({"shadow-rays", secondsSince(t0)});
-
-  // ---- the device's second part: the pass over the samples, the image
-  runStages({{splitsum ? "splitsum" : "fused",
-              [&](VkCommandBuffer cb) {
-                // Where the inputs are staged: their copies into device memory.
-                if (fused) {
-                  lightUpload.record(cb);
-                  pointLightUpload.record(cb);
-                }
-                maskUpload.record(cb);
-                computeBarrier(cb);
-                fusedPass->dispatchIndirect(cb, counter, offsetof(CoverageCounter, groups));
-                if (fused) {
-                  computeBarrier(cb);
-                  const VkBufferCopy counts{0, 0, sliceCounts.size()};
-                  vkCmdCopyBuffer(cb, sliceCounts.handle(), sliceCountsOut.handle(), 1, &counts);
-                }
-              }},
-             {"tonemap", [&](VkCommandBuffer cb) { recordTonemap(cb, request); }}},
-            request, frame);
-  if (frame.cancelled) return frame;
+    // ---- shadow-rays (host): each covered sample's point-light bits
+    frame.cancelled = cancelRequested();
+    if (frame.cancelled) return frame;
+    t0 = RendererClock::now();
+    render::enterFrameStage(request, "shadow-rays");
+    covered = computeShadowMasks(resolved, eye);
+    frame.stages.push_back({"shadow-rays", secondsSince(t0)});
+    runStages({passStage, tonemapStage}, request, frame);
+    if (frame.cancelled) return frame;
+  }
 
   // ---- Results: RGBA8 always, the linear image and mask only when asked for
   frame.rgba8.resize(pixels * 4);

@@ -202,10 +202,10 @@ void VulkanRenderer::Impl::uploadScene() {
   objects = Buffer(context, objectCount * sizeof(ObjectInfo));
   if (splitsum) {
     // No light per frame: the pass turns its lookup (ObjectInfo::toLight).
-    // The mirror rays' scene, as fused's shadow rays' (below).
+    // The mirror rays' scene, as fused's shadow rays' (below), where the host traces them.
     std::vector<Instance> instances;
     for (const render::PreparedObject& p : prepared.objects) instances.push_back({p.mesh.get(), glm::mat4(p.pose.objectToWorld())});
-    rays = std::make_unique<RayScene>(std::move(instances));
+    if (!deviceRays) rays = std::make_unique<RayScene>(std::move(instances));
   }
   // The light: per object and channel a header and at most (N − 1)/3 blocks;
   // for `fused` its pixel form, N RGB0 texels per object at its level (fusedLightTexels).
@@ -225,13 +225,13 @@ void VulkanRenderer::Impl::uploadScene() {
     // Per object, its samples shaded from one slice and from two (fused.comp).
     sliceCounts = Buffer(context, 2 * objectCount * sizeof(std::uint32_t), kStorageUsage, MemoryUse::DeviceOnly);
     sliceCountsOut = Buffer(context, 2 * objectCount * sizeof(std::uint32_t), kStorageUsage, MemoryUse::Readback);
-    // The shadow rays' scene: every object (the ground included) at its
-    // scene pose, posed per frame (CpuRenderer::makeRays).
+    // The shadow rays' scene where the host traces them: every object (the
+    // ground included) at its scene pose, posed per frame (CpuRenderer::makeRays).
     std::vector<Instance> instances;
     for (const render::PreparedObject& p : prepared.objects) {
       instances.push_back({p.mesh.get(), glm::mat4(p.pose.objectToWorld())});
     }
-    rays = std::make_unique<RayScene>(std::move(instances));
+    if (!deviceRays) rays = std::make_unique<RayScene>(std::move(instances));
   }
   frameParams = Buffer(context, sizeof(FrameParams));
   thresholds = Buffer(context, sizeof(render::ToneThresholds));
@@ -292,6 +292,9 @@ void VulkanRenderer::Impl::createFusedPipeline(std::uint32_t local) {
   // samples took 0.21 CPU-s per frame on lavapipe where one group per sample
   // took 0.25 (default scene, 256², level 5; docs/gpu.md).
   fusedLocal = limits.fusedLocalSize ? limits.fusedLocalSize : local;
+  // A workgroup of one subgroup reduces with subgroupAdd: no barrier, which
+  // lavapipe would compile into coroutines (shared_passes.h, kSpecSubgroupReduce).
+  const bool subgroupReduce = fusedLocal == context.subgroupSize() && context.subgroupArithmetic();
   const std::size_t maxGroups = context.properties().limits.maxComputeWorkGroupCount[0];
   const std::size_t groups = context.info().type == "cpu" ? 512u : 1u << 16;
   fusedGroups = static_cast<std::uint32_t>(std::min<std::size_t>(maxGroups, groups));
@@ -300,7 +303,8 @@ void VulkanRenderer::Impl::createFusedPipeline(std::uint32_t local) {
       context, "fused.comp", fusedBindings(), 0,
       std::vector<SpecConstant>{{shared::kSpecLocalSize, fusedLocal},
                                 {shared::kSpecInterpolate, options.interpolateSlices ? 1u : 0u},
-                                {shared::kSpecPrefilterFinest, static_cast<std::uint32_t>(std::max(prepared.lobeLight.finestLevel(), 0))}});
+                                {shared::kSpecPrefilterFinest, static_cast<std::uint32_t>(std::max(prepared.lobeLight.finestLevel(), 0))},
+                                {shared::kSpecSubgroupReduce, subgroupReduce ? 1u : 0u}});
 }
 
 }  // namespace haarcast::gpu

@@ -44,7 +44,9 @@ VulkanRenderer::Impl::Impl(std::shared_ptr<const render::PreparedScene> scene, c
   methodName = std::string(haarcast::methodName(options.method));
   level = options.level;
   coefficients = static_cast<std::size_t>(mapSize(level)) * static_cast<std::size_t>(mapSize(level));
+  chooseRays();
   uploadScene();
+  if (deviceRays) createDeviceRays();
   createGraphicsPipeline();
   useTimestamps = context.timestampsSupported() && context.properties().limits.timestampComputeAndGraphics &&
                   context.info().type != "cpu";
@@ -136,6 +138,11 @@ std::size_t VulkanRenderer::peakFramesInFlight() const {
 }
 
 std::string VulkanRenderer::deviceName() const { return slots_.front()->context.info().name; }
+std::string VulkanRenderer::rays() const {
+  const Impl& impl = *slots_.front();
+  if (!impl.fused && !impl.splitsum) return "none";
+  return impl.deviceRays ? "device" : "host";
+}
 const render::RenderOptions& VulkanRenderer::options() const { return slots_.front()->options; }
 std::size_t VulkanRenderer::objectCount() const { return slots_.front()->prepared.objects.size(); }
 std::vector<int> VulkanRenderer::objectLevels() const { return slots_.front()->prepared.objectLevels(); }
@@ -171,6 +178,12 @@ std::vector<ShadeSample> VulkanRenderer::shadeSamples() const {
   Impl& impl = last();
   const std::uint32_t covered = impl.counterOut.handle() ? impl.coveredSamples() : 0;
   return readAll<ShadeSample>(impl.context, impl.shade, covered);
+}
+std::vector<std::uint32_t> VulkanRenderer::shadowWords() const {
+  Impl& impl = last();
+  if (!impl.masks.handle()) return {};
+  const std::uint32_t covered = impl.counterOut.handle() ? impl.coveredSamples() : 0;
+  return readAll<std::uint32_t>(impl.context, impl.masks, covered);
 }
 std::vector<std::uint32_t> VulkanRenderer::edgeWords() const {
   if (!last().options.antialias) return {};

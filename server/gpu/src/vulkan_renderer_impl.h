@@ -5,7 +5,8 @@
 //   gbuffer_pass.cpp      the G-buffer's render pass, pipeline, projection, recording
 //   frame_buffers.cpp     the per-resolution images and buffers
 //   frame_stages.cpp      a frame's uniforms, its stages recorded, submitted and timed
-//   fused_frame.cpp       a `fused` or `splitsum` frame: two submissions around the host's shadow rays, indirect dispatch
+//   fused_frame.cpp       a `fused` or `splitsum` frame: its shadow rays on the device (one submission) or the host's between two
+//   device_rays.cpp       the shadow rays on the device: acceleration structures, the ray frame, the three launches
 //   rotating_frame.cpp    a frame of the rotating methods: rotation and triple product in batches
 #pragma once
 
@@ -21,6 +22,7 @@
 #include <glm/mat4x4.hpp>
 
 #include "haarcast/gpu/compute.h"
+#include "haarcast/gpu/ray_tracing.h"
 #include "haarcast/gpu/vulkan_renderer.h"
 #include "haarcast/render/embree_scene.h"
 
@@ -101,6 +103,24 @@ struct VulkanRenderer::Impl {
   std::uint32_t fusedGroups = 0;     // the most workgroups of the fused dispatch
   std::uint32_t fusedLocal = 0;      // its local size
   std::size_t fusedLightTexelCount = 0;  // Σ over objects of N at each one's level
+  // Where the shadow rays are traced (VulkanRendererLimits::rays, resolved
+  // when the renderer is built): on the device (device_rays.cpp) or by Embree
+  // on the host (`rays` below). The rotating methods trace none.
+  bool deviceRays = false;
+  // The device's: a bottom level per mesh and the frame's top level, the
+  // ray-generation pipeline, per frame the objects' and the frame's records
+  // (core/shared_rays.h); the map light's luminance (the ground's hidden
+  // sky); per pixel its centre sample and the coarse grid's values.
+  std::unique_ptr<AccelerationStructures> accelerationStructures;
+  std::unique_ptr<RayTracingPipeline> shadowRays;
+  Buffer rayObjects, rayFrame, skyLuminance, pixelSample, skyGrid;
+  BufferUpload rayObjectsUpload, rayFrameUpload;
+  std::vector<RayObject> rayObjectData;
+  RayFrame rayFrameData{};
+  std::vector<glm::mat4> posesData;  // this frame's object → world, for the top level
+  // The samples' launches are this many invocations wide (and as many rows
+  // as the sample capacity needs): under every device's launch-width limit.
+  static constexpr std::uint32_t kRaysLaunchWidth = 4096;
   // The point lights' shadow rays (render/point_lights.h), on the host: every
   // prepared object as an instance, posed per frame (setTransform), as the
   // CPU backend's ray scene.
@@ -239,6 +259,22 @@ struct VulkanRenderer::Impl {
   const ShadeSample* readShadeSamples(std::uint32_t covered);
   // Records the copy of the counter into counterOut (after rotation-input).
   void recordCounterCopy(VkCommandBuffer cb);
+
+  // device_rays.cpp
+  // Resolves limits.rays for this device and method (deviceRays); throws
+  // std::invalid_argument when `device` is asked for and the device has no
+  // ray tracing.
+  void chooseRays();
+  // The acceleration structures, the pipeline and the buffers the frame's
+  // size does not change (after uploadScene).
+  void createDeviceRays();
+  // The per-pixel and per-grid-point buffers (ensureResolution).
+  void ensureDeviceRayBuffers();
+  // This frame's RayObject and RayFrame records, written for their upload.
+  void writeRays(const render::ResolvedFrame& resolved, const glm::vec3& eye);
+  // The "shadow-rays" stage on the device: the uploads, the top level, the
+  // three launches (core/shared_rays.h), ending with the masks fused reads.
+  void recordDeviceRays(VkCommandBuffer cb);
 
   // rotating_frame.cpp
   render::Frame renderRotating(const render::FrameRequest& request);

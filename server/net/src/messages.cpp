@@ -22,6 +22,7 @@ std::string welcomeMessage(const SessionConfig& config, const Catalog& catalog, 
   *w->mutable_settings() = settingsToWire(config);
   w->set_object_count(static_cast<std::uint32_t>(facts.objectCount));
   w->set_device(facts.device);
+  w->set_rays(facts.rays);
   *w->mutable_scene_info() = sceneInfo(config, catalog, facts.objectLevels);
   *w->mutable_limits() = limitsToWire(limits);
   return serialize(m);

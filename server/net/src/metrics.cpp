@@ -155,6 +155,11 @@ std::string Metrics::prometheusText() const {
   out << "haarcast_http_requests_total " << httpRequests.load() << '\n';
   metric("haarcast_renderers_built_total", "counter", "Renderers prepared (scene, materials, level, method, backend).");
   out << "haarcast_renderers_built_total " << renderersBuilt.load() << '\n';
+  metric("haarcast_renderers_rays_total", "counter",
+         "Renderers prepared, by where their shadow rays are traced: on the device (the GPU), the host (Embree), none.");
+  out << "haarcast_renderers_rays_total{rays=\"device\"} " << renderersRaysDevice.load() << '\n';
+  out << "haarcast_renderers_rays_total{rays=\"host\"} " << renderersRaysHost.load() << '\n';
+  out << "haarcast_renderers_rays_total{rays=\"none\"} " << renderersRaysNone.load() << '\n';
   metric("haarcast_render_failures_total", "counter",
          "Frames that failed to render; each is told to its client (the same message again at most once a second, "
          "with a count).");

@@ -300,6 +300,9 @@ struct RenderService::Impl {
         // Cached even when abandoned: another session may want it next.
         renderer->key = build->key;
         metrics.renderersBuilt.fetch_add(1);
+        const std::string rays = renderer->renderer->rays();
+        (rays == "device" ? metrics.renderersRaysDevice : rays == "host" ? metrics.renderersRaysHost : metrics.renderersRaysNone)
+            .fetch_add(1);
         ready.push_front(renderer);
         while (ready.size() > options.maxRenderers) ready.pop_back();  // sessions keep theirs alive
       }

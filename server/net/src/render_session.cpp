@@ -244,7 +244,8 @@ void RenderSession::onPrepared(const std::string& key, std::shared_ptr<PreparedR
     welcomed_ = true;
     lastStats_ = now;
     port_.send(welcomeMessage(config_, catalog_, options_.limits,
-                              {id_, renderer_->renderer->objectCount(), renderer_->renderer->deviceName(), levels}));
+                              {id_, renderer_->renderer->objectCount(), renderer_->renderer->deviceName(), levels,
+                               renderer_->renderer->rays()}));
   } else if (levels != announcedLevels_) {
     port_.send(sceneInfoMessage(config_, catalog_, levels));
   }

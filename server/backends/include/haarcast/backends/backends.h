@@ -33,6 +33,9 @@ struct DeviceOptions {
   // Vulkan: frames one renderer may have in flight at once
   // (gpu::VulkanRendererLimits::framesInFlight; 0 = 1 on a CPU device, 2 on a GPU).
   std::size_t framesInFlight = 0;
+  // Vulkan: where the shadow rays are traced (render/backend_names.h,
+  // gpu::VulkanRendererLimits::rays).
+  render::RayMode rays = render::RayMode::Auto;
 };
 
 // True when this build has `name` (one of render::kBackendNames).

@@ -427,6 +427,9 @@ struct ShadeSample {
 // Auto exposure's metering, ExposurePush and ExposureResult.
 #include "haarcast/core/shared_exposure.h"
 
+// Shadow rays on the device: RayObject, RayFrame, RaysPush.
+#include "haarcast/core/shared_rays.h"
+
 // The passes' workgroup sizes, push blocks and bindings.
 #include "haarcast/core/shared_passes.h"
 
@@ -437,6 +440,9 @@ static_assert(sizeof(ObjectInfo) == 192 && offsetof(ObjectInfo, toLight) == 96 &
               offsetof(ObjectInfo, skipBelowY) == 68 && offsetof(ObjectInfo, groundRadiance) == 80 &&
               offsetof(ObjectInfo, level) == 160 && offsetof(ObjectInfo, visibilityBase) == 176);
 static_assert(sizeof(PointLight) == 32);
+static_assert(sizeof(RayObject) == 144 && offsetof(RayObject, sphere) == 112 && offsetof(RayObject, occluder) == 140);
+static_assert(sizeof(RayFrame) == 384 && offsetof(RayFrame, eye) == 256 && offsetof(RayFrame, toEnvironment) == 288 &&
+              offsetof(RayFrame, lights) == 336 && offsetof(RayFrame, framePad) == 380);
 static_assert(sizeof(SliceLobe) == 48 + 16 * kLobeSamples && offsetof(SliceLobe, median) == 16 &&
               offsetof(SliceLobe, core) == 32 && offsetof(SliceLobe, samples) == 48);
 static_assert(kLobeSeenBit >= (1u << kMaxPointLights), "the lobe's bit lies above the light bits");

@@ -27,6 +27,21 @@ HC_CONST uint kGpuLocalSize = 256u;
 HC_CONST uint kExposureLocalSize = 128u;
 HC_CONST uint kExposurePixelsPerInvocation = 16u;
 
+// shadow_rays.rgen (shared_rays.h): storage buffers at these bindings, the
+// top-level acceleration structure at kRaysSceneBinding.
+HC_CONST uint kRaysShadeBinding = 0u;
+HC_CONST uint kRaysCounterBinding = 1u;
+HC_CONST uint kRaysPositionsBinding = 2u;
+HC_CONST uint kRaysNormalsBinding = 3u;
+HC_CONST uint kRaysObjectsBinding = 4u;
+HC_CONST uint kRaysFrameBinding = 5u;
+HC_CONST uint kRaysLuminanceBinding = 6u;
+HC_CONST uint kRaysPixelSampleBinding = 7u;
+HC_CONST uint kRaysGridBinding = 8u;
+HC_CONST uint kRaysMasksBinding = 9u;
+HC_CONST uint kRaysSceneBinding = 10u;
+HC_CONST uint kRaysStorageBindings = 10u;
+
 // ---- Specialization constants: the ids the shaders declare them at
 // (layout(constant_id = …)) and the host sets them by (gpu::SpecConstant).
 HC_CONST uint kSpecLevel = 0u;            // LEVEL: the maps are 2^LEVEL × 2^LEVEL
@@ -34,6 +49,13 @@ HC_CONST uint kSpecThetaSamples = 1u;     // THETA_SAMPLES: slices per channel p
 HC_CONST uint kSpecLocalSize = 2u;        // local_size_x_id: the host's workgroup size
 HC_CONST uint kSpecInterpolate = 4u;      // INTERPOLATE: RenderOptions::interpolateSlices
 HC_CONST uint kSpecPrefilterFinest = 5u;  // PREFILTER_FINEST: the prefiltered light's finest level
+// SUBGROUP_REDUCE (fused.comp): 1 when the workgroup is one subgroup (a CPU
+// device's SIMD width) and the reduction is subgroupAdd, with no shared
+// memory and no barrier; 0: shared memory and barriers (GPUs, whose
+// workgroups span several subgroups). Mesa ≥ 24's lavapipe compiles a
+// shader with barriers into LLVM coroutines, which took 126 s for fused.comp
+// (docs/gpu.md, "Shader compilation on lavapipe").
+HC_CONST uint kSpecSubgroupReduce = 6u;
 
 // ---- Indirect dispatch
 

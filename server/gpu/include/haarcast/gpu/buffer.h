@@ -43,6 +43,10 @@ class Buffer {
 
   VkBuffer handle() const { return buffer_; }
   VkDeviceSize size() const { return size_; }
+  // Its address on the device; the buffer needs
+  // VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT (and the device, ray tracing:
+  // context.h), which also allocates its memory for device addresses.
+  VkDeviceAddress deviceAddress() const;
   // The host mapping, or null when the host cannot see the memory.
   void* mapped() const { return mapped_; }
   // Host data reaches it only through a staging buffer (BufferUpload).

@@ -101,6 +101,23 @@ std::vector<DeviceInfo> listDevices();
 std::string describeDevices(const std::vector<DeviceInfo>& devices);
 bool validationLayerInstalled();
 
+// Whether a device traces rays itself (VK_KHR_acceleration_structure and
+// VK_KHR_ray_tracing_pipeline with their features, and buffer device
+// addresses): the device-ray frame (render::RayMode, vulkan_renderer.h) and
+// gpu/ray_tracing.h need it. A ray-tracing pipeline rather than ray queries
+// in the compute passes, because the one data-centre GPU measured (an H100,
+// driver 580) offers the pipeline and not VK_KHR_ray_query; lavapipe (Mesa
+// ≥ 24.1) offers both.
+struct RayTracingSupport {
+  bool supported = false;
+  std::string missing;  // empty when supported, else what the device lacks
+  // VkPhysicalDeviceRayTracingPipelinePropertiesKHR: the shader binding
+  // table's record size and alignments.
+  std::uint32_t handleSize = 0, handleAlignment = 1, baseAlignment = 1;
+  // VkPhysicalDeviceAccelerationStructurePropertiesKHR: scratch alignment.
+  std::uint32_t scratchAlignment = 1;
+};
+
 class SharedDevice;
 
 class Context {
@@ -123,6 +140,10 @@ class Context {
   // Invocations a subgroup runs together (VkPhysicalDeviceSubgroupProperties):
   // the SIMD width on a CPU device (8 on lavapipe with AVX2).
   std::uint32_t subgroupSize() const;
+  // Whether compute shaders may use subgroup arithmetic (subgroupAdd).
+  bool subgroupArithmetic() const;
+
+  const RayTracingSupport& rayTracing() const;
 
   // Timestamp queries: supported on the queue, and nanoseconds per tick.
   bool timestampsSupported() const { return timestampValidBits() > 0 && properties().limits.timestampPeriod > 0; }
@@ -132,6 +153,9 @@ class Context {
   // Records with `record` into a fresh primary command buffer, submits it and
   // waits for this Context's fence (not for other Contexts' work).
   void submit(const std::function<void(VkCommandBuffer)>& record);
+  // Command buffers this Context has submitted: what a test counts to see
+  // that a frame is one submission.
+  std::uint64_t submissionCount() const { return submissions_.load(); }
   // Waits for a submission of this Context still in flight (one whose wait
   // threw); what destructors call in place of vkDeviceWaitIdle, which would
   // wait for every renderer on the device.
@@ -146,7 +170,9 @@ class Context {
   bool directInputs() const { return directInputs_; }
   // vkAllocateMemory through the context, so that allocations can be counted
   // (the renderer must not allocate per frame; a test checks it).
-  VkDeviceMemory allocate(VkDeviceSize bytes, std::uint32_t typeIndex);
+  // `flags`: VkMemoryAllocateFlags, VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT for
+  // a buffer whose device address a shader or an acceleration structure reads.
+  VkDeviceMemory allocate(VkDeviceSize bytes, std::uint32_t typeIndex, VkMemoryAllocateFlags flags = 0);
   void free(VkDeviceMemory memory);
   std::uint64_t allocationCount() const { return allocations_.load(); }
 
@@ -166,6 +192,7 @@ class Context {
   bool inFlight_ = false;  // submitted, not yet waited for
   bool directInputs_ = true;
   std::atomic<std::uint64_t> allocations_{0};
+  std::atomic<std::uint64_t> submissions_{0};
   std::atomic<std::uint64_t> validationMark_{0};  // ValidationLog::count() when made or cleared
 };
 

@@ -91,11 +91,15 @@ class SharedDevice {
   std::uint32_t queueFamily() const { return queueFamily_; }
   std::uint32_t timestampValidBits() const { return timestampValidBits_; }
   std::uint32_t subgroupSize() const { return subgroupSize_; }
+  bool subgroupArithmetic() const { return subgroupArithmetic_; }
   const DeviceInfo& info() const { return info_; }
   const VkPhysicalDeviceProperties& properties() const { return properties_; }
   const VkPhysicalDeviceMemoryProperties& memoryProperties() const { return memory_; }
   bool validationEnabled() const;
   ValidationLog& validationLog() const;
+  // Ray tracing (context.h, RayTracingSupport): enabled on the device when
+  // it offers it, else why not.
+  const RayTracingSupport& rayTracing() const { return rayTracing_; }
 
   // vkQueueSubmit on the shared queue, under its mutex (the queue needs
   // external synchronisation); the caller waits on its own `fence` after.
@@ -111,8 +115,10 @@ class SharedDevice {
   std::uint32_t queueFamily_ = 0;
   std::uint32_t timestampValidBits_ = 0;
   std::uint32_t subgroupSize_ = 1;
+  bool subgroupArithmetic_ = false;
   VkPhysicalDeviceProperties properties_{};
   VkPhysicalDeviceMemoryProperties memory_{};
+  RayTracingSupport rayTracing_;
 };
 
 struct EngineOptions {

@@ -31,6 +31,9 @@ using shared::FrameParams;
 using shared::GBufferPush;
 using shared::ObjectInfo;
 using shared::PointLight;
+using shared::RayFrame;
+using shared::RayObject;
+using shared::RaysPush;
 using shared::RotationSample;
 using shared::ShadeSample;
 

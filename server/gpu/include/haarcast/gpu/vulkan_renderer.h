@@ -69,6 +69,14 @@ struct VulkanRendererLimits {
   // its cores), 2 on a GPU. While one frame's host stages run (the light,
   // the shadow rays, the encoding after it), another's passes run on the device.
   std::size_t framesInFlight = 0;
+  // Where the shadow rays of `fused` and `splitsum` are traced
+  // (render/backend_names.h): `device` needs a device with ray tracing
+  // (context.h, RayTracingSupport) and is refused elsewhere.
+  render::RayMode rays = render::RayMode::Auto;
+  // On a CPU device each stage is a submission of its own, timed on the host
+  // (lavapipe's timestamps do not wait for compute); true records the frame
+  // into one submission there too, reported as one stage, "device".
+  bool oneSubmission = false;
 };
 
 class VulkanRenderer final : public render::Renderer {
@@ -82,6 +90,7 @@ class VulkanRenderer final : public render::Renderer {
 
   std::string backend() const override { return std::string(render::kVulkanBackend); }
   std::string deviceName() const override;
+  std::string rays() const override;
   const render::RenderOptions& options() const override;
   std::size_t objectCount() const override;
   std::vector<int> objectLevels() const override;
@@ -104,6 +113,10 @@ class VulkanRenderer final : public render::Renderer {
   // The compacted covered pixels, in the order the GPU wrote them.
   std::vector<RotationSample> rotationSamples() const;
   std::vector<ShadeSample> shadeSamples() const;
+  // `fused`, `splitsum`: each covered sample's shadow word as the pass read
+  // it (point-light bits, kLobeSeenBit, the ground's occlusion), in
+  // shadeSamples() order; empty for the rotating methods.
+  std::vector<std::uint32_t> shadowWords() const;
   // With antialiasing, each pixel's edge word (shared_layout.h kEdgeFlag);
   // empty without.
   std::vector<std::uint32_t> edgeWords() const;

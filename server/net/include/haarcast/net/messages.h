@@ -40,6 +40,7 @@ struct WelcomeFacts {
   std::size_t objectCount = 0;
   std::string device;
   std::vector<int> objectLevels;  // render::Renderer::objectLevels (SceneInfo.Object.level)
+  std::string rays;               // render::Renderer::rays: "device", "host" or "none"
 };
 std::string welcomeMessage(const SessionConfig& config, const Catalog& catalog, const Limits& limits,
                            const WelcomeFacts& facts);

@@ -34,6 +34,9 @@ class Metrics {
   std::atomic<std::uint64_t> grpcBytesTotal{0};
   std::atomic<std::uint64_t> httpRequests{0};
   std::atomic<std::uint64_t> renderersBuilt{0};
+  // Of them, by where their shadow rays are traced (render::Renderer::rays):
+  // on the device, on the host, none (the rotating methods).
+  std::atomic<std::uint64_t> renderersRaysDevice{0}, renderersRaysHost{0}, renderersRaysNone{0};
   std::atomic<std::uint64_t> renderFailures{0};    // frames that failed to render (each one, said or folded)
   std::atomic<std::uint64_t> framesCancelled{0};   // frame jobs ended without a frame (session gone, request replaced, stop)
   std::atomic<std::uint64_t> framesAbandoned{0};   // frames past the frame deadline (render_service.h)

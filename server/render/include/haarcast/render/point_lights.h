@@ -21,6 +21,7 @@
 #include <glm/vec3.hpp>
 
 #include "haarcast/core/mesh.h"
+#include "haarcast/core/shared_layout.h"
 #include "haarcast/core/sphere_map.h"
 #include "haarcast/render/embree_scene.h"
 
@@ -74,8 +75,8 @@ struct GroundSky {
   double total = 0.0;                // Σ luminance·cos·ΔΩ over the ground's upper hemisphere
   double minShare = 0.03;  // faded in up to twice this
 };
-inline constexpr int kGroundSkyRings = 2;
-inline constexpr int kGroundSkySectors = 8;
+inline constexpr int kGroundSkyRings = static_cast<int>(shared::kGroundSkyRings);  // the device's too (shared_rays.h)
+inline constexpr int kGroundSkySectors = static_cast<int>(shared::kGroundSkySectors);
 
 // The share in [0, 1] of the ground's map light that the scene hides from p.
 float groundSkyOcclusion(const RayScene& world, const ShadingPoint& p, const GroundSky& sky);

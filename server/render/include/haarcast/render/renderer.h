@@ -109,6 +109,9 @@ class Renderer {
   virtual std::string backend() const = 0;     // "cpu" | "vulkan"
   virtual std::string deviceName() const = 0;  // e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
   virtual const RenderOptions& options() const = 0;
+  // Where its frames' shadow rays are traced: "device" or "host"
+  // (backend_names.h, RayMode), "none" for a method that traces none.
+  virtual std::string rays() const { return "host"; }
   virtual std::size_t objectCount() const = 0;
   // Each object's map level (PreparedObject::level), in scene order; empty
   // where a renderer does not say.

@@ -1,0 +1,155 @@
+// The shadow rays of a `fused` or `splitsum` frame on the device
+// (shaders/shadow_rays.rgen, core/shared_rays.h): the same rays the host
+// traces with Embree (fused_frame.cpp computeShadowMasks), from the same
+// samples, so the frame needs no host work between its G-buffer and its
+// RGBA8 bytes and is one submission.
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+
+#include "haarcast/core/check.h"
+#include "haarcast/render/point_lights.h"
+
+#include "vulkan_renderer_impl.h"
+
+namespace haarcast::gpu {
+
+void VulkanRenderer::Impl::chooseRays() {
+  const bool traces = fused || splitsum;
+  const RayTracingSupport& rt = context.rayTracing();
+  switch (limits.rays) {
+    case render::RayMode::Host: deviceRays = false; break;
+    case render::RayMode::Device:
+      if (!rt.supported) {
+        throw std::invalid_argument("--rays device: " + context.info().name + " cannot trace rays (" + rt.missing +
+                                    "); valid here: auto, host");
+      }
+      deviceRays = traces;
+      break;
+    case render::RayMode::Auto:
+      // On a GPU the device's rays; on a CPU device (lavapipe) Embree, which
+      // runs on the same cores and is faster there (docs/gpu.md, "Rays").
+      deviceRays = traces && rt.supported && context.info().type != "cpu";
+      break;
+  }
+}
+
+void VulkanRenderer::Impl::createDeviceRays() {
+  std::vector<const Mesh*> meshes;
+  for (const render::PreparedObject& p : prepared.objects) meshes.push_back(p.mesh.get());
+  accelerationStructures = std::make_unique<AccelerationStructures>(context, meshes);
+  shadowRays = std::make_unique<RayTracingPipeline>(context, "shadow_rays.rgen", "shadow_rays.rmiss",
+                                                    shared::kRaysStorageBindings, shared::kRaysSceneBinding,
+                                                    sizeof(RaysPush));
+  rayObjectData.assign(prepared.objects.size(), RayObject{});
+  rayObjects = Buffer(context, rayObjectData.size() * sizeof(RayObject), kStorageUsage, MemoryUse::DeviceInput);
+  rayObjectsUpload = BufferUpload(context, rayObjects);
+  rayFrame = Buffer(context, sizeof(RayFrame), kStorageUsage, MemoryUse::DeviceInput);
+  rayFrameUpload = BufferUpload(context, rayFrame);
+  // The map light's luminance, for the ground's hidden sky (GroundSky::luminance).
+  const bool groundSky = fused && prepared.ground;
+  const std::vector<float> none(1, 0.0f);
+  const std::size_t texels = groundSky ? prepared.restLuminance.pixelCount() : 1;
+  skyLuminance = Buffer(context, texels * sizeof(float), kStorageUsage, MemoryUse::DeviceInput);
+  BufferUpload up(context, skyLuminance);
+  up.write(groundSky ? prepared.restLuminance.values().data() : none.data(), texels * sizeof(float));
+  up.submit();
+}
+
+void VulkanRenderer::Impl::ensureDeviceRayBuffers() {
+  const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  const int step = render::groundSkyStep(width, height);
+  const std::size_t gridPoints = static_cast<std::size_t>((width - 1) / step + 2) * static_cast<std::size_t>((height - 1) / step + 2);
+  pixelSample = Buffer(context, pixels * sizeof(std::uint32_t), kStorageUsage, MemoryUse::DeviceOnly);
+  skyGrid = Buffer(context, gridPoints * sizeof(float), kStorageUsage, MemoryUse::DeviceOnly);
+  shadowRays->bind({{shared::kRaysShadeBinding, &shade},
+                    {shared::kRaysCounterBinding, &counter},
+                    {shared::kRaysPositionsBinding, &positions},
+                    {shared::kRaysNormalsBinding, &normals},
+                    {shared::kRaysObjectsBinding, &rayObjects},
+                    {shared::kRaysFrameBinding, &rayFrame},
+                    {shared::kRaysLuminanceBinding, &skyLuminance},
+                    {shared::kRaysPixelSampleBinding, &pixelSample},
+                    {shared::kRaysGridBinding, &skyGrid},
+                    {shared::kRaysMasksBinding, &masks}},
+                   accelerationStructures->topLevel());
+}
+
+void VulkanRenderer::Impl::writeRays(const render::ResolvedFrame& resolved, const glm::vec3& eye) {
+  const std::size_t objectCount = prepared.objects.size();
+  HC_CHECK_EQ(resolved.objects.size(), objectCount);
+  const bool groundSky = fused && prepared.ground;
+  std::size_t occluder = 0;  // GroundSky::occluders: every object but the ground, in order
+  for (std::size_t i = 0; i < objectCount; ++i) {
+    const render::PreparedObject& p = prepared.objects[i];
+    const render::ResolvedObject& o = resolved.objects[i];
+    RayObject& r = rayObjectData[i];
+    r.toWorld = glm::mat4(o.objectToWorld);
+    for (int c = 0; c < 3; ++c) r.rotation[c] = glm::vec4(glm::vec3(glm::mat3(o.rotation)[c]), 0.0f);
+    r.shift = p.shadowShift * static_cast<float>(o.scale);
+    r.flags = (p.ground ? shared::kObjectGround : 0u) | (p.lobePath ? shared::kObjectLobePath : 0u);
+    r.vertexBase = objectInfo[i].vertexBase;
+    r.occluder = groundSky && !p.ground ? 1u : 0u;
+    r.sphere = glm::vec4(0.0f);
+    if (r.occluder) {
+      HC_CHECK_LT(occluder, resolved.groundSky.occluders.size());
+      r.sphere = resolved.groundSky.occluders[occluder++];
+    }
+  }
+  if (groundSky) HC_CHECK_EQ(occluder, resolved.groundSky.occluders.size());
+  rayObjectsUpload.write(rayObjectData.data(), rayObjectData.size() * sizeof(RayObject));
+
+  RayFrame& f = rayFrameData;
+  f = RayFrame{};
+  const std::size_t lights = resolved.pointLightDirections.size();
+  HC_CHECK_LE(lights, std::size_t{shared::kMaxPointLights});
+  for (std::size_t k = 0; k < lights; ++k) f.lightDirections[k] = glm::vec4(resolved.pointLightDirections[k], 0.0f);
+  f.lights = static_cast<std::uint32_t>(lights);
+  f.objects = static_cast<std::uint32_t>(objectCount);
+  f.eye = glm::vec4(eye, 0.0f);
+  f.width = static_cast<std::uint32_t>(width);
+  f.height = static_cast<std::uint32_t>(height);
+  f.gridStep = static_cast<std::uint32_t>(render::groundSkyStep(width, height));
+  f.gridColumns = static_cast<std::uint32_t>(width - 1) / f.gridStep + 2u;
+  f.gridRows = static_cast<std::uint32_t>(height - 1) / f.gridStep + 2u;
+  f.antialias = options.antialias ? 1u : 0u;
+  f.groundSky = groundSky ? 1u : 0u;
+  if (groundSky) {
+    const render::GroundSky& sky = resolved.groundSky;
+    f.sky = glm::vec4(sky.normal, static_cast<float>(sky.total));
+    for (int c = 0; c < 3; ++c) f.toEnvironment[c] = glm::vec4(sky.toEnvironment[c], 0.0f);
+    f.luminanceLevel = static_cast<std::uint32_t>(prepared.restLuminance.level());
+    f.minShare = static_cast<float>(sky.minShare);
+  }
+  rayFrameUpload.write(&f, sizeof f);
+
+  std::vector<glm::mat4> poses;
+  for (const render::ResolvedObject& o : resolved.objects) poses.emplace_back(o.objectToWorld);
+  posesData = std::move(poses);
+}
+
+void VulkanRenderer::Impl::recordDeviceRays(VkCommandBuffer cb) {
+  rayObjectsUpload.record(cb);
+  rayFrameUpload.record(cb);
+  rayTracingBarrier(cb);  // rotation-input's samples and the uploads, for the launches
+  accelerationStructures->recordTopLevel(cb, posesData);  // ends with a barrier for the launches
+  // The samples' launches: kRaysLaunchWidth wide, as many rows as the
+  // capacity needs; invocations past the covered count return at once.
+  const std::uint32_t rows = groupsOf(sampleCapacity, kRaysLaunchWidth);
+  if (rayFrameData.groundSky) {
+    vkCmdFillBuffer(cb, pixelSample.handle(), 0, VK_WHOLE_SIZE, ~0u);
+    rayTracingBarrier(cb);
+    RaysPush push{shared::kRaysPhaseCentres};
+    shadowRays->trace(cb, kRaysLaunchWidth, rows, &push, sizeof push);
+    rayTracingBarrier(cb);
+    push.phase = shared::kRaysPhaseGrid;
+    shadowRays->trace(cb, rayFrameData.gridColumns, rayFrameData.gridRows, &push, sizeof push);
+    rayTracingBarrier(cb);
+  }
+  const RaysPush push{shared::kRaysPhaseMasks};
+  shadowRays->trace(cb, kRaysLaunchWidth, rows, &push, sizeof push);
+  rayTracingBarrier(cb);
+}
+
+}  // namespace haarcast::gpu
