@@ -6,7 +6,8 @@
 # leaves the others' figures:
 #   the device and whether it offers ray queries (vulkaninfo);
 #   every GPU test, validation on, in one process (one engine per process);
-#   bench-frame, Vulkan, fused at 1280×720 and 1920×1080, levels auto and 6;
+#   bench-frame, Vulkan, fused at 1280×720 and 1920×1080, levels auto and 6
+#   (rays on the device where it traces them), and 1080p level 6 with the host's rays;
 #   serve --backend vulkan with 1, 4 and 16 load-test clients at 1280×720;
 #   H.264 at 1920×1080 (libx264 on the CPU: the H100/H200 have no NVENC),
 #   its encode time per frame read from the server's /metrics;
@@ -90,6 +91,9 @@ bench() {
 }
 frames="${HAARCAST_GPU_FRAMES:-20}"
 bench fused_vulkan 120 --backend vulkan --method fused --sizes 1280x720,1920x1080 --levels auto,6 --frames "$frames"
+# `auto` takes the device's rays on a GPU that traces them: the host's
+# (Embree, the frame in two parts) beside it, the same run.
+bench fused_vulkan_host_rays 60 --backend vulkan --rays host --method fused --sizes 1920x1080 --levels 6 --frames "$frames"
 old="$hc/bin/haarcast.old"
 [[ -x "$old" ]] && BIN="$old" bench fused_vulkan_old 60 --backend vulkan --method fused --sizes 1280x720,1920x1080 \
   --levels auto,6 --frames "$frames"
