@@ -5,6 +5,8 @@
 // RGBA8 bytes and is one submission.
 
 #include <algorithm>
+#include <cstdio>
+#include <exception>
 #include <stdexcept>
 #include <string>
 
@@ -36,6 +38,20 @@ void VulkanRenderer::Impl::chooseRays() {
 }
 
 void VulkanRenderer::Impl::createDeviceRays() {
+  try {
+    setUpDeviceRays();
+  } catch (const std::exception& e) {
+    if (limits.rays != render::RayMode::Auto) throw;
+    std::fprintf(stderr, "warning: %s: the device's rays could not be set up (%s); the host traces them\n",
+                 context.info().name.c_str(), e.what());
+    deviceRays = false;
+    shadowRays.reset();
+    accelerationStructures.reset();
+    createHostRays();
+  }
+}
+
+void VulkanRenderer::Impl::setUpDeviceRays() {
   std::vector<const Mesh*> meshes;
   for (const render::PreparedObject& p : prepared.objects) meshes.push_back(p.mesh.get());
   accelerationStructures = std::make_unique<AccelerationStructures>(context, meshes);

@@ -203,9 +203,7 @@ void VulkanRenderer::Impl::uploadScene() {
   if (splitsum) {
     // No light per frame: the pass turns its lookup (ObjectInfo::toLight).
     // The mirror rays' scene, as fused's shadow rays' (below), where the host traces them.
-    std::vector<Instance> instances;
-    for (const render::PreparedObject& p : prepared.objects) instances.push_back({p.mesh.get(), glm::mat4(p.pose.objectToWorld())});
-    if (!deviceRays) rays = std::make_unique<RayScene>(std::move(instances));
+    if (!deviceRays) createHostRays();
   }
   // The light: per object and channel a header and at most (N − 1)/3 blocks;
   // for `fused` its pixel form, N RGB0 texels per object at its level (fusedLightTexels).
@@ -225,13 +223,7 @@ void VulkanRenderer::Impl::uploadScene() {
     // Per object, its samples shaded from one slice and from two (fused.comp).
     sliceCounts = Buffer(context, 2 * objectCount * sizeof(std::uint32_t), kStorageUsage, MemoryUse::DeviceOnly);
     sliceCountsOut = Buffer(context, 2 * objectCount * sizeof(std::uint32_t), kStorageUsage, MemoryUse::Readback);
-    // The shadow rays' scene where the host traces them: every object (the
-    // ground included) at its scene pose, posed per frame (CpuRenderer::makeRays).
-    std::vector<Instance> instances;
-    for (const render::PreparedObject& p : prepared.objects) {
-      instances.push_back({p.mesh.get(), glm::mat4(p.pose.objectToWorld())});
-    }
-    if (!deviceRays) rays = std::make_unique<RayScene>(std::move(instances));
+    if (!deviceRays) createHostRays();
   }
   frameParams = Buffer(context, sizeof(FrameParams));
   thresholds = Buffer(context, sizeof(render::ToneThresholds));
@@ -327,6 +319,18 @@ void VulkanRenderer::Impl::createSplitsumPipeline() {
       std::vector<SpecConstant>{{shared::kSpecLocalSize, fusedLocal},
                                 {shared::kSpecInterpolate, options.interpolateSlices ? 1u : 0u},
                                 {shared::kSpecPrefilterFinest, static_cast<std::uint32_t>(prepared.lobeLight.finestLevel())}});
+}
+
+}  // namespace haarcast::gpu
+
+namespace haarcast::gpu {
+
+void VulkanRenderer::Impl::createHostRays() {
+  // The shadow rays' scene where the host traces them: every object (the
+  // ground included) at its scene pose, posed per frame (CpuRenderer::makeRays).
+  std::vector<Instance> instances;
+  for (const render::PreparedObject& p : prepared.objects) instances.push_back({p.mesh.get(), glm::mat4(p.pose.objectToWorld())});
+  rays = std::make_unique<RayScene>(std::move(instances));
 }
 
 }  // namespace haarcast::gpu

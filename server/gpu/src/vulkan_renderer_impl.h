@@ -260,14 +260,20 @@ struct VulkanRenderer::Impl {
   // Records the copy of the counter into counterOut (after rotation-input).
   void recordCounterCopy(VkCommandBuffer cb);
 
+  // The host's ray scene (`rays`), for the rays Embree traces.
+  void createHostRays();
+
   // device_rays.cpp
   // Resolves limits.rays for this device and method (deviceRays); throws
   // std::invalid_argument when `device` is asked for and the device has no
   // ray tracing.
   void chooseRays();
   // The acceleration structures, the pipeline and the buffers the frame's
-  // size does not change (after uploadScene).
+  // size does not change (after uploadScene). Under `auto`, a device that
+  // offers ray tracing but fails to set it up (a driver's error) falls back
+  // to the host's rays, with a warning on stderr; under `device` it throws.
   void createDeviceRays();
+  void setUpDeviceRays();
   // The per-pixel and per-grid-point buffers (ensureResolution).
   void ensureDeviceRayBuffers();
   // This frame's RayObject and RayFrame records, written for their upload.
