@@ -84,7 +84,7 @@ TEST(ServeCatalog, NoWelcomeOrSceneInfoFieldHoldsAPathOfTheServer) {
   config.scene = "gallery";
   config.materials = served.catalog.findScene("gallery")->defaultMaterials;
   v1::ServerMessage welcome, info;
-  ASSERT_TRUE(welcome.ParseFromString(net::welcomeMessage(config, served.catalog, net::Limits{}, {"s1", 3, "cpu", {}})));
+  ASSERT_TRUE(welcome.ParseFromString(net::welcomeMessage(config, served.catalog, net::Limits{}, {"s1", 3, "cpu", {}, "host"})));
   ASSERT_TRUE(info.ParseFromString(net::sceneInfoMessage(config, served.catalog)));
 
   const auto& objects = info.scene_info().objects();

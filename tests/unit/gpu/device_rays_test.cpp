@@ -176,7 +176,9 @@ TEST_P(DeviceRays, ShadowWordsMatchTheHostsRays) {
     EXPECT_GT(d.lightRays, d.samples);
     EXPECT_GT(d.groundOccluded, 100u);
   }
-  if (c.mirror || c.method == RotationMethod::Splitsum) EXPECT_GT(d.lobeSamples, 500u);
+  if (c.mirror || c.method == RotationMethod::Splitsum) {
+    EXPECT_GT(d.lobeSamples, 500u);
+  }
   // At most 2 in 1,000 of the rays flip (watertightness, above).
   EXPECT_LE(d.lightFlipped * 500, d.lightRays);
   EXPECT_LE(d.lobeFlipped * 500, std::max<std::size_t>(d.lobeSamples, 1));
@@ -192,8 +194,8 @@ INSTANTIATE_TEST_SUITE_P(Cases, DeviceRays,
                                            RaysCase{"fused-antialiased", RotationMethod::Fused, false, true},
                                            RaysCase{"fused-mirrors", RotationMethod::Fused, true, false},
                                            RaysCase{"splitsum", RotationMethod::Splitsum, false, false}),
-                         [](const ::testing::TestParamInfo<RaysCase>& info) {
-                           std::string name = info.param.name;
+                         [](const ::testing::TestParamInfo<RaysCase>& param) {
+                           std::string name = param.param.name;
                            for (char& ch : name) ch = ch == '-' ? '_' : ch;
                            return name;
                          });
