@@ -357,7 +357,7 @@ std::size_t CpuRenderer::shadePixels(const GBuffer& g, const FrameRequest& reque
           rowBytes += shade(*s, g.centre.size() + g.edge[i] * shared::kSubsamples + k, rgb);
           sum += glm::dvec3(rgb[0], rgb[1], rgb[2]);
         } else if (options_.environmentBackground) {
-          sum += backgroundRadiance(prepared_.background, request.lightRotation,
+          sum += backgroundRadiance(prepared_.background, lightRotationOf(prepared_, request),
                                     camera.subsampleDirection(x, static_cast<int>(y), k));
         }
       }
@@ -434,7 +434,7 @@ Frame CpuRenderer::renderFrame(const FrameRequest& request, const CancelPoint& c
       for (int x = 0; x < w; ++x) {
         const std::size_t i = y * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
         if (frame.objectMask[i] || g.edge[i] != kInterior) continue;  // drawn by the shading
-        const glm::dvec3 L = backgroundRadiance(prepared_.background, request.lightRotation, camera.direction(x, static_cast<int>(y)));
+        const glm::dvec3 L = backgroundRadiance(prepared_.background, lightRotationOf(prepared_, request), camera.direction(x, static_cast<int>(y)));
         for (int c = 0; c < 3; ++c) frame.image.at(static_cast<int>(y), x, c) = static_cast<float>(L[c]);
       }
     }, {}, options_.threads);

@@ -97,7 +97,7 @@ void VulkanRenderer::Impl::runStages(const std::vector<FrameStage>& stages, cons
 }
 
 void VulkanRenderer::Impl::uploadFrameUniforms(const render::FrameRequest& request, const render::ResolvedFrame& resolved) {
-  FrameParams params = makeFrameParams(resolved.camera, request.width, request.height, request.lightRotation,
+  FrameParams params = makeFrameParams(resolved.camera, request.width, request.height, resolved.lightRotation,
                                        options.environmentBackground, prepared.background[0].level());
   params.fusedGroups = fusedGroups;
   params.antialias = options.antialias ? 1u : 0u;

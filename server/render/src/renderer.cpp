@@ -347,16 +347,22 @@ void FusedLightCache::store(std::size_t index, const Key& key, const ResolvedObj
   entries_[index] = std::move(entry);
 }
 
+glm::dmat3 lightRotationOf(const PreparedScene& prepared, const FrameRequest& request) {
+  return request.lightRotation * prepared.scene.environment.rotation;
+}
+
 ResolvedFrame resolveFrame(const PreparedScene& prepared, const RenderOptions& options, const FrameRequest& request) {
   checkFrameRequest(request, prepared.objects.size());
   ResolvedFrame out;
+  const glm::dmat3 light = lightRotationOf(prepared, request);
+  out.lightRotation = light;
   out.lightCoefficients = request.lightCoefficients ? request.lightCoefficients : options.lightCoefficients;
   out.objects.resize(prepared.objects.size());
   const bool fused = options.method == RotationMethod::Fused;
   // A light at d in the environment's frame is seen at lightRotation·d (L'(ω) = L(Rᵀω)).
   if (fused) {
     for (const DirectionalLight& l : prepared.pointLights)
-      out.pointLightDirections.push_back(glm::vec3(glm::normalize(request.lightRotation * l.direction)));
+      out.pointLightDirections.push_back(glm::vec3(glm::normalize(light * l.direction)));
   }
   for (std::size_t i = 0; i < out.objects.size(); ++i) {
     const Pose& pose = request.poses.empty() ? prepared.objects[i].pose : request.poses[i];
@@ -364,7 +370,7 @@ ResolvedFrame resolveFrame(const PreparedScene& prepared, const RenderOptions& o
     o.rotation = pose.rotation();
     o.objectToWorld = pose.objectToWorld();
     o.scale = pose.scale;
-    o.toLight = glm::mat3(glm::transpose(request.lightRotation) * o.rotation);
+    o.toLight = glm::mat3(glm::transpose(light) * o.rotation);
   }
   out.camera = cameraBasis(request.camera, request.width, request.height);
   {
@@ -389,7 +395,7 @@ ResolvedFrame resolveFrame(const PreparedScene& prepared, const RenderOptions& o
     // over the ground's hemisphere.
     GroundSky& sky = out.groundSky;
     sky.normal = glm::vec3(*groundNormal);
-    sky.toEnvironment = glm::mat3(glm::transpose(request.lightRotation));
+    sky.toEnvironment = glm::mat3(glm::transpose(light));
     for (std::size_t i = 0; i < out.objects.size(); ++i) {
       if (prepared.objects[i].ground) continue;
       const PreparedObject& p = prepared.objects[i];
@@ -400,7 +406,7 @@ ResolvedFrame resolveFrame(const PreparedScene& prepared, const RenderOptions& o
     const int level = prepared.restLuminance.level();
     for (int r = 0; r < prepared.restLuminance.size(); ++r) {
       for (int c = 0; c < prepared.restLuminance.size(); ++c) {
-        const double cosine = glm::dot(request.lightRotation * sphericalToDirection(rowTheta(level, r), colPhi(level, c)), *groundNormal);
+        const double cosine = glm::dot(light * sphericalToDirection(rowTheta(level, r), colPhi(level, c)), *groundNormal);
         if (cosine > 0.0) sky.total += prepared.restLuminance.at(r, c) * cosine * pixelSolidAngle(level, r);
       }
     }
@@ -409,16 +415,16 @@ ResolvedFrame resolveFrame(const PreparedScene& prepared, const RenderOptions& o
     ResolvedObject& o = out.objects[i];
     if (fused) {
       // Everything resolveFusedLight reads that a request changes.
-      const FusedLightCache::Key key{request.lightRotation, o.rotation, groundNormal};
+      const FusedLightCache::Key key{light, o.rotation, groundNormal};
       if (!prepared.fusedLightCache->find(i, key, o)) {
-        resolveFusedLight(prepared, prepared.objects[i], request.lightRotation, groundNormal, out.pointLightDirections, o);
+        resolveFusedLight(prepared, prepared.objects[i], light, groundNormal, out.pointLightDirections, o);
         prepared.fusedLightCache->store(i, key, o);
       }
       out.lightBytes += o.fusedLight.planes.size() * sizeof(float);
       continue;
     }
     if (options.method == RotationMethod::Splitsum) continue;  // it turns the lookup (toLight), not the light
-    o.light = lightInObjectFrame(prepared.light, o.rotation, request.lightRotation, out.lightCoefficients);
+    o.light = lightInObjectFrame(prepared.light, o.rotation, light, out.lightCoefficients);
     for (const SparseHaar& l : o.light) out.lightBytes += l.size() * (sizeof(std::uint32_t) + sizeof(float));
   }
   return out;

@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include <glm/geometric.hpp>
+#include <glm/matrix.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/trigonometric.hpp>
 #include <nlohmann/json.hpp>
@@ -24,6 +25,15 @@
 namespace haarcast::render {
 
 namespace fs = std::filesystem;
+
+void rotateEnvironment(Environment& environment, const glm::dmat3& rotation) {
+  environment.rotation = rotation * environment.rotation;
+  if (environment.radiance) {
+    // L(ω) = L_before(Rᵀω): what came from Rᵀω now comes from ω.
+    environment.radiance = [radiance = std::move(environment.radiance), inverse = glm::transpose(rotation)](
+                               const glm::dvec3& d) { return radiance(inverse * d); };
+  }
+}
 
 glm::dmat3 Pose::rotation() const {
   const glm::dvec3 r = glm::radians(rotateDegrees);
@@ -300,6 +310,11 @@ Scene sceneFromJson(const nlohmann::json& j, const std::string& path, const Scen
       s.environment = sunsEnvironment();
     } else if (e.value("builtin", "") != "sky") {
       fail(path, "environment", "expected {\"file\": …} or {\"builtin\": \"sky\"|\"suns\"}");
+    }
+    if (e.contains("rotate")) {
+      Pose turn;
+      turn.rotateDegrees = vec3At(e["rotate"], path, "environment.rotate");
+      rotateEnvironment(s.environment, turn.rotation());
     }
   }
   if (j.contains("camera")) {

@@ -297,8 +297,15 @@ struct ResolvedFrame {
   std::vector<ResolvedObject> objects;
   std::size_t lightBytes = 0;         // the light lists, index + value per entry
   std::vector<glm::vec3> pointLightDirections;  // fused: world frame, unit, toward each light
+  // The environment's frame → the world this frame (lightRotationOf): what
+  // every pass that reads the light or the backdrop turns by.
+  glm::dmat3 lightRotation{1.0};
   GroundSky groundSky;                // fused with a ground: what its samples' rays need (point_lights.h)
 };
 ResolvedFrame resolveFrame(const PreparedScene& prepared, const RenderOptions& options, const FrameRequest& request);
+// The light's turn this frame: the request's (the wire's light pose) on top
+// of the scene's own (Environment::rotation, a scene file's
+// "environment": {"rotate": …}).
+glm::dmat3 lightRotationOf(const PreparedScene& prepared, const FrameRequest& request);
 
 }  // namespace haarcast::render

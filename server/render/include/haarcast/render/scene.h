@@ -44,11 +44,21 @@ struct Pose {
 
 // Radiance arriving from the world, two ways: per direction (background,
 // Monte Carlo) and as area-averaged level-n maps (the Haar pipeline).
+// `rotation` turns the environment's own frame into the world (a scene
+// file's "environment": {"rotate": [x, y, z]}, the convention of a pose and
+// of the wire's light_rotate_degrees): `radiance` is per world direction,
+// already turned (L(ω) = L_env(Rᵀω)); the `maps` stay in the environment's
+// own frame and the renderers turn them, composed with the request's light
+// rotation (render::lightRotationOf).
 struct Environment {
   std::string name;
   std::function<glm::dvec3(const glm::dvec3&)> radiance;
   std::function<std::array<SphereMap, 3>(int level)> maps;
+  glm::dmat3 rotation{1.0};
 };
+// The environment turned by `rotation` on top of any turn it has: its
+// radiance per world direction follows, its maps keep their own frame.
+void rotateEnvironment(Environment& environment, const glm::dmat3& rotation);
 
 Environment builtinEnvironment();
 // The shadow-test sky: a dim gradient and three small bright suns carrying
