@@ -78,7 +78,6 @@ std::uint32_t lobeRayBit(const RayScene& world, const ShadingPoint& p, const glm
 float groundSkyOcclusion(const RayScene& world, const ShadingPoint& p, const GroundSky& sky) {
   if (!(sky.total > 0.0) || sky.occluders.empty() || !sky.luminance) return 0.0f;
   const glm::vec3 origin = p.position + p.normal * p.shift;
-  constexpr int kSamples = kGroundSkyRings * kGroundSkySectors;
   // Per thread, kept across samples: no allocation per sample.
   thread_local std::vector<glm::vec3> directions;
   thread_local std::vector<float> weights;  // luminance·cos·ΔΩ of each direction
@@ -109,13 +108,17 @@ float groundSkyOcclusion(const RayScene& world, const ShadingPoint& p, const Gro
     const glm::vec3 helper = std::abs(axis.y) < 0.9f ? glm::vec3(0.0f, 1.0f, 0.0f) : glm::vec3(1.0f, 0.0f, 0.0f);
     const glm::vec3 t1 = glm::normalize(glm::cross(helper, axis));
     const glm::vec3 t2 = glm::cross(axis, t1);
-    for (int ring = 0; ring < kGroundSkyRings; ++ring) {
+    // More directions in a wider cone (shared_rays.h groundSkyScale).
+    const int scale = static_cast<int>(shared::groundSkyScale(solid));
+    const int rings = kGroundSkyRings * scale, sectors = kGroundSkySectors * scale;
+    const float samples = static_cast<float>(rings * sectors);
+    for (int ring = 0; ring < rings; ++ring) {
       // Equal solid angle per ring: cos θ uniform over [cos α, 1].
-      const float cosTheta = 1.0f - (static_cast<float>(ring) + 0.5f) / kGroundSkyRings * (1.0f - cosAlpha);
+      const float cosTheta = 1.0f - (static_cast<float>(ring) + 0.5f) / static_cast<float>(rings) * (1.0f - cosAlpha);
       const float sinTheta = std::sqrt(std::max(0.0f, 1.0f - cosTheta * cosTheta));
-      for (int sector = 0; sector < kGroundSkySectors; ++sector) {
+      for (int sector = 0; sector < sectors; ++sector) {
         const float phi = static_cast<float>(kTwoPi) * (static_cast<float>(sector) + 0.5f * static_cast<float>(ring % 2) + 0.25f) /
-                          kGroundSkySectors;
+                          static_cast<float>(sectors);
         const glm::vec3 d = sinTheta * std::cos(phi) * t1 + sinTheta * std::sin(phi) * t2 + cosTheta * axis;
         const float cosine = glm::dot(d, p.normal);
         if (cosine <= 0.0f) continue;
@@ -130,7 +133,7 @@ float groundSkyOcclusion(const RayScene& world, const ShadingPoint& p, const Gro
         if (earlier) continue;
         const Spherical s = directionToSpherical(glm::dvec3(sky.toEnvironment * d));
         directions.push_back(d);
-        weights.push_back(fade * static_cast<float>(sky.luminance->sampleBilinear(s.theta, s.phi)) * cosine * solid / kSamples);
+        weights.push_back(fade * static_cast<float>(sky.luminance->sampleBilinear(s.theta, s.phi)) * cosine * solid / samples);
       }
     }
   }

@@ -5,7 +5,7 @@
 //
 // Write in the shared headers only what both languages read alike: plain
 // structs of uint, float and vec3/vec4, `const` numbers, and functions built
-// from floor/min/max/clamp, log2, dot/cross/normalize, integer bit
+// from floor/ceil/min/max/clamp, sqrt, log2, dot/cross/normalize, integer bit
 // operations and findMSB. sin, cos, atan and acos are loose on a Vulkan
 // device: a shared function that needs them calls HC_ACOS, HC_SIN, HC_ATAN2
 // and the axis rotations rotX, rotY, which are std:: (and the templates
@@ -36,6 +36,7 @@ using vec3 = glm::vec3;
 using vec4 = glm::vec4;
 using mat4 = glm::mat4;
 using std::abs;
+using std::ceil;
 using std::clamp;
 using std::exp2;
 using std::floor;
@@ -43,6 +44,7 @@ using std::isinf;
 using std::log2;
 using std::max;
 using std::min;
+using std::sqrt;
 // GLSL's findMSB: the index of the highest set bit, −1 for 0.
 inline constexpr int findMSB(uint x) { return static_cast<int>(std::bit_width(x)) - 1; }
 // GLSL's floatBitsToUint.

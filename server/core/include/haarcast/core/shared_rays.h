@@ -21,9 +21,20 @@ HC_CONST uint kRaysPhaseGrid = 1u;
 HC_CONST uint kRaysPhaseMasks = 2u;
 
 // The ground's hidden-sky rays per occluder (render::groundSkyOcclusion):
-// rings × sectors directions in its bounding cone.
+// (kGroundSkyRings·m) × (kGroundSkySectors·m) directions in its bounding
+// cone, m = groundSkyScale(the cone's solid angle): 16 rays for a narrow
+// cone, up to 256 for the hemisphere a point inside the bounding sphere
+// sees. With 16 rays everywhere, a ground point beside an object (its cone
+// a hemisphere, every ray hitting the body) counted the whole sky hidden and
+// went black; the rays must resolve the body's outline in a wide cone.
 HC_CONST uint kGroundSkyRings = 2u;
 HC_CONST uint kGroundSkySectors = 8u;
+HC_CONST uint kGroundSkyMaxScale = 4u;
+HC_CONST float kGroundSkySolidPerScale = 0.4f;  // sr: m² cones of this solid angle share one m
+HC_FUNCTION uint groundSkyScale(float solidAngle) {
+  const float m = ceil(sqrt(max(solidAngle, 0.0f) / kGroundSkySolidPerScale));
+  return uint(clamp(m, 1.0f, float(kGroundSkyMaxScale)));
+}
 
 // One object as the rays see it this frame.
 struct RayObject {
