@@ -105,7 +105,6 @@ void VulkanRenderer::Impl::writeRays(const render::ResolvedFrame& resolved, cons
     for (int c = 0; c < 3; ++c) r.rotation[c] = glm::vec4(glm::vec3(glm::mat3(o.rotation)[c]), 0.0f);
     r.shift = p.shadowShift * static_cast<float>(o.scale);
     r.flags = (p.ground ? shared::kObjectGround : 0u) | (p.lobePath ? shared::kObjectLobePath : 0u);
-    r.vertexBase = objectInfo[i].vertexBase;
     r.occluder = groundSky && !p.ground ? 1u : 0u;
     r.sphere = glm::vec4(0.0f);
     if (r.occluder) {
@@ -140,9 +139,8 @@ void VulkanRenderer::Impl::writeRays(const render::ResolvedFrame& resolved, cons
   }
   rayFrameUpload.write(&f, sizeof f);
 
-  std::vector<glm::mat4> poses;
-  for (const render::ResolvedObject& o : resolved.objects) poses.emplace_back(o.objectToWorld);
-  posesData = std::move(poses);
+  posesData.resize(objectCount);
+  for (std::size_t i = 0; i < objectCount; ++i) posesData[i] = glm::mat4(resolved.objects[i].objectToWorld);
 }
 
 void VulkanRenderer::Impl::recordDeviceRays(VkCommandBuffer cb) {

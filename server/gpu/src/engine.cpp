@@ -4,6 +4,7 @@
 #include "haarcast/gpu/engine.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cctype>
 #include <cstdlib>
@@ -139,11 +140,15 @@ bool deviceExtensionAvailable(VkPhysicalDevice device, const char* name) {
                      [&](const VkExtensionProperties& e) { return std::strcmp(e.extensionName, name) == 0; });
 }
 
+// The extensions ray tracing needs (RayTracingSupport), checked and enabled alike.
+constexpr std::array<const char*, 3> kRayExtensions = {VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME,
+                                                       VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME,
+                                                       VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME};
+
 RayTracingSupport rayTracingSupport(VkPhysicalDevice device) {
   RayTracingSupport support;
   std::string missing;
-  for (const char* name : {VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME, VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME,
-                           VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME}) {
+  for (const char* name : kRayExtensions) {
     if (!deviceExtensionAvailable(device, name)) missing += std::string(missing.empty() ? "" : ", ") + name;
   }
   if (missing.empty()) {
@@ -305,9 +310,6 @@ SharedDevice::SharedDevice(std::shared_ptr<VulkanInstance> instance, VkPhysicalD
   // Ray tracing where the device offers all of it (context.h,
   // RayTracingSupport); the rest of the renderer needs none of it.
   rayTracing_ = rayTracingSupport(physical_);
-  const std::vector<const char*> rayExtensions = {VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME,
-                                                  VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME,
-                                                  VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME};
   VkPhysicalDeviceVulkan12Features v12{};
   v12.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES;
   VkPhysicalDeviceAccelerationStructureFeaturesKHR asFeatures{};
@@ -334,8 +336,8 @@ SharedDevice::SharedDevice(std::shared_ptr<VulkanInstance> instance, VkPhysicalD
   d.pQueueCreateInfos = &q;
   if (rayTracing_.supported) {
     d.pNext = &v12;
-    d.enabledExtensionCount = static_cast<std::uint32_t>(rayExtensions.size());
-    d.ppEnabledExtensionNames = rayExtensions.data();
+    d.enabledExtensionCount = static_cast<std::uint32_t>(kRayExtensions.size());
+    d.ppEnabledExtensionNames = kRayExtensions.data();
   }
   vkCheck(vkCreateDevice(physical_, &d, nullptr, &device_), "vkCreateDevice");
   ++gDevicesCreated;

@@ -93,7 +93,9 @@ AccelerationStructures::AccelerationStructures(Context& context, std::span<const
   std::vector<VkAccelerationStructureGeometryKHR> geometries(distinct.size());
   std::vector<VkAccelerationStructureBuildGeometryInfoKHR> builds(distinct.size());
   std::vector<VkAccelerationStructureBuildRangeInfoKHR> ranges(distinct.size());
-  std::vector<Buffer> scratch;
+  // Build inputs and scratch, freed once the bottom levels are built (a
+  // structure keeps its own copy of the triangles).
+  std::vector<Buffer> scratch, geometry;
   for (std::size_t i = 0; i < distinct.size(); ++i) {
     const Mesh& mesh = *distinct[i];
     Buffer vertices(context, mesh.positions.size() * sizeof(glm::vec3), kBuildInput, MemoryUse::DeviceInput);
@@ -119,8 +121,8 @@ AccelerationStructures::AccelerationStructures(Context& context, std::span<const
     g.geometry.triangles.maxVertex = static_cast<std::uint32_t>(mesh.positions.size() - 1);
     g.geometry.triangles.indexType = VK_INDEX_TYPE_UINT32;
     g.geometry.triangles.indexData.deviceAddress = indices.deviceAddress();
-    geometry_.push_back(std::move(vertices));
-    geometry_.push_back(std::move(indices));
+    geometry.push_back(std::move(vertices));
+    geometry.push_back(std::move(indices));
 
     VkAccelerationStructureBuildGeometryInfoKHR& b = builds[i];
     b.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR;
@@ -149,18 +151,12 @@ AccelerationStructures::AccelerationStructures(Context& context, std::span<const
   // The top level: its instance records (host-visible, written per frame),
   // storage and scratch sized once for every instance.
   instanceData_ = Buffer(context, instances_ * sizeof(VkAccelerationStructureInstanceKHR), kBuildInput, MemoryUse::Host);
-  VkAccelerationStructureGeometryKHR g{};
-  g.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR;
-  g.geometryType = VK_GEOMETRY_TYPE_INSTANCES_KHR;
-  g.geometry.instances.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_INSTANCES_DATA_KHR;
-  g.geometry.instances.data.deviceAddress = instanceData_.deviceAddress();
-  VkAccelerationStructureBuildGeometryInfoKHR b{};
-  b.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR;
-  b.type = VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR;
-  b.flags = VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR;
-  b.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
-  b.geometryCount = 1;
-  b.pGeometries = &g;
+  instanceRecords_.resize(instances_);
+  topGeometry_.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR;
+  topGeometry_.geometryType = VK_GEOMETRY_TYPE_INSTANCES_KHR;
+  topGeometry_.geometry.instances.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_INSTANCES_DATA_KHR;
+  topGeometry_.geometry.instances.data.deviceAddress = instanceData_.deviceAddress();
+  VkAccelerationStructureBuildGeometryInfoKHR b = topLevelBuild();
   const std::uint32_t count = static_cast<std::uint32_t>(instances_);
   VkAccelerationStructureBuildSizesInfoKHR sizes{};
   sizes.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_SIZES_INFO_KHR;
@@ -177,18 +173,21 @@ AccelerationStructures::~AccelerationStructures() {
   for (const Structure& s : bottom_) fn_.destroyAccelerationStructure(context_.device(), s.handle, nullptr);
 }
 
-std::size_t AccelerationStructures::bytes() const {
-  std::size_t sum = top_.storage.size() + scratch_.size() + instanceData_.size();
-  for (const Structure& s : bottom_) sum += s.storage.size();
-  for (const Buffer& g : geometry_) sum += g.size();
-  return sum;
+VkAccelerationStructureBuildGeometryInfoKHR AccelerationStructures::topLevelBuild() const {
+  VkAccelerationStructureBuildGeometryInfoKHR b{};
+  b.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR;
+  b.type = VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR;
+  b.flags = VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR;
+  b.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
+  b.geometryCount = 1;
+  b.pGeometries = &topGeometry_;
+  return b;
 }
 
 void AccelerationStructures::recordTopLevel(VkCommandBuffer cb, std::span<const glm::mat4> objectToWorld) {
   HC_CHECK_EQ(objectToWorld.size(), instances_);
-  std::vector<VkAccelerationStructureInstanceKHR> records(instances_);
   for (std::size_t i = 0; i < instances_; ++i) {
-    VkAccelerationStructureInstanceKHR& r = records[i];
+    VkAccelerationStructureInstanceKHR& r = instanceRecords_[i];
     const glm::mat4& m = objectToWorld[i];
     // VkTransformMatrixKHR is 3 rows × 4 columns, row-major; glm is column-major.
     for (int row = 0; row < 3; ++row)
@@ -200,21 +199,10 @@ void AccelerationStructures::recordTopLevel(VkCommandBuffer cb, std::span<const 
     r.flags = VK_GEOMETRY_INSTANCE_TRIANGLE_FACING_CULL_DISABLE_BIT_KHR;
     r.accelerationStructureReference = bottom_[bottomOf_[i]].address;
   }
-  instanceData_.write(records.data(), records.size() * sizeof(VkAccelerationStructureInstanceKHR));
+  instanceData_.write(instanceRecords_.data(), instanceRecords_.size() * sizeof(VkAccelerationStructureInstanceKHR));
 
-  VkAccelerationStructureGeometryKHR g{};
-  g.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR;
-  g.geometryType = VK_GEOMETRY_TYPE_INSTANCES_KHR;
-  g.geometry.instances.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_INSTANCES_DATA_KHR;
-  g.geometry.instances.data.deviceAddress = instanceData_.deviceAddress();
-  VkAccelerationStructureBuildGeometryInfoKHR b{};
-  b.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR;
-  b.type = VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR;
-  b.flags = VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR;
-  b.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
+  VkAccelerationStructureBuildGeometryInfoKHR b = topLevelBuild();
   b.dstAccelerationStructure = top_.handle;
-  b.geometryCount = 1;
-  b.pGeometries = &g;
   b.scratchData.deviceAddress = scratchAddress_;
   VkAccelerationStructureBuildRangeInfoKHR range{};
   range.primitiveCount = static_cast<std::uint32_t>(instances_);

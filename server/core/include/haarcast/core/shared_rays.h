@@ -43,7 +43,7 @@ struct RayObject {
   vec4 sphere;        // world bounding sphere (centre, radius): the ground's sky occluders are the others'
   float shift;        // the rays' origin shift along the normal, world units (shadowShift × scale)
   uint flags;         // ObjectInfo::flags: kObjectGround, kObjectLobePath
-  uint vertexBase;    // its vertex 0 in the global vertex numbering
+  uint objectPad;
   uint occluder;      // 1: one of GroundSky::occluders (every object but the ground)
 };
 

@@ -61,15 +61,12 @@ class AccelerationStructures {
   AccelerationStructures(const AccelerationStructures&) = delete;
   AccelerationStructures& operator=(const AccelerationStructures&) = delete;
 
-  std::size_t instanceCount() const { return instances_; }
   // Writes the instances' object → world transforms (affine, one per mesh
   // given, in order) and records the top level's build, then a barrier that
   // makes it visible to ray-tracing shaders. The previous build must be done
   // (the Context's submissions are waited for).
   void recordTopLevel(VkCommandBuffer cb, std::span<const glm::mat4> objectToWorld);
   VkAccelerationStructureKHR topLevel() const { return top_.handle; }
-  // Device memory of every structure and its scratch, bytes.
-  std::size_t bytes() const;
 
  private:
   struct Structure {
@@ -78,15 +75,18 @@ class AccelerationStructures {
     VkDeviceAddress address = 0;
   };
   Structure create(VkAccelerationStructureTypeKHR type, VkDeviceSize bytes);
+  // The top level's build: the same for its sizes and for every frame's build.
+  VkAccelerationStructureBuildGeometryInfoKHR topLevelBuild() const;
 
   Context& context_;
   RayFunctions fn_;
   std::size_t instances_ = 0;
   std::vector<Structure> bottom_;      // per distinct mesh
   std::vector<std::size_t> bottomOf_;  // per instance: its bottom level
-  std::vector<Buffer> geometry_;       // per distinct mesh: vertices, indices (kept for the build's life)
   Structure top_;
   Buffer instanceData_;  // VkAccelerationStructureInstanceKHR per instance, host-visible
+  std::vector<VkAccelerationStructureInstanceKHR> instanceRecords_;  // this frame's, before the write
+  VkAccelerationStructureGeometryKHR topGeometry_{};                  // the instances, at instanceData_
   Buffer scratch_;       // the top level's build scratch
   VkDeviceAddress scratchAddress_ = 0;
 };
