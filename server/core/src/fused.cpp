@@ -308,7 +308,7 @@ void setCore(detail::FusedPass& pass, const EulerYXY& r, float axisTheta, float 
 std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBlend& blend, const EulerYXY& r,
                                 const FusedLight& light, std::span<const WeightedBits> visibility,
                                 std::span<const FusedPointLight> lights, std::uint32_t visibleLights,
-                                FusedScratch& scratch, const LobePath* lobe) {
+                                FusedScratch& scratch, const LobePath* lobe, const FusedPointLight* hidden) {
   const int level = slices.level();
   if (lobe && lobe->coreAngle >= static_cast<float>(kPi)) return lobeShade(*lobe, blend, r, visibleLights);
   checkSameLevel(light.level, level, "the light");
@@ -346,6 +346,10 @@ std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBl
     if (((visibleLights >> k) & 1u) == 0) continue;
     const std::array<float, 3> rho = pointRhoAt(pass, slices, blend, lights[k].direction);
     for (std::size_t c = 0; c < 3; ++c) out[c] += lights[k].power[c] * rho[c];
+  }
+  if (hidden) {
+    const std::array<float, 3> rho = pointRhoAt(pass, slices, blend, hidden->direction);
+    for (std::size_t c = 0; c < 3; ++c) out[c] = std::max(0.0f, out[c] - hidden->power[c] * rho[c]);
   }
   if (lobe) {
     const std::array<float, 3> inCore = lobeShade(*lobe, blend, r, visibleLights);

@@ -527,7 +527,7 @@ std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const RayScen
   // interior pixels' centre samples, as the Vulkan backend takes them.
   GroundSkyGrid sky(frame.width, frame.height);
   if (prepared_.ground) {
-    sky.compute(rays, resolved.groundSky, [&](std::size_t pixel) -> std::optional<ShadingPoint> {
+    sky.compute(rays, resolved.skyOccluders, [&](std::size_t pixel) -> std::optional<ShadingPoint> {
       auto ground = [&](std::size_t i) { return g.centre[i] && prepared_.objects[g.centre[i]->hit.object].ground; };
       // Interior ground pixels only (the 3×3 rule of shared_layout.h), with
       // antialiasing or without, as the Vulkan backend.
@@ -542,6 +542,10 @@ std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const RayScen
   const std::size_t slotCount = g.centre.size() + g.sub.size() * shared::kSubsamples;
   std::vector<ShadingPoint> points(slotCount);
   std::vector<std::uint32_t> lightsSeen(slotCount, 0u);
+  // The sky other objects hide from each object sample (point_lights.h),
+  // packed as the Vulkan backend reads it.
+  const SkyOccluders& occluders = resolved.skyOccluders;
+  std::vector<shared::HiddenLight> hidden(occluders.objectSky ? slotCount : 0, shared::HiddenLight{});
   parallelFor(g.height, [&](std::size_t y) {
     cancelPoint();
     thread_local std::vector<ShadingPoint> row;
@@ -550,9 +554,12 @@ std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const RayScen
     row.clear();
     slots.clear();
     auto add = [&](const Sample& s, std::size_t slot) {
-      points[slot] = samplePoint(frames, resolved, s.hit.object, s.input);
+      const std::size_t object = s.hit.object;
+      points[slot] = samplePoint(frames, resolved, object, s.input);
       row.push_back(points[slot]);
       slots.push_back(slot);
+      if (occluders.objectSky && !prepared_.objects[object].ground)
+        hidden[slot] = hiddenLightOf(objectSkyHidden(rays, points[slot], object, occluders), frames.rotations[object]);
     };
     for (std::size_t i = y * g.width; i < (y + 1) * g.width; ++i) {
       if (g.edge[i] == kInterior) {
@@ -579,7 +586,7 @@ std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const RayScen
     if (p.lobePath) seen |= lobeRayBit(rays, point, eye);
     if (p.ground) {
       // The word the Vulkan backend reads too: bits, then the sky's occlusion.
-      seen = withGroundOcclusion(seen, sky.at(sample.pixel, [&] { return groundSkyOcclusion(rays, point, resolved.groundSky); }));
+      seen = withGroundOcclusion(seen, sky.at(sample.pixel, [&] { return groundSkyOcclusion(rays, point, resolved.skyOccluders); }));
       const float kept = shared::groundSkyKept(seen);
       for (std::size_t c = 0; c < 3; ++c) rgb[c] = kept * o.groundFlat[c];
       for (std::size_t k = 0; k < o.pointLights.size(); ++k)
@@ -594,8 +601,9 @@ std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const RayScen
                                                           static_cast<shared::uint>(slices.thetaSamples()),
                                                           options_.interpolateSlices ? 1u : 0u);
     const LobePath lobe{&prepared_.lobeLight, p.lobes, o.toLight, p.lobeCore};
+    const std::optional<FusedPointLight> hiddenSky = hidden.empty() ? std::nullopt : hiddenFusedLight(hidden[slot]);
     rgb = fusedShade(slices, blend, in.rotation.euler, o.fusedLight, vis, o.pointLights, seen, scratch,
-                     p.lobePath ? &lobe : nullptr);
+                     p.lobePath ? &lobe : nullptr, hiddenSky ? &*hiddenSky : nullptr);
     return fusedPixelBytes(slices.level(), blend.weight != 0.0f, 3 * p.visibilityBits.wordsPerPoint() * sizeof(std::uint32_t));
   }, cancelPoint);
   frame.stages.push_back({"fused", since(t0)});

@@ -63,7 +63,7 @@ void VulkanRenderer::Impl::setUpDeviceRays() {
   rayObjectsUpload = BufferUpload(context, rayObjects);
   rayFrame = Buffer(context, sizeof(RayFrame), kStorageUsage, MemoryUse::DeviceInput);
   rayFrameUpload = BufferUpload(context, rayFrame);
-  // The map light's luminance, for the ground's hidden sky (GroundSky::luminance).
+  // The map light's luminance, for the ground's hidden sky (SkyOccluders::luminance).
   const bool groundSky = fused && prepared.ground;
   const std::vector<float> none(1, 0.0f);
   const std::size_t texels = groundSky ? prepared.restLuminance.pixelCount() : 1;
@@ -96,7 +96,7 @@ void VulkanRenderer::Impl::writeRays(const render::ResolvedFrame& resolved, cons
   const std::size_t objectCount = prepared.objects.size();
   HC_CHECK_EQ(resolved.objects.size(), objectCount);
   const bool groundSky = fused && prepared.ground;
-  std::size_t occluder = 0;  // GroundSky::occluders: every object but the ground, in order
+  std::size_t occluder = 0;  // SkyOccluders::occluders: every object but the ground, in order
   for (std::size_t i = 0; i < objectCount; ++i) {
     const render::PreparedObject& p = prepared.objects[i];
     const render::ResolvedObject& o = resolved.objects[i];
@@ -108,11 +108,11 @@ void VulkanRenderer::Impl::writeRays(const render::ResolvedFrame& resolved, cons
     r.occluder = groundSky && !p.ground ? 1u : 0u;
     r.sphere = glm::vec4(0.0f);
     if (r.occluder) {
-      HC_CHECK_LT(occluder, resolved.groundSky.occluders.size());
-      r.sphere = resolved.groundSky.occluders[occluder++];
+      HC_CHECK_LT(occluder, resolved.skyOccluders.occluders.size());
+      r.sphere = resolved.skyOccluders.occluders[occluder++];
     }
   }
-  if (groundSky) HC_CHECK_EQ(occluder, resolved.groundSky.occluders.size());
+  if (groundSky) HC_CHECK_EQ(occluder, resolved.skyOccluders.occluders.size());
   rayObjectsUpload.write(rayObjectData.data(), rayObjectData.size() * sizeof(RayObject));
 
   RayFrame& f = rayFrameData;
@@ -131,7 +131,7 @@ void VulkanRenderer::Impl::writeRays(const render::ResolvedFrame& resolved, cons
   f.antialias = options.antialias ? 1u : 0u;
   f.groundSky = groundSky ? 1u : 0u;
   if (groundSky) {
-    const render::GroundSky& sky = resolved.groundSky;
+    const render::SkyOccluders& sky = resolved.skyOccluders;
     f.sky = glm::vec4(sky.normal, static_cast<float>(sky.total));
     for (int c = 0; c < 3; ++c) f.toEnvironment[c] = glm::vec4(sky.toEnvironment[c], 0.0f);
     f.luminanceLevel = static_cast<std::uint32_t>(prepared.restLuminance.level());

@@ -64,7 +64,7 @@ std::uint32_t VulkanRenderer::Impl::computeShadowMasks(const render::ResolvedFra
       const std::uint32_t s = centreOf[pixel];
       return s != ~0u && prepared.objects[sh[s].object].ground;
     };
-    sky.compute(*rays, resolved.groundSky, [&](std::size_t pixel) -> std::optional<render::ShadingPoint> {
+    sky.compute(*rays, resolved.skyOccluders, [&](std::size_t pixel) -> std::optional<render::ShadingPoint> {
       // Interior ground pixels only (the 3×3 rule of shared_layout.h), with
       // antialiasing or without: with it, only they have a centre sample.
       if (!ground(pixel)) return std::nullopt;
@@ -99,7 +99,7 @@ std::uint32_t VulkanRenderer::Impl::computeShadowMasks(const render::ResolvedFra
         // Its pixel: the slot itself, or the edge pixel a sub-sample's slot belongs to.
         const std::size_t pixel = sample.pixel < pixels ? sample.pixel : (sample.pixel - pixels) / shared::kSubsamples;
         out[s] = render::withGroundOcclusion(
-            out[s], sky.at(pixel, [&] { return render::groundSkyOcclusion(*rays, point, resolved.groundSky); }));
+            out[s], sky.at(pixel, [&] { return render::groundSkyOcclusion(*rays, point, resolved.skyOccluders); }));
       }
     }
   }, {}, options.threads);

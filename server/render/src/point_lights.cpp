@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -75,28 +76,43 @@ std::uint32_t lobeRayBit(const RayScene& world, const ShadingPoint& p, const glm
   return world.occluded(r) ? 0u : shared::kLobeSeenBit;
 }
 
-float groundSkyOcclusion(const RayScene& world, const ShadingPoint& p, const GroundSky& sky) {
-  if (!(sky.total > 0.0) || sky.occluders.empty() || !sky.luminance) return 0.0f;
-  const glm::vec3 origin = p.position + p.normal * p.shift;
-  // Per thread, kept across samples: no allocation per sample.
-  thread_local std::vector<glm::vec3> directions;
-  thread_local std::vector<float> weights;  // luminance·cos·ΔΩ of each direction
-  thread_local std::vector<std::uint8_t> blocked;
-  directions.clear();
-  weights.clear();
-  for (std::size_t k = 0; k < sky.occluders.size(); ++k) {
-    const glm::vec3 centre(sky.occluders[k]);
+namespace {
+
+// One direction of a cone toward an occluder: where it goes, its cosine
+// with the sample's normal, and its share of the cone's solid angle with the
+// occluder's fade (the weight a blocked direction takes, before the light).
+struct ConeRay {
+  glm::vec3 direction;
+  float cosine;
+  float weight;
+};
+
+// The cone rays of SkyOccluders from `origin` with normal `normal`, toward
+// every occluder but `skip`'s (an object index, or none), each direction
+// once, none below the horizon. `maxScale` caps groundSkyScale.
+void coneRays(const glm::vec3& origin, const glm::vec3& normal, const SkyOccluders& sky, std::optional<std::uint32_t> skip,
+              int maxScale, std::vector<ConeRay>& out) {
+  out.clear();
+  auto cone = [&](std::size_t k, glm::vec3& axis, float& cosAlpha) {
+    const glm::vec3 toward = glm::vec3(sky.occluders[k]) - origin;
     const float radius = sky.occluders[k].w;
-    const glm::vec3 toward = centre - origin;
     const float distance = glm::length(toward);
-    if (!(distance > 0.0f)) continue;
-    const glm::vec3 axis = toward / distance;
+    if (!(distance > 0.0f)) return false;
+    axis = toward / distance;
     // The cone's half-angle; inside the sphere, the hemisphere about the axis.
-    const float cosAlpha = distance > radius ? std::sqrt(1.0f - (radius / distance) * (radius / distance)) : 0.0f;
+    cosAlpha = distance > radius ? std::sqrt(1.0f - (radius / distance) * (radius / distance)) : 0.0f;
+    return true;
+  };
+  auto skipped = [&](std::size_t k) { return skip && sky.objects[k] == *skip; };
+  for (std::size_t k = 0; k < sky.occluders.size(); ++k) {
+    if (skipped(k)) continue;
+    glm::vec3 axis;
+    float cosAlpha;
+    if (!cone(k, axis, cosAlpha)) continue;
     const float sinAlpha = std::sqrt(std::max(0.0f, 1.0f - cosAlpha * cosAlpha));
     const float solid = static_cast<float>(kTwoPi) * (1.0f - cosAlpha);
-    // Its largest cosine with the ground's normal bounds what it can hide.
-    const float cosAxis = glm::dot(axis, p.normal);
+    // Its largest cosine with the normal bounds what it can hide.
+    const float cosAxis = glm::dot(axis, normal);
     const float sinAxis = std::sqrt(std::max(0.0f, 1.0f - cosAxis * cosAxis));
     const float cosMax = cosAxis >= cosAlpha ? 1.0f : cosAxis * cosAlpha + sinAxis * sinAlpha;
     const float bound = solid * cosMax / static_cast<float>(kPi);
@@ -109,9 +125,9 @@ float groundSkyOcclusion(const RayScene& world, const ShadingPoint& p, const Gro
     const glm::vec3 t1 = glm::normalize(glm::cross(helper, axis));
     const glm::vec3 t2 = glm::cross(axis, t1);
     // More directions in a wider cone (shared_rays.h groundSkyScale).
-    const int scale = static_cast<int>(shared::groundSkyScale(solid));
+    const int scale = std::min(static_cast<int>(shared::groundSkyScale(solid)), maxScale);
     const int rings = kGroundSkyRings * scale, sectors = kGroundSkySectors * scale;
-    const float samples = static_cast<float>(rings * sectors);
+    const float share = fade * solid / static_cast<float>(rings * sectors);
     for (int ring = 0; ring < rings; ++ring) {
       // Equal solid angle per ring: cos θ uniform over [cos α, 1].
       const float cosTheta = 1.0f - (static_cast<float>(ring) + 0.5f) / static_cast<float>(rings) * (1.0f - cosAlpha);
@@ -120,29 +136,105 @@ float groundSkyOcclusion(const RayScene& world, const ShadingPoint& p, const Gro
         const float phi = static_cast<float>(kTwoPi) * (static_cast<float>(sector) + 0.5f * static_cast<float>(ring % 2) + 0.25f) /
                           static_cast<float>(sectors);
         const glm::vec3 d = sinTheta * std::cos(phi) * t1 + sinTheta * std::sin(phi) * t2 + cosTheta * axis;
-        const float cosine = glm::dot(d, p.normal);
+        const float cosine = glm::dot(d, normal);
         if (cosine <= 0.0f) continue;
-        // Counted once: a direction inside an earlier object's cone was taken there.
+        // Counted once: a direction inside an earlier occluder's cone was taken there.
         bool earlier = false;
         for (std::size_t j = 0; j < k && !earlier; ++j) {
-          const glm::vec3 c(sky.occluders[j]);
-          const float dj = glm::length(c - origin);
-          const float cj = dj > sky.occluders[j].w ? std::sqrt(1.0f - (sky.occluders[j].w / dj) * (sky.occluders[j].w / dj)) : 0.0f;
-          earlier = dj > 0.0f && glm::dot(d, (c - origin) / dj) > cj;
+          glm::vec3 aj;
+          float cj;
+          earlier = !skipped(j) && cone(j, aj, cj) && glm::dot(d, aj) > cj;
         }
-        if (earlier) continue;
-        const Spherical s = directionToSpherical(glm::dvec3(sky.toEnvironment * d));
-        directions.push_back(d);
-        weights.push_back(fade * static_cast<float>(sky.luminance->sampleBilinear(s.theta, s.phi)) * cosine * solid / samples);
+        if (!earlier) out.push_back({d, cosine, share});
       }
     }
   }
-  if (directions.empty()) return 0.0f;
-  blocked.resize(directions.size());
+}
+
+float bilinearAt(const SphereMap& map, const Spherical& s) { return static_cast<float>(map.sampleBilinear(s.theta, s.phi)); }
+
+}  // namespace
+
+float groundSkyOcclusion(const RayScene& world, const ShadingPoint& p, const SkyOccluders& sky) {
+  if (!(sky.total > 0.0) || sky.occluders.empty() || !sky.luminance) return 0.0f;
+  const glm::vec3 origin = p.position + p.normal * p.shift;
+  // Per thread, kept across samples: no allocation per sample.
+  thread_local std::vector<ConeRay> rays;
+  thread_local std::vector<glm::vec3> directions;
+  thread_local std::vector<std::uint8_t> blocked;
+  coneRays(origin, p.normal, sky, std::nullopt, static_cast<int>(shared::kGroundSkyMaxScale), rays);
+  if (rays.empty()) return 0.0f;
+  directions.resize(rays.size());
+  for (std::size_t i = 0; i < rays.size(); ++i) directions[i] = rays[i].direction;
+  blocked.resize(rays.size());
   world.occludedFrom(origin, 0.0f, directions, blocked);
   double hidden = 0.0;
-  for (std::size_t i = 0; i < directions.size(); ++i) hidden += blocked[i] ? weights[i] : 0.0f;
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    if (!blocked[i]) continue;
+    // Each blocked direction takes its share of Σ luminance·cos·ΔΩ.
+    const Spherical s = directionToSpherical(glm::dvec3(sky.toEnvironment * rays[i].direction));
+    hidden += bilinearAt(*sky.luminance, s) * rays[i].cosine * rays[i].weight;
+  }
   return static_cast<float>(std::clamp(hidden / sky.total, 0.0, 1.0));
+}
+
+SkyHidden objectSkyHidden(const RayScene& world, const ShadingPoint& p, std::size_t object, const SkyOccluders& sky) {
+  SkyHidden out;
+  if (!sky.objectSky || !sky.luminance || !sky.colour || !(glm::dot(p.normal, p.normal) > 0.0f)) return out;
+  const glm::vec3 origin = p.position + p.normal * p.shift;
+  thread_local std::vector<ConeRay> rays;
+  thread_local std::vector<glm::vec3> directions;
+  thread_local std::vector<std::uint8_t> blocked;
+  thread_local std::vector<std::uint8_t> own;
+  coneRays(origin, p.normal, sky, static_cast<std::uint32_t>(object), static_cast<int>(shared::kObjectSkyMaxScale), rays);
+  // Below the ground's plane the ground hides the light already.
+  if (sky.ground)
+    std::erase_if(rays, [&](const ConeRay& r) { return !(glm::dot(r.direction, sky.normal) > 0.0f); });
+  if (rays.empty()) return out;
+  directions.resize(rays.size());
+  for (std::size_t i = 0; i < rays.size(); ++i) directions[i] = rays[i].direction;
+  blocked.resize(rays.size());
+  world.occludedFrom(origin, 0.0f, directions, blocked);
+  // Of the blocked ones, those the object itself blocks are its own
+  // visibility's: asked of the object alone.
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < rays.size(); ++i)
+    if (blocked[i]) rays[kept++] = rays[i];
+  rays.resize(kept);
+  if (rays.empty()) return out;
+  directions.resize(rays.size());
+  for (std::size_t i = 0; i < rays.size(); ++i) directions[i] = rays[i].direction;
+  own.resize(rays.size());
+  world.occludedByObjectFrom(object, origin, 0.0f, directions, own);
+  glm::vec3 mean(0.0f), sum(0.0f);
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    if (own[i]) continue;
+    const Spherical s = directionToSpherical(glm::dvec3(sky.toEnvironment * rays[i].direction));
+    const glm::vec3 colour(bilinearAt((*sky.colour)[0], s), bilinearAt((*sky.colour)[1], s), bilinearAt((*sky.colour)[2], s));
+    mean += bilinearAt(*sky.luminance, s) * rays[i].weight * rays[i].direction;
+    sum += colour * (rays[i].cosine * rays[i].weight);
+  }
+  const float length = glm::length(mean);
+  if (!(length > 0.0f)) return out;
+  out.direction = mean / length;
+  // Σ L·cos·ΔΩ / (n·d): a Lambert surface loses Σ L·cos·ΔΩ exactly (shared_rays.h HiddenLight).
+  out.power = sum / std::max(glm::dot(p.normal, out.direction), shared::kMinHiddenCosine);
+  return out;
+}
+
+shared::HiddenLight hiddenLightOf(const SkyHidden& hidden, const glm::mat3& rotation) {
+  shared::HiddenLight out{};
+  out.power = hidden.power;
+  out.direction = shared::packDirection(glm::transpose(rotation) * hidden.direction);
+  return out;
+}
+
+std::optional<FusedPointLight> hiddenFusedLight(const shared::HiddenLight& hidden) {
+  if (!(hidden.power.x > 0.0f || hidden.power.y > 0.0f || hidden.power.z > 0.0f)) return std::nullopt;
+  FusedPointLight out;
+  out.direction = shared::unpackDirection(hidden.direction);
+  out.power = {hidden.power.x, hidden.power.y, hidden.power.z};
+  return out;
 }
 
 bool interiorPixel(std::size_t pixel, std::size_t width, std::size_t height, const std::function<bool(std::size_t)>& ground) {
@@ -171,7 +263,7 @@ GroundSkyGrid::GroundSkyGrid(int width, int height)
 int GroundSkyGrid::gridX(int i) const { return std::min(i * step_, width_ - 1); }
 int GroundSkyGrid::gridY(int j) const { return std::min(j * step_, height_ - 1); }
 
-void GroundSkyGrid::compute(const RayScene& world, const GroundSky& sky,
+void GroundSkyGrid::compute(const RayScene& world, const SkyOccluders& sky,
                             const std::function<std::optional<ShadingPoint>(std::size_t pixel)>& point,
                             unsigned threads) {
   parallelFor(static_cast<std::size_t>(rows_), [&](std::size_t j) {

@@ -389,22 +389,27 @@ ResolvedFrame resolveFrame(const PreparedScene& prepared, const RenderOptions& o
   }
   std::optional<glm::dvec3> groundNormal;
   if (prepared.ground) groundNormal = out.objects[*prepared.ground].rotation * glm::dvec3(0.0, 1.0, 0.0);
-  if (fused && prepared.ground) {
-    // The ground's sky occlusion (point_lights.h): the other objects'
-    // bounding spheres as posed, the map light's luminance and its total
-    // over the ground's hemisphere.
-    GroundSky& sky = out.groundSky;
-    sky.normal = glm::vec3(*groundNormal);
+  const std::size_t standing = out.objects.size() - (prepared.ground ? 1 : 0);  // objects besides the ground
+  if (fused && (prepared.ground || standing >= 2)) {
+    // The sky the objects hide from the ground and from each other
+    // (point_lights.h): their bounding spheres as posed, the map light, its
+    // luminance and its total over the ground's hemisphere.
+    SkyOccluders& sky = out.skyOccluders;
+    sky.ground = prepared.ground.has_value();
+    if (groundNormal) sky.normal = glm::vec3(*groundNormal);
+    sky.objectSky = standing >= 2;
     sky.toEnvironment = glm::mat3(glm::transpose(light));
     for (std::size_t i = 0; i < out.objects.size(); ++i) {
       if (prepared.objects[i].ground) continue;
       const PreparedObject& p = prepared.objects[i];
       const glm::dvec3 centre = glm::dvec3(out.objects[i].objectToWorld * glm::dvec4(p.sphereCentre, 1.0));
       sky.occluders.emplace_back(glm::vec3(centre), static_cast<float>(p.sphereRadius * out.objects[i].scale));
+      sky.objects.push_back(static_cast<std::uint32_t>(i));
     }
     sky.luminance = &prepared.restLuminance;
     const int level = prepared.restLuminance.level();
-    for (int r = 0; r < prepared.restLuminance.size(); ++r) {
+    sky.colour = &prepared.restLightAt(level);
+    for (int r = 0; groundNormal && r < prepared.restLuminance.size(); ++r) {
       for (int c = 0; c < prepared.restLuminance.size(); ++c) {
         const double cosine = glm::dot(light * sphericalToDirection(rowTheta(level, r), colPhi(level, c)), *groundNormal);
         if (cosine > 0.0) sky.total += prepared.restLuminance.at(r, c) * cosine * pixelSolidAngle(level, r);

@@ -136,11 +136,14 @@ std::array<float, 3> lobeShade(const LobePath& path, const shared::SliceBlend& b
 // `visibleLights` (each pixel's own shadow rays). With a lobe path, the pass
 // leaves the directions within the path's core angle of the lobe's axis to
 // lobeShade (and sums the lobe's energy less the core's), or is skipped
-// when the path takes all.
+// when the path takes all. `hidden`, when given, is the sky other objects
+// hide from the pixel (shared_rays.h HiddenLight), taken off as a light:
+// I_c −= power_c·ρ_c(Rᵀd), the sum kept ≥ 0.
 std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBlend& blend, const EulerYXY& r,
                                 const FusedLight& light, std::span<const WeightedBits> visibility,
                                 std::span<const FusedPointLight> lights, std::uint32_t visibleLights,
-                                FusedScratch& scratch, const LobePath* lobe = nullptr);
+                                FusedScratch& scratch, const LobePath* lobe = nullptr,
+                                const FusedPointLight* hidden = nullptr);
 
 // One pixel of `fused` from Haar visibility lists: Σ_ω W_c(ω)·ρ_c(Rᵀω) for c = R, G, B, with
 // ρ = (1 − w)·slice[first] + w·slice[second] (shared::sliceBlendAt) looked up

@@ -442,7 +442,8 @@ static_assert(sizeof(ObjectInfo) == 192 && offsetof(ObjectInfo, toLight) == 96 &
 static_assert(sizeof(PointLight) == 32);
 static_assert(sizeof(RayObject) == 144 && offsetof(RayObject, sphere) == 112 && offsetof(RayObject, occluder) == 140);
 static_assert(sizeof(RayFrame) == 384 && offsetof(RayFrame, eye) == 256 && offsetof(RayFrame, toEnvironment) == 288 &&
-              offsetof(RayFrame, lights) == 336 && offsetof(RayFrame, framePad) == 380);
+              offsetof(RayFrame, lights) == 336 && offsetof(RayFrame, objectSky) == 380);
+static_assert(sizeof(HiddenLight) == 16 && offsetof(HiddenLight, direction) == 12);
 static_assert(sizeof(SliceLobe) == 48 + 16 * kLobeSamples && offsetof(SliceLobe, median) == 16 &&
               offsetof(SliceLobe, core) == 32 && offsetof(SliceLobe, samples) == 48);
 static_assert(kLobeSeenBit >= (1u << kMaxPointLights), "the lobe's bit lies above the light bits");

@@ -36,6 +36,51 @@ HC_FUNCTION uint groundSkyScale(float solidAngle) {
   return uint(clamp(m, 1.0f, float(kGroundSkyMaxScale)));
 }
 
+// The sky another object hides from an object's pixel (render::objectSkyHidden):
+// the same cone rays as the ground's, toward every other object's bounding
+// sphere, fewer of them (a pixel's own rays, no grid between), counted
+// where the other object blocks the ray and the pixel's own object does not
+// (what it hides from itself is its own visibility already).
+HC_CONST uint kObjectSkyMaxScale = 2u;
+
+// The sky another object hides from a sample, as one light `fused`
+// subtracts: I_c −= power_c·ρ_c(d). d is the hidden directions' mean,
+// weighted by luminance·ΔΩ, in the object's frame; power_c = Σ L_c·cos·ΔΩ
+// over them / (n·d), so that for a Lambert surface (ρ·cos linear in cos)
+// the subtraction is exact: ρ/π·power_c·(n·d) = ρ/π·Σ L_c·cos·ΔΩ.
+// power = 0: nothing hidden.
+// n·d below this divides by this instead: a grazing mean direction would
+// give a large power whose product with a non-Lambert ρ·cos is unsure.
+HC_CONST float kMinHiddenCosine = 0.05f;
+struct HiddenLight {
+  vec3 power;
+  uint direction;  // packDirection(d)
+};
+
+// A unit direction in one word: its octahedral projection, 16 bits an axis
+// (about 1e-4 rad apart); the same integer arithmetic in both languages.
+HC_FUNCTION uint packUnit16(float x) { return uint(floor(clamp(x, -1.0f, 1.0f) * 32767.0f + 32767.5f)); }
+HC_FUNCTION float unpackUnit16(uint u) { return (float(u) - 32767.0f) / 32767.0f; }
+HC_FUNCTION float signNotZero(float x) { return x >= 0.0f ? 1.0f : -1.0f; }
+HC_FUNCTION uint packDirection(vec3 d) {
+  const float s = abs(d.x) + abs(d.y) + abs(d.z);
+  float u = s > 0.0f ? d.x / s : 0.0f;
+  float v = s > 0.0f ? d.y / s : 0.0f;
+  if (d.z < 0.0f) {  // the lower half folded over the diagonals
+    const float fu = (1.0f - abs(v)) * signNotZero(u);
+    v = (1.0f - abs(u)) * signNotZero(v);
+    u = fu;
+  }
+  return packUnit16(u) | (packUnit16(v) << 16u);
+}
+HC_FUNCTION vec3 unpackDirection(uint word) {
+  const float u = unpackUnit16(word & 0xFFFFu);
+  const float v = unpackUnit16(word >> 16u);
+  const float z = 1.0f - abs(u) - abs(v);
+  const float t = max(-z, 0.0f);
+  return normalize(vec3(u - t * signNotZero(u), v - t * signNotZero(v), z));
+}
+
 // One object as the rays see it this frame.
 struct RayObject {
   mat4 toWorld;       // object → world (its pose; scales uniformly)
@@ -43,15 +88,15 @@ struct RayObject {
   vec4 sphere;        // world bounding sphere (centre, radius): the ground's sky occluders are the others'
   float shift;        // the rays' origin shift along the normal, world units (shadowShift × scale)
   uint flags;         // ObjectInfo::flags: kObjectGround, kObjectLobePath
-  uint objectPad;
-  uint occluder;      // 1: one of GroundSky::occluders (every object but the ground)
+  uint mask;          // its instance's mask in the top level (rayMaskOf): the rays that ask what it alone blocks
+  uint occluder;      // 1: one of SkyOccluders::occluders (every object but the ground)
 };
 
 // The frame's rays.
 struct RayFrame {
   vec4 lightDirections[kMaxPointLights];  // toward the point lights, world, unit (xyz)
   vec4 eye;               // xyz: the camera's position (the lobe ray's mirror direction)
-  vec4 sky;               // xyz: the ground's normal; w: Σ luminance·cos·ΔΩ over its hemisphere (GroundSky::total)
+  vec4 sky;               // xyz: the ground's normal; w: Σ luminance·cos·ΔΩ over its hemisphere (SkyOccluders::total)
   vec4 toEnvironment[3];  // world → the light's frame (columns): where the luminance is read
   uint lights;            // point lights this frame
   uint objects;           // RayObject records
@@ -62,10 +107,15 @@ struct RayFrame {
   uint gridRows;
   uint groundSky;         // 1: the ground's hidden sky is computed (fused with a ground)
   uint antialias;         // 1: edge pixels have no centre sample (the grid takes every centre)
-  uint luminanceLevel;    // the map light's luminance (PreparedScene::restLuminance): its level
-  float minShare;         // GroundSky::minShare
-  uint framePad;
+  uint luminanceLevel;    // the map light's level (PreparedScene::restLuminance): rgb and luminance per texel
+  float minShare;         // SkyOccluders::minShare
+  uint objectSky;         // 1: the objects' hidden sky is computed (fused, two objects or more besides a ground)
 };
+
+// Object i's instance mask in the top level: a bit of its own while there
+// are at most 8 objects (a ray with that cull mask sees it alone); beyond,
+// objects i and i + 8 share one, and each counts the other as itself.
+HC_FUNCTION uint rayMaskOf(uint object) { return 1u << (object & 7u); }
 
 struct RaysPush {
   uint phase;

@@ -110,6 +110,11 @@ class RayScene {
   // Thread-safe. Throws std::invalid_argument if the spans differ in size.
   void occludedToward(std::span<const glm::vec3> origins, const glm::vec3& direction, float tnear,
                       std::span<std::uint8_t> out) const;
+  // occludedFrom() against object `object` alone, as posed (what it blocks
+  // of the rays, whatever else lies in front or behind): the test of what
+  // an object hides from itself. Thread-safe.
+  void occludedByObjectFrom(std::size_t object, const glm::vec3& origin, float tnear, std::span<const glm::vec3> directions,
+                            std::span<std::uint8_t> out) const;
   // Moves object `object` and rebuilds the top level only (the meshes'
   // structures are kept): the per-frame path for posed objects. Not safe
   // while another thread queries this scene.

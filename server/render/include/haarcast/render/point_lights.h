@@ -10,6 +10,7 @@
 // the same bits.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -20,6 +21,7 @@
 #include <glm/mat4x4.hpp>
 #include <glm/vec3.hpp>
 
+#include "haarcast/core/fused.h"
 #include "haarcast/core/mesh.h"
 #include "haarcast/core/shared_layout.h"
 #include "haarcast/core/sphere_map.h"
@@ -57,31 +59,54 @@ void pointLightMasks(const RayScene& world, std::span<const ShadingPoint> points
 // narrower than the visibility's texels sees along one direction), else 0.
 std::uint32_t lobeRayBit(const RayScene& world, const ShadingPoint& p, const glm::vec3& eye);
 
-// What the objects hide of a ground's map light (the sky less its point
-// lights): the ground is shaded in closed form, the same at every point,
-// so without this an object standing on it casts no contact shadow from
-// the sky. Per ground sample, rays go toward each object's bounding
+// What the objects hide of the map light (the sky less its point lights)
+// from the ground and from each other. The ground is shaded in closed
+// form, the same at every point, and an object's map part meets its own
+// visibility only, so without this an object standing on the ground casts
+// no contact shadow from the sky, and objects side by side do not darken
+// each other. Per sample, rays go toward each other object's bounding
 // sphere — a cone of (2m) × (8m) stratified directions, m from 1 for a
 // narrow cone to 4 for the hemisphere of a point beside the object
-// (shared_rays.h groundSkyScale), the same pattern at every sample so the
-// result is smooth and steady from frame to frame —
-// against the whole posed scene; each blocked direction takes its share
-// of Σ L·cos·ΔΩ. Objects whose cone can hide less than `minShare` of the
-// sky are skipped (and faded in above it, so no edge shows), so rays go
-// only near the objects.
-struct GroundSky {
+// (shared_rays.h groundSkyScale; at most 2 for an object's own pixels), the
+// same pattern at every sample so the result is smooth and steady from
+// frame to frame — against the whole posed scene. Objects whose cone can
+// hide less than `minShare` of the sky are skipped (and faded in above it,
+// so no edge shows), so rays go only near the objects.
+struct SkyOccluders {
   std::vector<glm::vec4> occluders;  // world bounding spheres of the objects other than the ground (centre, radius)
+  std::vector<std::uint32_t> objects;  // occluders[k]'s object index
   const SphereMap* luminance = nullptr;  // the map light's luminance, environment frame (PreparedScene::restLuminance)
+  const std::array<SphereMap, 3>* colour = nullptr;  // the map light itself (rgb) at that level, environment frame
   glm::mat3 toEnvironment{1.0f};     // world → environment (lightRotationᵀ)
+  bool ground = false;               // the scene has a ground: it hides what lies below its plane
   glm::vec3 normal{0.0f, 1.0f, 0.0f};  // the ground's, world
   double total = 0.0;                // Σ luminance·cos·ΔΩ over the ground's upper hemisphere
   double minShare = 0.03;  // faded in up to twice this
+  bool objectSky = false;  // the objects' own hidden sky is computed (two objects or more besides the ground)
 };
 inline constexpr int kGroundSkyRings = static_cast<int>(shared::kGroundSkyRings);  // the device's too (shared_rays.h)
 inline constexpr int kGroundSkySectors = static_cast<int>(shared::kGroundSkySectors);
 
 // The share in [0, 1] of the ground's map light that the scene hides from p.
-float groundSkyOcclusion(const RayScene& world, const ShadingPoint& p, const GroundSky& sky);
+float groundSkyOcclusion(const RayScene& world, const ShadingPoint& p, const SkyOccluders& sky);
+
+// The sky the other objects hide from p on object `object` (shared_rays.h
+// HiddenLight): of each cone ray above p's horizon and above the ground's
+// plane, the ones another object blocks and `object` itself does not (what
+// it hides from itself is its visibility bits already; what lies below the
+// ground's plane the ground hides from it already). `direction` is world
+// frame; power 0 when nothing is hidden.
+struct SkyHidden {
+  glm::vec3 direction{0.0f, 1.0f, 0.0f};
+  glm::vec3 power{0.0f};
+};
+SkyHidden objectSkyHidden(const RayScene& world, const ShadingPoint& p, std::size_t object, const SkyOccluders& sky);
+// The same, packed for `fused` with its direction in the object's frame
+// (`rotation`: the object's pose, object → world).
+shared::HiddenLight hiddenLightOf(const SkyHidden& hidden, const glm::mat3& rotation);
+// What `fused` takes off for it (core/fused.h fusedShade's `hidden`), or
+// nullopt when nothing is hidden.
+std::optional<FusedPointLight> hiddenFusedLight(const shared::HiddenLight& hidden);
 
 // groundSkyOcclusion on a coarse grid of the frame, the pixels (i·step, j·step)
 // and the last row and column, then for every ground sample the bilinear
@@ -104,7 +129,7 @@ class GroundSkyGrid {
   GroundSkyGrid(int width, int height);
   // point(pixel) is the ground's shading point at that interior pixel's
   // centre, or nullopt (not the ground, an edge pixel, nothing).
-  void compute(const RayScene& world, const GroundSky& sky,
+  void compute(const RayScene& world, const SkyOccluders& sky,
                const std::function<std::optional<ShadingPoint>(std::size_t pixel)>& point, unsigned threads);
   // The occlusion for a ground sample of pixel y·width + x.
   float at(std::size_t pixel, const std::function<float()>& direct) const;

@@ -300,7 +300,7 @@ struct ResolvedFrame {
   // The environment's frame → the world this frame (lightRotationOf): what
   // every pass that reads the light or the backdrop turns by.
   glm::dmat3 lightRotation{1.0};
-  GroundSky groundSky;                // fused with a ground: what its samples' rays need (point_lights.h)
+  SkyOccluders skyOccluders;          // fused with a ground or two objects: what their samples' hidden-sky rays need (point_lights.h)
 };
 ResolvedFrame resolveFrame(const PreparedScene& prepared, const RenderOptions& options, const FrameRequest& request);
 // The light's turn this frame: the request's (the wire's light pose) on top
