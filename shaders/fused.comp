@@ -76,6 +76,7 @@ layout(std430, set = 0, binding = kFusedPointLightsBinding) readonly buffer Poin
 layout(std430, set = 0, binding = kFusedRadianceBinding) buffer Radiance { vec4 radiance[]; };
 layout(std430, set = 0, binding = kFusedCounterBinding) readonly buffer Counter { CoverageCounter counter; };
 layout(std430, set = 0, binding = kFusedMasksBinding) readonly buffer Masks { uint masks[]; };  // sample s: bit k = sees light k
+layout(std430, set = 0, binding = kFusedHiddenBinding) readonly buffer Hidden { HiddenLight hidden[]; };  // sample s: the sky other objects hide
 layout(std430, set = 0, binding = kFusedSliceEnergyBinding) readonly buffer SliceEnergies { vec4 sliceEnergy[]; };  // global slice: ∫ρ_c (rgb)
 layout(std430, set = 0, binding = kFusedLobesBinding) readonly buffer Lobes { SliceLobe lobes[]; };          // global slice: its lobe
 // Level l of the prefiltered light at prefilterOffset(l), RGB0 (core PrefilteredLight).
@@ -369,6 +370,13 @@ void shadePixel(uint s) {
     }
     if ((seen & 0xFFFFu) != 0u) {
       sum = addPointLights(p, sh.object, o.pointLights, seen, sum);
+    }
+    // The sky other objects hide from it, taken off as a light (fusedShade's `hidden`).
+    if ((o.flags & kObjectSkyHidden) != 0u) {
+      const HiddenLight h = hidden[s];
+      if (h.power.r > 0.0 || h.power.g > 0.0 || h.power.b > 0.0) {
+        sum = max(sum - h.power * pointRhoAt(p, unpackDirection(h.direction)), vec3(0.0));
+      }
     }
     if (lobePath) sum += lobeShade(o, rs, blend, seen);
     radiance[sh.pixel] = vec4(sum, 1.0);

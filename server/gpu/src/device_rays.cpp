@@ -63,13 +63,20 @@ void VulkanRenderer::Impl::setUpDeviceRays() {
   rayObjectsUpload = BufferUpload(context, rayObjects);
   rayFrame = Buffer(context, sizeof(RayFrame), kStorageUsage, MemoryUse::DeviceInput);
   rayFrameUpload = BufferUpload(context, rayFrame);
-  // The map light's luminance, for the ground's hidden sky (SkyOccluders::luminance).
-  const bool groundSky = fused && prepared.ground;
-  const std::vector<float> none(1, 0.0f);
-  const std::size_t texels = groundSky ? prepared.restLuminance.pixelCount() : 1;
-  skyLuminance = Buffer(context, texels * sizeof(float), kStorageUsage, MemoryUse::DeviceInput);
-  BufferUpload up(context, skyLuminance);
-  up.write(groundSky ? prepared.restLuminance.values().data() : none.data(), texels * sizeof(float));
+  // The map light, rgb and luminance per texel, for the sky the objects
+  // hide (SkyOccluders::colour, ::luminance).
+  const bool skyRays = fused && (prepared.ground || objectSky());
+  std::vector<glm::vec4> texels(1, glm::vec4(0.0f));
+  if (skyRays) {
+    const SphereMap& luminance = prepared.restLuminance;
+    const std::array<SphereMap, 3>& colour = prepared.restLightAt(luminance.level());
+    texels.resize(luminance.pixelCount());
+    for (std::size_t i = 0; i < texels.size(); ++i)
+      texels[i] = glm::vec4(colour[0].values()[i], colour[1].values()[i], colour[2].values()[i], luminance.values()[i]);
+  }
+  skyLight = Buffer(context, texels.size() * sizeof(glm::vec4), kStorageUsage, MemoryUse::DeviceInput);
+  BufferUpload up(context, skyLight);
+  up.write(texels.data(), texels.size() * sizeof(glm::vec4));
   up.submit();
 }
 
@@ -85,10 +92,11 @@ void VulkanRenderer::Impl::ensureDeviceRayBuffers() {
                     {shared::kRaysNormalsBinding, &normals},
                     {shared::kRaysObjectsBinding, &rayObjects},
                     {shared::kRaysFrameBinding, &rayFrame},
-                    {shared::kRaysLuminanceBinding, &skyLuminance},
+                    {shared::kRaysSkyLightBinding, &skyLight},
                     {shared::kRaysPixelSampleBinding, &pixelSample},
                     {shared::kRaysGridBinding, &skyGrid},
-                    {shared::kRaysMasksBinding, &masks}},
+                    {shared::kRaysMasksBinding, &masks},
+                    {shared::kRaysHiddenBinding, &hidden}},
                    accelerationStructures->topLevel());
 }
 
@@ -96,6 +104,7 @@ void VulkanRenderer::Impl::writeRays(const render::ResolvedFrame& resolved, cons
   const std::size_t objectCount = prepared.objects.size();
   HC_CHECK_EQ(resolved.objects.size(), objectCount);
   const bool groundSky = fused && prepared.ground;
+  const bool hides = objectSky();
   std::size_t occluder = 0;  // SkyOccluders::occluders: every object but the ground, in order
   for (std::size_t i = 0; i < objectCount; ++i) {
     const render::PreparedObject& p = prepared.objects[i];
@@ -105,14 +114,15 @@ void VulkanRenderer::Impl::writeRays(const render::ResolvedFrame& resolved, cons
     for (int c = 0; c < 3; ++c) r.rotation[c] = glm::vec4(glm::vec3(glm::mat3(o.rotation)[c]), 0.0f);
     r.shift = p.shadowShift * static_cast<float>(o.scale);
     r.flags = (p.ground ? shared::kObjectGround : 0u) | (p.lobePath ? shared::kObjectLobePath : 0u);
-    r.occluder = groundSky && !p.ground ? 1u : 0u;
+    r.mask = shared::rayMaskOf(static_cast<std::uint32_t>(i));
+    r.occluder = (groundSky || hides) && !p.ground ? 1u : 0u;
     r.sphere = glm::vec4(0.0f);
     if (r.occluder) {
       HC_CHECK_LT(occluder, resolved.skyOccluders.occluders.size());
       r.sphere = resolved.skyOccluders.occluders[occluder++];
     }
   }
-  if (groundSky) HC_CHECK_EQ(occluder, resolved.skyOccluders.occluders.size());
+  if (groundSky || hides) HC_CHECK_EQ(occluder, resolved.skyOccluders.occluders.size());
   rayObjectsUpload.write(rayObjectData.data(), rayObjectData.size() * sizeof(RayObject));
 
   RayFrame& f = rayFrameData;
@@ -130,7 +140,8 @@ void VulkanRenderer::Impl::writeRays(const render::ResolvedFrame& resolved, cons
   f.gridRows = static_cast<std::uint32_t>(height - 1) / f.gridStep + 2u;
   f.antialias = options.antialias ? 1u : 0u;
   f.groundSky = groundSky ? 1u : 0u;
-  if (groundSky) {
+  f.objectSky = hides ? 1u : 0u;
+  if (groundSky || hides) {
     const render::SkyOccluders& sky = resolved.skyOccluders;
     f.sky = glm::vec4(sky.normal, static_cast<float>(sky.total));
     for (int c = 0; c < 3; ++c) f.toEnvironment[c] = glm::vec4(sky.toEnvironment[c], 0.0f);

@@ -87,8 +87,9 @@ void VulkanRenderer::Impl::releaseResolution() {
   destroyTarget(target);
   destroyTarget(subTarget);
   maskUpload = BufferUpload();
+  hiddenUpload = BufferUpload();
   for (Buffer* b : {&gbufIds, &gbufNormals, &gbufPositions, &samples, &shade, &counter, &counterOut, &shadeOut, &radiance,
-                    &rgba8, &rotated, &radianceOut, &idsOut, &batchArgs, &subIds, &subNormals, &edges, &masks, &pixelSample, &skyGrid}) {
+                    &rgba8, &rotated, &radianceOut, &idsOut, &batchArgs, &subIds, &subNormals, &edges, &masks, &hidden, &pixelSample, &skyGrid}) {
     *b = Buffer();
   }
   width = height = 0;
@@ -170,12 +171,17 @@ void VulkanRenderer::Impl::ensureResolution(int w, int h) {
     // Each sample's point-light mask, written by the host every frame (the
     // frame's "shadow-rays" stage) and read by the fused pass.
     // On the device, the ray-generation shader writes them instead (device_rays.cpp).
+    // Likewise the sky other objects hide from each sample, where they can.
+    const std::size_t hiddenRecords = objectSky() ? sampleCapacity : 1;
     if (deviceRays) {
       masks = Buffer(context, sampleCapacity * sizeof(std::uint32_t), kStorageUsage, MemoryUse::DeviceOnly);
+      hidden = Buffer(context, hiddenRecords * sizeof(HiddenLight), kStorageUsage, MemoryUse::DeviceOnly);
       ensureDeviceRayBuffers();
     } else {
       masks = Buffer(context, sampleCapacity * sizeof(std::uint32_t), kStorageUsage, MemoryUse::DeviceInput);
       maskUpload = BufferUpload(context, masks);
+      hidden = Buffer(context, hiddenRecords * sizeof(HiddenLight), kStorageUsage, MemoryUse::DeviceInput);
+      hiddenUpload = BufferUpload(context, hidden);
     }
     if (splitsum) {
       fusedPass->bind({{kSplitsumSamplesBinding, &samples},
@@ -203,7 +209,8 @@ void VulkanRenderer::Impl::ensureResolution(int w, int h) {
                      {kFusedLobesBinding, &lobes},
                      {kFusedLobeLightTexelsBinding, &lobeLightTexels},
                      {kFusedPointSliceTexelsBinding, &pointSliceTexels},
-                     {kFusedSliceCountsBinding, &sliceCounts}});
+                     {kFusedSliceCountsBinding, &sliceCounts},
+                     {kFusedHiddenBinding, &hidden}});
     return;
   }
 

@@ -39,6 +39,9 @@ std::uint32_t VulkanRenderer::Impl::computeShadowMasks(const render::ResolvedFra
   const ShadeSample* sh = readShadeSamples(covered);
   std::vector<std::uint32_t>& out = maskData;
   out.resize(covered);
+  // The sky other objects hide from each object sample (render::objectSkyHidden).
+  const bool hides = objectSky();
+  if (hides) hiddenData.assign(covered, HiddenLight{});
   constexpr std::size_t kChunk = 256;
   const std::span<const glm::vec3> lightDirections = resolved.pointLightDirections;
   auto pointOf = [&](const ShadeSample& sample) {
@@ -95,6 +98,10 @@ std::uint32_t VulkanRenderer::Impl::computeShadowMasks(const render::ResolvedFra
       const render::ShadingPoint& point = points[s - begin];
       out[s] = lightMasks[s - begin];
       if (prepared.objects[sample.object].lobePath) out[s] |= render::lobeRayBit(*rays, point, eye);
+      if (hides && !prepared.objects[sample.object].ground) {
+        hiddenData[s] = render::hiddenLightOf(render::objectSkyHidden(*rays, point, sample.object, resolved.skyOccluders),
+                                              rotations[sample.object]);
+      }
       if (groundSky && prepared.objects[sample.object].ground) {
         // Its pixel: the slot itself, or the edge pixel a sub-sample's slot belongs to.
         const std::size_t pixel = sample.pixel < pixels ? sample.pixel : (sample.pixel - pixels) / shared::kSubsamples;
@@ -104,6 +111,7 @@ std::uint32_t VulkanRenderer::Impl::computeShadowMasks(const render::ResolvedFra
     }
   }, {}, options.threads);
   if (!out.empty()) maskUpload.write(out.data(), out.size() * sizeof(std::uint32_t));
+  if (hides && !hiddenData.empty()) hiddenUpload.write(hiddenData.data(), hiddenData.size() * sizeof(HiddenLight));
   return covered;
 }
 
@@ -167,6 +175,7 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
                                  pointLightUpload.record(cb);
                                }
                                if (!deviceRays) maskUpload.record(cb);
+                               if (!deviceRays && objectSky()) hiddenUpload.record(cb);
                                computeBarrier(cb);
                                fusedPass->dispatchIndirect(cb, counter, offsetof(CoverageCounter, groups));
                                if (fused) {

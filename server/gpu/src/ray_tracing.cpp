@@ -8,6 +8,7 @@
 #include <string>
 
 #include "haarcast/core/check.h"
+#include "haarcast/core/shared_layout.h"
 
 namespace haarcast::gpu {
 namespace {
@@ -193,7 +194,9 @@ void AccelerationStructures::recordTopLevel(VkCommandBuffer cb, std::span<const 
     for (int row = 0; row < 3; ++row)
       for (int col = 0; col < 4; ++col) r.transform.matrix[row][col] = m[col][row];
     r.instanceCustomIndex = static_cast<std::uint32_t>(i);
-    r.mask = 0xFF;
+    // Its own bit, so that a ray can ask what this object alone blocks
+    // (shared_rays.h rayMaskOf); the scene's rays see every bit.
+    r.mask = shared::rayMaskOf(static_cast<std::uint32_t>(i));
     r.instanceShaderBindingTableRecordOffset = 0;
     // Both faces block, as Embree's rays (no culling).
     r.flags = VK_GEOMETRY_INSTANCE_TRIANGLE_FACING_CULL_DISABLE_BIT_KHR;

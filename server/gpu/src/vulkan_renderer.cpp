@@ -185,6 +185,12 @@ std::vector<std::uint32_t> VulkanRenderer::shadowWords() const {
   const std::uint32_t covered = impl.counterOut.handle() ? impl.coveredSamples() : 0;
   return readAll<std::uint32_t>(impl.context, impl.masks, covered);
 }
+std::vector<HiddenLight> VulkanRenderer::hiddenLights() const {
+  Impl& impl = last();
+  if (!impl.objectSky() || !impl.hidden.handle()) return {};
+  const std::uint32_t covered = impl.counterOut.handle() ? impl.coveredSamples() : 0;
+  return readAll<HiddenLight>(impl.context, impl.hidden, covered);
+}
 std::vector<std::uint32_t> VulkanRenderer::edgeWords() const {
   if (!last().options.antialias) return {};
   return readAll<std::uint32_t>(last().context, last().edges, static_cast<std::size_t>(last().width) * static_cast<std::size_t>(last().height));

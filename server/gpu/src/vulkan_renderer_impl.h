@@ -91,6 +91,8 @@ struct VulkanRenderer::Impl {
   // ObjectInfo::sliceBase + t) its SliceLobe, and the prefiltered light.
   // Its frame is fused's (renderFused) with shaders/splitsum.comp as the pass.
   bool splitsum = false;
+  // `fused` whose objects hide sky from each other (kObjectSkyHidden).
+  bool objectSky() const { return fused && prepared.standingObjects() >= 2; }
   Buffer directions, pointLights, pointSlices;
   // `fused`: per global slice its ∫ρ (vec4) and its lobe (SliceLobe), and
   // the prefiltered light (core/prefiltered_light.h) the lobe path reads.
@@ -109,11 +111,11 @@ struct VulkanRenderer::Impl {
   bool deviceRays = false;
   // The device's: a bottom level per mesh and the frame's top level, the
   // ray-generation pipeline, per frame the objects' and the frame's records
-  // (core/shared_rays.h); the map light's luminance (the ground's hidden
+  // (core/shared_rays.h); the map light, rgb and luminance (the hidden
   // sky); per pixel its centre sample and the coarse grid's values.
   std::unique_ptr<AccelerationStructures> accelerationStructures;
   std::unique_ptr<RayTracingPipeline> shadowRays;
-  Buffer rayObjects, rayFrame, skyLuminance, pixelSample, skyGrid;
+  Buffer rayObjects, rayFrame, skyLight, pixelSample, skyGrid;
   BufferUpload rayObjectsUpload, rayFrameUpload;
   std::vector<RayObject> rayObjectData;
   RayFrame rayFrameData{};
@@ -171,6 +173,11 @@ struct VulkanRenderer::Impl {
   Buffer masks;
   BufferUpload maskUpload;
   std::vector<std::uint32_t> maskData;  // this frame's masks, before upload
+  // `fused` with objects that hide sky from each other (kObjectSkyHidden):
+  // per covered sample its HiddenLight (shared_rays.h), else one record.
+  Buffer hidden;
+  BufferUpload hiddenUpload;
+  std::vector<HiddenLight> hiddenData;
   // Antialiasing: the sub-samples' ids and normals (else 4-byte stand-ins),
   // and each pixel's edge word (shared_layout.h kEdgeFlag).
   Buffer subIds, subNormals, edges;

@@ -389,7 +389,7 @@ ResolvedFrame resolveFrame(const PreparedScene& prepared, const RenderOptions& o
   }
   std::optional<glm::dvec3> groundNormal;
   if (prepared.ground) groundNormal = out.objects[*prepared.ground].rotation * glm::dvec3(0.0, 1.0, 0.0);
-  const std::size_t standing = out.objects.size() - (prepared.ground ? 1 : 0);  // objects besides the ground
+  const std::size_t standing = prepared.standingObjects();
   if (fused && (prepared.ground || standing >= 2)) {
     // The sky the objects hide from the ground and from each other
     // (point_lights.h): their bounding spheres as posed, the map light, its

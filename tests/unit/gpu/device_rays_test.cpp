@@ -74,7 +74,15 @@ struct WordDiff {
   std::size_t groundSamples = 0, groundOff = 0;  // off: the occlusion differs by more than kGroundSlack
   double groundWorst = 0.0;
   std::size_t groundOccluded = 0;  // ground samples with some occlusion on the host
+  // The sky the other objects hide (HiddenLight), on the objects' samples:
+  // those with some on the host, those whose Σ power·(n·d)… differs by more
+  // than kHiddenSlack of the largest, and whose directions differ by more
+  // than 0.05 rad where both hide something.
+  std::size_t hiddenSamples = 0, hiddenOff = 0, hiddenTurned = 0;
+  double hiddenLargest = 0.0;
 };
+// A ray's share of a cone, as kGroundSlack.
+constexpr double kHiddenSlack = 0.05;
 // A ray's weight in one 2 × 8 cone is at most a few per cent of the sky;
 // flips of one or two rays stay under this.
 constexpr double kGroundSlack = 0.05;
@@ -82,8 +90,13 @@ constexpr double kGroundSlack = 0.05;
 // groundSky: the ground's word carries its hidden sky (`fused`); else
 // (`splitsum`) its upper bit is the lobe's, as on every object.
 WordDiff diffWords(const VulkanRenderer& host, const VulkanRenderer& device, bool groundSky) {
+  WordDiff d;
   const std::vector<ShadeSample> hs = host.shadeSamples(), ds = device.shadeSamples();
   const std::vector<std::uint32_t> hw = host.shadowWords(), dw = device.shadowWords();
+  const std::vector<HiddenLight> hh = host.hiddenLights(), dh = device.hiddenLights();
+  EXPECT_EQ(hh.size(), groundSky ? hw.size() : 0u) << "fused with two objects on a ground hides sky";
+  EXPECT_EQ(dh.size(), hh.size());
+  for (const HiddenLight& l : hh) d.hiddenLargest = std::max(d.hiddenLargest, static_cast<double>(l.power.x));
   EXPECT_EQ(hs.size(), hw.size());
   EXPECT_EQ(ds.size(), dw.size());
   EXPECT_EQ(hs.size(), ds.size());  // the same G-buffer: the same covered samples
@@ -91,7 +104,6 @@ WordDiff diffWords(const VulkanRenderer& host, const VulkanRenderer& device, boo
   for (std::size_t s = 0; s < hs.size(); ++s) hostAt[hs[s].pixel] = s;
   const render::PreparedScene& prepared = host.prepared();
   const std::uint32_t lightMask = (1u << shared::kMaxPointLights) - 1u;
-  WordDiff d;
   for (std::size_t s = 0; s < ds.size(); ++s) {
     const auto it = hostAt.find(ds[s].pixel);
     if (it == hostAt.end()) {
@@ -121,6 +133,14 @@ WordDiff diffWords(const VulkanRenderer& host, const VulkanRenderer& device, boo
       }
       EXPECT_EQ(a >> (shared::kMaxPointLights + 1), 0u);  // nothing above the lobe's bit off the ground
       EXPECT_EQ(b >> (shared::kMaxPointLights + 1), 0u);
+      if (!hh.empty()) {
+        const HiddenLight& x = hh[it->second];
+        const HiddenLight& y = dh[s];
+        if (x.power.x > 0.0f) ++d.hiddenSamples;
+        if (std::abs(x.power.x - y.power.x) > kHiddenSlack * d.hiddenLargest) ++d.hiddenOff;
+        const glm::vec3 u = shared::unpackDirection(x.direction), v = shared::unpackDirection(y.direction);
+        if (x.power.x > 0.0f && y.power.x > 0.0f && glm::dot(u, v) < std::cos(0.05f)) ++d.hiddenTurned;
+      }
     }
   }
   return d;
@@ -166,15 +186,18 @@ TEST_P(DeviceRays, ShadowWordsMatchTheHostsRays) {
   const WordDiff d = diffWords(host, device, c.method == RotationMethod::Fused);
   const Comparison image = compare(a, b);
   std::printf("%s: %zu samples; light rays %zu, %zu flipped; lobe samples %zu, %zu flipped; ground samples %zu "
-              "(%zu occluded), %zu off by > %.2f, worst %.4f; image %.1f dB\n",
+              "(%zu occluded), %zu off by > %.2f, worst %.4f; hidden sky on %zu samples, %zu off, %zu turned; "
+              "image %.1f dB\n",
               c.name, d.samples, d.lightRays, d.lightFlipped, d.lobeSamples, d.lobeFlipped, d.groundSamples,
-              d.groundOccluded, d.groundOff, kGroundSlack, d.groundWorst, image.psnr);
+              d.groundOccluded, d.groundOff, kGroundSlack, d.groundWorst, d.hiddenSamples, d.hiddenOff, d.hiddenTurned,
+              image.psnr);
   EXPECT_GT(d.samples, 3000u);
   // The rays this scene must exercise: its lights, its ground's hidden sky,
   // and with mirrors the lobe path.
   if (c.method == RotationMethod::Fused) {
     EXPECT_GT(d.lightRays, d.samples);
     EXPECT_GT(d.groundOccluded, 100u);
+    EXPECT_GT(d.hiddenSamples, 100u) << "the objects hide sky from each other";
   }
   if (c.mirror || c.method == RotationMethod::Splitsum) {
     EXPECT_GT(d.lobeSamples, 500u);
@@ -183,6 +206,7 @@ TEST_P(DeviceRays, ShadowWordsMatchTheHostsRays) {
   EXPECT_LE(d.lightFlipped * 500, d.lightRays);
   EXPECT_LE(d.lobeFlipped * 500, std::max<std::size_t>(d.lobeSamples, 1));
   EXPECT_LE(d.groundOff * 500, std::max<std::size_t>(d.groundSamples, 1));
+  EXPECT_LE((d.hiddenOff + d.hiddenTurned) * 500, std::max<std::size_t>(d.hiddenSamples, 1));
   // The image: the same but where a ray flipped.
   EXPECT_GE(image.psnr, 60.0);
   EXPECT_EQ(image.mismatched, 0u);

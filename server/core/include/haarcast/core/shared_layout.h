@@ -284,6 +284,10 @@ HC_CONST uint kObjectGround = 1u;
 // ObjectInfo::flags: some of the object's pixels take `fused`'s lobe path
 // (their shadow word carries kLobeSeenBit).
 HC_CONST uint kObjectLobePath = 2u;
+// ObjectInfo::flags: other objects can hide sky from it (the scene has two
+// objects or more besides a ground): `fused` reads its samples' HiddenLight
+// (shared_rays.h).
+HC_CONST uint kObjectSkyHidden = 4u;
 
 // `fused`'s point lights (core/light_split.h): the light's brightest
 // regions, shaded per pixel with a shadow ray each. Records per object and

@@ -35,12 +35,13 @@ HC_CONST uint kRaysPositionsBinding = 2u;
 HC_CONST uint kRaysNormalsBinding = 3u;
 HC_CONST uint kRaysObjectsBinding = 4u;
 HC_CONST uint kRaysFrameBinding = 5u;
-HC_CONST uint kRaysLuminanceBinding = 6u;
+HC_CONST uint kRaysSkyLightBinding = 6u;
 HC_CONST uint kRaysPixelSampleBinding = 7u;
 HC_CONST uint kRaysGridBinding = 8u;
 HC_CONST uint kRaysMasksBinding = 9u;
-HC_CONST uint kRaysSceneBinding = 10u;
-HC_CONST uint kRaysStorageBindings = 10u;
+HC_CONST uint kRaysHiddenBinding = 10u;
+HC_CONST uint kRaysSceneBinding = 11u;
+HC_CONST uint kRaysStorageBindings = 11u;
 
 // ---- Specialization constants: the ids the shaders declare them at
 // (layout(constant_id = …)) and the host sets them by (gpu::SpecConstant).
@@ -186,7 +187,8 @@ HC_CONST uint kFusedLobesBinding = 12u;
 HC_CONST uint kFusedLobeLightTexelsBinding = 13u;
 HC_CONST uint kFusedPointSliceTexelsBinding = 14u;
 HC_CONST uint kFusedSliceCountsBinding = 15u;
-HC_CONST uint kFusedBindings = 16u;
+HC_CONST uint kFusedHiddenBinding = 16u;
+HC_CONST uint kFusedBindings = 17u;
 
 // splitsum.comp; kSplitsumLobeLightTexelsBinding is a uniform texel
 // buffer, the rest storage buffers (gpu::splitsumBindings).

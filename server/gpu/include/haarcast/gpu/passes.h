@@ -29,6 +29,7 @@ using shared::ExposurePush;
 using shared::ExposureResult;
 using shared::FrameParams;
 using shared::GBufferPush;
+using shared::HiddenLight;
 using shared::ObjectInfo;
 using shared::PointLight;
 using shared::RayFrame;

@@ -117,6 +117,10 @@ class VulkanRenderer final : public render::Renderer {
   // it (point-light bits, kLobeSeenBit, the ground's occlusion), in
   // shadeSamples() order; empty for the rotating methods.
   std::vector<std::uint32_t> shadowWords() const;
+  // `fused` whose objects hide sky from each other: each covered sample's
+  // HiddenLight (core/shared_rays.h) as the pass read it, in shadeSamples()
+  // order (the ground's are not written); else empty.
+  std::vector<HiddenLight> hiddenLights() const;
   // With antialiasing, each pixel's edge word (shared_layout.h kEdgeFlag);
   // empty without.
   std::vector<std::uint32_t> edgeWords() const;

@@ -207,6 +207,9 @@ struct PreparedScene {
   // The rest at a level some object uses or is turned from; throws
   // std::out_of_range otherwise.
   const std::array<SphereMap, 3>& restLightAt(int level) const;
+  // The objects besides the ground: with two or more, `fused` lets them hide
+  // sky from each other (point_lights.h SkyOccluders::objectSky).
+  std::size_t standingObjects() const { return objects.size() - (ground ? 1 : 0); }
   // Each object's level, in scene order (PreparedObject::level).
   std::vector<int> objectLevels() const;
   PrefilteredLight lobeLight;           // `fused`, `splitsum`: the backdrop's maps at every level, for the lobe path (empty when no object has one)
