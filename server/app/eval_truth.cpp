@@ -157,6 +157,21 @@ std::string methodTruthMarkdown(const nlohmann::json& truth) {
 
 // ---- Shadow scenes ----------------------------------------------------------
 
+// A torus (assets::makeTorus) less the sector of `gapDegrees` about +X:
+// an open tube, both ends open, whose inside the rays can reach.
+Mesh openTube(double majorRadius, double minorRadius, double gapDegrees) {
+  Mesh torus = assets::makeTorus(majorRadius, minorRadius, 96, 24);
+  const double half = 0.5 * gapDegrees * kPi / 180.0;
+  std::vector<glm::uvec3> kept;
+  for (const glm::uvec3& t : torus.triangles) {
+    const glm::vec3 c = (torus.positions[t.x] + torus.positions[t.y] + torus.positions[t.z]) / 3.0f;
+    if (std::abs(std::atan2(static_cast<double>(c.z), static_cast<double>(c.x))) > half) kept.push_back(t);
+  }
+  torus.triangles = std::move(kept);
+  torus.name = "open tube";
+  return torus;
+}
+
 render::Scene groundedScene(const render::Environment& environment, std::vector<render::SceneObject> objects,
                             double groundHalfSize, int groundSubdivisions) {
   render::Scene s;
@@ -207,6 +222,44 @@ std::vector<ShadowScene> shadowScenes(const EvalOptions& o, std::vector<std::str
                    "suns", groundedScene(suns, {ball, torus}, 3.0, o.quick ? 16 : 64)};
     sc.scene.camera.eye = {0.0, 1.4, 3.0};
     sc.scene.camera.target = {0.0, 0.25, 0.0};
+    sc.scene.camera.fovYDegrees = 40.0;
+    out.push_back(std::move(sc));
+  }
+  // An open mesh on the ground beside a glossy ball: a torus with a sector
+  // cut away (its tube open at both ends, so rays enter it), lying on the
+  // ground, Lambert, 5 cm from a GGX 0.1 ball. Where the tube meets the
+  // ground the ground's hidden sky must see through its open ends, and the
+  // tube's side and the ball hide sky from each other.
+  {
+    render::SceneObject tube{"open tube", std::make_shared<Mesh>(openTube(1.0, 0.3, 100.0)), render::materialFromSpec("lambert"), {}};
+    tube.pose.scale = 0.5;
+    tube.pose.rotateDegrees = {0.0, 150.0, 0.0};  // the cut toward the back left
+    tube.pose.translate = {-0.35, 0.15, 0.0};  // its lowest point r·scale = 0.15 below its centre
+    render::SceneObject ball{"ball", std::make_shared<Mesh>(assets::makeSphere(48)), render::materialFromSpec("ggx:0.1"), {}};
+    ball.pose.scale = 0.35;
+    // 5 cm from the tube: the tube's core circle (radius 0.5, height 0.15)
+    // is √((1.012 − 0.5)² + 0.2²) = 0.55 from the ball's centre.
+    ball.pose.translate = {0.662, 0.35, 0.0};
+    ShadowScene sc{"open-tube", "an open Lambert tube (a torus less 100°) beside a GGX 0.1 ball on a Lambert ground, suns sky",
+                   "suns", groundedScene(suns, {tube, ball}, 3.0, o.quick ? 16 : 64)};
+    sc.scene.camera.eye = {0.3, 1.3, 2.6};
+    sc.scene.camera.target = {0.0, 0.15, 0.0};
+    sc.scene.camera.fovYDegrees = 40.0;
+    out.push_back(std::move(sc));
+  }
+  // Two objects close together: a Lambert box and a Lambert ball 5 cm
+  // apart on the ground, the gap between them in view.
+  {
+    render::SceneObject box{"box", std::make_shared<Mesh>(assets::makeBox(0.35, 0.35, 0.35)), render::materialFromSpec("lambert"), {}};
+    box.pose.rotateDegrees = {0.0, 15.0, 0.0};
+    box.pose.translate = {-0.4, 0.35, 0.0};
+    render::SceneObject ball{"ball", std::make_shared<Mesh>(assets::makeSphere(48)), render::materialFromSpec("lambert"), {}};
+    ball.pose.scale = 0.4;
+    ball.pose.translate = {0.43, 0.4, 0.0};  // (0.83, 0, 0)·(cos 15°, 0, −sin 15°) − 0.35 − 0.4 = 5 cm from the box's face
+    ShadowScene sc{"close-pair", "a Lambert box and a Lambert ball 5 cm apart on a Lambert ground, suns sky", "suns",
+                   groundedScene(suns, {box, ball}, 3.0, o.quick ? 16 : 64)};
+    sc.scene.camera.eye = {0.0, 0.9, 2.4};
+    sc.scene.camera.target = {0.0, 0.3, 0.0};
     sc.scene.camera.fovYDegrees = 40.0;
     out.push_back(std::move(sc));
   }

@@ -112,6 +112,9 @@ std::function<int()> addRenderCommand(CLI::App& app) {
                 "fused: rounds of refining the mesh where its vertices' visibility disagrees (0 = off)")
       ->capture_default_str()
       ->check(CLI::Range(0, 16));
+  c->add_option("--object-sky", args->options.objectSky,
+                "fused: objects hide sky from each other (true|false; false: each meets its own visibility alone)")
+      ->capture_default_str();
   c->add_option("--backend", args->backend, "The backend: " + backends::availableText())->capture_default_str();
   c->add_option("--antialias", args->antialias, "auto|on|off: edge pixels as the mean of 4 sub-samples (auto: on)")
       ->capture_default_str();

@@ -47,7 +47,7 @@ void VulkanRenderer::Impl::uploadScene() {
     }
     info.thetaSamples = static_cast<std::uint32_t>(T);
     info.flags = p.ground ? shared::kObjectGround : 0u;
-    if (fused && !p.ground && prepared.standingObjects() >= 2) info.flags |= shared::kObjectSkyHidden;
+    if (objectSky() && !p.ground) info.flags |= shared::kObjectSkyHidden;
     if (splitsum) {
       // Its lobes are all it keeps: lobe t of the object at sliceBase + t.
       info.sliceBase = static_cast<std::uint32_t>(lobeData.size());

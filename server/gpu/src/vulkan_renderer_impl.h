@@ -92,7 +92,7 @@ struct VulkanRenderer::Impl {
   // Its frame is fused's (renderFused) with shaders/splitsum.comp as the pass.
   bool splitsum = false;
   // `fused` whose objects hide sky from each other (kObjectSkyHidden).
-  bool objectSky() const { return fused && prepared.standingObjects() >= 2; }
+  bool objectSky() const { return fused && options.objectSky && prepared.standingObjects() >= 2; }
   Buffer directions, pointLights, pointSlices;
   // `fused`: per global slice its ∫ρ (vec4) and its lobe (SliceLobe), and
   // the prefiltered light (core/prefiltered_light.h) the lobe path reads.

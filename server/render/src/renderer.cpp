@@ -137,17 +137,18 @@ PreparedScene prepareScene(const Scene& scene, const RenderOptions& options, con
   if (splitsum) prepared.lobeLight = PrefilteredLight::build(prepared.background);
   if (fused) {
     // Lights found on the backdrop's fine map (light_split.h: their
-    // directions to a tenth of a degree), the rest at each level in use:
-    // the solid-angle mean of the fine map's rest (SphereMap::downsampled).
+    // directions to a tenth of a degree), the rest at each level in use and
+    // at kSkyRaysLevel: the solid-angle mean of the fine map's rest
+    // (SphereMap::downsampled).
     LightSplit split = splitLight(prepared.background, options.pointLights);
     prepared.pointLights = std::move(split.lights);
     prepared.restLight.assign(static_cast<std::size_t>(kBackgroundLevel) + 1, {});
-    for (const int level : levelsInUse(prepared.objectLevels())) {
-      for (const int at : {level, lightTurnLevel(level)}) {
-        std::array<SphereMap, 3>& rest = prepared.restLight[static_cast<std::size_t>(at)];
-        if (rest[0].level() == at && rest[0].pixelCount() > 1) continue;
-        for (std::size_t c = 0; c < 3; ++c) rest[c] = split.rest[c].downsampled(at);
-      }
+    std::vector<int> restLevels{kSkyRaysLevel};
+    for (const int level : levelsInUse(prepared.objectLevels())) restLevels.insert(restLevels.end(), {level, lightTurnLevel(level)});
+    for (const int at : restLevels) {
+      std::array<SphereMap, 3>& rest = prepared.restLight[static_cast<std::size_t>(at)];
+      if (rest[0].level() == at && rest[0].pixelCount() > 1) continue;
+      for (std::size_t c = 0; c < 3; ++c) rest[c] = split.rest[c].downsampled(at);
     }
     for (std::size_t k = 0; k < prepared.objects.size(); ++k) {
       PreparedObject& p = prepared.objects[k];
@@ -161,7 +162,7 @@ PreparedScene prepareScene(const Scene& scene, const RenderOptions& options, con
       // The prefiltered light (5.6 MB at level 9) only where a pixel can read it.
       if (p.lobePath && prepared.lobeLight.empty()) prepared.lobeLight = PrefilteredLight::build(prepared.background);
     }
-    const std::array<SphereMap, 3>& rest = prepared.restLightAt(finest);
+    const std::array<SphereMap, 3>& rest = prepared.restLightAt(kSkyRaysLevel);
     prepared.restLuminance = SphereMap(rest[0].level());
     for (int r = 0; r < rest[0].size(); ++r)
       for (int c = 0; c < rest[0].size(); ++c)
@@ -397,7 +398,7 @@ ResolvedFrame resolveFrame(const PreparedScene& prepared, const RenderOptions& o
     SkyOccluders& sky = out.skyOccluders;
     sky.ground = prepared.ground.has_value();
     if (groundNormal) sky.normal = glm::vec3(*groundNormal);
-    sky.objectSky = standing >= 2;
+    sky.objectSky = options.objectSky && standing >= 2;
     sky.toEnvironment = glm::mat3(glm::transpose(light));
     for (std::size_t i = 0; i < out.objects.size(); ++i) {
       if (prepared.objects[i].ground) continue;

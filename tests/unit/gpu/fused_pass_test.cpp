@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <random>
 #include <span>
 #include <string>
@@ -26,6 +27,7 @@
 #include "haarcast/core/visibility_bits.h"
 #include "haarcast/gpu/compute.h"
 #include "haarcast/gpu/passes.h"
+#include "haarcast/render/point_lights.h"
 #include "../core/test_maps.h"
 
 namespace haarcast::gpu {
@@ -117,6 +119,9 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
     }
   }
   objects[kGround].flags = shared::kObjectGround;
+  // The sky other objects hide (HiddenLight): on the plain object and on
+  // the one whose lobe path takes the core.
+  constexpr std::size_t kPlain = 2;
 
   // The lobe path: object 1 takes all of its lobes by the path, object 0
   // their core (two texels about the axis) and the pass the rest; random
@@ -147,6 +152,7 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
     }
     objects[o].flags = shared::kObjectLobePath;
   }
+  for (const std::size_t o : {kPlain, kLobeSplit}) objects[o].flags |= shared::kObjectSkyHidden;
   objects[kLobeAll].lobeCore = glm::vec4(-1.0f, 0.0f, 0.0f, 0.0f);
   objects[kLobeSplit].lobeCore = glm::vec4(std::cos(coreAngle), 0.0f, 0.0f, 0.0f);
   const glm::mat3 toLight(rotationMatrix(randomRotations(1, 7)[0]));
@@ -178,6 +184,7 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
   std::vector<RotationSample> samples(kPixels);
   std::vector<ShadeSample> shade(kPixels);
   std::vector<std::uint32_t> masks(kPixels);
+  std::vector<HiddenLight> hidden(kPixels, HiddenLight{});
   const std::vector<EulerYXY> rotations = randomRotations(kPixels, 23);
   for (std::size_t i = 0; i < kPixels; ++i) {
     RotationSample& s = samples[i];
@@ -197,6 +204,12 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
     // Every light seen, none, and random masks (with bits past kLights).
     masks[i] = i < 3 ? 0xFFu : i < 6 ? 0u : static_cast<std::uint32_t>(rng() & 0xFFu);
     if (sh.object != kGround && i % 4 != 3) masks[i] |= shared::kLobeSeenBit;  // the lobe ray: mostly seen
+    // Hidden sky on most samples of every object: read only where the
+    // object's flag says so, and not at all with power 0.
+    if (i % 3 != 0) {
+      hidden[i].direction = shared::packDirection(glm::normalize(glm::vec3(2.0f * u(rng) - 1.0f, u(rng), 2.0f * u(rng) - 1.0f)));
+      hidden[i].power = glm::vec3(0.5f + 2.0f * u(rng), 0.5f + 2.0f * u(rng), 0.5f + 2.0f * u(rng));
+    }
   }
   const std::vector<glm::vec4>& dirs = directionTable.directions;
   const CoverageCounter counter{static_cast<std::uint32_t>(kPixels), {kGroups, 1, 1}};
@@ -219,6 +232,7 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
   Buffer radiance(context, kPixels * sizeof(glm::vec4));
   Buffer counterBuf = upload(&counter, sizeof counter);
   Buffer maskBuf = upload(masks.data(), masks.size() * sizeof(std::uint32_t));
+  Buffer hiddenBuf = upload(hidden.data(), hidden.size() * sizeof(HiddenLight));
   Buffer energyBuf = upload(energies.data(), energies.size() * sizeof(glm::vec4));
   Buffer lobeBuf = upload(lobes.data(), lobes.size() * sizeof(shared::SliceLobe));
   Buffer prefilterBuf = upload(prefiltered.texels().data(), prefiltered.texels().size_bytes());
@@ -235,14 +249,14 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
   std::vector<std::uint32_t> sliceCounts(2 * objects.size(), 0u);
   Buffer sliceCountBuf = upload(sliceCounts.data(), sliceCounts.size() * sizeof(std::uint32_t));
   p.bind({&sampleBuf, &shadeBuf, &objectBuf, &texelView, &lightView, &bitsView, &dirView, &pointBuf, &radiance,
-          &counterBuf, &maskBuf, &energyBuf, &lobeBuf, &prefilterView, &pointTexelView, &sliceCountBuf});
+          &counterBuf, &maskBuf, &energyBuf, &lobeBuf, &prefilterView, &pointTexelView, &sliceCountBuf, &hiddenBuf});
   context.submit([&](VkCommandBuffer cb) { p.dispatch(cb, {kGroups, 1, 1}); });
   std::vector<glm::vec4> got(kPixels);
   radiance.read(got.data(), got.size() * sizeof(glm::vec4));
   sliceCountBuf.read(sliceCounts.data(), sliceCounts.size() * sizeof(std::uint32_t));
   std::vector<std::uint32_t> wantCounts(2 * objects.size(), 0u);  // per object: samples of one slice, of two
 
-  double worst = 0.0, scale = 0.0, lightShare = 0.0;
+  double worst = 0.0, scale = 0.0, lightShare = 0.0, hiddenTaken = 0.0;
   std::array<int, 2> lobeSamples{};  // samples all on the path, in part
   FusedScratch work;
   std::vector<std::array<float, 3>> expected(kPixels);
@@ -268,7 +282,14 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
                         o == kLobeAll ? static_cast<float>(kPi) : coreAngle};
     const LobePath* lobe = o == kLobeAll || o == kLobeSplit ? &path : nullptr;
     if (lobe) lobeSamples[o == kLobeAll ? 0 : 1]++;
-    expected[i] = fusedShade(slices[o], blend, r, lights[o], vis, pointLights[o], masks[i], work, lobe);
+    const std::optional<FusedPointLight> sky =
+        (objects[o].flags & shared::kObjectSkyHidden) != 0u ? render::hiddenFusedLight(hidden[i]) : std::nullopt;
+    expected[i] = fusedShade(slices[o], blend, r, lights[o], vis, pointLights[o], masks[i], work, lobe, sky ? &*sky : nullptr);
+    if (sky) {
+      const std::array<float, 3> open = fusedShade(slices[o], blend, r, lights[o], vis, pointLights[o], masks[i], work, lobe);
+      for (std::size_t c = 0; c < 3; ++c)
+        hiddenTaken = std::max(hiddenTaken, static_cast<double>(open[c] - expected[i][c]));
+    }
     // How much of the sample the point lights make (the test must see them).
     const std::array<float, 3> mapOnly =
         fusedShade(slices[o], blend, r, lights[o], vis, pointLights[o], masks[i] & shared::kLobeSeenBit, work, lobe);
@@ -278,6 +299,9 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
     for (float x : expected[i]) scale = std::max(scale, std::abs(static_cast<double>(x)));
   }
   EXPECT_GT(lightShare, 0.1) << "the point lights make too little of any sample for the test to see them";
+  // What the hidden sky takes, against the tolerance below: a pass that
+  // ignored it would fail by far.
+  EXPECT_GT(hiddenTaken / scale, 1e-3) << "the hidden sky takes too little of any sample for the test to see it";
   std::size_t groundSamples = 0;
   for (std::size_t i = 0; i < kPixels; ++i) {
     const glm::vec4& g = got[shade[i].pixel];

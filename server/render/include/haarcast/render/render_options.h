@@ -58,6 +58,10 @@ struct RenderOptions {
   // at most shared::kMaxPointLights.
   LightSplitOptions pointLights;
   RefineOptions refine;                   // fused: the mesh refined where visibility changes (visibility_refine.h)
+  // fused, two objects or more besides a ground: each hides sky from the
+  // others (point_lights.h objectSkyHidden); false: each object's map part
+  // meets its own visibility alone.
+  bool objectSky = true;
   SceneLimits sceneLimits;                // objects, triangles, visibility memory (prepareScene)
   bool environmentBackground = true;      // false: black where no object is
   std::string cacheDir;                   // slice-table and visibility cache; empty = none

@@ -203,7 +203,7 @@ struct PreparedScene {
   // solid-angle mean of the backdrop's rest (restLightAt).
   std::vector<DirectionalLight> pointLights;
   std::vector<std::array<SphereMap, 3>> restLight;  // [level] 0 … kBackgroundLevel: empty where not needed
-  SphereMap restLuminance;              // the finest object level's rest, Rec. 709 luminance (the ground's hidden sky, point_lights.h)
+  SphereMap restLuminance;              // the rest at kSkyRaysLevel, Rec. 709 luminance (the hidden sky's rays, point_lights.h)
   // The rest at a level some object uses or is turned from; throws
   // std::out_of_range otherwise.
   const std::array<SphereMap, 3>& restLightAt(int level) const;
@@ -219,6 +219,10 @@ struct PreparedScene {
 
 // Level of the backdrop maps: fine enough to look like the probe (512²).
 inline constexpr int kBackgroundLevel = 9;
+// The level of the map light the hidden sky's rays read (point_lights.h
+// SkyOccluders): one for every scene, so that what an object's neighbours
+// hide from it does not depend on the levels the others are drawn at.
+inline constexpr int kSkyRaysLevel = 6;
 
 // `fused`: the level an object's light is turned into its frame at, then
 // averaged down to the object's by solid angle (core rotateSpatialMapsDown:
