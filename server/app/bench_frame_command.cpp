@@ -41,6 +41,7 @@ struct BenchArgs {
   std::string scene;  // scene file; empty = the built-in default
   std::string device;
   std::string rays = "auto";
+  bool objectSky = true;  // fused: objects hide sky from each other (RenderOptions::objectSky)
   std::string cacheDir;
   int frames = 3;
   int warmup = 1;
@@ -173,6 +174,7 @@ int run(const BenchArgs& a) {
       render::applyLevelChoice(options, choice);
       options.interpolateSlices = a.slices == "blend";
       options.antialias = antialias;
+      options.objectSky = a.objectSky;
       options.cacheDir = a.cacheDir == "none" ? "" : a.cacheDir;
       progress.message("level " + level + ", " + std::string(methodName(method)) + ": preparing");
       std::unique_ptr<render::Renderer> cpuRenderer, gpuRenderer;
@@ -293,6 +295,8 @@ std::function<int()> addBenchFrameCommand(CLI::App& app) {
   c->add_option("--scene", args->scene, "Scene file (default: the built-in scene)");
   c->add_option("--device", args->device, "Vulkan device: an index or a name substring");
   c->add_option("--rays", args->rays, rayModeHelp())->capture_default_str();
+  c->add_option("--object-sky", args->objectSky, "fused: objects hide sky from each other (true|false: its cost, side by side)")
+      ->capture_default_str();
   c->add_option("--cache-dir", args->cacheDir, "Cache of slice tables and visibility ('none' or empty: no cache)");
   c->add_flag("--json", args->json, "Print JSON instead of a table");
   return [c, args]() { return c->parsed() ? run(*args) : -1; };

@@ -230,7 +230,7 @@ std::vector<ShadowScene> shadowScenes(const EvalOptions& o, std::vector<std::str
   // ground, Lambert, 5 cm from a GGX 0.1 ball. Where the tube meets the
   // ground the ground's hidden sky must see through its open ends, and the
   // tube's side and the ball hide sky from each other.
-  {
+  if (!o.quick) {
     render::SceneObject tube{"open tube", std::make_shared<Mesh>(openTube(1.0, 0.3, 100.0)), render::materialFromSpec("lambert"), {}};
     tube.pose.scale = 0.5;
     tube.pose.rotateDegrees = {0.0, 150.0, 0.0};  // the cut toward the back left
@@ -249,7 +249,7 @@ std::vector<ShadowScene> shadowScenes(const EvalOptions& o, std::vector<std::str
   }
   // Two objects close together: a Lambert box and a Lambert ball 5 cm
   // apart on the ground, the gap between them in view.
-  {
+  if (!o.quick) {
     render::SceneObject box{"box", std::make_shared<Mesh>(assets::makeBox(0.35, 0.35, 0.35)), render::materialFromSpec("lambert"), {}};
     box.pose.rotateDegrees = {0.0, 15.0, 0.0};
     box.pose.translate = {-0.4, 0.35, 0.0};

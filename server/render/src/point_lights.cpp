@@ -285,19 +285,20 @@ float GroundSkyGrid::at(std::size_t pixel, const std::function<float()>& direct)
   const int x0 = gridX(i), x1 = gridX(i + 1), y0 = gridY(j), y1 = gridY(j + 1);
   const float tx = x1 > x0 ? static_cast<float>(x - x0) / static_cast<float>(x1 - x0) : 0.0f;
   const float ty = y1 > y0 ? static_cast<float>(y - y0) / static_cast<float>(y1 - y0) : 0.0f;
-  // The corners that are ground, by their bilinear weights renormalised;
-  // none of them (or only ones of weight 0): the sample's own rays.
-  float sum = 0.0f, weight = 0.0f;
+  // All four corners ground: their bilinear blend. A corner off the ground
+  // (an object's outline runs through the cell): the sample's own rays. A
+  // blend of the corners that are ground reached past the outline, away
+  // from where the object meets the ground, and left a too-bright halo
+  // around an object's foot.
+  float sum = 0.0f;
   for (int dj = 0; dj < 2; ++dj) {
     for (int di = 0; di < 2; ++di) {
       const float v = value_[static_cast<std::size_t>(j + dj) * static_cast<std::size_t>(columns_) + static_cast<std::size_t>(i + di)];
-      if (v < 0.0f) continue;
-      const float w = (di ? tx : 1.0f - tx) * (dj ? ty : 1.0f - ty);
-      sum += w * v;
-      weight += w;
+      if (v < 0.0f) return direct();
+      sum += (di ? tx : 1.0f - tx) * (dj ? ty : 1.0f - ty) * v;
     }
   }
-  return weight > 0.0f ? sum / weight : direct();
+  return sum;
 }
 
 std::uint32_t withGroundOcclusion(std::uint32_t lightBits, float occlusion) {

@@ -4,11 +4,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <optional>
 
 #include "haarcast/assets/procedural_mesh.h"
 #include "haarcast/core/brdf.h"
 #include "haarcast/core/brdf_slices.h"
 #include "haarcast/cpu/cpu_renderer.h"
+#include "haarcast/render/embree_scene.h"
+#include "haarcast/render/point_lights.h"
 #include "haarcast/render/renderer.h"
 
 namespace haarcast::render {
@@ -124,6 +127,27 @@ TEST(Ground, ObjectsShadowEachOther) {
   request.poses = {s.objects[0].pose, Pose{{0.0, 0.0, 0.0}, {4.0, 3.0, 0.0}, 0.3}, s.objects[2].pose};
   const float lit = centre(renderer->render(request));
   EXPECT_GT(lit, 5.0f * hidden) << "hidden " << hidden << ", lit " << lit;
+}
+
+// The ground's hidden sky on its coarse grid (point_lights.h
+// GroundSkyGrid): a cell whose four corners are ground blends them; a cell
+// an object's outline crosses (a corner off the ground) takes the sample's
+// own rays, so that the blend never reaches past the outline.
+TEST(Ground, TheGridBlendsOpenCellsAndTracesCellsAnOutlineCrosses) {
+  const Mesh plane = assets::makePlane(1.0, 1);
+  const RayScene world({Instance{&plane, glm::mat4(1.0f)}});
+  SkyOccluders sky;  // no occluders: every grid point hides nothing
+  GroundSkyGrid grid(40, 40);
+  ASSERT_EQ(groundSkyStep(40, 40), 4);
+  const std::size_t offGround = 8 * 40 + 8;  // grid point (2, 2): an object's pixel
+  grid.compute(world, sky, [&](std::size_t pixel) -> std::optional<ShadingPoint> {
+    if (pixel == offGround) return std::nullopt;
+    return ShadingPoint{glm::vec3(0.0f), glm::vec3(0.0f, 1.0f, 0.0f), 1e-4f};
+  }, 1);
+  const auto own = [] { return 0.25f; };  // what the sample's own rays would say
+  EXPECT_EQ(grid.at(5 * 40 + 5, own), 0.25f) << "the cell (4…8)² has a corner off the ground";
+  EXPECT_EQ(grid.at(9 * 40 + 5, own), 0.25f) << "so has the cell below it";
+  EXPECT_EQ(grid.at(13 * 40 + 13, own), 0.0f) << "the cell (12…16)² is open ground: its corners' blend";
 }
 
 TEST(Ground, AddGroundPutsAWidePlaneUnderTheObjects) {

@@ -110,12 +110,15 @@ std::optional<FusedPointLight> hiddenFusedLight(const shared::HiddenLight& hidde
 
 // groundSkyOcclusion on a coarse grid of the frame, the pixels (i·step, j·step)
 // and the last row and column, then for every ground sample the bilinear
-// blend of its cell's corners that are ground (renormalised), or its own
-// rays when none is: the hidden sky changes slowly over the ground, and rays
-// at every pixel would cost most of a frame. (Where a cell's corners
-// disagree, its samples' own rays were tried: their estimates, each from
-// one stratified pattern, showed arcs where the pattern's size steps, which
-// the blend smooths; and they cost 60 % more frame time on the bunny.) Both backends fill the grid
+// blend of its cell's corners when all four are ground, or its own rays
+// when one is not (an object's outline crosses the cell: a blend of the
+// other corners reached past the outline, away from where the object meets
+// the ground, and left a too-bright halo around its foot): the hidden sky
+// changes slowly over the open ground, and rays at every pixel would cost
+// most of a frame. (Where a cell's ground corners disagree, its samples'
+// own rays were tried: their estimates, each from one stratified pattern,
+// showed arcs where the pattern's size steps, which the blend smooths; and
+// they cost 60 % more frame time on the bunny.) Both backends fill the grid
 // from the same samples (interior pixels' centres) and blend alike.
 // The grid's spacing: a 40th of the frame's larger side, 4 to 16 pixels (a
 // contact shadow spans a share of the frame, not a number of pixels).
