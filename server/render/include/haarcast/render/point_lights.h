@@ -67,7 +67,7 @@ std::uint32_t lobeRayBit(const RayScene& world, const ShadingPoint& p, const glm
 // each other. Per sample, rays go toward each other object's bounding
 // sphere — a cone of (2m) × (8m) stratified directions, m from 1 for a
 // narrow cone to 4 for the hemisphere of a point beside the object
-// (shared_rays.h groundSkyScale; at most 2 for an object's own pixels), the
+// (shared_rays.h groundSkyScale; 1 for an object's own pixels), the
 // same pattern at every sample so the result is smooth and steady from
 // frame to frame — against the whole posed scene. Objects whose cone can
 // hide less than `minShare` of the sky are skipped (and faded in above it,
