@@ -375,7 +375,7 @@ void shadePixel(uint s) {
     if ((o.flags & kObjectSkyHidden) != 0u) {
       const HiddenLight h = hidden[s];
       if (h.power.r > 0.0 || h.power.g > 0.0 || h.power.b > 0.0) {
-        sum = max(sum - h.power * pointRhoAt(p, unpackDirection(h.direction)), vec3(0.0));
+        sum = max(sum - h.power * energy / kPiF, vec3(0.0));
       }
     }
     if (lobePath) sum += lobeShade(o, rs, blend, seen);

@@ -348,8 +348,8 @@ std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBl
     for (std::size_t c = 0; c < 3; ++c) out[c] += lights[k].power[c] * rho[c];
   }
   if (hidden) {
-    const std::array<float, 3> rho = pointRhoAt(pass, slices, blend, hidden->direction);
-    for (std::size_t c = 0; c < 3; ++c) out[c] = std::max(0.0f, out[c] - hidden->power[c] * rho[c]);
+    for (std::size_t c = 0; c < 3; ++c)
+      out[c] = std::max(0.0f, out[c] - hidden->power[c] * energy[c] / static_cast<float>(kPi));
   }
   if (lobe) {
     const std::array<float, 3> inCore = lobeShade(*lobe, blend, r, visibleLights);

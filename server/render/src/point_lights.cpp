@@ -217,8 +217,7 @@ SkyHidden objectSkyHidden(const RayScene& world, const ShadingPoint& p, std::siz
   const float length = glm::length(mean);
   if (!(length > 0.0f)) return out;
   out.direction = mean / length;
-  // Σ L·cos·ΔΩ / (n·d): a Lambert surface loses Σ L·cos·ΔΩ exactly (shared_rays.h HiddenLight).
-  out.power = sum / std::max(glm::dot(p.normal, out.direction), shared::kMinHiddenCosine);
+  out.power = sum;  // Σ L·cos·ΔΩ: the irradiance the hidden directions would give (shared_rays.h HiddenLight)
   return out;
 }
 

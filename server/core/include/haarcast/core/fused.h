@@ -137,8 +137,9 @@ std::array<float, 3> lobeShade(const LobePath& path, const shared::SliceBlend& b
 // leaves the directions within the path's core angle of the lobe's axis to
 // lobeShade (and sums the lobe's energy less the core's), or is skipped
 // when the path takes all. `hidden`, when given, is the sky other objects
-// hide from the pixel (shared_rays.h HiddenLight), taken off as a light:
-// I_c −= power_c·ρ_c(Rᵀd), the sum kept ≥ 0.
+// hide from the pixel (shared_rays.h HiddenLight): its power, the
+// irradiance hidden, is taken off as a diffuse surface of the pass's
+// albedo E_c would lose it, I_c −= power_c·E_c/π, the sum kept ≥ 0.
 std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBlend& blend, const EulerYXY& r,
                                 const FusedLight& light, std::span<const WeightedBits> visibility,
                                 std::span<const FusedPointLight> lights, std::uint32_t visibleLights,

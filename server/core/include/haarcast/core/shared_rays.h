@@ -45,18 +45,19 @@ HC_FUNCTION uint groundSkyScale(float solidAngle) {
 // (what it hides from itself is its own visibility already).
 HC_CONST uint kObjectSkyMaxScale = 1u;
 
-// The sky another object hides from a sample, as one light `fused`
-// subtracts: I_c −= power_c·ρ_c(d). d is the hidden directions' mean,
-// weighted by luminance·ΔΩ, in the object's frame; power_c = Σ L_c·cos·ΔΩ
-// over them / (n·d), so that for a Lambert surface (ρ·cos linear in cos)
-// the subtraction is exact: ρ/π·power_c·(n·d) = ρ/π·Σ L_c·cos·ΔΩ.
-// power = 0: nothing hidden.
-// n·d below this divides by this instead: a grazing mean direction would
-// give a large power whose product with a non-Lambert ρ·cos is unsure.
-HC_CONST float kMinHiddenCosine = 0.05f;
+// The sky other objects hide from a sample: power_c = Σ L_c·cos·ΔΩ over
+// the hidden directions, the irradiance they would give, which `fused`
+// takes off as a diffuse surface of the slice's albedo would lose it:
+// I_c −= power_c·E_c/π, E_c = ∫ρ_c·cos dω of the pass's part of the lobe.
+// Exact for a Lambert surface (E = its albedo); for a glossy one the
+// lobe's shape within the hidden sky is not followed. (Read as a light at
+// the hidden directions' mean, power·ρ(d), a glossy lobe near d took off
+// the whole of a wide hidden cone at its peak: black spots.) `direction`
+// is that mean (luminance·ΔΩ-weighted, the object's frame), packed: where
+// the hidden sky lies, for diagnostics. power = 0: nothing hidden.
 struct HiddenLight {
   vec3 power;
-  uint direction;  // packDirection(d)
+  uint direction;  // packDirection(the mean hidden direction)
 };
 
 // A unit direction in one word: its octahedral projection, 16 bits an axis
