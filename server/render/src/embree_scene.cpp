@@ -14,10 +14,11 @@
 #include <utility>
 
 #include <embree3/rtcore.h>
-#include "haarcast/core/check.h"
 #include <glm/geometric.hpp>
 #include <glm/mat3x3.hpp>
 #include <glm/matrix.hpp>
+
+#include "haarcast/core/check.h"
 
 namespace haarcast {
 namespace {
