@@ -308,7 +308,7 @@ void setCore(detail::FusedPass& pass, const EulerYXY& r, float axisTheta, float 
 std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBlend& blend, const EulerYXY& r,
                                 const FusedLight& light, std::span<const WeightedBits> visibility,
                                 std::span<const FusedPointLight> lights, std::uint32_t visibleLights,
-                                FusedScratch& scratch, const LobePath* lobe, const FusedPointLight* hidden) {
+                                FusedScratch& scratch, const LobePath* lobe, const std::array<float, 3>* hidden) {
   const int level = slices.level();
   if (lobe && lobe->coreAngle >= static_cast<float>(kPi)) return lobeShade(*lobe, blend, r, visibleLights);
   checkSameLevel(light.level, level, "the light");
@@ -349,7 +349,7 @@ std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBl
   }
   if (hidden) {
     for (std::size_t c = 0; c < 3; ++c)
-      out[c] = std::max(0.0f, out[c] - hidden->power[c] * energy[c] / static_cast<float>(kPi));
+      out[c] = std::max(0.0f, out[c] - (*hidden)[c] * energy[c] / static_cast<float>(kPi));
   }
   if (lobe) {
     const std::array<float, 3> inCore = lobeShade(*lobe, blend, r, visibleLights);

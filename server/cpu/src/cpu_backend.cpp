@@ -601,7 +601,7 @@ std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const RayScen
                                                           static_cast<shared::uint>(slices.thetaSamples()),
                                                           options_.interpolateSlices ? 1u : 0u);
     const LobePath lobe{&prepared_.lobeLight, p.lobes, o.toLight, p.lobeCore};
-    const std::optional<FusedPointLight> hiddenSky = hidden.empty() ? std::nullopt : hiddenFusedLight(hidden[slot]);
+    const std::optional<std::array<float, 3>> hiddenSky = hidden.empty() ? std::nullopt : hiddenIrradiance(hidden[slot]);
     rgb = fusedShade(slices, blend, in.rotation.euler, o.fusedLight, vis, o.pointLights, seen, scratch,
                      p.lobePath ? &lobe : nullptr, hiddenSky ? &*hiddenSky : nullptr);
     return fusedPixelBytes(slices.level(), blend.weight != 0.0f, 3 * p.visibilityBits.wordsPerPoint() * sizeof(std::uint32_t));

@@ -33,6 +33,21 @@ constexpr VkBufferUsageFlags kAddressed = VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_
 constexpr VkBufferUsageFlags kBuildInput =
     kAddressed | VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
 
+// A build of one geometry into a structure of `type`, traced more than
+// built (the bottom levels once, the top level every frame, both traced by
+// every sample's rays).
+VkAccelerationStructureBuildGeometryInfoKHR buildOf(VkAccelerationStructureTypeKHR type,
+                                                    const VkAccelerationStructureGeometryKHR* geometry) {
+  VkAccelerationStructureBuildGeometryInfoKHR b{};
+  b.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR;
+  b.type = type;
+  b.flags = VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR;
+  b.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
+  b.geometryCount = 1;
+  b.pGeometries = geometry;
+  return b;
+}
+
 }  // namespace
 
 RayFunctions::RayFunctions(VkDevice device)
@@ -126,12 +141,7 @@ AccelerationStructures::AccelerationStructures(Context& context, std::span<const
     geometry.push_back(std::move(indices));
 
     VkAccelerationStructureBuildGeometryInfoKHR& b = builds[i];
-    b.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR;
-    b.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
-    b.flags = VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR;
-    b.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
-    b.geometryCount = 1;
-    b.pGeometries = &g;
+    b = buildOf(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, &g);
     const std::uint32_t triangles = static_cast<std::uint32_t>(mesh.triangles.size());
     VkAccelerationStructureBuildSizesInfoKHR sizes{};
     sizes.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_SIZES_INFO_KHR;
@@ -175,14 +185,7 @@ AccelerationStructures::~AccelerationStructures() {
 }
 
 VkAccelerationStructureBuildGeometryInfoKHR AccelerationStructures::topLevelBuild() const {
-  VkAccelerationStructureBuildGeometryInfoKHR b{};
-  b.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR;
-  b.type = VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR;
-  b.flags = VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR;
-  b.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
-  b.geometryCount = 1;
-  b.pGeometries = &topGeometry_;
-  return b;
+  return buildOf(VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR, &topGeometry_);
 }
 
 void AccelerationStructures::recordTopLevel(VkCommandBuffer cb, std::span<const glm::mat4> objectToWorld) {

@@ -228,12 +228,9 @@ shared::HiddenLight hiddenLightOf(const SkyHidden& hidden, const glm::mat3& rota
   return out;
 }
 
-std::optional<FusedPointLight> hiddenFusedLight(const shared::HiddenLight& hidden) {
+std::optional<std::array<float, 3>> hiddenIrradiance(const shared::HiddenLight& hidden) {
   if (!(hidden.power.x > 0.0f || hidden.power.y > 0.0f || hidden.power.z > 0.0f)) return std::nullopt;
-  FusedPointLight out;
-  out.direction = shared::unpackDirection(hidden.direction);
-  out.power = {hidden.power.x, hidden.power.y, hidden.power.z};
-  return out;
+  return std::array<float, 3>{hidden.power.x, hidden.power.y, hidden.power.z};
 }
 
 bool interiorPixel(std::size_t pixel, std::size_t width, std::size_t height, const std::function<bool(std::size_t)>& ground) {

@@ -282,8 +282,8 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
                         o == kLobeAll ? static_cast<float>(kPi) : coreAngle};
     const LobePath* lobe = o == kLobeAll || o == kLobeSplit ? &path : nullptr;
     if (lobe) lobeSamples[o == kLobeAll ? 0 : 1]++;
-    const std::optional<FusedPointLight> sky =
-        (objects[o].flags & shared::kObjectSkyHidden) != 0u ? render::hiddenFusedLight(hidden[i]) : std::nullopt;
+    const std::optional<std::array<float, 3>> sky =
+        (objects[o].flags & shared::kObjectSkyHidden) != 0u ? render::hiddenIrradiance(hidden[i]) : std::nullopt;
     expected[i] = fusedShade(slices[o], blend, r, lights[o], vis, pointLights[o], masks[i], work, lobe, sky ? &*sky : nullptr);
     if (sky) {
       const std::array<float, 3> open = fusedShade(slices[o], blend, r, lights[o], vis, pointLights[o], masks[i], work, lobe);

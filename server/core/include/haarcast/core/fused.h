@@ -144,7 +144,7 @@ std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBl
                                 const FusedLight& light, std::span<const WeightedBits> visibility,
                                 std::span<const FusedPointLight> lights, std::uint32_t visibleLights,
                                 FusedScratch& scratch, const LobePath* lobe = nullptr,
-                                const FusedPointLight* hidden = nullptr);
+                                const std::array<float, 3>* hidden = nullptr);
 
 // One pixel of `fused` from Haar visibility lists: Σ_ω W_c(ω)·ρ_c(Rᵀω) for c = R, G, B, with
 // ρ = (1 − w)·slice[first] + w·slice[second] (shared::sliceBlendAt) looked up

@@ -106,7 +106,7 @@ SkyHidden objectSkyHidden(const RayScene& world, const ShadingPoint& p, std::siz
 shared::HiddenLight hiddenLightOf(const SkyHidden& hidden, const glm::mat3& rotation);
 // What `fused` takes off for it (core/fused.h fusedShade's `hidden`), or
 // nullopt when nothing is hidden.
-std::optional<FusedPointLight> hiddenFusedLight(const shared::HiddenLight& hidden);
+std::optional<std::array<float, 3>> hiddenIrradiance(const shared::HiddenLight& hidden);
 
 // groundSkyOcclusion on a coarse grid of the frame, the pixels (i·step, j·step)
 // and the last row and column, then for every ground sample the bilinear
