@@ -15,6 +15,7 @@
 #include "haarcast/core/light_split.h"
 #include "haarcast/core/metrics.h"
 #include "haarcast/io/image.h"
+#include "truth_metrics.h"
 
 namespace haarcast::app {
 namespace {
@@ -122,6 +123,26 @@ int run(const CompareOptions& o) {
       if (count == 0) continue;
       const ErrorStats e = compareSignals(std::span<const double>(gather(reference, *keep)), gather(test, *keep));
       printRow(name, count, covered, e, totalSquared > 0.0 ? e.mse * static_cast<double>(3 * count) / totalSquared : 0.0);
+    }
+    std::vector<std::uint8_t> mask(pixels, 0);
+    for (std::size_t p = 0; p < pixels; ++p) mask[p] = object[p] ? 1 : 0;
+    const DarkPixels d = darkPixels(reference.rgb, open.rgb, test.rgb, mask);
+    std::printf("\ndark: %zu of the %zu pixels whose reference keeps more than %.0f %% of its unoccluded light are over %.0f %% "
+                "darker than the reference",
+                d.dark, d.eligible, 100.0 * kDarkKeptShare, 100.0 * kDarkDrop);
+    if (d.eligible > 0) {
+      std::printf("; the darkest, test/reference %.3f, at x %zu, y %zu", d.worstRatio,
+                  d.worstPixel % static_cast<std::size_t>(reference.width), d.worstPixel / static_cast<std::size_t>(reference.width));
+    }
+    std::printf("\n");
+    // Where they are, when few enough to read.
+    constexpr std::size_t kListed = 8;
+    if (d.dark > 0 && d.dark <= kListed) {
+      std::printf("dark pixels (x, y, test/reference):");
+      for (std::size_t p : d.where)
+        std::printf(" (%zu, %zu, %.3f)", p % static_cast<std::size_t>(reference.width),
+                    p / static_cast<std::size_t>(reference.width), luminanceAt(test, p) / luminanceAt(reference, p));
+      std::printf("\n");
     }
   }
   if (!o.errorImage.empty()) writeErrorImage(o.errorImage, reference, test, object, o.errorScale);

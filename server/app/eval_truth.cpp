@@ -350,6 +350,7 @@ nlohmann::json runShadowTruth(const TruthRun& run, std::vector<std::string>& not
                 {"seconds", truth.seconds},          {"second_seconds", second.seconds},
                 {"unoccluded_seconds", open.seconds}};
     js["floor"] = toJson(floor);
+    js["floor"]["dark_ground"] = toJson(darkPixels(truth.image.rgb, open.image.rgb, second.image.rgb, truth.groundMask));
     run.log("shadow truth " + sc.name + ": " + std::to_string(truth.samples) + " samples, half error " +
             fmt(truth.halfError, 4) + "; floor " + fmt(floor.psnr) + " dB, relative L2 " + fmt(floor.relativeL2, 4) +
             "; shadowed " + fmt(100.0 * floor.shadowed.pixelFraction, 1) + " % of the pixels");
@@ -366,11 +367,15 @@ nlohmann::json runShadowTruth(const TruthRun& run, std::vector<std::string>& not
         const render::RenderResult r = render::renderCpu(sc.scene, opt, inner);
         const TruthError e = compareWithTruth(truth.image.rgb, r.image.rgb, truth.objectMask, shadowed);
         nlohmann::json j = toJson(e);
+        const DarkPixels dark = darkPixels(truth.image.rgb, open.image.rgb, r.image.rgb, truth.groundMask);
+        j["dark_ground"] = toJson(dark);
         j["seconds"] = since(t);
         js["methods"][levelKey(level)][v.name] = std::move(j);
         run.log("shadow truth " + sc.name + " level " + std::to_string(level) + " " + v.name + ": " + fmt(e.psnr) +
                 " dB, relative L2 " + fmt(e.relativeL2, 4) + ", brightness " + fmt(e.brightness, 4) +
-                "; shadowed pixels hold " + fmt(100.0 * e.shadowed.errorShare, 1) + " % of the squared error");
+                "; shadowed pixels hold " + fmt(100.0 * e.shadowed.errorShare, 1) + " % of the squared error; " +
+                std::to_string(dark.dark) + " of " + std::to_string(dark.eligible) + " mostly lit ground pixels over " +
+                fmt(100.0 * kDarkDrop, 0) + " % too dark");
         run.progress.update(stage + ": methods", ++rendered, renders);
       }
     }
@@ -395,8 +400,18 @@ std::string shadowTruthMarkdown(const nlohmann::json& st) {
      << c["render_defaults"]["light_coefficients"].get<std::size_t>() << " light coefficients, visibility "
      << c["render_defaults"]["visibility_supersampling"].get<int>() << "² supersampled, "
      << c["render_defaults"]["visibility_keep"].get<std::size_t>()
-     << " coefficients per vertex); `fused/all-k` keeps every light coefficient.\n";
+     << " coefficients per vertex); `fused/all-k` keeps every light coefficient. **Dark ground**: of the ground's "
+        "pixels whose truth keeps more than "
+     << fmt(100.0 * kDarkKeptShare, 0) << " % of its unoccluded luminance, how many the method draws over "
+     << fmt(100.0 * kDarkDrop, 0) << " % darker than the truth (and the lowest ratio render / truth among them).\n";
   if (!st.contains("scenes")) return md.str();
+  // "dark / eligible (worst ratio)", or "—" for a scene without a ground.
+  auto darkCell = [](const nlohmann::json& e) -> std::string {
+    if (!e.contains("dark_ground") || e["dark_ground"]["eligible"].get<std::size_t>() == 0) return "—";
+    const auto& d = e["dark_ground"];
+    return std::to_string(d["dark"].get<std::size_t>()) + " / " + std::to_string(d["eligible"].get<std::size_t>()) +
+           " (" + fmt(d["worst_ratio"].get<double>(), 2) + ")";
+  };
   auto row = [&](const std::string& level, const std::string& name, const nlohmann::json& e, const std::string& s) {
     const auto& sh = e["shadowed"];
     const auto& li = e["lit"];
@@ -405,7 +420,7 @@ std::string shadowTruthMarkdown(const nlohmann::json& st) {
        << fmt(100.0 * sh["pixel_fraction"].get<double>(), 1) << " % | " << fmt(100.0 * sh["error_share"].get<double>(), 1)
        << " % | " << fmt(100.0 * sh["relative_l2"].get<double>()) << " % | " << fmt(sh["brightness"].get<double>(), 3)
        << " | " << fmt(100.0 * li["relative_l2"].get<double>()) << " % | " << fmt(li["brightness"].get<double>(), 3)
-       << " | " << s << " |\n";
+       << " | " << darkCell(e) << " | " << s << " |\n";
   };
   for (const auto& [name, sc] : st["scenes"].items()) {
     md << "\n### " << name << "\n\n" << sc["description"].get<std::string>() << ". Truth: "
@@ -413,8 +428,8 @@ std::string shadowTruthMarkdown(const nlohmann::json& st) {
        << fmt(sc["mc"]["half_error"].get<double>(), 4) << ", " << fmt(sc["mc"]["seconds"].get<double>(), 1)
        << " s (and as long again for each of the floor and the unoccluded render).\n\n"
           "| level | method | PSNR (dB) | rel. L2 | brightness | shadowed px | shadowed err | shadowed rel. L2 | "
-          "shadowed bright. | lit rel. L2 | lit bright. | s |\n"
-          "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+          "shadowed bright. | lit rel. L2 | lit bright. | dark ground | s |\n"
+          "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
     row("", "floor (2nd truth)", sc["floor"], "");
     for (const auto& [level, methods] : sc["methods"].items()) {
       for (const auto& [method, e] : methods.items()) row(level.substr(5), method, e, fmt(e["seconds"].get<double>(), 1));

@@ -90,4 +90,30 @@ nlohmann::json toJson(const TruthError& e) {
           {"brightness", e.brightness}, {"shadowed", group(e.shadowed)}, {"lit", group(e.lit)}};
 }
 
+DarkPixels darkPixels(std::span<const float> truth, std::span<const float> unoccluded, std::span<const float> test,
+                      std::span<const std::uint8_t> mask, double keptShare, double darker) {
+  checkSizes(truth.size(), unoccluded.size(), mask.size(), 0, "darkPixels");
+  checkSizes(truth.size(), test.size(), mask.size(), 0, "darkPixels");
+  DarkPixels out;
+  for (std::size_t i = 0; i < mask.size(); ++i) {
+    const double r = luminance(&truth[3 * i]);
+    if (!mask[i] || !(r > keptShare * luminance(&unoccluded[3 * i]))) continue;
+    ++out.eligible;
+    const double ratio = luminance(&test[3 * i]) / r;  // r > 0 here
+    if (ratio < 1.0 - darker) {
+      ++out.dark;
+      out.where.push_back(i);
+    }
+    if (ratio < out.worstRatio) {
+      out.worstRatio = ratio;
+      out.worstPixel = i;
+    }
+  }
+  return out;
+}
+
+nlohmann::json toJson(const DarkPixels& d) {
+  return {{"eligible", d.eligible}, {"dark", d.dark}, {"worst_ratio", d.worstRatio}, {"worst_pixel", d.worstPixel}};
+}
+
 }  // namespace haarcast::app

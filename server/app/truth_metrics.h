@@ -56,4 +56,27 @@ TruthError compareWithTruth(std::span<const float> truth, std::span<const float>
 
 nlohmann::json toJson(const TruthError& e);
 
+// Pixels drawn much darker than the truth where the truth is mostly lit
+// (docs/evaluation.md "Shadows"): of `mask`'s pixels whose truth keeps more
+// than `keptShare` of its unoccluded luminance (the light it would get with
+// nothing occluding), those whose render is more than `darker` below the
+// truth in luminance. A render that takes a lit region for a shadow shows
+// here, however little it weighs in relative L2.
+inline constexpr double kDarkKeptShare = 0.5;
+inline constexpr double kDarkDrop = 0.2;
+
+struct DarkPixels {
+  std::size_t eligible = 0;       // mask pixels that keep more than keptShare of their open light
+  std::size_t dark = 0;           // of those, drawn more than `darker` below the truth
+  double worstRatio = 1.0;        // the smallest render / truth luminance among the eligible (1 when none)
+  std::size_t worstPixel = 0;     // where it is (row-major); 0 when none
+  std::vector<std::size_t> where; // the dark pixels (row-major), in order
+};
+
+// Throws std::invalid_argument on mismatched sizes.
+DarkPixels darkPixels(std::span<const float> truth, std::span<const float> unoccluded, std::span<const float> test,
+                      std::span<const std::uint8_t> mask, double keptShare = kDarkKeptShare, double darker = kDarkDrop);
+
+nlohmann::json toJson(const DarkPixels& d);
+
 }  // namespace haarcast::app

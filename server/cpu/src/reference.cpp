@@ -255,6 +255,7 @@ ReferenceResult renderReference(const Scene& scene, const ReferenceOptions& opti
   ReferenceResult result;
   result.image = io::makeImage(w, h);
   result.objectMask.assign(pixels, 0);
+  result.groundMask.assign(pixels, 0);
   std::vector<PixelHit> hits(pixels);
   const int bins = options.brdfTableThetaOut;
   parallelFor(static_cast<std::size_t>(h), threads, [&](std::size_t yy) {
@@ -274,6 +275,7 @@ ReferenceResult renderReference(const Scene& scene, const ReferenceOptions& opti
         continue;
       }
       result.objectMask[i] = 1;
+      result.groundMask[i] = scene.objects[hit->object].ground ? 1 : 0;
       const PreparedObject& p = objects[hit->object];
       const Mesh& mesh = *p.mesh;
       const glm::uvec3 tri = mesh.triangles[hit->triangle];

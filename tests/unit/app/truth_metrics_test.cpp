@@ -56,5 +56,26 @@ TEST(TruthMetrics, ShadowedIsTwoPercentDarkerInLuminance) {
   EXPECT_THROW(compareWithTruth(occluded, unoccluded, std::vector<std::uint8_t>(5, 0), {}), std::invalid_argument);
 }
 
+TEST(TruthMetrics, DarkPixelsAreMostlyLitInTheTruthAndOverAFifthDarkerInTheRender) {
+  // Open light 10 everywhere. Truth: 6 (keeps 60 %), 4 (40 %: not eligible),
+  // 8, 9, 5.5 (outside the mask). Render: 4.7 (−21.7 %: dark), 1 (ignored),
+  // 6.5 (−18.75 %: not dark), 9.9 (brighter), 0 (outside).
+  const std::vector<float> open = grey({10, 10, 10, 10, 10});
+  const std::vector<float> truth = grey({6, 4, 8, 9, 5.5f}), test = grey({4.7f, 1, 6.5f, 9.9f, 0});
+  const std::vector<std::uint8_t> mask = {1, 1, 1, 1, 0};
+  const DarkPixels d = darkPixels(truth, open, test, mask);
+  EXPECT_EQ(d.eligible, 3u);
+  EXPECT_EQ(d.dark, 1u);
+  EXPECT_NEAR(d.worstRatio, 4.7 / 6.0, 1e-6);
+  EXPECT_EQ(d.worstPixel, 0u);
+  EXPECT_EQ(d.where, (std::vector<std::size_t>{0}));
+  // A stricter drop counts pixel 2 too; a stricter share leaves pixel 0 out.
+  EXPECT_EQ(darkPixels(truth, open, test, mask, kDarkKeptShare, 0.15).dark, 2u);
+  EXPECT_EQ(darkPixels(truth, open, test, mask, 0.65, kDarkDrop).eligible, 2u);
+  EXPECT_EQ(toJson(d)["dark"].get<std::size_t>(), 1u);
+  EXPECT_THROW(darkPixels(truth, grey({1}), test, mask), std::invalid_argument);
+  EXPECT_THROW(darkPixels(truth, open, grey({1}), mask), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace haarcast::app

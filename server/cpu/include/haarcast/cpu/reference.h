@@ -153,6 +153,7 @@ void checkReferenceOptions(const ReferenceOptions& options);
 struct ReferenceResult {
   io::RgbImage image;                    // linear radiance, the average of all samples
   std::vector<std::uint8_t> objectMask;  // 1 where an object was hit
+  std::vector<std::uint8_t> groundMask;  // 1 where a ground (SceneObject::ground) was hit
   int samples = 0;                       // per pixel, both halves together
   double halfError = 0.0;                // at the end (see the file comment)
   double seconds = 0.0;                  // wall time, tables included
