@@ -82,8 +82,11 @@ void VulkanRenderer::Impl::setUpDeviceRays() {
 
 void VulkanRenderer::Impl::ensureDeviceRayBuffers() {
   const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  // The coarse grid's points, then the fine grid's (shared_rays.h).
   const int step = render::groundSkyStep(width, height);
-  const std::size_t gridPoints = static_cast<std::size_t>((width - 1) / step + 2) * static_cast<std::size_t>((height - 1) / step + 2);
+  const int fine = static_cast<int>(shared::groundSkyFineStep(static_cast<std::uint32_t>(step)));
+  const std::size_t gridPoints = static_cast<std::size_t>((width - 1) / step + 2) * static_cast<std::size_t>((height - 1) / step + 2) +
+                                 static_cast<std::size_t>((width - 1) / fine + 2) * static_cast<std::size_t>((height - 1) / fine + 2);
   pixelSample = Buffer(context, pixels * sizeof(std::uint32_t), kStorageUsage, MemoryUse::DeviceOnly);
   skyGrid = Buffer(context, gridPoints * sizeof(float), kStorageUsage, MemoryUse::DeviceOnly);
   shadowRays->bind({{shared::kRaysShadeBinding, &shade},
@@ -138,6 +141,9 @@ void VulkanRenderer::Impl::writeRays(const render::ResolvedFrame& resolved, cons
   f.gridStep = static_cast<std::uint32_t>(render::groundSkyStep(width, height));
   f.gridColumns = static_cast<std::uint32_t>(width - 1) / f.gridStep + 2u;
   f.gridRows = static_cast<std::uint32_t>(height - 1) / f.gridStep + 2u;
+  f.fineStep = shared::groundSkyFineStep(f.gridStep);
+  f.fineColumns = static_cast<std::uint32_t>(width - 1) / f.fineStep + 2u;
+  f.fineRows = static_cast<std::uint32_t>(height - 1) / f.fineStep + 2u;
   f.antialias = options.antialias ? 1u : 0u;
   f.groundSky = groundSky ? 1u : 0u;
   f.objectSky = hides ? 1u : 0u;
@@ -170,6 +176,9 @@ void VulkanRenderer::Impl::recordDeviceRays(VkCommandBuffer cb) {
     rayTracingBarrier(cb);
     push.phase = shared::kRaysPhaseGrid;
     shadowRays->trace(cb, rayFrameData.gridColumns, rayFrameData.gridRows, &push, sizeof push);
+    rayTracingBarrier(cb);
+    push.phase = shared::kRaysPhaseFineGrid;  // reads the coarse grid: after it
+    shadowRays->trace(cb, rayFrameData.fineColumns, rayFrameData.fineRows, &push, sizeof push);
     rayTracingBarrier(cb);
   }
   const RaysPush push{shared::kRaysPhaseMasks};

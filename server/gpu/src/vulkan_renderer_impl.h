@@ -6,7 +6,7 @@
 //   frame_buffers.cpp     the per-resolution images and buffers
 //   frame_stages.cpp      a frame's uniforms, its stages recorded, submitted and timed
 //   fused_frame.cpp       a `fused` or `splitsum` frame: its shadow rays on the device (one submission) or the host's between two
-//   device_rays.cpp       the shadow rays on the device: acceleration structures, the ray frame, the three launches
+//   device_rays.cpp       the shadow rays on the device: acceleration structures, the ray frame, the four launches
 //   rotating_frame.cpp    a frame of the rotating methods: rotation and triple product in batches
 #pragma once
 
@@ -286,7 +286,7 @@ struct VulkanRenderer::Impl {
   // This frame's RayObject and RayFrame records, written for their upload.
   void writeRays(const render::ResolvedFrame& resolved, const glm::vec3& eye);
   // The "shadow-rays" stage on the device: the uploads, the top level, the
-  // three launches (core/shared_rays.h), ending with the masks fused reads.
+  // four launches (core/shared_rays.h), ending with the masks fused reads.
   void recordDeviceRays(VkCommandBuffer cb);
 
   // rotating_frame.cpp

@@ -2,6 +2,7 @@
 #include "haarcast/render/point_lights.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <optional>
 #include <vector>
@@ -250,51 +251,97 @@ GroundSkyGrid::GroundSkyGrid(int width, int height)
       height_(height),
       step_(groundSkyStep(width, height)),
       columns_((width - 1) / step_ + 2),
-      rows_((height - 1) / step_ + 2) {
+      rows_((height - 1) / step_ + 2),
+      fineStep_(static_cast<int>(shared::groundSkyFineStep(static_cast<shared::uint>(step_)))),
+      fineColumns_((width - 1) / fineStep_ + 2),
+      fineRows_((height - 1) / fineStep_ + 2) {
   HC_CHECK_LT(0, width);
   HC_CHECK_LT(0, height);
   value_.assign(static_cast<std::size_t>(columns_) * static_cast<std::size_t>(rows_), -1.0f);
+  fine_.assign(static_cast<std::size_t>(fineColumns_) * static_cast<std::size_t>(fineRows_), -1.0f);
 }
 
-int GroundSkyGrid::gridX(int i) const { return std::min(i * step_, width_ - 1); }
-int GroundSkyGrid::gridY(int j) const { return std::min(j * step_, height_ - 1); }
+namespace {
+
+// Pixel column (row) of grid column (row) i at this spacing, the last one
+// clamped to the frame's edge.
+int gridPixel(int i, int step, int extent) { return std::min(i * step, extent - 1); }
+
+// The blend of cell (i, j)'s corners in `values` (columns wide) at pixel
+// (x, y), or nullopt when a corner is not the ground.
+std::optional<float> blendCell(const std::vector<float>& values, int columns, int step, int width, int height, int x, int y) {
+  const int i = x / step, j = y / step;
+  const int x0 = gridPixel(i, step, width), x1 = gridPixel(i + 1, step, width);
+  const int y0 = gridPixel(j, step, height), y1 = gridPixel(j + 1, step, height);
+  const float tx = x1 > x0 ? static_cast<float>(x - x0) / static_cast<float>(x1 - x0) : 0.0f;
+  const float ty = y1 > y0 ? static_cast<float>(y - y0) / static_cast<float>(y1 - y0) : 0.0f;
+  float sum = 0.0f;
+  for (int dj = 0; dj < 2; ++dj) {
+    for (int di = 0; di < 2; ++di) {
+      const float v = values[static_cast<std::size_t>(j + dj) * static_cast<std::size_t>(columns) + static_cast<std::size_t>(i + di)];
+      if (v < 0.0f) return std::nullopt;
+      sum += (di ? tx : 1.0f - tx) * (dj ? ty : 1.0f - ty) * v;
+    }
+  }
+  return sum;
+}
+
+}  // namespace
+
+bool GroundSkyGrid::crossed(int i, int j) const {
+  for (int dj = 0; dj < 2; ++dj)
+    for (int di = 0; di < 2; ++di)
+      if (value_[static_cast<std::size_t>(j + dj) * static_cast<std::size_t>(columns_) + static_cast<std::size_t>(i + di)] < 0.0f)
+        return true;
+  return false;
+}
+
+bool GroundSkyGrid::fineNeeded(int k, int l) const {
+  using shared::uint;
+  const auto [f, c] = std::pair{static_cast<uint>(fineStep_), static_cast<uint>(step_)};
+  const uint i0 = shared::groundFineFirstCell(static_cast<uint>(k), f, c);
+  const uint i1 = shared::groundFineLastCell(static_cast<uint>(k), f, c, static_cast<uint>(width_));
+  const uint j0 = shared::groundFineFirstCell(static_cast<uint>(l), f, c);
+  const uint j1 = shared::groundFineLastCell(static_cast<uint>(l), f, c, static_cast<uint>(height_));
+  for (uint j = j0; j <= j1; ++j)
+    for (uint i = i0; i <= i1; ++i)
+      if (crossed(static_cast<int>(i), static_cast<int>(j))) return true;
+  return false;
+}
 
 void GroundSkyGrid::compute(const RayScene& world, const SkyOccluders& sky,
                             const std::function<std::optional<ShadingPoint>(std::size_t pixel)>& point,
                             unsigned threads) {
+  auto occlusionAt = [&](int x, int y) {
+    const std::optional<ShadingPoint> p = point(static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(x));
+    return p ? groundSkyOcclusion(world, *p, sky) : -1.0f;
+  };
   parallelFor(static_cast<std::size_t>(rows_), [&](std::size_t j) {
-    for (int i = 0; i < columns_; ++i) {
-      const std::size_t pixel = static_cast<std::size_t>(gridY(static_cast<int>(j))) * static_cast<std::size_t>(width_) +
-                                static_cast<std::size_t>(gridX(i));
-      const std::optional<ShadingPoint> p = point(pixel);
+    for (int i = 0; i < columns_; ++i)
       value_[j * static_cast<std::size_t>(columns_) + static_cast<std::size_t>(i)] =
-          p ? groundSkyOcclusion(world, *p, sky) : -1.0f;
+          occlusionAt(gridPixel(i, step_, width_), gridPixel(static_cast<int>(j), step_, height_));
+  }, {}, threads);
+  // The fine points the crossed cells read, after every coarse value is known.
+  std::atomic<std::size_t> traced{0};
+  parallelFor(static_cast<std::size_t>(fineRows_), [&](std::size_t l) {
+    for (int k = 0; k < fineColumns_; ++k) {
+      float& v = fine_[l * static_cast<std::size_t>(fineColumns_) + static_cast<std::size_t>(k)];
+      v = -1.0f;
+      if (!fineNeeded(k, static_cast<int>(l))) continue;
+      v = occlusionAt(gridPixel(k, fineStep_, width_), gridPixel(static_cast<int>(l), fineStep_, height_));
+      traced.fetch_add(1, std::memory_order_relaxed);
     }
   }, {}, threads);
+  fineTraced_ = traced.load();
 }
 
 float GroundSkyGrid::at(std::size_t pixel, const std::function<float()>& direct) const {
   const int x = static_cast<int>(pixel % static_cast<std::size_t>(width_));
   const int y = static_cast<int>(pixel / static_cast<std::size_t>(width_));
   HC_CHECK_LT(y, height_);
-  const int i = std::min(x / step_, columns_ - 2), j = std::min(y / step_, rows_ - 2);
-  const int x0 = gridX(i), x1 = gridX(i + 1), y0 = gridY(j), y1 = gridY(j + 1);
-  const float tx = x1 > x0 ? static_cast<float>(x - x0) / static_cast<float>(x1 - x0) : 0.0f;
-  const float ty = y1 > y0 ? static_cast<float>(y - y0) / static_cast<float>(y1 - y0) : 0.0f;
-  // All four corners ground: their bilinear blend. A corner off the ground
-  // (an object's outline runs through the cell): the sample's own rays. A
-  // blend of the corners that are ground reached past the outline, away
-  // from where the object meets the ground, and left a too-bright halo
-  // around an object's foot.
-  float sum = 0.0f;
-  for (int dj = 0; dj < 2; ++dj) {
-    for (int di = 0; di < 2; ++di) {
-      const float v = value_[static_cast<std::size_t>(j + dj) * static_cast<std::size_t>(columns_) + static_cast<std::size_t>(i + di)];
-      if (v < 0.0f) return direct();
-      sum += (di ? tx : 1.0f - tx) * (dj ? ty : 1.0f - ty) * v;
-    }
-  }
-  return sum;
+  if (const std::optional<float> v = blendCell(value_, columns_, step_, width_, height_, x, y)) return *v;
+  if (const std::optional<float> v = blendCell(fine_, fineColumns_, fineStep_, width_, height_, x, y)) return *v;
+  return direct();
 }
 
 std::uint32_t withGroundOcclusion(std::uint32_t lightBits, float occlusion) {

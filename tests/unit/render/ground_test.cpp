@@ -9,6 +9,7 @@
 #include "haarcast/assets/procedural_mesh.h"
 #include "haarcast/core/brdf.h"
 #include "haarcast/core/brdf_slices.h"
+#include "haarcast/core/shared_layout.h"
 #include "haarcast/cpu/cpu_renderer.h"
 #include "haarcast/render/embree_scene.h"
 #include "haarcast/render/point_lights.h"
@@ -129,25 +130,34 @@ TEST(Ground, ObjectsShadowEachOther) {
   EXPECT_GT(lit, 5.0f * hidden) << "hidden " << hidden << ", lit " << lit;
 }
 
-// The ground's hidden sky on its coarse grid (point_lights.h
-// GroundSkyGrid): a cell whose four corners are ground blends them; a cell
-// an object's outline crosses (a corner off the ground) takes the sample's
-// own rays, so that the blend never reaches past the outline.
-TEST(Ground, TheGridBlendsOpenCellsAndTracesCellsAnOutlineCrosses) {
+// The ground's hidden sky on its grids (point_lights.h GroundSkyGrid): a
+// cell whose four corners are ground blends them; a cell an object's
+// outline crosses (a corner off the ground) reads the fine grid, traced
+// only around it, and a fine cell the outline crosses takes the sample's
+// own rays, so that no blend reaches past the outline.
+TEST(Ground, TheGridBlendsOpenCellsAndRefinesCellsAnOutlineCrosses) {
   const Mesh plane = assets::makePlane(1.0, 1);
   const RayScene world({Instance{&plane, glm::mat4(1.0f)}});
   SkyOccluders sky;  // no occluders: every grid point hides nothing
   GroundSkyGrid grid(40, 40);
   ASSERT_EQ(groundSkyStep(40, 40), 4);
-  const std::size_t offGround = 8 * 40 + 8;  // grid point (2, 2): an object's pixel
+  ASSERT_EQ(shared::groundSkyFineStep(4u), 2u);
+  const std::size_t offGround = 8 * 40 + 8;  // coarse point (2, 2), fine point (4, 4): an object's pixel
   grid.compute(world, sky, [&](std::size_t pixel) -> std::optional<ShadingPoint> {
     if (pixel == offGround) return std::nullopt;
     return ShadingPoint{glm::vec3(0.0f), glm::vec3(0.0f, 1.0f, 0.0f), 1e-4f};
   }, 1);
   const auto own = [] { return 0.25f; };  // what the sample's own rays would say
-  EXPECT_EQ(grid.at(5 * 40 + 5, own), 0.25f) << "the cell (4…8)² has a corner off the ground";
-  EXPECT_EQ(grid.at(9 * 40 + 5, own), 0.25f) << "so has the cell below it";
-  EXPECT_EQ(grid.at(13 * 40 + 13, own), 0.0f) << "the cell (12…16)² is open ground: its corners' blend";
+  auto at = [&](int x, int y) { return grid.at(static_cast<std::size_t>(y) * 40 + static_cast<std::size_t>(x), own); };
+  EXPECT_EQ(at(13, 13), 0.0f) << "the cell (12…16)² is open ground: its corners' blend";
+  EXPECT_EQ(at(5, 5), 0.0f) << "the cell (4…8)² is crossed; its fine cell (4…6)² is open ground";
+  EXPECT_EQ(at(9, 5), 0.0f) << "the cell (8…12) × (4…8) is crossed; its fine cell (8…10) × (4…6) is open";
+  EXPECT_EQ(at(7, 7), 0.25f) << "the fine cell (6…8)² has a corner off the ground";
+  EXPECT_EQ(at(9, 9), 0.25f) << "so has the fine cell (8…10)²";
+  EXPECT_EQ(at(11, 7), 0.0f) << "the fine cell (10…12) × (6…8) is open";
+  // The four crossed cells span pixels 4…11 each way: fine points 2…6 (the
+  // points whose fine cells reach them), 5 × 5, and no other.
+  EXPECT_EQ(grid.finePointsTraced(), 25u);
 }
 
 TEST(Ground, AddGroundPutsAWidePlaneUnderTheObjects) {

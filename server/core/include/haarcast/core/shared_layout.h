@@ -445,8 +445,8 @@ static_assert(sizeof(ObjectInfo) == 192 && offsetof(ObjectInfo, toLight) == 96 &
               offsetof(ObjectInfo, level) == 160 && offsetof(ObjectInfo, visibilityBase) == 176);
 static_assert(sizeof(PointLight) == 32);
 static_assert(sizeof(RayObject) == 144 && offsetof(RayObject, sphere) == 112 && offsetof(RayObject, occluder) == 140);
-static_assert(sizeof(RayFrame) == 384 && offsetof(RayFrame, eye) == 256 && offsetof(RayFrame, toEnvironment) == 288 &&
-              offsetof(RayFrame, lights) == 336 && offsetof(RayFrame, objectSky) == 380);
+static_assert(sizeof(RayFrame) == 400 && offsetof(RayFrame, eye) == 256 && offsetof(RayFrame, toEnvironment) == 288 &&
+              offsetof(RayFrame, lights) == 336 && offsetof(RayFrame, objectSky) == 380 && offsetof(RayFrame, fineRows) == 392);
 static_assert(sizeof(HiddenLight) == 16 && offsetof(HiddenLight, direction) == 12);
 static_assert(sizeof(SliceLobe) == 48 + 16 * kLobeSamples && offsetof(SliceLobe, median) == 16 &&
               offsetof(SliceLobe, core) == 32 && offsetof(SliceLobe, samples) == 48);

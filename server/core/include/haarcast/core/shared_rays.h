@@ -6,11 +6,13 @@
 // The rays are the host's (render/point_lights.h) for the same samples:
 // each sample's point-light rays, the lobe ray, and the ground's hidden-sky
 // rays, on the same coarse grid, from the same shading points. The pass
-// runs in three launches of one pipeline, told apart by RaysPush::phase:
+// runs in four launches of one pipeline, told apart by RaysPush::phase:
 //   kRaysPhaseCentres  per covered sample: a pixel's centre sample into
 //                      pixelSample[pixel] (cleared to ~0 before);
 //   kRaysPhaseGrid     per grid point (RayFrame::gridColumns × gridRows):
 //                      the hidden sky of an interior ground pixel, or −1;
+//   kRaysPhaseFineGrid per fine grid point (fineColumns × fineRows): the
+//                      same, where a coarse cell an outline crosses uses it;
 //   kRaysPhaseMasks    per covered sample: its shadow word (fused.comp's
 //                      `masks`), the ground's occlusion blended from the grid.
 #ifndef HAARCAST_CORE_SHARED_RAYS_H
@@ -19,6 +21,19 @@
 HC_CONST uint kRaysPhaseCentres = 0u;
 HC_CONST uint kRaysPhaseGrid = 1u;
 HC_CONST uint kRaysPhaseMasks = 2u;
+HC_CONST uint kRaysPhaseFineGrid = 3u;
+
+// The ground grid's refinement (render::GroundSkyGrid): a coarse cell that
+// an object's outline crosses (a corner off the ground) is read from a grid
+// this much finer, traced only where such a cell needs it, and a fine cell
+// that the outline crosses too takes its samples' own rays. Fine point k
+// is a corner of fine cells k − 1 and k: pixels max(0, (k − 1)·fine) up to
+// min((k + 1)·fine, extent) − 1, in coarse cells first…last of these.
+HC_FUNCTION uint groundSkyFineStep(uint coarse) { return max(2u, coarse / 4u); }
+HC_FUNCTION uint groundFineFirstCell(uint k, uint fine, uint coarse) { return (k > 0u ? (k - 1u) * fine : 0u) / coarse; }
+HC_FUNCTION uint groundFineLastCell(uint k, uint fine, uint coarse, uint extent) {
+  return (min((k + 1u) * fine, extent) - 1u) / coarse;
+}
 
 // The ground's hidden-sky rays per occluder (render::groundSkyOcclusion):
 // (kGroundSkyRings·m) × (kGroundSkySectors·m) directions in its bounding
@@ -113,6 +128,10 @@ struct RayFrame {
   uint luminanceLevel;    // the map light's level (PreparedScene::restLuminance): rgb and luminance per texel
   float minShare;         // SkyOccluders::minShare
   uint objectSky;         // 1: the objects' hidden sky is computed (fused, two objects or more besides a ground)
+  uint fineStep;          // groundSkyFineStep(gridStep); the fine points follow the coarse ones in `grid`
+  uint fineColumns;       // (width − 1)/fineStep + 2
+  uint fineRows;
+  uint framePad;
 };
 
 // Object i's instance mask in the top level: a bit of its own while there

@@ -110,16 +110,19 @@ std::optional<std::array<float, 3>> hiddenIrradiance(const shared::HiddenLight& 
 
 // groundSkyOcclusion on a coarse grid of the frame, the pixels (i·step, j·step)
 // and the last row and column, then for every ground sample the bilinear
-// blend of its cell's corners when all four are ground, or its own rays
-// when one is not (an object's outline crosses the cell: a blend of the
-// other corners reached past the outline, away from where the object meets
-// the ground, and left a too-bright halo around its foot): the hidden sky
-// changes slowly over the open ground, and rays at every pixel would cost
-// most of a frame. (Where a cell's ground corners disagree, its samples'
-// own rays were tried: their estimates, each from one stratified pattern,
-// showed arcs where the pattern's size steps, which the blend smooths; and
-// they cost 60 % more frame time on the bunny.) Both backends fill the grid
-// from the same samples (interior pixels' centres) and blend alike.
+// blend of its cell's corners when all four are ground. A cell an object's
+// outline crosses (a corner off the ground) is refined: read from a grid
+// groundSkyFineStep apart (shared_rays.h), whose points are traced only in
+// such cells; there too the blend of a fine cell whose four corners are
+// ground, else the sample's own rays. The hidden sky changes slowly over
+// the open ground, and rays at every pixel would cost most of a frame.
+// (Blending a crossed cell's other corners reached past the outline, away
+// from where the object meets the ground, and left a too-bright halo around
+// its foot. Every sample of a crossed coarse cell taking its own rays,
+// 16 pixels wide at 720p, cost 40,000 samples' rays a frame on the default
+// scene, and showed arcs where the pattern's size steps; the fine grid
+// takes a sixth of that.) Both backends fill both grids from the same
+// samples (interior pixels' centres) and blend alike.
 // The grid's spacing: a 40th of the frame's larger side, 4 to 16 pixels (a
 // contact shadow spans a share of the frame, not a number of pixels).
 int groundSkyStep(int width, int height);
@@ -136,12 +139,17 @@ class GroundSkyGrid {
                const std::function<std::optional<ShadingPoint>(std::size_t pixel)>& point, unsigned threads);
   // The occlusion for a ground sample of pixel y·width + x.
   float at(std::size_t pixel, const std::function<float()>& direct) const;
+  // Fine grid points traced by the last compute (what the refinement costs).
+  std::size_t finePointsTraced() const { return fineTraced_; }
 
  private:
   int width_, height_, step_, columns_, rows_;
+  int fineStep_, fineColumns_, fineRows_;
   std::vector<float> value_;  // per grid point; < 0 where it is not the ground
-  int gridX(int i) const;     // pixel column of grid column i
-  int gridY(int j) const;
+  std::vector<float> fine_;   // per fine grid point; < 0 off the ground or where no crossed cell needs it
+  std::size_t fineTraced_ = 0;
+  bool crossed(int i, int j) const;  // a corner of coarse cell (i, j) is off the ground
+  bool fineNeeded(int k, int l) const;
 };
 
 // A ground sample's word: its light bits and the occlusion above them
