@@ -1,18 +1,23 @@
 #!/usr/bin/env python3
-"""The Python gRPC client of docs/service.md, run as written: its code block
-is cut out of the page, Python stubs are generated from proto/haarcast.proto
-(protoc + grpc_python_plugin) into a temporary folder, and the script runs
-against `haarcast serve --grpc-port` on loopback. Then every saved frame must
-be a 256×256 RGBA PNG that decodes, and the orbit must show different views.
-Before that, with raw calls (no stubs), the health service must answer
-SERVING and reflection must list the services.
+"""The Python gRPC client of docs/service.md, run as written: its two code
+blocks are cut out of the page, the client saved as orbit.py in an empty
+folder and the shell block run there by bash, as a reader would, with
+HAARCAST, SERVER and TOKEN set and a PATH whose first python3 has no grpc
+module (the shell block must not depend on it), against `haarcast serve
+--grpc-port` on loopback. Then every saved frame must be a 256×256 RGBA PNG
+that decodes, the orbit must show different views, and nothing may have been
+written into the repository. Before that, with raw calls (no stubs), the
+health service must answer SERVING, and reflection v1 and v1alpha must both
+list the services; v1 must describe haarcast.v1.Render (its file,
+haarcast.proto) and answer NOT_FOUND for a symbol that does not exist.
 
 usage: grpc_docs_client.py --haarcast BIN --docs docs/service.md --proto proto/haarcast.proto
-Exit 77 (skip) when grpc or protobuf is missing from this Python.
+Exit 77 (skip) when grpc or protobuf is missing from Debian's /usr/bin/python3.
 """
 import argparse
 import os
 import re
+import shutil
 import signal
 import socket
 import struct
@@ -31,13 +36,45 @@ def fail(what):
     sys.exit(1)
 
 
-def script_from(docs):
-    """The ```python block that starts with '# orbit.py'."""
-    blocks = re.findall(r"```python\n(.*?)```", open(docs, encoding="utf-8").read(), re.S)
-    scripts = [b for b in blocks if b.startswith("# orbit.py")]
-    if len(scripts) != 1:
-        fail(f"{docs}: {len(scripts)} python blocks start with '# orbit.py', expected 1")
-    return scripts[0]
+DEBIAN_PYTHON = "/usr/bin/python3"
+
+
+def block_from(docs, language, first_line):
+    """The ```language block that starts with first_line."""
+    blocks = re.findall(rf"```{language}\n(.*?)```", open(docs, encoding="utf-8").read(), re.S)
+    found = [b for b in blocks if b.startswith(first_line)]
+    if len(found) != 1:
+        fail(f"{docs}: {len(found)} {language} blocks start with {first_line!r}, expected 1")
+    return found[0]
+
+
+def varint(n):
+    out = b""
+    while True:
+        byte, n = n & 0x7F, n >> 7
+        out += bytes([byte | (0x80 if n else 0)])
+        if not n:
+            return out
+
+
+def field(number, payload):
+    """A length-delimited protobuf field."""
+    return varint(number << 3 | 2) + varint(len(payload)) + payload
+
+
+def reflection(channel, version, request):
+    """One ServerReflectionRequest, raw, on a stream of its own: the answer's bytes."""
+    call = channel.stream_stream(f"/grpc.reflection.{version}.ServerReflection/ServerReflectionInfo")
+    return b"".join(call(iter([request]), timeout=10))
+
+
+def repo_files(repo):
+    """The repository's files outside build folders and .git (what a run must not add to)."""
+    out = set()
+    for root, dirs, files in os.walk(repo):
+        dirs[:] = [d for d in dirs if d != ".git" and not d.startswith("build") and d != "node_modules"]
+        out.update(os.path.relpath(os.path.join(root, f), repo) for f in files)
+    return out
 
 
 def free_port():
@@ -86,16 +123,34 @@ def main():
     except ImportError as e:
         print(f"SKIP: {e} (apt-get install python3-grpcio python3-protobuf)")
         return SKIP
+    if subprocess.run([DEBIAN_PYTHON, "-c", "import grpc, google.protobuf"], capture_output=True).returncode != 0:
+        print(f"SKIP: {DEBIAN_PYTHON} has no grpc module (apt-get install python3-grpcio python3-protobuf)")
+        return SKIP
 
+    # The reader's folder: orbit.py as the page has it, nothing else.
     work = tempfile.mkdtemp(prefix="haarcast-grpc-docs-")
     script = os.path.join(work, "orbit.py")
     with open(script, "w", encoding="utf-8") as f:
-        f.write(script_from(opts.docs))
-    proto_dir = os.path.dirname(os.path.abspath(opts.proto))
-    subprocess.run(["protoc", f"-I{proto_dir}", f"--python_out={work}", f"--grpc_out={work}",
-                    f"--plugin=protoc-gen-grpc={opts.grpc_python_plugin}", os.path.abspath(opts.proto)], check=True)
+        f.write(block_from(opts.docs, "python", "# orbit.py"))
+    shell = block_from(opts.docs, "sh", "# run-orbit.sh")
+    repo = os.path.dirname(os.path.dirname(os.path.abspath(opts.proto)))
+    # A python3 first on the PATH without grpc (a virtual environment's, say),
+    # and grpc_python_plugin where the build found it.
+    fake_bin = os.path.join(work, "fake-bin")
+    os.mkdir(fake_bin)
+    with open(os.path.join(fake_bin, "python3"), "w", encoding="utf-8") as f:
+        f.write("#!/bin/sh\necho \"ModuleNotFoundError: No module named 'grpc' (a python3 that is not Debian's)\" >&2\nexit 1\n")
+    os.chmod(os.path.join(fake_bin, "python3"), 0o755)
+    plugin = shutil.which(opts.grpc_python_plugin) or opts.grpc_python_plugin
+    path = os.pathsep.join([fake_bin, os.path.dirname(os.path.abspath(plugin)), os.environ.get("PATH", "")])
     frames = os.path.join(work, "frames")
-    os.mkdir(frames)
+    before = repo_files(repo)
+
+    def run_block(token, timeout):
+        env = dict(os.environ, PATH=path, HAARCAST=repo, SERVER=f"127.0.0.1:{port}", TOKEN=token)
+        env.pop("PYTHONPATH", None)
+        return subprocess.run(["bash", "-euo", "pipefail", "-c", shell], cwd=work, env=env,
+                              capture_output=True, text=True, timeout=timeout)
 
     port = free_port()
     server = subprocess.Popen([opts.haarcast, "serve", "--port", "0", "--grpc-port", str(port), "--token", TOKEN,
@@ -111,17 +166,27 @@ def main():
         health = channel.unary_unary("/grpc.health.v1.Health/Check")(b"", timeout=10)
         if health != b"\x08\x01":
             fail(f"health check answered {health!r}, expected SERVING (b'\\x08\\x01')")
-        # Reflection: ServerReflectionRequest{list_services: ""} (field 7).
-        reflect = channel.stream_stream("/grpc.reflection.v1alpha.ServerReflection/ServerReflectionInfo")
-        listing = b"".join(reflect(iter([b"\x3a\x00"]), timeout=10))
-        for name in (b"haarcast.v1.Render", b"grpc.health.v1.Health"):
-            if name not in listing:
-                fail(f"reflection does not list {name.decode()}: {listing!r}")
+        # Reflection, both versions: ServerReflectionRequest{list_services: ""} (field 7).
+        for version in ("v1", "v1alpha"):
+            listing = reflection(channel, version, field(7, b""))
+            for name in (b"haarcast.v1.Render", b"grpc.health.v1.Health", b"grpc.reflection.v1.ServerReflection"):
+                if name not in listing:
+                    fail(f"reflection {version} does not list {name.decode()}: {listing!r}")
+        # v1 describes the service: file_containing_symbol (field 4) → the
+        # FileDescriptorResponse (field 4) of haarcast.proto, which declares it.
+        described = reflection(channel, "v1", field(4, b"haarcast.v1.Render"))
+        if b"haarcast.proto" not in described or b"Session" not in described:
+            fail(f"reflection v1 does not describe haarcast.v1.Render: {described[:200]!r}")
+        # An unknown symbol: ErrorResponse (field 7) with NOT_FOUND (5).
+        missing = reflection(channel, "v1", field(4, b"haarcast.v1.NoSuchThing"))
+        if b"\x08\x05" not in missing or b"no symbol named haarcast.v1.NoSuchThing" not in missing:
+            fail(f"reflection v1 answers an unknown symbol with {missing!r}, expected NOT_FOUND")
 
-        run = subprocess.run([sys.executable, script, f"127.0.0.1:{port}", TOKEN, frames], cwd=work,
-                             capture_output=True, text=True, timeout=120)
+        run = run_block(TOKEN, 120)
         if run.returncode != 0:
-            fail(f"the docs' client exited {run.returncode}: {run.stderr[-2000:]}")
+            fail(f"the docs' shell block exited {run.returncode}: {run.stderr[-2000:]}")
+        if repo_files(repo) != before:
+            fail(f"running the docs' blocks wrote into {repo}: {sorted(repo_files(repo) - before)}")
         names = sorted(os.listdir(frames))
         expected = [f"frame{n:02d}.png" for n in range(STEPS)]
         if names != expected:
@@ -135,8 +200,7 @@ def main():
         if len(pictures) < STEPS // 2:
             fail(f"only {len(pictures)} different pictures in {STEPS} steps of the orbit")
         # A wrong token: UNAUTHENTICATED, and the script says so.
-        wrong = subprocess.run([sys.executable, script, f"127.0.0.1:{port}", "wrong", frames], cwd=work,
-                               capture_output=True, text=True, timeout=60)
+        wrong = run_block("wrong", 60)
         if wrong.returncode == 0 or "UNAUTHENTICATED" not in wrong.stderr:
             fail(f"a wrong token: exit {wrong.returncode}, stderr {wrong.stderr[-500:]!r}")
     finally:
@@ -148,8 +212,9 @@ def main():
             fail("the server did not exit within 10 s of SIGTERM")
     if code != 0:
         fail(f"the server exited {code} after SIGTERM")
-    print(f"PASS: {STEPS} frames of the docs' orbit decode ({len(pictures)} different), health SERVING, "
-          "reflection lists the services, a wrong token is UNAUTHENTICATED, SIGTERM exits 0")
+    print(f"PASS: the docs' blocks run as written; {STEPS} frames of the orbit decode ({len(pictures)} different), "
+          "health SERVING, reflection v1 and v1alpha list the services and v1 describes them, a wrong token is "
+          "UNAUTHENTICATED, SIGTERM exits 0")
     return 0
 
 

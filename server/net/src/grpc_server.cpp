@@ -15,6 +15,7 @@
 #include <grpcpp/grpcpp.h>
 #include <grpcpp/health_check_service_interface.h>
 
+#include "grpc_reflection.h"
 #include "grpc_session.h"
 #include "haarcast/proto/haarcast.grpc.pb.h"
 
@@ -55,7 +56,10 @@ struct GrpcServer::State {
   State(Server::Impl& s, GrpcServer& owner) : server(s), service(s, owner) {}
 
   Server::Impl& server;
-  RenderGrpcService service;  // outlives grpc (declared first)
+  RenderGrpcService service;  // outlives grpc (declared first), as reflection does
+  // v1alpha comes from libgrpc++'s plugin, which lists what is registered.
+  ReflectionV1Service reflection{{kServiceName, "grpc.health.v1.Health", "grpc.reflection.v1.ServerReflection",
+                                  "grpc.reflection.v1alpha.ServerReflection"}};
   std::unique_ptr<grpc::Server> grpc;
   int port = 0;
 
@@ -107,6 +111,7 @@ GrpcServer::GrpcServer(Server::Impl& server) : state_(std::make_unique<State>(se
   grpc::ServerBuilder builder;
   builder.AddListeningPort(where, grpc::InsecureServerCredentials(), &state_->port);
   builder.RegisterService(&state_->service);
+  builder.RegisterService(&state_->reflection);
   // As the WebSocket's read limit (upgrade.h): messages up to 4× the
   // protocol's limit reach the session, which answers MESSAGE_TOO_LARGE;
   // larger ones gRPC refuses before buffering (RESOURCE_EXHAUSTED).
@@ -125,7 +130,7 @@ GrpcServer::GrpcServer(Server::Impl& server) : state_(std::make_unique<State>(se
   }
   state_->setServing(!server.atCapacity());
   state_->health = std::thread([s = state_.get()] { s->watchHealth(); });
-  server.log("gRPC on %s (port %d): haarcast.v1.Render, grpc.health.v1.Health, reflection", where.c_str(),
+  server.log("gRPC on %s (port %d): haarcast.v1.Render, grpc.health.v1.Health, reflection v1 and v1alpha", where.c_str(),
              state_->port);
 }
 

@@ -5,9 +5,11 @@
 #include <future>
 #include <thread>
 
+#include <google/protobuf/descriptor.pb.h>
 #include <grpcpp/generic/generic_stub.h>
 #include <grpcpp/grpcpp.h>
 
+#include "haarcast/proto/grpc/reflection/v1/reflection.grpc.pb.h"
 #include "haarcast/proto/haarcast.grpc.pb.h"
 #include "server_fixture.h"
 
@@ -212,6 +214,78 @@ TEST(GrpcServer, HealthIsServingUntilTheSessionBudgetIsFull) {
     client.finish();
   }
   EXPECT_TRUE(eventually([&] { return healthStatus(port) == 1; })) << "SERVING again once the slot is free";
+}
+
+// Reflection v1 (server/net/src/grpc_reflection.h), through its generated
+// stub: the services listed, a symbol's file with its imports, each file
+// once per stream, and errors that say what was not found.
+TEST(GrpcServer, ReflectionV1ListsAndDescribesTheServices) {
+  namespace r = grpc::reflection::v1;
+  TestServer server(grpcOptions());
+  const auto stub = r::ServerReflection::NewStub(channelTo(server.server().grpcPort()));
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(20));
+  const auto stream = stub->ServerReflectionInfo(&context);
+  auto ask = [&](const r::ServerReflectionRequest& request) {
+    r::ServerReflectionResponse response;
+    EXPECT_TRUE(stream->Write(request));
+    EXPECT_TRUE(stream->Read(&response));
+    return response;
+  };
+  r::ServerReflectionRequest list;
+  list.set_list_services("");
+  const r::ServerReflectionResponse listed = ask(list);
+  ASSERT_TRUE(listed.has_list_services_response());
+  std::vector<std::string> names;
+  for (const auto& service : listed.list_services_response().service()) names.push_back(service.name());
+  EXPECT_EQ(names, (std::vector<std::string>{"haarcast.v1.Render", "grpc.health.v1.Health",
+                                             "grpc.reflection.v1.ServerReflection",
+                                             "grpc.reflection.v1alpha.ServerReflection"}));
+
+  r::ServerReflectionRequest symbol;
+  symbol.set_file_containing_symbol("haarcast.v1.Render.Session");
+  const r::ServerReflectionResponse described = ask(symbol);
+  ASSERT_TRUE(described.has_file_descriptor_response());
+  ASSERT_GE(described.file_descriptor_response().file_descriptor_proto_size(), 1);
+  google::protobuf::FileDescriptorProto file;
+  ASSERT_TRUE(file.ParseFromString(described.file_descriptor_response().file_descriptor_proto(0)));
+  EXPECT_EQ(file.name(), "haarcast.proto") << "the file that declares the symbol comes first";
+  ASSERT_EQ(file.service_size(), 1);
+  EXPECT_EQ(file.service(0).name(), "Render");
+  EXPECT_EQ(file.service(0).method(0).name(), "Session");
+  EXPECT_TRUE(file.service(0).method(0).client_streaming() && file.service(0).method(0).server_streaming());
+  EXPECT_EQ(described.original_request().file_containing_symbol(), "haarcast.v1.Render.Session");
+  // The same file again on this stream: already sent, so not again.
+  symbol.set_file_containing_symbol("haarcast.v1.ClientMessage");
+  const r::ServerReflectionResponse again = ask(symbol);
+  ASSERT_TRUE(again.has_file_descriptor_response());
+  EXPECT_EQ(again.file_descriptor_response().file_descriptor_proto_size(), 0);
+
+  r::ServerReflectionRequest byName;
+  byName.set_file_by_filename("grpc/reflection/v1/reflection.proto");
+  const r::ServerReflectionResponse own = ask(byName);
+  ASSERT_TRUE(own.has_file_descriptor_response());
+  ASSERT_EQ(own.file_descriptor_response().file_descriptor_proto_size(), 1);
+  ASSERT_TRUE(file.ParseFromString(own.file_descriptor_response().file_descriptor_proto(0)));
+  EXPECT_EQ(file.package(), "grpc.reflection.v1");
+
+  symbol.set_file_containing_symbol("haarcast.v1.NoSuchThing");
+  const r::ServerReflectionResponse missing = ask(symbol);
+  ASSERT_TRUE(missing.has_error_response());
+  EXPECT_EQ(missing.error_response().error_code(), static_cast<int>(grpc::StatusCode::NOT_FOUND));
+  EXPECT_NE(missing.error_response().error_message().find("haarcast.v1.NoSuchThing"), std::string::npos);
+  const r::ServerReflectionResponse empty = ask(r::ServerReflectionRequest{});
+  ASSERT_TRUE(empty.has_error_response());
+  EXPECT_EQ(empty.error_response().error_code(), static_cast<int>(grpc::StatusCode::INVALID_ARGUMENT));
+  r::ServerReflectionRequest numbers;
+  numbers.set_all_extension_numbers_of_type("haarcast.v1.ClientMessage");
+  const r::ServerReflectionResponse none = ask(numbers);
+  ASSERT_TRUE(none.has_all_extension_numbers_response());
+  EXPECT_EQ(none.all_extension_numbers_response().base_type_name(), "haarcast.v1.ClientMessage");
+  EXPECT_EQ(none.all_extension_numbers_response().extension_number_size(), 0) << "proto3: no extensions";
+
+  stream->WritesDone();
+  EXPECT_TRUE(stream->Finish().ok());
 }
 
 TEST(GrpcServer, SessionSlotsAreSharedWithWebSocketSessions) {
