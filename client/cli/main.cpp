@@ -242,14 +242,18 @@ int run(int argc, char** argv) {
 
   try {
     app.parse(argc, argv);
-  } catch (const CLI::ExtrasError& e) {
-    // A flag the client does not take: name it and the one meant.
-    const auto lines = haarcast::cli::unknownFlags(app, std::vector<std::string>(argv + 1, argv + argc));
-    if (lines.empty()) return app.exit(e) == 0 ? 0 : 2;
-    for (const auto& line : lines) std::fprintf(stderr, "haarcast-client: error: %s\n", line.c_str());
-    std::fprintf(stderr, "`haarcast-client --help` lists the flags.\n");
-    return 2;
   } catch (const CLI::ParseError& e) {
+    // A flag the client does not take: name it and the one meant, before
+    // anything else CLI11 found (it checks the required url first, so
+    // `haarcast-client --bogus` would otherwise say only that the url is
+    // missing).
+    const auto lines = haarcast::cli::unknownFlags(app, std::vector<std::string>(argv + 1, argv + argc));
+    if (!lines.empty()) {
+      for (const auto& line : lines) std::fprintf(stderr, "haarcast-client: error: %s\n", line.c_str());
+      if (url.empty()) std::fprintf(stderr, "haarcast-client: error: the server's url (ws://HOST:PORT) is missing\n");
+      std::fprintf(stderr, "`haarcast-client --help` lists the flags.\n");
+      return 2;
+    }
     // --help and --version exit 0; every flag error exits 2, as the checks
     // below do.
     return app.exit(e) == 0 ? 0 : 2;

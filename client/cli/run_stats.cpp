@@ -40,6 +40,12 @@ nlohmann::json latencyFields(const std::vector<double>& latency) {
 
 }  // namespace
 
+std::optional<double> SessionStats::serverFps() const {
+  if (!firstStats || !lastStats || !(lastStats->first > firstStats->first)) return std::nullopt;
+  const double frames = static_cast<double>(lastStats->second) - static_cast<double>(firstStats->second);
+  return std::max(0.0, frames) / (lastStats->first - firstStats->first);
+}
+
 nlohmann::json summaryJson(const RunSummary& run) {
   std::uint64_t frames = 0, dropped = 0, errors = 0, payload = 0, wire = 0, blank = 0, extra = 0, failed = 0;
   std::uint64_t clippedFrames = 0, undecoded = 0, keyframeRequests = 0;
@@ -73,7 +79,7 @@ nlohmann::json summaryJson(const RunSummary& run) {
         {"errors", s.errors},
         {"undecoded_frames", s.undecodedFrames},
         {"keyframe_requests", s.keyframeRequests},
-        {"server_fps", s.serverFps},
+        {"server_fps", s.serverFps() ? nlohmann::json(*s.serverFps()) : nlohmann::json(nullptr)},
         {"exposure_stops", s.lastExposureStops},
         {"failure", s.failure},
     };

@@ -227,7 +227,8 @@ struct Session::Impl : std::enable_shared_from_this<Session::Impl> {
       case v1::ServerMessage::kWelcome: onWelcome(message.welcome()); break;
       case v1::ServerMessage::kFrame: onFrameMessage(message.frame(), bytes); break;
       case v1::ServerMessage::kStats:
-        stats.serverFps = message.stats().fps();
+        stats.lastStats = std::pair{nowMs() / 1000.0, message.stats().frames_sent()};
+        if (!stats.firstStats) stats.firstStats = stats.lastStats;
         stats.serverSessions = message.stats().sessions();
         break;
       case v1::ServerMessage::kError: onError(message.error()); break;

@@ -40,6 +40,9 @@ expect "wss:// refused" 2 "wss://" -- "$client_bin" wss://127.0.0.1:1
 expect "bad --level" 2 "--level must be N, auto or auto:N, N a map level the server serves (got \"12x\")" -- "$client_bin" ws://127.0.0.1:1 --level 12x
 expect "bad --exposure" 2 "--exposure must be auto or a number of stops" -- "$client_bin" ws://127.0.0.1:1 --exposure bright
 expect "misspelt flag" 2 "unknown flag --frmes; did you mean --frames?" -- "$client_bin" ws://127.0.0.1:1 --frmes 3
+# Without the url too: the unknown flag first (CLI11 checks the url first).
+expect "unknown flag, no url" 2 "unknown flag --bogus" -- "$client_bin" --bogus
+expect "unknown flag, no url: the url named" 2 "the server's url (ws://HOST:PORT) is missing" -- "$client_bin" --bogus
 expect "connection refused" 1 "Connection refused" -- "$client_bin" ws://127.0.0.1:1 --frames 1 --quiet
 
 # The server's --encoding takes the wire's names (wire::encodingName) of

@@ -263,6 +263,9 @@ TEST(Summary, AggregatesClients) {
   b.errors = 1;
   b.undecodedFrames = 3;
   b.keyframeRequests = 1;
+  // The server's Stats: 12 frames sent between arrivals 0.5 s and 2.5 s apart.
+  b.firstStats = std::pair{0.5, std::uint64_t{3}};
+  b.lastStats = std::pair{2.5, std::uint64_t{15}};
   run.sessions = {a, b};
   const auto j = summaryJson(run);
   EXPECT_EQ(j["frames"], 40u);
@@ -280,6 +283,11 @@ TEST(Summary, AggregatesClients) {
   EXPECT_EQ(j["clients"], 2u);
   ASSERT_EQ(j["per_client"].size(), 2u);
   EXPECT_DOUBLE_EQ(j["per_client"][1]["fps"].get<double>(), 15.0);
+  EXPECT_DOUBLE_EQ(j["per_client"][1]["server_fps"].get<double>(), 6.0);
+  EXPECT_TRUE(j["per_client"][0]["server_fps"].is_null()) << "no Stats: no figure, not 0";
+  SessionStats one;
+  one.firstStats = one.lastStats = std::pair{1.0, std::uint64_t{5}};
+  EXPECT_FALSE(one.serverFps()) << "one Stats spans no time";
 }
 
 // ---- frames: the blank check and PAM on decoded frames ----

@@ -4,7 +4,9 @@
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json_fwd.hpp>
@@ -40,9 +42,18 @@ struct SessionStats {
   // The server's per-stage timings (Frame.timings), by stage name.
   std::map<std::string, std::vector<double>> stageMs;
   std::string failure;              // non-empty: why the session failed
-  // The last Stats message from the server, as received.
-  double serverFps = 0.0;
+  // The server's Stats messages: the first and the last, as (seconds from
+  // the run's start when it arrived, its frames_sent), and the last one's
+  // session count.
+  std::optional<std::pair<double, std::uint64_t>> firstStats, lastStats;
   std::uint32_t serverSessions = 0;
+
+  // The frames the server says it sent between the first and the last
+  // Stats, over the time between them: its frame rate through the run
+  // (each Stats' own fps covers its last second only, 0 once the poses
+  // stop). nullopt with fewer than two Stats (a run shorter than the
+  // server's Stats period).
+  std::optional<double> serverFps() const;
 };
 
 struct RunSummary {
