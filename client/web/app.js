@@ -17,6 +17,7 @@
 //   ?resolution=auto|360p|540p|720p|1080p (or ?size=WxH, fixed)
 //   &encoding=jpeg|png|raw|h264&quality=85&fps=30&token=T
 //   &method=fused&level=4&k=256&exposure=auto|STOPS&scene=NAME
+import './save_frame.js';  // the save button and s: the frame as a PNG
 import './view_input.js';  // drags, pinches, the wheel and the reset button steer the view
 import { endBuild, expectBuild, showBuildProgress } from './build_view.js';
 import { onFrame, startH264View } from './frames.js';

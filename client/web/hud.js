@@ -10,6 +10,7 @@ import { idleText } from './build_status.js';
 import { FrameWindow, formatNumber, formatStops } from './frame_stats.js';
 import { state } from './page_state.js';
 import { resolutionLabel } from './resolution.js';
+import { onShortcut } from './shortcuts.js';
 import { showReconnectCountdown } from './session.js';
 
 const $ = (id) => document.getElementById(id);
@@ -43,10 +44,7 @@ window.addEventListener('resize', () => {
   if (!userChose) setHudFolded(window.innerWidth < HUD_FOLDED_BELOW_PX);
 });
 $('hud-toggle').addEventListener('click', toggle);
-document.addEventListener('keydown', (e) => {
-  if (e.target instanceof HTMLInputElement || e.target instanceof HTMLSelectElement) return;
-  if (e.key === 'h' && !e.ctrlKey && !e.metaKey && !e.altKey) toggle();
-});
+onShortcut('h', toggle);
 
 export function updateHud() {
   const s = frameWindow.summary(performance.now());

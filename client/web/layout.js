@@ -1,6 +1,8 @@
 // The canvas on the page: it keeps the frame's aspect ratio at any window
 // size, so a frame is never stretched, and it can take the whole window
 // (f / Esc, or the button on the view) for a closer look.
+import { onShortcut } from './shortcuts.js';
+
 const $ = (id) => document.getElementById(id);
 
 export const canvas = $('frame');
@@ -42,8 +44,5 @@ function setFullWindow(on) {
 }
 $('fullwindow').addEventListener('click', () => setFullWindow(!fullWindow));
 document.addEventListener('fullscreenchange', () => { if (!document.fullscreenElement && fullWindow) setFullWindow(false); });
-document.addEventListener('keydown', (e) => {
-  if (e.target instanceof HTMLInputElement || e.target instanceof HTMLSelectElement) return;
-  if (e.key === 'f' && !e.ctrlKey && !e.metaKey && !e.altKey) setFullWindow(!fullWindow);
-  else if (e.key === 'Escape' && fullWindow) setFullWindow(false);
-});
+onShortcut('f', () => setFullWindow(!fullWindow));
+onShortcut('Escape', () => { if (fullWindow) setFullWindow(false); });

@@ -46,7 +46,7 @@
 // usage: node browser_e2e.mjs --haarcast BUILD/bin/haarcast [--chromium /usr/bin/chromium]
 //        [--out DIR] [--page-query 'size=96x96&encoding=jpeg'] [-- extra `serve` args]
 import { spawn } from 'node:child_process';
-import { mkdirSync, mkdtempSync, rmSync, symlinkSync, writeFileSync } from 'node:fs';
+import { mkdirSync, mkdtempSync, readFileSync, rmSync, symlinkSync, writeFileSync } from 'node:fs';
 import { createRequire } from 'node:module';
 import net from 'node:net';
 import { tmpdir } from 'node:os';
@@ -677,6 +677,38 @@ try {
   const leftFull = await page.evaluate(() => !document.getElementById('app').classList.contains('fullwindow') &&
                                              !document.fullscreenElement);
   check(leftFull, 'Escape leaves the full window');
+
+  // Save the frame: the button, then s with focus left on a radio button
+  // (a click leaves it there; the shortcuts must still work). Both give a
+  // PNG of the stream's own size whose pixels are the canvas's.
+  const savedFrame = async (trigger, what) => {
+    const [download] = await Promise.all([page.waitForEvent('download', { timeout: 10000 }), trigger()]);
+    const name = download.suggestedFilename();
+    const png = decodePng(readFileSync(await download.path()));
+    const shown = await page.evaluate(() => ({ w: document.getElementById('frame').width,
+                                               h: document.getElementById('frame').height,
+                                               last: [window.haarcast.lastFrame.width, window.haarcast.lastFrame.height] }));
+    const canvas = await canvasPixels(page);
+    let diff = 0;
+    for (let i = 0, j = 0; i < canvas.length; i += 4, j += png.channels) {
+      for (let c = 0; c < 3; c++) diff = Math.max(diff, Math.abs(canvas[i + c] - png.pixels[j + c]));
+    }
+    check(/^haarcast-default-\d+x\d+-\d{8}-\d{6}\.png$/.test(name) && png.width === shown.w && png.height === shown.h &&
+          shown.w === shown.last[0] && shown.h === shown.last[1] && diff === 0,
+          `${what}: ${name}, ${png.width}×${png.height} (the stream's ${shown.last.join('×')}), ` +
+          `the canvas's pixels to ${diff} levels`);
+  };
+  await savedFrame(() => page.click('#save-frame'), 'the save button');
+  await page.check('input[name="drag"][value="light"]');
+  await page.check('input[name="drag"][value="camera"]');
+  const focusType = await page.evaluate(() => document.activeElement && document.activeElement.type);
+  await savedFrame(() => page.keyboard.press('s'), `s with focus on a ${focusType}`);
+  await page.keyboard.press('f');
+  await page.waitForTimeout(300);
+  const fullFromRadio = await page.evaluate(() => document.getElementById('app').classList.contains('fullwindow'));
+  await page.keyboard.press('Escape');
+  await page.waitForTimeout(300);
+  check(focusType === 'radio' && fullFromRadio, `f with focus on a ${focusType} takes the full window`);
 
   s = await state();
   check(s.errors.length === expectedErrors, `no other server errors (${JSON.stringify(s.errors)})`);

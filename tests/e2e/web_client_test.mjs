@@ -20,6 +20,7 @@ const { DRAG_DEGREES_PER_PIXEL, dragOrbit, orbitEye, orbitFromCamera, pinchOrbit
 const { AutoResolution, FIRST_LIMITS, FPS_FLOOR, autoSteps, fpsFloor, frameSize, sizeWithin } =
   await import(pathToFileURL(join(web, 'stream_size.js')));
 const { describeBuild, formatSeconds, idleText } = await import(pathToFileURL(join(web, 'build_status.js')));
+const { takesTyping } = await import(pathToFileURL(join(web, 'shortcuts.js')));
 
 const tests = [];
 const test = (name, fn) => tests.push({ name, fn });
@@ -552,6 +553,20 @@ test('H.264 view: a delta frame before any keyframe asks for one keyframe, then 
     delete globalThis.VideoDecoder;
     delete globalThis.EncodedVideoChunk;
   }
+});
+
+test('shortcuts: keys go to the page except where they type', () => {
+  const input = (type) => ({ tagName: 'INPUT', type });
+  for (const type of ['checkbox', 'radio', 'range', 'button', 'color']) assert.equal(takesTyping(input(type)), false, type);
+  for (const type of ['text', 'number', 'search', 'email', 'password', 'TEXT']) assert.equal(takesTyping(input(type)), true, type);
+  assert.equal(takesTyping({ tagName: 'INPUT' }), true, 'an input without a type is a text field');
+  assert.equal(takesTyping({ tagName: 'select' }), true, "a select's letters pick its options");
+  assert.equal(takesTyping({ tagName: 'TEXTAREA' }), true);
+  assert.equal(takesTyping({ tagName: 'DIV', isContentEditable: true }), true);
+  assert.equal(takesTyping({ tagName: 'CANVAS', isContentEditable: false }), false);
+  assert.equal(takesTyping({ tagName: 'BUTTON' }), false);
+  assert.equal(takesTyping(null), false);
+  assert.equal(takesTyping({}), false, 'the document: no tag');
 });
 
 let failed = 0;
