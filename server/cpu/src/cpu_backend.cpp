@@ -88,9 +88,11 @@ class CpuRenderer final : public Renderer {
 
   std::string backend() const override { return std::string(kCpuBackend); }
   std::string deviceName() const override {
-    // The SIMD target the fused pass dispatched to on this machine, for reports.
-    return "cpu reference (" + std::to_string(hardwareThreads(options_.threads)) + " threads" +
-           (options_.method == RotationMethod::Fused ? ", " + fusedTargetName() : std::string()) + ")";
+    // The threads and the SIMD target the fused pass dispatched to on this
+    // machine, for reports. (Not "reference": that is the Monte Carlo truth,
+    // `haarcast reference`.)
+    return std::to_string(hardwareThreads(options_.threads)) + " CPU threads" +
+           (options_.method == RotationMethod::Fused ? ", " + fusedTargetName() + " kernels" : std::string());
   }
   const RenderOptions& options() const override { return options_; }
   std::size_t objectCount() const override { return prepared_.objects.size(); }
