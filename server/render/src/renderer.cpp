@@ -84,7 +84,7 @@ PreparedScene prepareScene(const Scene& scene, const RenderOptions& options, con
       const SceneObject& object = scene.objects[k];
       const std::size_t v = object.mesh->positions.size();
       bound += perVertex(levels[k].level) *
-               (object.ground ? v : std::max(static_cast<std::size_t>(refine.growth * static_cast<double>(v)), refine.floor));
+               (object.ground ? v : refineVertexBudget(v, refine));
     }
     if (bound > options.sceneLimits.maxVisibilityBytes) refine.rounds = 0;
   }

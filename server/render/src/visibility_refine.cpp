@@ -165,8 +165,7 @@ RefinedVisibility refineVisibility(const RayScene& occluders, const Mesh& mesh, 
   Mesh& m = out.mesh;
   const DirectionTable table(options.level);
   const double minEdge = refine.minEdge * mesh.bounds().radius();
-  const std::size_t maxVertices =
-      std::max(static_cast<std::size_t>(refine.growth * static_cast<double>(mesh.positions.size())), refine.floor);
+  const std::size_t maxVertices = refineVertexBudget(mesh.positions.size(), refine);
 
   for (int round = 0; round < refine.rounds; ++round) {
     // Each position edge's largest disagreement over the index edges on it.
@@ -241,11 +240,20 @@ RefinedVisibility refineVisibility(const RayScene& occluders, const Mesh& mesh, 
     std::vector<std::uint32_t> words(grown.pointCount() * grown.wordsPerPoint(), 0u);
     std::copy(out.bits.words().begin(), out.bits.words().end(), words.begin());
     grown.assign(words);
-    computeVisibilityBitsFrom(occluders, m, options, first, grown, progress);
+    // Every vertex with bits so far, against the budget (the header).
+    const auto cumulative = [&](std::size_t done, std::size_t /*added*/) {
+      if (progress) progress(std::min(first + done, maxVertices), maxVertices);
+    };
+    computeVisibilityBitsFrom(occluders, m, options, first, grown, cumulative);
     out.bits = std::move(grown);
     ++out.rounds;
   }
+  if (progress) progress(maxVertices, maxVertices);
   return out;
+}
+
+std::size_t refineVertexBudget(std::size_t vertices, const RefineOptions& refine) {
+  return std::max({static_cast<std::size_t>(refine.growth * static_cast<double>(vertices)), refine.floor, vertices});
 }
 
 RefinedVisibility computeRefinedVisibility(const Mesh& mesh, const VisibilityOptions& options,
@@ -255,7 +263,11 @@ RefinedVisibility computeRefinedVisibility(const Mesh& mesh, const VisibilityOpt
   Mesh withNormals = mesh;
   if (withNormals.normals.empty()) withNormals.computeNormals();
   const RayScene scene({Instance{&withNormals}});
-  VisibilityBits bits = computeVisibilityBits(scene, withNormals, options, progress);
+  // The mesh's own vertices first, on the same scale as the rounds after.
+  const std::size_t budget = refineVertexBudget(withNormals.positions.size(), refine);
+  VisibilityBits bits = computeVisibilityBits(scene, withNormals, options, [&](std::size_t done, std::size_t /*total*/) {
+    if (progress) progress(std::min(done, budget), budget);
+  });
   return refineVisibility(scene, withNormals, std::move(bits), options, refine, progress);
 }
 

@@ -11,6 +11,7 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <mutex>
 #include <map>
 #include <random>
 #include <stdexcept>
@@ -153,6 +154,40 @@ TEST(VisibilityRefine, NewVerticesHaveTheirRaysBitsAndFewEdgesStillDisagree) {
   EXPECT_LT(after, 0.25 * before) << "disagreeing edges: " << before << " of the original's, " << after
                                   << " of the refined mesh's (" << r.rounds << " rounds, "
                                   << r.mesh.positions.size() << " vertices)";
+}
+
+// One progress over the whole computation: the mesh's vertices and each
+// round's, against the vertex budget, never going back, ending at the budget.
+TEST(VisibilityRefine, ProgressCountsEveryRoundAgainstTheBudgetAndNeverGoesBack) {
+  const Mesh mesh = slabWithPillars();
+  RefineOptions refine;
+  refine.rounds = 3;
+  const std::size_t budget = refineVertexBudget(mesh.positions.size(), refine);
+  ASSERT_GE(budget, mesh.positions.size());
+  std::mutex lock;  // the progress comes from the worker threads
+  std::vector<std::pair<std::size_t, std::size_t>> calls;
+  const RefinedVisibility r = computeRefinedVisibility(mesh, level4(), refine, [&](std::size_t done, std::size_t total) {
+    const std::lock_guard<std::mutex> hold(lock);
+    calls.emplace_back(done, total);
+  });
+  ASSERT_GE(r.rounds, 1) << "the test needs a round that adds vertices";
+  ASSERT_FALSE(calls.empty());
+  std::size_t backwards = 0, past = 0, highest = 0;
+  bool beyondTheMesh = false;
+  for (const auto& [done, total] : calls) {
+    EXPECT_EQ(total, budget);
+    past += done > total ? 1 : 0;
+    // Workers report in the order they finish: small steps back within a
+    // pass are allowed; a pass restarting from 0 (the old per-round count)
+    // is not.
+    backwards += done + 64 < highest ? 1 : 0;
+    highest = std::max(highest, done);
+    beyondTheMesh = beyondTheMesh || done > mesh.positions.size();
+  }
+  EXPECT_EQ(backwards, 0u) << "the count went back by more than the workers' reordering";
+  EXPECT_EQ(past, 0u);
+  EXPECT_TRUE(beyondTheMesh) << "a round's vertices count after the mesh's own";
+  EXPECT_EQ(calls.back(), std::pair(budget, budget));
 }
 
 TEST(VisibilityRefine, TheBlendComesCloserToTheRaysInsideTriangles) {

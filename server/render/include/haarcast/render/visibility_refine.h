@@ -54,12 +54,20 @@ struct RefinedVisibility {
 // Refines `mesh` (with normals) whose vertices' bits are `bits` (computed
 // against `occluders` under `options`, as computeVisibilityBits does); the
 // added vertices' bits are cast against the same occluders. progress(done,
-// total) counts the added vertices of the round under way.
+// total) counts vertices against the budget, refineVertexBudget: done is
+// every vertex with bits so far (the mesh's own, then each round's added
+// ones), so it never goes back from one round to the next; the last call
+// is (budget, budget), however many rounds stopped short of it.
 RefinedVisibility refineVisibility(const RayScene& occluders, const Mesh& mesh, VisibilityBits bits,
                                    const VisibilityOptions& options, const RefineOptions& refine,
                                    const std::function<void(std::size_t done, std::size_t total)>& progress = {});
 
-// The same against the mesh alone: bits computed, then refined.
+// The most vertices refinement may give a mesh of `vertices`: max(growth ×
+// vertices, floor), and never fewer than it has.
+std::size_t refineVertexBudget(std::size_t vertices, const RefineOptions& refine);
+
+// The same against the mesh alone: bits computed, then refined; one
+// progress over both, against the budget.
 RefinedVisibility computeRefinedVisibility(const Mesh& mesh, const VisibilityOptions& options,
                                            const RefineOptions& refine,
                                            const std::function<void(std::size_t done, std::size_t total)>& progress = {});
