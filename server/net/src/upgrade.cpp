@@ -19,6 +19,21 @@ void limitRequestParser(http::request_parser<http::string_body>& parser) {
 
 std::optional<UpgradeRefusal> checkHost(const HttpRequest& request, const ServerOptions& options,
                                         const std::string& address) {
+  // RFC 9112 §3.2: an HTTP/1.1 request has exactly one Host field. With two,
+  // which one names the server is a guess (a proxy and this server may
+  // guess differently); without one (HTTP/1.1), the name check below would
+  // have nothing to check. HTTP/1.0 may omit it.
+  std::size_t hosts = 0;
+  for (const auto& field : request.base()) hosts += field.name() == http::field::host ? 1 : 0;
+  if (hosts > 1 || (hosts == 0 && request.version() >= 11)) {
+    UpgradeRefusal r;
+    r.status = http::status::bad_request;
+    r.body = hosts > 1 ? "bad request: " + std::to_string(hosts) + " Host header fields (HTTP/1.1 takes exactly one)\n"
+                       : std::string("bad request: no Host header field (HTTP/1.1 requires one)\n");
+    r.metric = "host";
+    r.logLine = "request from " + address + " refused: " + std::to_string(hosts) + " Host header fields";
+    return r;
+  }
   const std::string_view host = view(request[http::field::host]);
   if (hostAllowed(host, options.allowHosts)) return std::nullopt;
   UpgradeRefusal r;

@@ -56,6 +56,26 @@ TEST(HostileClient, DnsRebindingIsRefusedByTheHostCheck) {
   EXPECT_EQ(metric(port, "haarcast_refusals_total{reason=\"host\"}"), 3);
 }
 
+// RFC 9112 §3.2: two Host fields, or none in HTTP/1.1, are a bad request,
+// for every path the host check guards (probes answer whatever the Host).
+TEST(HostileClient, TwoHostFieldsOrNoneAre400) {
+  auto options = testOptions();
+  options.token.clear();
+  TestServer server(options);
+  const auto port = server.port();
+  EXPECT_EQ(rawStatusLine(port, "GET /metrics HTTP/1.1\r\nHost: 127.0.0.1\r\nHost: evil.example\r\n\r\n").substr(0, 3), "400");
+  EXPECT_EQ(rawStatusLine(port, "GET /metrics HTTP/1.1\r\nHost: 127.0.0.1\r\nHost: 127.0.0.1\r\n\r\n").substr(0, 3), "400");
+  EXPECT_EQ(rawStatusLine(port, "GET /metrics HTTP/1.1\r\n\r\n").substr(0, 3), "400");
+  EXPECT_EQ(rawStatusLine(port, "GET /ws HTTP/1.1\r\nHost: a\r\nHost: b\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+                                "Sec-WebSocket-Version: 13\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n\r\n")
+                .substr(0, 3),
+            "400");
+  EXPECT_EQ(rawStatusLine(port, "GET /metrics HTTP/1.0\r\n\r\n").substr(0, 3), "200") << "HTTP/1.0 may omit the Host";
+  EXPECT_EQ(rawStatusLine(port, "GET /metrics HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n").substr(0, 3), "200");
+  EXPECT_EQ(rawStatusLine(port, "GET /healthz HTTP/1.1\r\nHost: a\r\nHost: b\r\n\r\n"), "200 ok\n") << "probes answer";
+  EXPECT_EQ(metric(port, "haarcast_refusals_total{reason=\"host\"}"), 4);
+}
+
 TEST(HostileClient, UnknownTransferCodingsAre400) {
   TestServer server;
   const auto port = server.port();
