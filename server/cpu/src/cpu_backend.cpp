@@ -91,8 +91,8 @@ class CpuRenderer final : public Renderer {
     // The threads and the SIMD target the fused pass dispatched to on this
     // machine, for reports. (Not "reference": that is the Monte Carlo truth,
     // `haarcast reference`.)
-    return std::to_string(hardwareThreads(options_.threads)) + " CPU threads" +
-           (options_.method == RotationMethod::Fused ? ", " + fusedTargetName() + " kernels" : std::string());
+    return "cpu (" + std::to_string(hardwareThreads(options_.threads)) + " threads" +
+           (options_.method == RotationMethod::Fused ? ", " + fusedTargetName() + " kernels" : std::string()) + ")";
   }
   const RenderOptions& options() const override { return options_; }
   std::size_t objectCount() const override { return prepared_.objects.size(); }
