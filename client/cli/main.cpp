@@ -3,9 +3,11 @@
 // bytes per frame (a progress line on stderr, a --json summary on stdout).
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <iostream>
 #include <map>
 #include <string>
@@ -339,8 +341,18 @@ int run(int argc, char** argv) {
         io, i, std::move(config), summary.sessions[i], [&progress](const FrameEvent& e) { progress.frame(e); },
         [&progress](const std::string& line) { progress.message(line); },
         [&progress](std::size_t client, const haarcast::v1::BuildProgress* p) { progress.build(client, p); });
-    sessions.back().start();
   }
+  // At most kPendingClients sessions between their connection and the
+  // server's first answer: the server keeps a per-address pre-Hello budget
+  // (--max-pending-per-address, 8 by default), and 16 upgrades at once from
+  // this one address lost half of them to it. Each answer starts the next.
+  constexpr std::size_t kPendingClients = 4;
+  std::size_t nextToStart = 0;
+  std::function<void()> startNext;
+  startNext = [&] {
+    if (nextToStart < sessions.size()) sessions[nextToStart++].start(startNext);
+  };
+  for (std::size_t k = 0; k < std::min<std::size_t>(kPendingClients, sessions.size()); ++k) startNext();
   io.run();
   progress.endLine();
 

@@ -49,6 +49,7 @@ struct Session::Impl : std::enable_shared_from_this<Session::Impl> {
   FrameCallback onFrame;
   MessageCallback onMessage;
   BuildCallback onBuild;
+  std::function<void()> answered;  // Session::start's, until called
 
   tcp::resolver resolver;
   websocket::stream<beast::tcp_stream> ws;
@@ -80,7 +81,16 @@ struct Session::Impl : std::enable_shared_from_this<Session::Impl> {
 
   // The session ends here on any failure, once: the reason is kept for the
   // summary and the exit code, and the socket is closed.
+  // Once: the server has answered, or the session is over.
+  void markAnswered() {
+    if (!answered) return;
+    const auto callback = std::move(answered);
+    answered = nullptr;
+    callback();
+  }
+
   void fail(const std::string& why) {
+    markAnswered();
     if (stats.failure.empty()) {
       stats.failure = why;
       onMessage(who() + why);
@@ -223,6 +233,7 @@ struct Session::Impl : std::enable_shared_from_this<Session::Impl> {
       return fail("the server sent " + std::to_string(bytes) + " bytes that are not a haarcast.v1.ServerMessage");
     }
     readBuffer.consume(readBuffer.size());
+    markAnswered();
     switch (message.body_case()) {
       case v1::ServerMessage::kWelcome: onWelcome(message.welcome()); break;
       case v1::ServerMessage::kFrame: onFrameMessage(message.frame(), bytes); break;
@@ -459,7 +470,10 @@ Session::Session(asio::io_context& io, std::size_t index, SessionConfig config, 
     : impl_(std::make_shared<Impl>(io, index, std::move(config), stats, std::move(onFrame), std::move(onMessage),
                                    std::move(onBuild))) {}
 
-void Session::start() { impl_->start(); }
+void Session::start(std::function<void()> answered) {
+  impl_->answered = std::move(answered);
+  impl_->start();
+}
 
 const v1::Welcome& Session::welcome() const { return impl_->welcome; }
 

@@ -89,6 +89,12 @@ for c in 0 1; do
   fi
 done
 
+# Sixteen clients in one process against the server's default caps (8
+# connections per address before their Hello): the client keeps at most 4
+# waiting for the server's first answer, so every one gets its frames.
+expect "sixteen clients, default caps" 0 "" -- "$client_bin" "$url" --token sekret --size 32x32 --clients 16 \
+  --frames 2 --quiet --timeout 60
+
 kill -TERM "$server_pid"
 rc=""
 for ((i = 0; i < 300; i++)); do

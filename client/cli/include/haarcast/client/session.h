@@ -55,7 +55,11 @@ class Session {
 
   Session(boost::asio::io_context& io, std::size_t index, SessionConfig config, SessionStats& stats,
           FrameCallback onFrame, MessageCallback onMessage, BuildCallback onBuild = {});
-  void start();
+  // Connects, upgrades and sends the Hello. `answered`, if given, is called
+  // once: when the server first answers (any message) or the session fails,
+  // i.e. when the connection no longer holds one of the server's pre-Hello
+  // slots (--max-pending-per-address).
+  void start(std::function<void()> answered = {});
   // The Welcome as received (empty before it arrives).
   const v1::Welcome& welcome() const;
 
