@@ -52,12 +52,21 @@ std::string grpcPeerGroup(std::string_view peer) {
 std::optional<GrpcRefusal> checkGrpcToken(std::string_view authorization, const std::string& serverToken,
                                           TokenGuard& guard, const std::string& address, Clock::time_point now) {
   if (serverToken.empty()) return std::nullopt;
-  if (guard.locked(address, now)) {
-    return GrpcRefusal{GrpcCode::ResourceExhausted, "too many wrong tokens from " + address + ": try again later",
-                       "token_rate"};
+  // As the upgrade (upgrade.cpp checkUpgrade): which lock holds, by its own
+  // label; the right token recorded, so that a known client passes a
+  // server-wide lock that a spray from many addresses has set.
+  if (const auto lock = guard.check(address, now); lock != TokenGuard::Lock::None) {
+    const bool server = lock == TokenGuard::Lock::Server;
+    return GrpcRefusal{GrpcCode::ResourceExhausted,
+                       server ? "too many wrong tokens on this server from many addresses: try again later"
+                              : "too many wrong tokens from " + address + ": try again later",
+                       server ? "token_rate_server" : "token_rate"};
   }
   const std::string given = bearerToken(authorization);
-  if (tokensEqual(given, serverToken)) return std::nullopt;
+  if (tokensEqual(given, serverToken)) {
+    guard.succeeded(address, now);
+    return std::nullopt;
+  }
   if (!given.empty()) guard.failed(address, now);  // a guess; no token is not one
   return GrpcRefusal{GrpcCode::Unauthenticated,
                      given.empty() ? "no token: send the metadata `authorization: Bearer <token>`" : "wrong token",

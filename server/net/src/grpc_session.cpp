@@ -71,7 +71,9 @@ void GrpcSession::open() {
                                     Clock::now())) {
     server_.metrics.addRefusal(refusal->metric);
     if (refusal->code == GrpcCode::Unauthenticated) server_.metrics.addError(errorLabel(v1::ERROR_CODE_UNAUTHORIZED));
-    server_.log("%s: gRPC stream from %s refused: %s", id_.c_str(), address_.c_str(), refusal->message.c_str());
+    // Through the refusal log, as the upgrade's: a line per address a
+    // period and a summary, not a line per guess of a spray.
+    server_.logRefusal(address_, "gRPC stream from " + address_ + " refused: " + refusal->message);
     finishCall(status(refusal->code, refusal->message));
     return;
   }

@@ -65,5 +65,20 @@ TEST(GrpcRules, TokenInMetadataIsCheckedAndWrongOnesAreGuesses) {
   EXPECT_FALSE(checkGrpcToken("Bearer s3cret", "s3cret", guard, "b", now)) << "another address is not";
 }
 
+// A spray from many addresses sets the server-wide lock: it is named as
+// such, and a client that has shown the right token before still passes.
+TEST(GrpcRules, AServerWideLockSparesKnownClients) {
+  TokenGuard guard({100, 60.0, 60.0, 10, 4096});
+  const auto now = Clock::now();
+  EXPECT_FALSE(checkGrpcToken("Bearer s3cret", "s3cret", guard, "known", now));
+  for (int i = 0; i < 10; ++i) checkGrpcToken("Bearer guess", "s3cret", guard, "sprayer-" + std::to_string(i), now);
+  const auto newcomer = checkGrpcToken("Bearer s3cret", "s3cret", guard, "new", now);
+  ASSERT_TRUE(newcomer) << "an address that never showed the token waits out the server-wide lock";
+  EXPECT_EQ(newcomer->code, GrpcCode::ResourceExhausted);
+  EXPECT_EQ(newcomer->metric, "token_rate_server");
+  EXPECT_NE(newcomer->message.find("many addresses"), std::string::npos) << newcomer->message;
+  EXPECT_FALSE(checkGrpcToken("Bearer s3cret", "s3cret", guard, "known", now)) << "a known client goes on";
+}
+
 }  // namespace
 }  // namespace haarcast::net
