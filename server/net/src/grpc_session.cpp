@@ -89,11 +89,35 @@ void GrpcSession::open() {
   server_.metrics.pending.fetch_add(1);
   registry_.add(this, weak_from_this());
   registered_ = true;
+  // A newcomer from another address may take this stream's pre-Hello slot
+  // while the budget is full (admission.h): then it ends, as a WebSocket
+  // connection does, on its own executor.
+  const bool held = pendingSlot_.onEvicted([weak = weak_from_this(), executor = executor_] {
+    asio::post(executor, [weak] {
+      if (auto self = weak.lock()) self->evicted();
+    });
+  });
+  if (!held) {
+    evicted();
+    return;
+  }
   server_.log("%s: opened from %s (gRPC)", id_.c_str(), address_.c_str());
   StartRead(&in_);
   tick();
   // stop() may have taken its list of sessions just before this one joined.
   if (server_.stopping.load()) shutdown();
+}
+
+void GrpcSession::evicted() {
+  if (finished_ || sessionSlot_) return;  // said Hello in the meantime: a session now
+  if (pendingSlot_) {
+    pendingSlot_.release();  // no longer counted (the eviction uncounted it)
+    server_.metrics.pending.fetch_sub(1);
+  }
+  server_.metrics.addCut("pending_evicted");
+  server_.log("%s: cut: no Hello yet, and the pre-Hello budget is full (gRPC)", id_.c_str());
+  finishCall(status(GrpcCode::ResourceExhausted,
+                    "no Hello yet, and the pre-Hello budget is full: a connection from another address took its place"));
 }
 
 void GrpcSession::shutdown() {

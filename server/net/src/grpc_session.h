@@ -71,6 +71,7 @@ class GrpcSession : public grpc::ServerBidiReactor<grpc::ByteBuffer, grpc::ByteB
 
   // The strand.
   void open();
+  void evicted();  // the pre-Hello budget gave this stream's slot to a newcomer
   void onRead(std::string bytes);
   void onReadEnded();
   void doWrite();

@@ -288,6 +288,31 @@ TEST(GrpcServer, ReflectionV1ListsAndDescribesTheServices) {
   EXPECT_TRUE(stream->Finish().ok());
 }
 
+// The pre-Hello budget holds for gRPC streams: when a newcomer from another
+// address takes a silent stream's slot, that stream ends (it used to stay
+// open, uncounted) with RESOURCE_EXHAUSTED, and the live pending count
+// stays within the budget.
+TEST(GrpcServer, AnEvictedSilentStreamIsEnded) {
+  ServerOptions o = grpcOptions();
+  o.admission.pending = 2;
+  o.admission.pendingPerAddress = 2;
+  TestServer server(o);
+  const auto grpcPort = server.server().grpcPort();
+  GrpcClient first(grpcPort), second(grpcPort);  // silent: no Hello
+  ASSERT_TRUE(eventually([&] { return metric(server.port(), "haarcast_pending_connections") == 2; }));
+  Client newcomer(server.port(), std::string("/ws?token=") + kToken, 0, "127.0.0.7");
+  ASSERT_TRUE(newcomer.connected());
+  newcomer.handshake();
+  const grpc::Status ended = first.statusAfterReading();  // the oldest of the largest holder
+  EXPECT_EQ(ended.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED) << ended.error_message();
+  EXPECT_NE(ended.error_message().find("pre-Hello budget is full"), std::string::npos) << ended.error_message();
+  EXPECT_EQ(metric(server.port(), "haarcast_session_cuts_total{reason=\"pending_evicted\"}"), 1);
+  EXPECT_TRUE(eventually([&] { return metric(server.port(), "haarcast_pending_connections") <= 2; }));
+  second.send(hello());
+  EXPECT_TRUE(second.expect(v1::ServerMessage::kWelcome)) << "the other silent stream is still served";
+  second.finish();
+}
+
 TEST(GrpcServer, SessionSlotsAreSharedWithWebSocketSessions) {
   ServerOptions o = grpcOptions();
   o.admission.sessionsPerAddress = 1;
