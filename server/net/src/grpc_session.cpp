@@ -101,7 +101,9 @@ void GrpcSession::open() {
     evicted();
     return;
   }
-  server_.log("%s: opened from %s (gRPC)", id_.c_str(), address_.c_str());
+  // No log line yet: a stream costs one only once its Hello is valid
+  // (admit), so that streams opened and reset by the thousand cannot flood
+  // the log.
   StartRead(&in_);
   tick();
   // stop() may have taken its list of sessions just before this one joined.
@@ -115,7 +117,8 @@ void GrpcSession::evicted() {
     server_.metrics.pending.fetch_sub(1);
   }
   server_.metrics.addCut("pending_evicted");
-  server_.log("%s: cut: no Hello yet, and the pre-Hello budget is full (gRPC)", id_.c_str());
+  server_.logRefusal(address_, id_ + ": gRPC stream from " + address_ +
+                                   " cut: no Hello yet, and the pre-Hello budget is full");
   finishCall(status(GrpcCode::ResourceExhausted,
                     "no Hello yet, and the pre-Hello budget is full: a connection from another address took its place"));
 }
@@ -151,7 +154,7 @@ void GrpcSession::OnWriteDone(bool ok) {
 void GrpcSession::OnCancel() {
   asio::post(executor_, [self = shared_from_this()] {
     if (self->finished_) return;
-    self->server_.log("%s: cancelled (the client went away, or its deadline passed)", self->id_.c_str());
+    if (self->sessionSlot_) self->server_.log("%s: cancelled (the client went away, or its deadline passed)", self->id_.c_str());
     self->finishCall(grpc::Status::CANCELLED);
   });
 }
@@ -177,7 +180,7 @@ void GrpcSession::onRead(std::string bytes) {
 // (then OnCancel comes too): what is queued goes out, then Finish(OK).
 void GrpcSession::onReadEnded() {
   if (finished_ || closeRequested_) return;
-  server_.log("%s: the client ended its stream", id_.c_str());
+  if (sessionSlot_) server_.log("%s: the client ended its stream", id_.c_str());
   session_.end();
   closeRequested_ = true;
   closeAt_ = Clock::now();
@@ -243,6 +246,7 @@ std::optional<ProtocolError> GrpcSession::admit() {
     return ProtocolError{v1::ERROR_CODE_TOO_MANY_SESSIONS, refusal.reason, true};
   }
   sessionSlot_ = std::move(*slot);
+  server_.log("%s: opened from %s (gRPC)", id_.c_str(), address_.c_str());
   server_.metrics.sessions.fetch_add(1);
   server_.metrics.sessionsTotal.fetch_add(1);
   server_.metrics.grpcSessions.fetch_add(1);
@@ -316,7 +320,7 @@ void GrpcSession::finishCall(grpc::Status finalStatus) {
   paceTimer_.cancel();
   if (!registered_) return;  // refused before it opened: nothing was started
   server_.renderService->withdraw(id_);
-  logClosed(server_, id_, session_);
+  if (sessionSlot_) logClosed(server_, id_, session_);  // the line that "opened" began
 }
 
 // Cuts the call: operations in flight fail, the client sees CANCELLED.

@@ -313,6 +313,34 @@ TEST(GrpcServer, AnEvictedSilentStreamIsEnded) {
   second.finish();
 }
 
+// A stream writes no log line before its Hello: a thousand streams opened
+// and reset (HTTP/2 rapid reset) must not write two thousand lines. One
+// that says Hello is logged from "opened" to "closed".
+TEST(GrpcServer, StreamsAreLoggedFromTheirHelloOn) {
+  TestServer server(grpcOptions());
+  const auto grpcPort = server.server().grpcPort();
+  testing::internal::CaptureStderr();
+  for (int i = 0; i < 5; ++i) {
+    GrpcClient silent(grpcPort);
+    ASSERT_TRUE(eventually([&] { return metric(server.port(), "haarcast_pending_connections") == 1; }));
+    silent.context().TryCancel();
+    ASSERT_TRUE(eventually([&] { return metric(server.port(), "haarcast_pending_connections") == 0; }));
+  }
+  const std::string silentLog = testing::internal::GetCapturedStderr();
+  EXPECT_EQ(silentLog.find("[serve]"), std::string::npos) << silentLog;
+  testing::internal::CaptureStderr();
+  {
+    GrpcClient client(grpcPort);
+    client.send(hello());
+    ASSERT_TRUE(client.expect(v1::ServerMessage::kWelcome));
+    client.finish();
+  }
+  ASSERT_TRUE(eventually([&] { return metric(server.port(), "haarcast_sessions") == 0; }));
+  const std::string log = testing::internal::GetCapturedStderr();
+  EXPECT_NE(log.find("opened from 127.0.0.1 (gRPC)"), std::string::npos) << log;
+  EXPECT_NE(log.find(": closed ("), std::string::npos) << log;
+}
+
 TEST(GrpcServer, SessionSlotsAreSharedWithWebSocketSessions) {
   ServerOptions o = grpcOptions();
   o.admission.sessionsPerAddress = 1;
