@@ -278,8 +278,10 @@ sanitized_tests() {
   deploy/sanitize_build.sh "${SANITIZE_TESTS[@]}"
   for t in "${SANITIZE_TESTS[@]}"; do
     log "running $t (ASan + UBSan)"
+    # A limit per binary (the suite takes about 5 minutes here): a test that
+    # hangs on another machine fails the run instead of holding it.
     ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
-      "$dir/bin/$t" "$@" </dev/null || failed=1
+      timeout --kill-after=10 1800 "$dir/bin/$t" "$@" </dev/null || failed=1
   done
   return "$failed"
 }
@@ -385,7 +387,9 @@ case "$command" in
       dpkg --compare-versions "$(dpkg-query -W -f='${Version}' mesa-vulkan-drivers 2>/dev/null || echo 0)" ge 24.1; then
       export HAARCAST_REQUIRE_RAY_TRACING=1
     fi
-    exec ctest --test-dir "$BUILD_DIR" --output-on-failure "$@" </dev/null
+    # --timeout: the limit of a test that sets none of its own (each suite
+    # sets one; this catches a test added without).
+    exec ctest --test-dir "$BUILD_DIR" --output-on-failure --timeout 600 "$@" </dev/null
     ;;
   bench)
     bench_backend="${HAARCAST_BENCH_BACKEND:-both}"
