@@ -74,33 +74,31 @@ ServerReflectionResponse ReflectionV1Service::answer(const ServerReflectionReque
   ServerReflectionResponse out;
   out.set_valid_host(request.host());
   *out.mutable_original_request() = request;
+  // The file with its imports, or NOT_FOUND saying what was looked for.
+  auto answerFile = [&](const pb::FileDescriptor* file, const std::string& missing) {
+    if (file) {
+      addFile(file, sent, *out.mutable_file_descriptor_response());
+    } else {
+      notFound(out, missing);
+    }
+  };
   switch (request.message_request_case()) {
     case ServerReflectionRequest::kListServices:
       for (const std::string& name : services_) out.mutable_list_services_response()->add_service()->set_name(name);
       break;
     case ServerReflectionRequest::kFileByFilename:
-      if (const pb::FileDescriptor* f = pool->FindFileByName(request.file_by_filename())) {
-        addFile(f, sent, *out.mutable_file_descriptor_response());
-      } else {
-        notFound(out, "no file named " + request.file_by_filename());
-      }
+      answerFile(pool->FindFileByName(request.file_by_filename()), "no file named " + request.file_by_filename());
       break;
     case ServerReflectionRequest::kFileContainingSymbol:
-      if (const pb::FileDescriptor* f = pool->FindFileContainingSymbol(request.file_containing_symbol())) {
-        addFile(f, sent, *out.mutable_file_descriptor_response());
-      } else {
-        notFound(out, "no symbol named " + request.file_containing_symbol());
-      }
+      answerFile(pool->FindFileContainingSymbol(request.file_containing_symbol()),
+                 "no symbol named " + request.file_containing_symbol());
       break;
     case ServerReflectionRequest::kFileContainingExtension: {
       const auto& e = request.file_containing_extension();
       const pb::Descriptor* type = pool->FindMessageTypeByName(e.containing_type());
       const pb::FieldDescriptor* field = type ? pool->FindExtensionByNumber(type, e.extension_number()) : nullptr;
-      if (field) {
-        addFile(field->file(), sent, *out.mutable_file_descriptor_response());
-      } else {
-        notFound(out, "no extension " + std::to_string(e.extension_number()) + " of " + e.containing_type());
-      }
+      answerFile(field ? field->file() : nullptr,
+                 "no extension " + std::to_string(e.extension_number()) + " of " + e.containing_type());
       break;
     }
     case ServerReflectionRequest::kAllExtensionNumbersOfType:

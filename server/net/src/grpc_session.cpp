@@ -92,11 +92,7 @@ void GrpcSession::open() {
   // A newcomer from another address may take this stream's pre-Hello slot
   // while the budget is full (admission.h): then it ends, as a WebSocket
   // connection does, on its own executor.
-  const bool held = pendingSlot_.onEvicted([weak = weak_from_this(), executor = executor_] {
-    asio::post(executor, [weak] {
-      if (auto self = weak.lock()) self->evicted();
-    });
-  });
+  const bool held = endOnEviction(pendingSlot_, shared_from_this());
   if (!held) {
     evicted();
     return;
@@ -112,11 +108,7 @@ void GrpcSession::open() {
 
 void GrpcSession::evicted() {
   if (finished_ || sessionSlot_) return;  // said Hello in the meantime: a session now
-  if (pendingSlot_) {
-    pendingSlot_.release();  // no longer counted (the eviction uncounted it)
-    server_.metrics.pending.fetch_sub(1);
-  }
-  server_.metrics.addCut("pending_evicted");
+  countEviction(server_, pendingSlot_);
   server_.logRefusal(address_, id_ + ": gRPC stream from " + address_ +
                                    " cut: no Hello yet, and the pre-Hello budget is full");
   finishCall(status(GrpcCode::ResourceExhausted,

@@ -55,6 +55,9 @@ class GrpcSession : public grpc::ServerBidiReactor<grpc::ByteBuffer, grpc::ByteB
   RenderSession& renderSession() { return session_; }
   bool gone() const { return gone_; }
   const std::string& sessionId() const { return id_; }
+  // For session_jobs.h endOnEviction, on the strand: a newcomer took this
+  // stream's pre-Hello slot: end it.
+  void evicted();
 
  private:
   struct Outgoing {
@@ -71,7 +74,6 @@ class GrpcSession : public grpc::ServerBidiReactor<grpc::ByteBuffer, grpc::ByteB
 
   // The strand.
   void open();
-  void evicted();  // the pre-Hello budget gave this stream's slot to a newcomer
   void onRead(std::string bytes);
   void onReadEnded();
   void doWrite();

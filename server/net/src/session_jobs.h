@@ -136,6 +136,29 @@ inline const char* watchdogCut(Server::Impl& server, bool writing, Clock::time_p
   return nullptr;
 }
 
+// A transport's pre-Hello slot given to a newcomer from another address
+// while the budget is full (admission.h): Transport::evicted() runs on its
+// strand. Returns Slot::onEvicted's answer: false when the slot was taken
+// already, and the caller ends the transport at once.
+template <class Transport>
+bool endOnEviction(Admission::Slot& pending, const std::shared_ptr<Transport>& transport) {
+  return pending.onEvicted([weak = std::weak_ptr<Transport>(transport), executor = transport->executor()] {
+    boost::asio::post(executor, [weak] {
+      if (auto self = weak.lock()) self->evicted();
+    });
+  });
+}
+
+// What an evicted transport counts before it ends: its slot no longer
+// (the eviction uncounted it in Admission already), and the cut.
+inline void countEviction(Server::Impl& server, Admission::Slot& pending) {
+  if (pending) {
+    pending.release();
+    server.metrics.pending.fetch_sub(1);
+  }
+  server.metrics.addCut("pending_evicted");
+}
+
 // The session's last log line.
 inline void logClosed(Server::Impl& server, const std::string& id, const RenderSession& session) {
   server.log("%s: closed (%llu frames, %llu dropped, %llu bytes)", id.c_str(),

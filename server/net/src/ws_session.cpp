@@ -62,22 +62,14 @@ void WsSession::accept(http::request<http::string_body> request) {
   }
   // A newcomer may take this connection's pre-Hello slot while the budget
   // is full (admission.h): then it ends, on its own strand.
-  const bool held = pendingSlot_.onEvicted([weak = weak_from_this(), executor = executor_] {
-    asio::post(executor, [weak] {
-      if (auto self = weak.lock()) self->evicted();
-    });
-  });
+  const bool held = endOnEviction(pendingSlot_, shared_from_this());
   ws_.async_accept(request, [self = shared_from_this()](beast::error_code ec) { self->onAccept(ec); });
   if (!held) evicted();
 }
 
 void WsSession::evicted() {
   if (gone_ || sessionSlot_) return;  // said Hello in the meantime: a session now
-  if (pendingSlot_) {
-    pendingSlot_.release();  // no longer counted (the eviction uncounted it)
-    server_.metrics.pending.fetch_sub(1);
-  }
-  server_.metrics.addCut("pending_evicted");
+  countEviction(server_, pendingSlot_);
   hardClose("no Hello yet, and the pre-Hello budget is full: a connection from another address took its place");
 }
 

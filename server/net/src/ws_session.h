@@ -37,6 +37,10 @@ class WsSession : public std::enable_shared_from_this<WsSession>, private Sessio
   bool gone() const { return gone_; }
   const std::string& sessionId() const { return id_; }
 
+  // For session_jobs.h endOnEviction, on the strand: a newcomer took this
+  // connection's pre-Hello slot: close it.
+  void evicted();
+
  private:
   struct Outgoing {
     std::shared_ptr<const std::string> bytes;
@@ -45,8 +49,6 @@ class WsSession : public std::enable_shared_from_this<WsSession>, private Sessio
   };
 
   void onAccept(boost::beast::error_code ec);
-  // A newcomer took this connection's pre-Hello slot: close it.
-  void evicted();
   void doRead();
   void onRead(boost::beast::error_code ec);
   void doWrite();
