@@ -73,6 +73,8 @@ struct Session::Impl : std::enable_shared_from_this<Session::Impl> {
   bool keyframeWanted = false;     // the next pose asks for a keyframe (PoseUpdate.keyframe)
   std::uint64_t keyframeAskedAt = 0;  // the pose that last asked; 0: none outstanding
   std::string phase = "connecting";
+  std::string lastFrameStage;     // the last FrameProgress that moved (onFrameProgress)
+  double lastFrameFraction = 0.0;
 
   double nowMs() const {
     return std::chrono::duration<double, std::milli>(Clock::now() - config.runStart).count();
@@ -246,6 +248,7 @@ struct Session::Impl : std::enable_shared_from_this<Session::Impl> {
       case v1::ServerMessage::kPong: break;
       case v1::ServerMessage::kSceneInfo: break;  // this client changes no scene after Hello
       case v1::ServerMessage::kBuildProgress: onBuildProgress(message.build_progress()); break;
+      case v1::ServerMessage::kFrameProgress: onFrameProgress(message.frame_progress()); break;
       case v1::ServerMessage::BODY_NOT_SET:
         // A newer server's message type arrives as unknown fields: ignored,
         // as the protocol's "fields are only ever added" asks. Nothing at
@@ -263,6 +266,16 @@ struct Session::Impl : std::enable_shared_from_this<Session::Impl> {
   void onBuildProgress(const v1::BuildProgress& progress) {
     if (onBuild) onBuild(index, &progress);
     armWatchdog(welcomed ? phase : "Welcome (the renderer build last reported: " + buildProgressText(progress) + ")");
+  }
+
+  // A long frame moves on: the wait for it starts again. Only when it has
+  // moved (another stage, a larger fraction): a frame stuck in one place
+  // still runs into the watchdog, however many of these the server sends.
+  void onFrameProgress(const v1::FrameProgress& progress) {
+    if (progress.stage() == lastFrameStage && progress.fraction() <= lastFrameFraction) return;
+    lastFrameStage = progress.stage();
+    lastFrameFraction = progress.fraction();
+    armWatchdog(phase);
   }
 
   void onWelcome(const v1::Welcome& w) {
@@ -343,6 +356,8 @@ struct Session::Impl : std::enable_shared_from_this<Session::Impl> {
   }
 
   void onFrameMessage(const v1::Frame& frame, std::size_t wireBytes) {
+    lastFrameStage.clear();  // the next frame's progress starts afresh
+    lastFrameFraction = 0.0;
     // Decoded before anything else, so that warm-up and extra frames reach
     // the decoder too; only when a frame is inspected or recorded at all.
     std::optional<wire::Rgba8Image> h264;

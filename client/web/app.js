@@ -20,6 +20,7 @@
 import './save_frame.js';  // the save button and s: the frame as a PNG
 import './view_input.js';  // drags, pinches, the wheel and the reset button steer the view
 import { endBuild, expectBuild, showBuildProgress } from './build_view.js';
+import { endWaiting, showFrameProgress, showWaiting } from './frame_progress_view.js';
 import { onFrame, startH264View } from './frames.js';
 import { frameWindow, setServerStats, updateHud } from './hud.js';
 import { setFrameSize } from './layout.js';
@@ -73,6 +74,7 @@ function onWelcome(w) {
   // (or the view changed meanwhile): ask for the one that fits now.
   granted(w.width, w.height);
   refit();
+  showWaiting('rendering the first frame', `${w.width}×${w.height}`, 'the server says how far once it takes over half a second');
 }
 
 // A change the server refused; the session goes on as before.
@@ -89,7 +91,11 @@ onServerMessages({
   sceneInfo: (info) => onSceneInfo(info, false),
   stats: setServerStats,
   refused: onRefused,
-  buildProgress: showBuildProgress,
+  buildProgress: (p) => {
+    showBuildProgress(p);
+    endWaiting();  // the build's overlay says more
+  },
+  frameProgress: showFrameProgress,
 });
 
 // At most one pose and one exposure change per display frame: pointer and

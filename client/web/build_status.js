@@ -34,17 +34,27 @@ function stageText(stage) {
 }
 
 // progress: a BuildProgress (protobufjs object: stage, stageIndex, done,
-// total, fraction, elapsedSeconds, estimatedStageSecondsLeft; uint64s may
-// be Longs). what: what the page asked for that needs the build ("level 6",
-// "scene gallery"), or ''.
+// total, fraction, elapsedSeconds, estimatedStageSecondsLeft, buildFraction,
+// stages, estimatedBuildSecondsLeft; uint64s may be Longs). what: what the
+// page asked for that needs the build ("level 6", "scene gallery"), or ''.
+// With the server's plan (`stages`), the bar and the percentage are the
+// whole build's, which never go back, the step is counted in the plan
+// ("step 2 of 4") and the time left is the build's; without one, the
+// stage's own.
 // Returns {title, stage, fraction (null: unknown), percent, detail}.
 export function describeBuild(progress, what = '') {
   const p = progress || {};
   const total = Number(p.total || 0);
-  const fraction = total > 0 && Number.isFinite(p.fraction) ? Math.min(1, Math.max(0, p.fraction)) : null;
-  const details = [`step ${(p.stageIndex || 0) + 1}`];
+  const planned = Array.isArray(p.stages) && p.stages.length > 0;
+  const clamp = (f) => Math.min(1, Math.max(0, f));
+  let fraction = null;
+  if (planned && Number.isFinite(p.buildFraction)) fraction = clamp(p.buildFraction);
+  else if (total > 0 && Number.isFinite(p.fraction)) fraction = clamp(p.fraction);
+  const step = planned ? p.stages.indexOf(p.stage) : -1;
+  const details = [step >= 0 ? `step ${step + 1} of ${p.stages.length}` : `step ${(p.stageIndex || 0) + 1}`];
   if (total > 0) details.push(`${Number(p.done || 0)} of ${total}`);
-  if (p.estimatedStageSecondsLeft > 0) details.push(`about ${formatSeconds(p.estimatedStageSecondsLeft)} left in this step`);
+  if (planned && p.estimatedBuildSecondsLeft > 0) details.push(`about ${formatSeconds(p.estimatedBuildSecondsLeft)} left`);
+  else if (!planned && p.estimatedStageSecondsLeft > 0) details.push(`about ${formatSeconds(p.estimatedStageSecondsLeft)} left in this step`);
   if (p.elapsedSeconds > 0) details.push(`${formatSeconds(p.elapsedSeconds)} so far`);
   return {
     title: `preparing ${what || 'the renderer'}`,
@@ -61,4 +71,37 @@ export function describeBuild(progress, what = '') {
 // last one came.
 export function idleText(sinceLastMs) {
   return `idle — last frame ${formatSeconds(Math.max(0, sinceLastMs) / 1000)} ago, up to date`;
+}
+
+// The renderer's stage names (FrameProgress.stage, the HUD's stage times)
+// as a reader would say them.
+const FRAME_STAGES = {
+  queued: 'waiting for a render thread',
+  light: 'turning the light',
+  gbuffer: 'primary rays',
+  'rotation-input': 'shading frames',
+  'shadow-rays': 'shadow rays',
+  fused: 'shading',
+  rotation: 'rotating the BRDF slices',
+  'triple-product': 'triple product',
+  splitsum: 'shading (split sum)',
+  tonemap: 'tone mapping',
+};
+
+// progress: a FrameProgress (stage, stageFraction, fraction, elapsedSeconds,
+// estimatedSecondsLeft, width, height). Returns {title, stage, fraction,
+// percent, detail}, as describeBuild.
+export function describeFrame(progress) {
+  const p = progress || {};
+  const fraction = Number.isFinite(p.fraction) ? Math.min(1, Math.max(0, p.fraction)) : 0;
+  const size = p.width > 0 && p.height > 0 ? ` ${p.width}×${p.height}` : '';
+  const details = [`${formatSeconds(Number(p.elapsedSeconds) || 0)} so far`];
+  if (p.estimatedSecondsLeft > 0) details.push(`about ${formatSeconds(p.estimatedSecondsLeft)} left`);
+  return {
+    title: `rendering the frame${size}`,
+    stage: FRAME_STAGES[p.stage] || String(p.stage || 'rendering'),
+    fraction,
+    percent: Math.min(99, Math.floor(100 * fraction)),
+    detail: details.join(' · '),
+  };
 }

@@ -3,6 +3,7 @@
 // H.264 through WebCodecs (h264_view.js). Only a frame newer than the one on
 // the canvas is drawn, and each is counted for the HUD.
 import { buildShown, endBuild } from './build_view.js';
+import { endWaiting } from './frame_progress_view.js';
 import { H264View } from './h264_view.js';
 import { frameWindow } from './hud.js';
 import { ctx, setFrameSize } from './layout.js';
@@ -48,6 +49,7 @@ export async function onFrame(f, gen) {
     // The first frame of a change ends its build on the page, and the first
     // of a new scene lists its objects.
     if (f.poseSequence >= view.changeFromPose) endBuild();
+    endWaiting();
     sceneShown();
   };
   if (f.encoding === Encoding.values.ENCODING_RAW_RGBA8) {

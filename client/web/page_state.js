@@ -35,6 +35,10 @@ export const state = {
   build: null,         // the build on the page: {what, stage, percent, fraction, detail}; null: none
   buildProgressMessages: 0,
   buildsEnded: 0,      // builds shown and over
+  progress: null,      // the waiting overlay: {title, stage, fraction (null: indeterminate), detail, shown}
+  progressUpdates: 0,  // times it was redrawn
+  frameProgress: null, // the last FrameProgress shown: {stage, fraction, elapsedSeconds}
+  frameProgressMessages: 0,
   hudFolded: false,    // the HUD shows its first line only
   pinches: 0,          // pointer moves with two fingers down (pinch zoom)
   sceneReady: true,    // false while a new scene's renderer is prepared: its objects are not listed yet

@@ -8,6 +8,7 @@ import { helloEncoding } from './h264_view.js';
 import { choices, exposureSettings, page, state, toneSettings } from './page_state.js';
 import { helloSize } from './resolution.js';
 import { ClientMessage, Encoding, ErrorCode, ServerMessage, methodValue } from './schema.js';
+import { endWaiting, showWaiting } from './frame_progress_view.js';
 import { setStatus, showBanner } from './status.js';
 
 const $ = (id) => document.getElementById(id);
@@ -22,7 +23,7 @@ let reconnectWhy = '';
 
 // What the page does with the server's messages:
 // {welcome(w), frame(f, generation) → Promise, sceneInfo(info), stats(s), refused(code),
-//  buildProgress(p)}; refused: a non-fatal Error, the change it answers was not made.
+//  buildProgress(p), frameProgress(p)}; refused: a non-fatal Error, the change it answers was not made.
 let handlers = null;
 export function onServerMessages(h) {
   handlers = h;
@@ -81,12 +82,14 @@ export function connect() {
   setStatus(`connecting to ${socketUrl().replace(/\?token=.*/, '?token=…')}` +
             (state.reconnectAttempt ? ` (attempt ${state.reconnectAttempt + 1})` : '') + '…');
   $('reconnect').hidden = true;
+  showWaiting('connecting to the server', state.reconnectAttempt ? `attempt ${state.reconnectAttempt + 1}` : '');
   socket.binaryType = 'arraybuffer';
   socket.onopen = () => {
     opened = true;
     state.connection = 'waiting-welcome';
     setStatus('connected; waiting for Welcome (the server prepares the scene: seconds the first time)…');
     send({ hello: hello() });
+    showWaiting('waiting for the server', 'it prepares the scene', 'seconds the first time; progress shows once it starts');
   };
   socket.onmessage = (event) => {
     if (gen !== generation) return;
@@ -103,6 +106,7 @@ export function connect() {
     else if (m.stats) handlers.stats(m.stats);
     else if (m.error) onError(m.error);
     else if (m.buildProgress) handlers.buildProgress(m.buildProgress);
+    else if (m.frameProgress) handlers.frameProgress(m.frameProgress);
     // Pong needs no answer. Any other message type a newer server adds
     // decodes to none of the above and is ignored too.
     else if (m.pong) { /* nothing to do */ }
@@ -149,6 +153,7 @@ export function restartSession() {
 export function stop(text) {
   state.connection = 'stopped';
   state.reconnectInS = null;
+  endWaiting();  // nothing is coming: the status line and the banner say why
   setStatus(text, true);
   $('reconnect').textContent = 'reconnect';
   $('reconnect').hidden = false;
@@ -161,6 +166,7 @@ function scheduleReconnect(why) {
   reconnectWhy = why;
   state.connection = 'reconnect-wait';
   reconnectTimer = setTimeout(connect, delay);
+  showWaiting('not connected', why, `the page reconnects on its own (attempt ${state.reconnectAttempt})`);
   $('reconnect').textContent = 'reconnect now';
   $('reconnect').hidden = false;
   showReconnectCountdown();

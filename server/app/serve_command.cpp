@@ -22,6 +22,7 @@
 #include "haarcast/net/host_check.h"
 #include "haarcast/net/protocol.h"
 #include "haarcast/net/server.h"
+#include "haarcast/render/build_plan.h"
 #include "haarcast/render/object_levels.h"
 #include "haarcast/render/renderer.h"
 #include "haarcast/render/scene.h"
@@ -187,25 +188,43 @@ int run(ServeArgs& a) {
   // build of seconds still exits at once. Every progress step also goes to
   // the waiting clients (`toClients`: BuildProgress messages, throttled by
   // the render service) besides the log.
-  net::AbandonableRendererBuilder builder = [sharedScenes, materialFiles, base, vulkanOptions, quiet, antialias](
-                                                const net::SessionConfig& c, const std::function<bool()>& abandoned,
-                                                const render::RenderProgress& toClients) {
+  // A session's config → the scene with its materials and the render
+  // options: what the builder builds and what the planner plans.
+  struct Resolved {
+    render::Scene scene;
+    render::RenderOptions options;
+    std::string backend;
+  };
+  auto resolve = [sharedScenes, materialFiles, base, antialias](const net::SessionConfig& c) {
     const auto it = std::find_if(sharedScenes->begin(), sharedScenes->end(),
                                  [&](const SceneSource& s) { return s.name == c.scene; });
     if (it == sharedScenes->end()) throw std::invalid_argument("unknown scene \"" + c.scene + "\"");
-    render::Scene scene = it->scene;
+    Resolved r{it->scene, base, std::string(net::backendName(c.backend))};
+    render::Scene& scene = r.scene;
     for (std::size_t i = 0; i < scene.objects.size() && i < c.materials.size(); ++i) {
       if (c.materials[i] == scene.objects[i].material.name) continue;  // the scene's own
       const auto file = materialFiles->find(c.materials[i]);
       scene.objects[i].material = render::materialFromSpec(file != materialFiles->end() ? file->second : c.materials[i]);
       scene.objects[i].material.name = c.materials[i];
     }
-    render::RenderOptions options = base;
+    render::RenderOptions& options = r.options;
     options.method = c.method;
     render::applyLevelChoice(options, {c.level, c.automaticLevel});
     options.lightCoefficients = c.lightCoefficients;
-    const std::string backend(net::backendName(c.backend));
-    options.antialias = antialiasFor(antialias, backend);
+    options.antialias = antialiasFor(antialias, r.backend);
+    return r;
+  };
+  a.server.render.planner = [resolve](const net::SessionConfig& c) {
+    const Resolved r = resolve(c);
+    return render::planBuild(r.scene, r.options, r.backend);
+  };
+  net::AbandonableRendererBuilder builder = [resolve, vulkanOptions, quiet](
+                                                const net::SessionConfig& c, const std::function<bool()>& abandoned,
+                                                const render::RenderProgress& toClients) {
+    const Resolved r = resolve(c);
+    const render::Scene& scene = r.scene;
+    const render::RenderOptions& options = r.options;
+    const std::string& backend = r.backend;
     if (!quiet) std::fprintf(stderr, "[serve] preparing renderer %s\n", c.rendererKey().c_str());
     auto prepared = std::make_shared<net::PreparedRenderer>();
     // Slice tables and visibility: lines, not a redrawn one (sessions log in between).

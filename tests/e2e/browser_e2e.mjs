@@ -531,7 +531,8 @@ try {
       window.buildLog.push({
         t: performance.now(), shown: !b.hidden, dimmed: document.getElementById('view').classList.contains('building'),
         stage: document.getElementById('build-stage').textContent, title: document.getElementById('build-title').textContent,
-        bar: document.getElementById('build-bar').value, objects: document.getElementById('objects').textContent,
+        bar: document.getElementById('build-bar').hasAttribute('value') ? document.getElementById('build-bar').value : null,
+        detail: document.getElementById('build-detail').textContent, objects: document.getElementById('objects').textContent,
       });
     };
     new MutationObserver(snap).observe(document.getElementById('build'), { attributes: true, subtree: true, childList: true, characterData: true });
@@ -552,6 +553,13 @@ try {
           during.some((r) => /preparing scene e2e-box/.test(r.title) && /(BRDF slice table|visibility) of /.test(r.stage)),
           'a build: the frame is dimmed and the stage of the scene being prepared is shown');
     check(during.some((r) => r.bar >= 0 && r.bar <= 1 && /\d+ %/.test(r.stage)), 'a build: a progress bar and a percentage');
+    // The bar is the whole build's (BuildProgress.build_fraction against the
+    // server's plan): it never goes back, and the steps count in the plan.
+    const bars = during.map((r) => r.bar).filter((b) => b !== null);
+    const back = bars.findIndex((b, i) => i > 0 && b < bars[i - 1]);
+    check(bars.length > 1 && back < 0, `a build's bar never goes back (${bars.map((b) => b.toFixed(2)).join(' → ')})`);
+    check(during.some((r) => /step \d+ of \d+/.test(r.detail)),
+          `a build's steps are counted in its plan (${JSON.stringify(during.at(-1) && during.at(-1).detail)})`);
     // Listed objects read "box #0", "gilded ball … #1".
     check(during.every((r) => !/#\d|gilded/.test(r.objects)) && during.some((r) => /preparing e2e-box/.test(r.objects)),
           `while it builds the new scene's objects are not listed (${JSON.stringify(during.map((r) => r.objects).slice(-1))})`);
@@ -925,6 +933,69 @@ try {
     check((await p.evaluate(() => window.haarcast.lastFrame.poseSequence)) >= after.poses, 'the pinch is answered with a frame');
     check(problems.length === 0, `pinch page: no page errors (${problems.join('; ')})`);
     await context.close();
+  }
+
+  // 18. From the first second to the first frame the page says what is going
+  // on, and a frame that takes long shows how far it is over the old one,
+  // dimmed (FrameProgress). A 1600×1200 frame takes seconds on the CPU
+  // backend of a small machine.
+  section('waiting and frame progress');
+  {
+    const p = await browser.newPage({ viewport: { width: 900, height: 700 } });
+    const problems = [];
+    p.on('pageerror', (e) => problems.push(e.message));
+    // Every state of the waiting overlay, from the document's start.
+    await p.addInitScript(() => {
+      window.progressLog = [];
+      document.addEventListener('DOMContentLoaded', () => {
+        const el = document.getElementById('progress');
+        const snap = () => {
+          const h = window.haarcast;
+          window.progressLog.push({
+            t: performance.now(), shown: !el.hidden && getComputedStyle(el).display !== 'none',
+            title: document.getElementById('progress-title').textContent,
+            stage: document.getElementById('progress-stage').textContent,
+            dimmed: document.getElementById('view').classList.contains('rendering'),
+            frames: h ? h.framesShown : 0, messages: h ? h.frameProgressMessages : 0,
+          });
+        };
+        snap();
+        new MutationObserver(snap).observe(el, { attributes: true, subtree: true, childList: true, characterData: true });
+        new MutationObserver(snap).observe(document.getElementById('view'), { attributes: true });
+      });
+    });
+    await p.goto(`${base}?size=1600x1200&encoding=jpeg`);
+    await waitFrames(p, 1);
+    const log = await p.evaluate(() => window.progressLog);
+    const early = log.find((r) => r.shown && r.title.length > 0);
+    check(early && early.t <= 1000, `the page says what it waits for within 1 s of load ("${early && early.title}" at ` +
+          `${early && early.t.toFixed(0)} ms)`);
+    const beforeFrame = log.filter((r) => r.frames === 0);
+    check(beforeFrame.every((r) => r.shown), `until the first frame the waiting overlay stays up (${beforeFrame.length} states)`);
+    const firstProgress = beforeFrame.filter((r) => r.messages > 0);
+    check(firstProgress.some((r) => /\d+ %/.test(r.stage)),
+          `the first frame's progress is shown (${JSON.stringify(firstProgress.at(-1) && firstProgress.at(-1).stage)})`);
+    const percents = firstProgress.map((r) => Number((/(\d+) %/.exec(r.stage) || [])[1])).filter(Number.isFinite);
+    check(percents.every((v, i) => i === 0 || v >= percents[i - 1]), `a frame's progress never goes back (${percents.join(' → ')})`);
+    check(!log.at(-1).shown, 'the first frame ends the waiting');
+    if (opts.out) await p.screenshot({ path: join(opts.out, 'waiting-first-frame.png') });
+    // A drag: its frame takes seconds, and shows its progress over the old frame, dimmed.
+    const marker = log.length;
+    const c = await p.locator('#frame').boundingBox();
+    await p.mouse.move(c.x + c.width / 2, c.y + c.height / 2);
+    await p.mouse.down();
+    await p.mouse.move(c.x + c.width / 2 + 60, c.y + c.height / 2, { steps: 4 });
+    await p.mouse.up();
+    await p.waitForFunction(() => window.haarcast.framesShown >= 2, null, { timeout: 120000 });
+    await p.waitForFunction((n) => window.haarcast.lastFrame.poseSequence >= n, await p.evaluate(() => window.haarcast.posesSent),
+                            { timeout: 120000 });
+    const after = (await p.evaluate(() => window.progressLog)).slice(marker);
+    const over = after.filter((r) => r.shown && r.frames >= 1);
+    check(over.length > 0 && over.every((r) => r.dimmed) && over.some((r) => /\d+ %/.test(r.stage)),
+          `a long frame shows its progress over the old one, dimmed (${JSON.stringify(over.at(-1))})`);
+    check(!after.at(-1).shown && !after.at(-1).dimmed, 'its frame ends it');
+    check(problems.length === 0, `waiting page: no page errors (${problems.join('; ')})`);
+    await p.close();
   }
 
   // 10. A dropped connection: the page counts down and reconnects.

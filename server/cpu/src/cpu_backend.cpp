@@ -40,15 +40,19 @@ struct FrameCancelled {};
 
 // The tile-boundary check: a tile is one row of a pass (or a run of edge
 // pixels), so a cancelled frame stops after at most the rows in flight.
+// Each tile is also counted in the frame's stage (frame_stage.h): the
+// watcher's fraction of the stage is the tiles started over the tiles the
+// stage said it has.
 class CancelPoint {
  public:
-  explicit CancelPoint(const std::function<bool()>& cancelled) : cancelled_(cancelled) {}
+  explicit CancelPoint(const FrameRequest& request) : request_(request) {}
   void operator()() const {
-    if (cancelled_ && cancelled_()) throw FrameCancelled{};
+    if (request_.cancelled && request_.cancelled()) throw FrameCancelled{};
+    tickFrameStage(request_);
   }
 
  private:
-  const std::function<bool()>& cancelled_;
+  const FrameRequest& request_;
 };
 
 class CpuRenderer final : public Renderer {
@@ -372,7 +376,7 @@ std::size_t CpuRenderer::shadePixels(const GBuffer& g, const FrameRequest& reque
 }
 
 Frame CpuRenderer::render(const FrameRequest& request) {
-  const CancelPoint cancelPoint(request.cancelled);
+  const CancelPoint cancelPoint(request);
   try {
     return renderFrame(request, cancelPoint);
   } catch (const FrameCancelled&) {
@@ -406,11 +410,14 @@ Frame CpuRenderer::renderFrame(const FrameRequest& request, const CancelPoint& c
   const std::size_t pixels = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
   GBuffer g;
   t0 = Clock::now();
-  enterFrameStage(request, "gbuffer");
+  // Its tiles: the 4-row bands of centres, then with antialiasing the edge
+  // search's rows, one check, and the edge samples' rows (traceGBuffer).
+  const std::size_t rows = static_cast<std::size_t>(h);
+  enterFrameStage(request, "gbuffer", (rows + 3) / 4 + (options_.antialias ? 2 * rows + 1 : 0));
   traceGBuffer(*rays, camera, w, h, g, cancelPoint);
   frame.stages.push_back({"gbuffer", since(t0)});
   t0 = Clock::now();
-  enterFrameStage(request, "rotation-input");
+  enterFrameStage(request, "rotation-input", rows + (g.sub.size() + 63) / 64);
   fillInputs(resolved, g, cancelPoint);
   frame.stages.push_back({"rotation-input", since(t0)});
 
@@ -418,9 +425,13 @@ Frame CpuRenderer::renderFrame(const FrameRequest& request, const CancelPoint& c
   frame.objectMask.assign(pixels, 0);
   // The rotating methods rotate and multiply pixel by pixel: one stage
   // entered, "rotation", for both.
-  enterFrameStage(request, options_.method == RotationMethod::Fused      ? "fused"
-                           : options_.method == RotationMethod::Splitsum ? "splitsum"
-                                                                         : "rotation");
+  // Their tiles: the rows of shadePixels, and fused's row pass of shadow
+  // rays before it.
+  enterFrameStage(request,
+                  options_.method == RotationMethod::Fused      ? "fused"
+                  : options_.method == RotationMethod::Splitsum ? "splitsum"
+                                                                : "rotation",
+                  options_.method == RotationMethod::Fused ? 2 * rows : rows);
   switch (options_.method) {
     case RotationMethod::Fused: bytes += shadeFused(resolved, *rays, g, request, camera, frame, cancelPoint); break;
     case RotationMethod::Splitsum: bytes += shadeSplitsum(resolved, *rays, g, request, camera, frame, cancelPoint); break;
@@ -429,7 +440,7 @@ Frame CpuRenderer::renderFrame(const FrameRequest& request, const CancelPoint& c
 
   // ---- tonemap: backdrop, RGBA8 --------------------------------------------
   t0 = Clock::now();
-  enterFrameStage(request, "tonemap");
+  enterFrameStage(request, "tonemap", options_.environmentBackground ? rows : 0);
   if (options_.environmentBackground) {
     parallelFor(static_cast<std::size_t>(h), [&](std::size_t y) {
       cancelPoint();

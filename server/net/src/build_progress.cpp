@@ -56,20 +56,33 @@ double BuildProgressUpdate::fraction() const {
   return std::clamp(static_cast<double>(done) / static_cast<double>(total), 0.0, 1.0);
 }
 
-BuildProgressTracker::BuildProgressTracker(Clock::time_point started, double minIntervalSeconds)
+BuildProgressTracker::BuildProgressTracker(Clock::time_point started, double minIntervalSeconds, render::BuildPlan plan)
     : started_(started),
-      minInterval_(std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(std::max(0.0, minIntervalSeconds)))) {}
+      minInterval_(std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(std::max(0.0, minIntervalSeconds)))),
+      plan_(std::move(plan)),
+      planWork_(plan_.totalWork()) {}
 
 std::optional<BuildProgressUpdate> BuildProgressTracker::step(const std::string& stage, std::size_t done, std::size_t total,
                                                               Clock::time_point now) {
   auto it = std::find_if(stages_.begin(), stages_.end(), [&](const Stage& s) { return s.name == stage; });
   const bool isNew = it == stages_.end();
   if (isNew) {
-    stages_.push_back({stage, now, done});
+    Stage s{stage, now, done, std::nullopt, 0.0};
+    const auto p = std::find_if(plan_.stages.begin(), plan_.stages.end(), [&](const render::PlannedStage& q) { return q.name == stage; });
+    if (p != plan_.stages.end()) s.planned = static_cast<std::size_t>(p - plan_.stages.begin());
+    stages_.push_back(std::move(s));
     it = std::prev(stages_.end());
-  } else if (lastPublished_ && now - *lastPublished_ < minInterval_) {
-    return std::nullopt;
   }
+  // Every report moves the build's fraction, published or not (Eq. in the
+  // class comment: whole stages before it, this one by its own fraction).
+  const double stageFraction = total ? std::clamp(static_cast<double>(done) / static_cast<double>(total), 0.0, 1.0) : 0.0;
+  it->fraction = std::max(it->fraction, stageFraction);
+  if (it->planned && planWork_ > 0.0) {
+    double before = 0.0;
+    for (std::size_t j = 0; j < *it->planned; ++j) before += plan_.stages[j].work;
+    buildFraction_ = std::max(buildFraction_, std::min(1.0, (before + it->fraction * plan_.stages[*it->planned].work) / planWork_));
+  }
+  if (!isNew && lastPublished_ && now - *lastPublished_ < minInterval_) return std::nullopt;
   lastPublished_ = now;
   BuildProgressUpdate u;
   u.stage = stage;
@@ -84,7 +97,56 @@ std::optional<BuildProgressUpdate> BuildProgressTracker::step(const std::string&
     const double rate = static_cast<double>(done - it->startDone) / stageSeconds;
     u.stageSecondsLeft = static_cast<double>(total - done) / rate;
   }
+  if (!plan_.empty()) {
+    u.buildFraction = buildFraction_;
+    for (const render::PlannedStage& s : plan_.stages) u.stages.push_back(s.name);
+    u.buildSecondsLeft = buildSecondsLeft(static_cast<std::size_t>(it - stages_.begin()), now);
+  }
   return u;
+}
+
+double BuildProgressTracker::buildSecondsLeft(std::size_t current, Clock::time_point now) const {
+  auto kind = [](std::string_view name) { return name.substr(0, name.find(' ')); };
+  // Seconds and planned work done, per kind and in all, over the reported
+  // stages of the plan: a stage's seconds run to the next one's start.
+  struct Rate {
+    double seconds = 0.0, work = 0.0;
+  };
+  std::vector<std::pair<std::string_view, Rate>> kinds;
+  Rate all;
+  for (std::size_t i = 0; i < stages_.size(); ++i) {
+    const Stage& s = stages_[i];
+    if (!s.planned) continue;
+    const Clock::time_point end = i + 1 < stages_.size() ? stages_[i + 1].start : now;
+    const double seconds = std::max(0.0, secondsBetween(s.start, end));
+    // A stage that another followed is done, whatever it last said.
+    const double work = plan_.stages[*s.planned].work * (i == current ? s.fraction : 1.0);
+    auto k = std::find_if(kinds.begin(), kinds.end(), [&](const auto& e) { return e.first == kind(s.name); });
+    if (k == kinds.end()) k = kinds.insert(kinds.end(), {kind(s.name), Rate{}});
+    k->second.seconds += seconds;
+    k->second.work += work;
+    all.seconds += seconds;
+    all.work += work;
+  }
+  if (all.work < planWork_ / 50.0 || all.seconds < 0.5) return 0.0;
+  auto secondsPerWork = [&](std::string_view name) {
+    const auto k = std::find_if(kinds.begin(), kinds.end(), [&](const auto& e) { return e.first == kind(name); });
+    return k != kinds.end() && k->second.work > 0.0 ? k->second.seconds / k->second.work : all.seconds / all.work;
+  };
+  // The plan's stages after the current one (a stage outside the plan: those
+  // after the last planned stage reported) and the current one's rest.
+  std::size_t next = 0;
+  double left = 0.0;
+  const Stage& c = stages_[current];
+  if (c.planned) {
+    next = *c.planned + 1;
+    left += plan_.stages[*c.planned].work * (1.0 - c.fraction) * secondsPerWork(c.name);
+  } else {
+    for (const Stage& s : stages_)
+      if (s.planned) next = std::max(next, *s.planned + 1);
+  }
+  for (std::size_t j = next; j < plan_.stages.size(); ++j) left += plan_.stages[j].work * secondsPerWork(plan_.stages[j].name);
+  return left;
 }
 
 std::string publicStageName(std::string_view stage) {

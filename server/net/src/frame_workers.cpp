@@ -190,10 +190,12 @@ void FrameWorkers::render(Worker& w, RenderJob& job, Clock::time_point submitted
   request->cancelled = [this, &w, &job, own = std::move(request->cancelled)] {
     return w.abandoned.load() || stopping_.load() || isCancelled(job) || (own && own());
   };
-  w.stage.enter(nullptr);
-  request->stage = &w.stage;
+  std::shared_ptr<render::StageMark> stage = job.stage ? job.stage : std::make_shared<render::StageMark>();
+  stage->enter(nullptr);
+  request->stage = stage.get();
   {
     std::lock_guard lock(mutex_);
+    w.stage = std::move(stage);
     pixelsInFlight_ = pixelsInFlight_ - w.charge + pixels;  // the session's size may have changed since submit
     w.charge = pixels;
     w.rendering = true;
@@ -214,6 +216,8 @@ void FrameWorkers::render(Worker& w, RenderJob& job, Clock::time_point submitted
     return;
   }
   if (out.frame.cancelled || stopping_) return cancel();
+  // The weights of the next frame's progress (frame_progress.h), any session's.
+  job.renderer->setLastFrame({out.frame.stages, pixels});
   // Encoding goes to its own threads: the next frame can render meanwhile.
   encoders_.push([job = std::move(job), out = std::move(out)]() mutable {
     try {
@@ -301,7 +305,7 @@ FrameWorkers::Done FrameWorkers::abandonLocked(const std::shared_ptr<Worker>& w,
   HC_CHECK_NE(w->job, nullptr);
   HC_CHECK_NE(w->device, nullptr);
   Device& device = *w->device;
-  const char* stage = w->stage.current();
+  const char* stage = w->stage->current();
   const std::string after = "after " + formatSeconds(options_.frameDeadlineSeconds) + " s in stage " + (stage ? stage : "unknown");
   error = "frame abandoned " + after + " on device " + device.name + " (frame-deadline); the device is marked unhealthy";
   device.reason = "a frame abandoned " + after;
@@ -350,7 +354,7 @@ std::vector<StuckRender> FrameWorkers::stuckRenders() const {
   std::lock_guard lock(mutex_);
   std::vector<StuckRender> out;
   for (const auto& w : left_) {
-    const char* stage = w->stage.current();
+    const char* stage = w->stage->current();
     StuckRender s;
     if (w->rendering) {
       s.backend = w->device->backend;

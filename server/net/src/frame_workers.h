@@ -76,10 +76,13 @@ class FrameWorkers : public std::enable_shared_from_this<FrameWorkers> {
     Clock::time_point submitted;
     Device* device = nullptr;
   };
-  // One render thread. Fields below `stage` are under mutex_.
+  // One render thread. Fields from `stage` on are under mutex_ (`abandoned`
+  // is also read without it).
   struct Worker {
     std::thread thread;
-    render::StageMark stage;                // the stage its frame is in
+    // The stage its frame is in: the job's mark (RenderJob::stage) or a
+    // fresh one, set under mutex_ before the frame starts.
+    std::shared_ptr<render::StageMark> stage = std::make_shared<render::StageMark>();
     std::atomic<bool> abandoned{false};     // left behind: it must not answer its job, nor take another
     bool rendering = false;                 // inside Renderer::render
     bool counted = false;                   // counted in its device's `stuck`

@@ -101,6 +101,22 @@ std::string buildProgressMessage(const BuildProgressUpdate& update) {
   b->set_fraction(update.fraction());
   b->set_elapsed_seconds(std::max(0.0, update.elapsedSeconds));
   b->set_estimated_stage_seconds_left(std::max(0.0, update.stageSecondsLeft));
+  b->set_build_fraction(std::clamp(update.buildFraction, 0.0, 1.0));
+  for (const std::string& stage : update.stages) b->add_stages(publicStageName(stage));
+  b->set_estimated_build_seconds_left(std::max(0.0, update.buildSecondsLeft));
+  return serialize(m);
+}
+
+std::string frameProgressMessage(const FrameProgressUpdate& update, int width, int height) {
+  v1::ServerMessage m;
+  auto* f = m.mutable_frame_progress();
+  f->set_stage(update.stage);  // the backends' own names (renderer.h), never a client's
+  f->set_stage_fraction(std::clamp(update.stageFraction, 0.0, 1.0));
+  f->set_fraction(std::clamp(update.fraction, 0.0, 1.0));
+  f->set_elapsed_seconds(std::max(0.0, update.elapsedSeconds));
+  f->set_estimated_seconds_left(std::max(0.0, update.secondsLeft));
+  f->set_width(static_cast<std::uint32_t>(std::max(0, width)));
+  f->set_height(static_cast<std::uint32_t>(std::max(0, height)));
   return serialize(m);
 }
 

@@ -246,7 +246,13 @@ struct RenderService::Impl {
       std::shared_ptr<PreparedRenderer> renderer = cached;
       std::string error;
       if (!renderer) {
-        BuildProgressTracker tracker(build->started, options.progressIntervalSeconds);
+        render::BuildPlan plan;
+        try {
+          if (options.planner) plan = options.planner(build->config);
+        } catch (...) {
+          // A plan is information: the build says what is wrong with the config.
+        }
+        BuildProgressTracker tracker(build->started, options.progressIntervalSeconds, std::move(plan));
         const render::RenderProgress progress = [&](const std::string& stage, std::size_t done, std::size_t total) {
           if (auto update = tracker.step(stage, done, total, Clock::now())) publish(*build, std::move(*update));
         };

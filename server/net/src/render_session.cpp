@@ -279,6 +279,8 @@ void RenderSession::maybeRender(Clock::time_point now) {
   nextFrameAt_ = now + toDuration(1.0 / std::max(config_.fps, 1e-3));
   current_ = std::make_shared<FrameContext>();
   const std::size_t pixels = static_cast<std::size_t>(config_.width) * static_cast<std::size_t>(config_.height);
+  const PreparedRenderer::LastFrame last = renderer_->lastFrame();
+  frameProgress_.emplace(now, config_.method, last.stages, last.pixels, pixels);
   FrameOrder order{renderer_, config_.encoding, config_.jpegQuality, pixels, current_, {}};
   if (config_.encoding == FrameEncoding::H264) {
     if (!h264_) h264_ = std::make_shared<H264Stream>();
@@ -313,6 +315,7 @@ void RenderSession::onCancelled(const FrameContext& context, Clock::time_point n
   if (current_.get() != &context) return;  // not the frame in flight (cannot happen: one at a time)
   inFlight_ = false;
   current_.reset();
+  frameProgress_.reset();
   if (closed_) return;
   // The frame was wanted for the old request; the new one still wants one.
   wantFrame_ = true;
@@ -338,6 +341,7 @@ void RenderSession::onRendered(const FrameContext& context, std::optional<Render
                                const std::string& error, Clock::time_point now) {
   inFlight_ = false;
   current_.reset();
+  frameProgress_.reset();
   if (closed_) return;
   if (!rendered) {
     renderFailed(error, now);
@@ -460,8 +464,18 @@ void RenderSession::onTick(Clock::time_point now) {
   } else {
     flushRenderErrorRepeats(now, false);
     flushBuildProgress();
+    sendFrameProgress(now);
     if (welcomed_ && secondsBetween(lastStats_, now) >= o.statsSeconds) sendStats(now);
   }
+}
+
+// A frame in flight past kFrameProgressAfterSeconds says how far it is.
+// Like Stats it is skipped behind a backlog: the next tick has a newer one.
+void RenderSession::sendFrameProgress(Clock::time_point now) {
+  if (!inFlight_ || !current_ || !frameProgress_) return;
+  const auto update = frameProgress_->poll(current_->stage, now);
+  if (!update || port_.backlog() >= kMaxBacklogForStats) return;
+  port_.send(frameProgressMessage(*update, config_.width, config_.height));
 }
 
 void RenderSession::sendStats(Clock::time_point now) {

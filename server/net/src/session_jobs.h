@@ -88,6 +88,9 @@ void submitFrame(Server::Impl& server, const std::shared_ptr<Transport>& transpo
   job.jpegQuality = order.jpegQuality;
   job.pixels = order.pixels;
   job.encode = std::move(order.encode);
+  // The context's mark, kept alive with it (aliasing): the session reads it
+  // for FrameProgress while the worker's render moves it on.
+  job.stage = std::shared_ptr<render::StageMark>(order.context, &order.context->stage);
   // Polled by a render worker at every tile or batch boundary: atomics and
   // a weak pointer only, never the session's strand or the service's lock.
   // The server's `stopping` outlives the service's threads (server_impl.h:

@@ -25,10 +25,14 @@ const char* stallStage() {
 
 }  // namespace
 
-void enterFrameStage(const FrameRequest& request, const char* stage) {
+void enterFrameStage(const FrameRequest& request, const char* stage, std::size_t tiles) {
   if (!request.stage) return;
-  request.stage->enter(stage);
+  request.stage->enter(stage, tiles);
   if (const char* stall = stallStage(); stall && std::strcmp(stall, stage) == 0) stallForever();
+}
+
+void tickFrameStage(const FrameRequest& request) {
+  if (request.stage) request.stage->tick();
 }
 
 }  // namespace haarcast::render

@@ -72,8 +72,58 @@ TEST(BuildProgressMessage, StageNamesShowNoServerPathAndStayPrintableUtf8) {
   EXPECT_LE(publicStageName(std::string(500, 'x')).size(), kMaxStageBytes);
 }
 
+// The whole build against its plan (render::BuildPlan): the fraction weighs
+// the stages by their planned work, counts a stage never reported (found in
+// a cache) as done once a later one reports, holds through stages outside
+// the plan and never goes back; the time left takes each kind's own rate.
+TEST(BuildProgressTracker, TheBuildFractionFollowsThePlanAndTheEstimateEachKindsRate) {
+  const auto t0 = TrackerClock::time_point{} + 1h;
+  render::BuildPlan plan;
+  plan.stages = {{"slices a", 1.0}, {"visibility a", 4.0}, {"slices b", 1.0}, {"visibility b", 4.0}};
+  BuildProgressTracker tracker(t0, 0.25, plan);
+  auto first = tracker.step("slices a", 0, 10, t0);
+  ASSERT_TRUE(first);
+  EXPECT_EQ(first->buildFraction, 0.0);
+  EXPECT_EQ(first->stages, (std::vector<std::string>{"slices a", "visibility a", "slices b", "visibility b"}));
+  EXPECT_EQ(first->buildSecondsLeft, 0.0) << "no rate yet";
+  // slices a: 1 unit of work in 2 s.
+  auto slices = tracker.step("slices a", 10, 10, t0 + 2s);
+  ASSERT_TRUE(slices);
+  EXPECT_DOUBLE_EQ(slices->buildFraction, 0.1);
+  // visibility a: half of its 4 units in the next 2 s (1 s a unit).
+  ASSERT_TRUE(tracker.step("visibility a", 0, 100, t0 + 2s));
+  auto half = tracker.step("visibility a", 50, 100, t0 + 4s);
+  ASSERT_TRUE(half);
+  EXPECT_DOUBLE_EQ(half->buildFraction, 0.3);
+  // Left: visibility a's 2 units and visibility b's 4 at 1 s, slices b's 1 at 2 s.
+  EXPECT_NEAR(half->buildSecondsLeft, 2.0 * 1.0 + 1.0 * 2.0 + 4.0 * 1.0, 1e-9);
+  // slices b never reported (a cache hit): visibility b starts at 0.6.
+  auto b = tracker.step("visibility b", 0, 100, t0 + 6s);
+  ASSERT_TRUE(b);
+  EXPECT_DOUBLE_EQ(b->buildFraction, 0.6);
+  // Outside the plan, or an earlier stage again: the fraction holds.
+  auto other = tracker.step("frame slots", 1, 2, t0 + 7s);
+  ASSERT_TRUE(other);
+  EXPECT_DOUBLE_EQ(other->buildFraction, 0.6);
+  auto again = tracker.step("visibility a", 10, 100, t0 + 8s);
+  ASSERT_TRUE(again);
+  EXPECT_DOUBLE_EQ(again->buildFraction, 0.6);
+  // Throttled reports still move it: the next one published says so.
+  EXPECT_FALSE(tracker.step("visibility b", 50, 100, t0 + 8s + 10ms));
+  auto later = tracker.step("visibility b", 50, 100, t0 + 9s);
+  ASSERT_TRUE(later);
+  EXPECT_DOUBLE_EQ(later->buildFraction, 0.8);
+  // Without a plan: none of the build's fields.
+  BuildProgressTracker bare(t0, 0.25);
+  auto u = bare.step("slices a", 5, 10, t0);
+  ASSERT_TRUE(u);
+  EXPECT_EQ(u->buildFraction, 0.0);
+  EXPECT_TRUE(u->stages.empty());
+}
+
 TEST(BuildProgressMessage, CarriesEveryField) {
-  BuildProgressUpdate u{"visibility /home/op/bunny.ply", 2, 30, 120, 4.5, 2.25};
+  BuildProgressUpdate u{"visibility /home/op/bunny.ply", 2, 30, 120, 4.5, 2.25, 0.4,
+                       {"slices /home/op/bunny.ply", "visibility /home/op/bunny.ply"}, 12.5};
   v1::ServerMessage m;
   ASSERT_TRUE(m.ParseFromString(buildProgressMessage(u)));
   ASSERT_TRUE(m.has_build_progress());
@@ -85,6 +135,11 @@ TEST(BuildProgressMessage, CarriesEveryField) {
   EXPECT_DOUBLE_EQ(b.fraction(), 0.25);
   EXPECT_DOUBLE_EQ(b.elapsed_seconds(), 4.5);
   EXPECT_DOUBLE_EQ(b.estimated_stage_seconds_left(), 2.25);
+  EXPECT_DOUBLE_EQ(b.build_fraction(), 0.4);
+  ASSERT_EQ(b.stages_size(), 2);
+  EXPECT_EQ(b.stages(0), "slices bunny.ply") << "the plan's names go out as the stage's: no server path";
+  EXPECT_EQ(b.stages(1), "visibility bunny.ply");
+  EXPECT_DOUBLE_EQ(b.estimated_build_seconds_left(), 12.5);
 }
 
 // ---------------------------------------------------------------- the service's fan-out

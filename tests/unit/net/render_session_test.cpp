@@ -217,8 +217,8 @@ TEST(RenderSession, SceneSwitchAnnouncesSceneInfoAndBuildsItsRenderer) {
   EXPECT_EQ(f.port.prepared.back().scene, "other");
   EXPECT_EQ(f.session.config().scene, "other");
   // Its build's progress follows the SceneInfo; the old renderer's build has none.
-  f.session.onBuildProgress(f.port.prepared.front().rendererKey(), {"slices a", 0, 1, 2, 0.1, 0.0});
-  f.session.onBuildProgress(f.port.prepared.back().rendererKey(), {"slices b", 0, 1, 2, 0.1, 0.0});
+  f.session.onBuildProgress(f.port.prepared.front().rendererKey(), {"slices a", 0, 1, 2, 0.1, 0.0, 0.0, {}, 0.0});
+  f.session.onBuildProgress(f.port.prepared.back().rendererKey(), {"slices b", 0, 1, 2, 0.1, 0.0, 0.0, {}, 0.0});
   EXPECT_EQ(f.port.sent.back().build_progress().stage(), "slices b");
   EXPECT_TRUE(f.port.sent[f.port.sent.size() - 2].has_scene_info());
   // The SceneInfo could not say the objects' levels (0); once the new
@@ -335,6 +335,54 @@ TEST(RenderSession, HelloTimeoutIdleTimeoutAndStats) {
   g.session.onTick(g.t0 + 31s);
   EXPECT_EQ(g.port.sent.back().error().code(), v1::ERROR_CODE_TIMEOUT);
   EXPECT_NE(g.port.sent.back().error().message().find("idle"), std::string::npos);
+}
+
+// A frame that takes long says how far it is (FrameProgress, from the
+// render's StageMark), and one that does not, nothing.
+TEST(RenderSession, AFrameInFlightPastHalfASecondSendsItsProgressUntilItEnds) {
+  Fixture f;
+  f.welcome();
+  ASSERT_EQ(f.port.orders.size(), 1u);
+  auto sent = [&] {
+    return std::count_if(f.port.sent.begin(), f.port.sent.end(), [](const v1::ServerMessage& m) { return m.has_frame_progress(); });
+  };
+  // A frame of 300 ms: nothing.
+  f.session.onTick(f.t0 + 200ms);
+  f.finishRender(f.t0 + 300ms);
+  EXPECT_EQ(sent(), 0);
+  // The renderer's last frame (the render service keeps it): the weights.
+  f.port.orders.back().renderer->setLastFrame({{{"gbuffer", 0.1}, {"fused", 0.9}}, 256});
+  // The next one, ordered at 1 s, is slow.
+  f.receive(pose(1), f.t0 + 1s);
+  ASSERT_EQ(f.port.orders.size(), 2u);
+  f.session.onTick(f.t0 + 1400ms);
+  EXPECT_EQ(sent(), 0) << "not before half a second";
+  render::StageMark& mark = f.port.orders.back().context->stage;
+  mark.enter("fused", 4);
+  mark.tick();
+  mark.tick();
+  f.session.onTick(f.t0 + 1500ms);
+  ASSERT_EQ(sent(), 1);
+  const auto& p = f.port.sent.back().frame_progress();
+  EXPECT_EQ(p.stage(), "fused");
+  EXPECT_DOUBLE_EQ(p.stage_fraction(), 0.5);
+  EXPECT_DOUBLE_EQ(p.fraction(), 0.1 + 0.5 * 0.9);
+  EXPECT_GT(p.estimated_seconds_left(), 0.0);
+  EXPECT_EQ(p.width(), 16u);
+  EXPECT_EQ(p.height(), 16u);
+  f.session.onTick(f.t0 + 1600ms);
+  EXPECT_EQ(sent(), 1) << "at most four a second";
+  f.session.onTick(f.t0 + 1800ms);
+  EXPECT_EQ(sent(), 2);
+  // Behind a backlog: skipped.
+  f.port.backlogSize = 4;
+  f.session.onTick(f.t0 + 2100ms);
+  EXPECT_EQ(sent(), 2);
+  f.port.backlogSize = 0;
+  // The frame ends it.
+  f.finishRender(f.t0 + 2200ms);
+  f.session.onTick(f.t0 + 3s);
+  EXPECT_EQ(sent(), 2);
 }
 
 TEST(RenderSession, FatalErrorsCloseOnceWithAReasonCutOnUtf8) {
@@ -543,16 +591,16 @@ TEST(RenderSession, BuildProgressWaitsBehindABacklogLatestOnlyAndEndsWithTheRend
   Fixture f;
   f.receive(hello(), f.t0);
   const std::string key = f.port.prepared.back().rendererKey();
-  f.session.onBuildProgress("another key", {"slices a", 0, 1, 10, 0.1, 0.0});
+  f.session.onBuildProgress("another key", {"slices a", 0, 1, 10, 0.1, 0.0, 0.0, {}, 0.0});
   EXPECT_TRUE(f.port.sent.empty()) << "a superseded build's progress is not this session's";
-  f.session.onBuildProgress(key, {"slices a", 0, 1, 10, 0.1, 0.0});
+  f.session.onBuildProgress(key, {"slices a", 0, 1, 10, 0.1, 0.0, 0.0, {}, 0.0});
   ASSERT_EQ(f.port.sent.size(), 1u);
   EXPECT_TRUE(f.port.sent.back().has_build_progress());
   // A client that does not read: progress is held, the latest replacing
   // the one before, and sent once the backlog drains.
   f.port.backlogSize = 10;
-  f.session.onBuildProgress(key, {"slices a", 0, 5, 10, 0.5, 0.4});
-  f.session.onBuildProgress(key, {"slices a", 0, 8, 10, 0.8, 0.1});
+  f.session.onBuildProgress(key, {"slices a", 0, 5, 10, 0.5, 0.4, 0.0, {}, 0.0});
+  f.session.onBuildProgress(key, {"slices a", 0, 8, 10, 0.8, 0.1, 0.0, {}, 0.0});
   f.session.onTick(f.t0 + 100ms);
   EXPECT_EQ(f.port.sent.size(), 1u) << "held behind the backlog";
   f.port.backlogSize = 0;
@@ -564,10 +612,10 @@ TEST(RenderSession, BuildProgressWaitsBehindABacklogLatestOnlyAndEndsWithTheRend
   // Held again when the renderer comes: dropped, the Welcome goes, and
   // later progress (a race with the build's end) is ignored.
   f.port.backlogSize = 10;
-  f.session.onBuildProgress(key, {"visibility a", 1, 3, 10, 0.9, 0.2});
+  f.session.onBuildProgress(key, {"visibility a", 1, 3, 10, 0.9, 0.2, 0.0, {}, 0.0});
   f.port.backlogSize = 0;
   f.session.onPrepared(key, Fixture::prepared(), "", f.t0 + 300ms);
-  f.session.onBuildProgress(key, {"visibility a", 1, 9, 10, 1.0, 0.0});
+  f.session.onBuildProgress(key, {"visibility a", 1, 9, 10, 1.0, 0.0, 0.0, {}, 0.0});
   f.session.onTick(f.t0 + 400ms);
   ASSERT_EQ(f.port.sent.size(), 3u);
   EXPECT_TRUE(f.port.sent.back().has_welcome());

@@ -3,7 +3,11 @@
 #include "haarcast/cpu/cpu_renderer.h"
 #include "haarcast/render/renderer.h"
 
+#include <algorithm>
 #include <atomic>
+#include <map>
+#include <mutex>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -70,6 +74,41 @@ TEST(CpuBackend, EveryRowOfEveryPassPollsTheCancelAndAnUncancelledFrameIsUnchang
   // Four passes run row by row: gbuffer, rotation-input, shading and the
   // backdrop; each row is a tile boundary.
   EXPECT_GE(never.polls.load(), 4L * request.height);
+}
+
+// A watched frame's stage fractions (frame_stage.h), as the server's
+// FrameProgress reads them: each tile polls the cancel, then ticks, so a
+// poll sees at most tiles − 1 ticks of its stage. A stage whose count is
+// right is seen nearly done (≥ 0.95 of 200 rows) and never whole; one that
+// said too few tiles is seen whole early, one that said too many never
+// gets near the end.
+TEST(CpuBackend, EachStageOfAWatchedFrameCountsItsTilesToTheEnd) {
+  const Scene scene = torusScene();
+  for (const RotationMethod method : {RotationMethod::Haar, RotationMethod::Fused}) {
+    RenderOptions options = smallOptions();
+    options.method = method;
+    const auto renderer = makeCpuRenderer(scene, options);
+    FrameRequest request = tallRequest(scene);
+    StageMark mark;
+    request.stage = &mark;
+    std::mutex mutex;
+    std::map<std::string, double> seen;  // the largest fraction a poll saw, per stage
+    request.cancelled = [&] {
+      const char* stage = mark.current();
+      const double fraction = mark.fraction();
+      std::lock_guard lock(mutex);
+      double& most = seen[stage ? stage : "none"];
+      most = std::max(most, fraction);
+      return false;
+    };
+    EXPECT_FALSE(renderer->render(request).cancelled);
+    const char* shading = method == RotationMethod::Fused ? "fused" : "rotation";
+    for (const char* stage : {"gbuffer", "rotation-input", shading, "tonemap"}) {
+      ASSERT_TRUE(seen.count(stage)) << stage;
+      EXPECT_GE(seen[stage], 0.95) << methodName(method) << " " << stage;
+      EXPECT_LT(seen[stage], 1.0) << methodName(method) << " " << stage;
+    }
+  }
 }
 
 TEST(CpuBackend, ACancelledFrameStopsAtTheRowsInFlight) {

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "haarcast/net/build_progress.h"
+#include "haarcast/net/frame_progress.h"
 #include "haarcast/net/protocol.h"
 #include "haarcast/render/renderer.h"
 
@@ -74,6 +75,7 @@ std::string pongMessage(std::uint64_t nonce);
 std::string errorMessage(const ProtocolError& error);
 // The stage goes out through publicStageName (build_progress.h).
 std::string buildProgressMessage(const BuildProgressUpdate& update);
+std::string frameProgressMessage(const FrameProgressUpdate& update, int width, int height);
 
 // The longest prefix of `text` of at most `maxBytes` bytes that does not
 // split a UTF-8 sequence (a truncated close reason must still be valid

@@ -45,6 +45,7 @@
 #include <cstddef>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -60,6 +61,26 @@ namespace haarcast::net {
 struct PreparedRenderer {
   std::string key;
   std::unique_ptr<render::Renderer> renderer;
+
+  // The stages of its last frame, any session's, with their times and the
+  // frame's pixels: the weights of a frame's progress (frame_progress.h).
+  // Empty before its first frame.
+  struct LastFrame {
+    std::vector<render::StageTime> stages;
+    std::size_t pixels = 0;
+  };
+  LastFrame lastFrame() const {
+    std::lock_guard lock(lastFrameMutex_);
+    return lastFrame_;
+  }
+  void setLastFrame(LastFrame frame) {
+    std::lock_guard lock(lastFrameMutex_);
+    lastFrame_ = std::move(frame);
+  }
+
+ private:
+  mutable std::mutex lastFrameMutex_;
+  LastFrame lastFrame_;
 };
 
 // Builds the renderer for a config; runs on the builder thread. Throws with
@@ -115,6 +136,10 @@ struct RenderJob {
   // without an error: cancelled before or during its render, or take()
   // returned nullopt. On a service thread; may be empty.
   std::function<void()> onCancelled;
+  // Where the frame is while it renders (the request's StageMark): the
+  // session's, which shows a long frame's progress to its client; empty =
+  // the service's own. The frame deadline reads it too.
+  std::shared_ptr<render::StageMark> stage;
 };
 
 // How a prepare() ended.
@@ -184,6 +209,12 @@ class RenderService {
     // again); empty = none. Called on service threads, never under a lock
     // the caller could take.
     std::function<void(const std::string&)> log;
+    // The stages a build for a config will report, in order, with their
+    // estimated work (render::planBuild): the sessions' BuildProgress then
+    // carries the whole build's fraction and time left. Called on the
+    // builder thread before the build; empty, or a plan that throws or is
+    // empty: no plan (the stage fractions alone).
+    std::function<render::BuildPlan(const SessionConfig&)> planner;
   };
 
   // Throws std::invalid_argument naming an option out of range.

@@ -7,7 +7,8 @@
 //                accepted SceneChoice
 //   PoseUpdate → the latest pose wins; a frame is rendered at most once per
 //                1/fps (pacing), one at a time
-//   Ping       → Pong;  ticks → Hello and idle timeouts, Stats
+//   Ping       → Pong;  ticks → Hello and idle timeouts, Stats, FrameProgress
+//                of a frame in flight past 0.5 s (frame_progress.h)
 //
 // It emits bytes and requests through a SessionPort: ws_session.cpp
 // implements it on a WebSocket, the unit tests with a recorder, so every
@@ -25,6 +26,7 @@
 #include <string>
 #include <string_view>
 
+#include "haarcast/net/frame_progress.h"
 #include "haarcast/net/h264_encoder.h"
 #include "haarcast/net/messages.h"
 #include "haarcast/net/metrics.h"
@@ -49,6 +51,9 @@ struct FrameContext {
   // counts from here: a build is not frame time).
   Clock::time_point requested;
   SessionConfig config;
+  // Where the render is (the backend moves it on, the session's ticks read
+  // it for FrameProgress): the request's StageMark (RenderJob::stage).
+  render::StageMark stage;
 };
 
 // One frame to render: the transport turns it into a RenderJob whose take()
@@ -166,6 +171,7 @@ class RenderSession {
   void flushRenderErrorRepeats(Clock::time_point now, bool force);
   void sendError(const ProtocolError& e);
   void sendStats(Clock::time_point now);
+  void sendFrameProgress(Clock::time_point now);
   void log(const std::string& line) { port_.log(id_ + ": " + line); }
 
   const ServerOptions& options_;
@@ -185,6 +191,7 @@ class RenderSession {
   std::string clientName_;  // sanitised for the log
   std::shared_ptr<PreparedRenderer> renderer_;
   std::shared_ptr<FrameContext> current_;  // the frame in flight (inFlight_), to cancel
+  std::optional<FrameProgressTracker> frameProgress_;  // its progress (FrameProgress), while in flight
   std::shared_ptr<H264Stream> h264_;       // ENCODING_H264 sessions
   bool frameUnsent_ = false;               // a frame waits in the transport's frame slot
   Clock::time_point opened_, lastMessage_, lastStats_, nextFrameAt_{};
