@@ -53,6 +53,22 @@ std::string buildProgressText(const v1::BuildProgress& p) {
     std::snprintf(pct, sizeof pct, " %3d %%", percent);
     out += pct;
   }
+  if (p.stages_size() > 0) {
+    // The server's plan: the whole build's share, the step counted in it,
+    // and the build's time left.
+    const double f = std::isfinite(p.build_fraction()) ? std::clamp(p.build_fraction(), 0.0, 1.0) : 0.0;
+    char build[64];
+    std::snprintf(build, sizeof build, " · build %d %%", std::min(99, static_cast<int>(f * 100.0)));
+    out += build;
+    for (int i = 0; i < p.stages_size(); ++i) {
+      if (p.stages(i) != p.stage()) continue;
+      out += " (step " + std::to_string(i + 1) + " of " + std::to_string(p.stages_size()) + ")";
+      break;
+    }
+    const double buildLeft = p.estimated_build_seconds_left();
+    if (std::isfinite(buildLeft) && buildLeft > 0.0) out += ", ~" + formatDuration(buildLeft) + " left";
+    return out;
+  }
   const double left = p.estimated_stage_seconds_left();
   if (percent >= 0 && percent < 100 && std::isfinite(left) && left > 0.0) {
     out += " (~" + formatDuration(left) + " left in this stage)";

@@ -214,9 +214,20 @@ int run(ServeArgs& a) {
     options.antialias = antialiasFor(antialias, r.backend);
     return r;
   };
-  a.server.render.planner = [resolve](const net::SessionConfig& c) {
+  a.server.render.planner = [resolve, quiet](const net::SessionConfig& c) {
     const Resolved r = resolve(c);
-    return render::planBuild(r.scene, r.options, r.backend);
+    render::BuildPlan plan = render::planBuild(r.scene, r.options, r.backend);
+    if (!quiet) {
+      // The plan beside the stages' own lines: how the estimate was made.
+      std::string line = "[serve] build plan (estimated work, s on the reference machine):";
+      for (const render::PlannedStage& s : plan.stages) {
+        char work[32];
+        std::snprintf(work, sizeof work, " %.3g", s.work);
+        line += " " + s.name + work + ";";
+      }
+      std::fprintf(stderr, "%s\n", line.c_str());
+    }
+    return plan;
   };
   net::AbandonableRendererBuilder builder = [resolve, vulkanOptions, quiet](
                                                 const net::SessionConfig& c, const std::function<bool()>& abandoned,

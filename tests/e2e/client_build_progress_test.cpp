@@ -51,6 +51,23 @@ TEST(BuildProgressText, StagePercentAndTheStagesEstimate) {
       << "no escape sequence from the server reaches the terminal";
 }
 
+// With the server's plan (BuildProgress.stages): the whole build's share,
+// the step counted in the plan, and the build's time left in place of the
+// stage's.
+TEST(BuildProgressText, WithAPlanTheBuildsShareStepAndTimeLeft) {
+  v1::BuildProgress p = progress("visibility bunny", 1, 42, 100, 3.14);
+  p.add_stages("slices bunny");
+  p.add_stages("visibility bunny");
+  p.add_stages("slices ground");
+  p.set_build_fraction(0.456);
+  p.set_estimated_build_seconds_left(12.0);
+  EXPECT_EQ(buildProgressText(p), "visibility bunny  42 % · build 45 % (step 2 of 3), ~12 s left");
+  p.set_estimated_build_seconds_left(0.0);
+  p.set_build_fraction(1.0);
+  p.set_stage("warm-up");
+  EXPECT_EQ(buildProgressText(p), "warm-up  42 % · build 99 %") << "a stage outside the plan; never 100 before the end";
+}
+
 TEST(BuildProgressDisplay, OneRedrawnLineOnATerminal) {
   std::string out;
   BuildProgressDisplay d(true, [&](const std::string& s) { out += s; });
