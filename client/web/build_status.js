@@ -41,7 +41,10 @@ function stageText(stage) {
 // whole build's, which never go back, the step is counted in the plan
 // ("step 2 of 4") and the time left is the build's; without one, the
 // stage's own.
-// Returns {title, stage, fraction (null: unknown), percent, detail}.
+// Returns {title, stage, fraction (null: unknown), percent, detail,
+// stageLine}: stageLine is what the overlay's bold line says (with a plan
+// the stage and its own share, "visibility of bunny · this step 40 %", the
+// build's percentage going to the title; without, the stage's percentage).
 export function describeBuild(progress, what = '') {
   const p = progress || {};
   const total = Number(p.total || 0);
@@ -52,18 +55,21 @@ export function describeBuild(progress, what = '') {
   else if (total > 0 && Number.isFinite(p.fraction)) fraction = clamp(p.fraction);
   const step = planned ? p.stages.indexOf(p.stage) : -1;
   const details = [step >= 0 ? `step ${step + 1} of ${p.stages.length}` : `step ${(p.stageIndex || 0) + 1}`];
-  if (total > 0) details.push(`${Number(p.done || 0)} of ${total}`);
+  if (total > 0 && !planned) details.push(`${Number(p.done || 0)} of ${total}`);
   if (planned && p.estimatedBuildSecondsLeft > 0) details.push(`about ${formatSeconds(p.estimatedBuildSecondsLeft)} left`);
   else if (!planned && p.estimatedStageSecondsLeft > 0) details.push(`about ${formatSeconds(p.estimatedStageSecondsLeft)} left in this step`);
   if (p.elapsedSeconds > 0) details.push(`${formatSeconds(p.elapsedSeconds)} so far`);
-  return {
-    title: `preparing ${what || 'the renderer'}`,
-    stage: stageText(p.stage),
-    fraction,
-    // Never "100 %" before the end.
-    percent: fraction === null ? null : Math.min(99, Math.floor(100 * fraction)),
-    detail: details.join(' · '),
-  };
+  // Never "100 %" before the end.
+  const percent = fraction === null ? null : Math.min(99, Math.floor(100 * fraction));
+  const stage = stageText(p.stage);
+  const title = `preparing ${what || 'the renderer'}`;
+  if (planned) {
+    const own = total > 0 && Number.isFinite(p.fraction) ? ` · this step ${Math.min(99, Math.floor(100 * clamp(p.fraction)))} %` : '';
+    return { title: percent === null ? title : `${title}: ${percent} %`, stage, fraction, percent,
+             detail: details.join(' · '), stageLine: `${stage}${own}` };
+  }
+  return { title, stage, fraction, percent, detail: details.join(' · '),
+           stageLine: percent === null ? stage : `${stage}: ${percent} %` };
 }
 
 // The HUD's first line while no frame comes: the stream is up to date (the

@@ -20,7 +20,7 @@ export function showBuildProgress(progress) {
   const d = describeBuild(progress, build.what);
   build.shown = true;
   $('build-title').textContent = d.title;
-  $('build-stage').textContent = d.percent === null ? d.stage : `${d.stage}: ${d.percent} %`;
+  $('build-stage').textContent = d.stageLine;
   const bar = $('build-bar');
   if (d.fraction === null) bar.removeAttribute('value');  // indeterminate: the total is not known
   else bar.value = d.fraction;

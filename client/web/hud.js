@@ -6,10 +6,10 @@
 // Its details fold away (the button, or h) to one line; folded is the
 // default on a window under 600 px wide, where the view is small. Its
 // numbers come from frame_stats.js.
-import { idleText } from './build_status.js';
+import { formatSeconds, idleText } from './build_status.js';
 import { FrameWindow, formatNumber, formatStops } from './frame_stats.js';
 import { state } from './page_state.js';
-import { resolutionLabel } from './resolution.js';
+import { autoSharpening, resolutionLabel } from './resolution.js';
 import { onShortcut } from './shortcuts.js';
 import { showReconnectCountdown } from './session.js';
 
@@ -52,7 +52,11 @@ export function updateHud() {
   const idle = s.idle && s.sinceLastMs !== null;
   $('hud-rates').hidden = idle;
   $('hud-idle').hidden = !idle;
-  if (idle) $('hud-idle').textContent = idleText(s.sinceLastMs);
+  // Not "up to date" while auto waits for a still view's full-size frame.
+  if (idle) {
+    $('hud-idle').textContent = autoSharpening()
+      ? `auto: sharpening… — last frame ${formatSeconds(Math.max(0, s.sinceLastMs) / 1000)} ago` : idleText(s.sinceLastMs);
+  }
   $('hud-fps').textContent = formatNumber(s.fps);
   $('hud-latency').textContent = formatNumber(s.latencyMs);
   $('hud-kbps').textContent = formatNumber(s.kbps);
@@ -68,6 +72,8 @@ export function updateHud() {
     `over the last ${s.frames} frame(s)${s.idle ? '; no frames lately (the server sends one when something changes)' : ''}`,
     'frame: the server\'s time from the request (a pose, a change) to the frame queued, never a renderer build; ' +
       'stages: the renderer\'s and the encoder\'s',
+    'size: auto is the view\'s own size once it has been still for a moment, a smaller one while it moves ' +
+      'on a server too slow for a smooth drag',
     serverStats ? `server: ${serverStats.fps.toFixed(1)} fps, ${serverStats.sessions} session(s)` : '',
   ].filter(Boolean).join('\n');
   state.hudUpdates++;

@@ -1,9 +1,10 @@
 // The frame size the page asks for: one that fits the view (the resolution
 // control's "auto", the default), a fixed number of lines (360p … 1080p), or
 // the address's ?size=. The size is asked for in the Hello and again, as
-// RenderSettings.width/height, after the view is resized (debounced) or
-// when auto steps the size down or up (stream_size.js has the sizes and the
-// rule, docs/clients.md says them).
+// RenderSettings.width/height, after the view is resized (debounced), when
+// a move starts or auto steps the size down or up while it goes on, and once
+// the view is still again (stream_size.js has the sizes and the rule,
+// docs/clients.md says them).
 import { MOVE_EVENT, choices, page, state } from './page_state.js';
 import { send } from './session.js';
 import { AutoResolution, FIRST_LIMITS, STILL_MS, autoSteps, fpsFloor, frameSize } from './stream_size.js';
@@ -86,36 +87,56 @@ function viewChanged() {
 new ResizeObserver(viewChanged).observe(stage);
 window.addEventListener('resize', viewChanged);  // devicePixelRatio changes with the browser's zoom
 
-// A still view at its own size (stream_size.js AutoResolution.still): each
-// move restarts the timer, and the first move after a still frame goes
-// back to auto's step before its pose leaves.
+// Auto's steps for the view as it is now: [{lines, pixels}] from its own size down.
+function stepsNow() {
+  const view = viewBox();
+  return autoSteps(view.cssHeight * view.dpr).map((lines) => {
+    const s = frameSize('auto', view, limits(), lines);
+    return { lines, pixels: s.width * s.height };
+  });
+}
+
+const autoActive = () => choices.resolution === 'auto' && !fixedByAddress() && state.welcome !== null;
+
+// Moving and still (stream_size.js AutoResolution): the first move picks
+// its step from the last frame and asks for it before its pose leaves (the
+// pose goes at the next display frame); each move restarts the timer, and
+// STILL_MS after the last one the view's own size is asked for, whatever
+// else changed meanwhile (the steps are for moves only).
 let stillTimer = null;
 window.addEventListener(MOVE_EVENT, () => {
   clearTimeout(stillTimer);
-  if (auto.moved()) refit();
+  if (autoActive() && auto.moved(performance.now(), stepsNow(), fpsFloor(state.welcome.fpsCap))) {
+    state.autoSteps++;
+    refit();
+  }
   stillTimer = setTimeout(() => {
-    if (choices.resolution === 'auto' && !fixedByAddress() && auto.still()) refit();
+    if (auto.still() && autoActive()) refit();
   }, STILL_MS);
 });
 
 // Each frame's size and server time, for auto's rule.
 export function frameTiming(width, height, serverMs) {
-  if (fixedByAddress() || choices.resolution !== 'auto' || !state.welcome) return;
-  const view = viewBox();
-  const steps = autoSteps(view.cssHeight * view.dpr).map((lines) => {
-    const s = frameSize('auto', view, limits(), lines);
-    return { lines, pixels: s.width * s.height };
-  });
-  if (auto.frame(performance.now(), { pixels: width * height, serverMs }, steps, fpsFloor(state.welcome.fpsCap)) !== null) {
+  if (!autoActive()) return;
+  if (auto.frame(performance.now(), { pixels: width * height, serverMs }, stepsNow(), fpsFloor(state.welcome.fpsCap)) !== null) {
     state.autoSteps++;
     refit();
   }
 }
 
-// What the HUD says of the size: "fixed", "720p", "auto", "auto ≤360p".
+const pixelsOf = (size) => (size ? size.width * size.height : 0);
+
+// Auto asked for a still view's own size and the canvas still shows a smaller frame.
+export function autoSharpening() {
+  return autoActive() && !auto.moving && pixelsOf(state.lastFrame) < pixelsOf(state.requestedSize);
+}
+
+// What the HUD says of the size: "?size=", "720p", or what auto is doing
+// ("auto ≤180p (moving)", "auto: sharpening…", "auto: full size (still)").
 export function resolutionLabel() {
   if (fixedByAddress()) return '?size=';
-  return choices.resolution === 'auto' ? auto.label() : choices.resolution;
+  return choices.resolution === 'auto' ? auto.label(pixelsOf(state.lastFrame), pixelsOf(state.requestedSize))
+    : choices.resolution;
 }
 
 // The control, from the address: ?size= shows as its own choice.

@@ -2,9 +2,10 @@
 // view's size in device pixels (CSS pixels × devicePixelRatio) within the
 // server's limits (Welcome.limits: max_width, max_height, max_pixels), or a
 // fixed number of lines (360p … 1080p) with the view's aspect ratio. And the
-// rule of "auto": step the size down while the server cannot render frames
-// at the frame-rate floor, and back up when it can. Pure (no DOM, no clock),
-// so that node tests it (tests/e2e/web_client_test.mjs).
+// rule of "auto": while the view moves, a smaller size when the server
+// cannot render frames at the frame-rate floor (and back up when it can);
+// once it is still, the view's own size. Pure (no DOM, no clock), so that
+// node tests it (tests/e2e/web_client_test.mjs).
 
 // The choices of the resolution control (?resolution=).
 export const RESOLUTIONS = ['auto', '360p', '540p', '720p', '1080p'];
@@ -69,57 +70,82 @@ export function autoSteps(viewLines) {
 
 // The automatic rule. Each frame reports its pixel count and the server's
 // time for it (Frame.server_ms: the request it answers → frame queued, a
-// build never included). Over the last `frames` frames of the size in
-// effect, the median time t gives the frame rate the server can hold at
-// this size, 1000 / t; the time at another size is taken as t × its pixels /
-// these pixels (the render is per pixel).
-//   - down: when 1000 / t is under the floor, to the largest step whose
-//     estimate makes the floor (the smallest step when none does);
-//   - up: one step, when the estimate at the next step up is at least
-//     `headroom` × the floor and the size has held for `holdMs`.
-//   - still: the steps hold a frame rate while the view moves, and a view
-//     that has stopped needs none, so once it has been still for STILL_MS
-//     (the page's timer: still()) the view's own size is asked for, one
-//     frame however long the server takes; the next move (moved()) goes
-//     back to the step in effect before its pose is sent.
+// build never included); the time at another size is taken as t × its
+// pixels / these pixels (as if the render were all per pixel: where a frame
+// costs something besides, the move's own frames step further). Steps are
+// for a view that moves; a still view needs no frame rate:
+//   - still (the default, and STILL_MS after the last move, whatever else
+//     changed meanwhile: a scene, a material, a setting, a resize): the
+//     view's own size, one frame however long the server takes. Frames of a
+//     still view step nothing; the last one is kept for the next move.
+//   - a move starts (moved()): the step for the move is chosen from the last
+//     frame's time and pixels alone, before the move's first pose is sent:
+//     the largest step whose estimate holds the floor (the smallest when
+//     none does), so a slow server's first drag frame already comes small.
+//     Above the step of the last move only with `headroom` and after
+//     `holdMs` (as up, below), so that it does not flap between moves.
+//   - while it moves, over the frames of the size asked for (the median of
+//     the last `frames`): down as soon as `downFrames` of them say the floor
+//     is missed, to the largest step that holds it; up one step, when the
+//     estimate at the next step up is at least `headroom` × inside the
+//     floor's budget and the size has held for `holdMs`.
 // The floor (fpsFloor) and the rule are in docs/clients.md.
 // How long a view stays unmoved before auto shows it at its own size.
 export const STILL_MS = 700;
 
 export class AutoResolution {
-  constructor({ frames = 4, headroom = 1.5, holdMs = 3000 } = {}) {
+  constructor({ frames = 4, downFrames = 2, headroom = 1.5, holdMs = 3000 } = {}) {
     this.frames = frames;
+    this.downFrames = downFrames;
     this.headroom = headroom;
     this.holdMs = holdMs;
-    this.capLines = Infinity;  // the current step: lines at most
-    this.samples = [];         // server ms of frames of the size in effect
+    this.capLines = Infinity;  // the step of a moving view: lines at most
+    this.samples = [];         // server ms of this move's frames of the size in effect
     this.pixels = 0;           // the size in effect (the one asked for)
-    this.changedAt = -Infinity;
-    this.sharp = false;        // a still view, shown at its own size
+    this.changedAt = -Infinity;  // when that size was asked for
+    this.steppedAt = -Infinity;  // when capLines last changed
+    this.moving = false;
+    this.last = null;          // {pixels, serverMs} of the last frame with a time, of any size
   }
 
-  // The cap to ask for now: the step in effect, or none while still.
+  // The cap to ask for now: the step while the view moves, none while still.
   wantedCap() {
-    return this.sharp ? Infinity : this.capLines;
+    return this.moving ? this.capLines : Infinity;
   }
 
   // The view has been still for STILL_MS. True when that changes the size
-  // asked for (auto had stepped down).
+  // asked for (the move had a step).
   still() {
-    if (this.sharp || !Number.isFinite(this.capLines)) return false;
-    this.sharp = true;
-    return true;
+    if (!this.moving) return false;
+    this.moving = false;
+    this.samples = [];
+    return Number.isFinite(this.capLines);
   }
 
-  // The view moves. True when the size asked for goes back to the step.
-  moved() {
-    if (!this.sharp) return false;
-    this.sharp = false;
-    return true;
+  // The view moves (each drag, wheel or pinch event). The first of a move
+  // picks its step from the last frame; `steps` and `floor` as for frame().
+  // True when the size asked for changes (before the move's pose is sent).
+  moved(now, steps, floor) {
+    if (this.moving) return false;
+    this.moving = true;
+    this.samples = [];
+    if (this.last) {
+      const budget = 1000 / floor;
+      const estimate = (s) => this.last.serverMs * s.pixels / this.last.pixels;
+      const mayRise = now - this.steppedAt >= this.holdMs;
+      const fits = (s) => estimate(s) <= budget &&
+        (s.lines <= this.capLines || (mayRise && estimate(s) * this.headroom <= budget));
+      const pick = steps.find(fits) || steps[steps.length - 1];
+      if (pick && pick.lines !== this.capLines) {
+        this.capLines = pick.lines;
+        this.steppedAt = now;
+      }
+    }
+    return Number.isFinite(this.capLines);
   }
 
-  // A new size was asked for (a step, a resize): samples of the old one no
-  // longer say anything.
+  // A new size was asked for (a step, a resize, still or moving): samples of
+  // the old one no longer say anything.
   asked(pixels, now) {
     if (pixels !== this.pixels) {
       this.pixels = pixels;
@@ -133,12 +159,15 @@ export class AutoResolution {
   // (autoSteps with the pixels frameSize gives each). Returns the new cap in
   // lines when the rule changes it, else null.
   frame(now, { pixels, serverMs }, steps, floor) {
-    if (pixels !== this.pixels || !(serverMs > 0)) return null;
+    if (!(serverMs > 0)) return null;
+    this.last = { pixels, serverMs };
+    if (!this.moving || pixels !== this.pixels) return null;
     this.samples.push(serverMs);
     if (this.samples.length > this.frames) this.samples.shift();
-    if (this.samples.length < this.frames) return null;
-    const sorted = [...this.samples].sort((a, b) => a - b);
-    const t = sorted[Math.floor(sorted.length / 2)];
+    const n = this.samples.length;
+    if (n < Math.min(this.downFrames, this.frames)) return null;
+    // The lower median: one slow frame among quick ones steps nothing.
+    const t = [...this.samples].sort((a, b) => a - b)[Math.floor((n - 1) / 2)];
     const budget = 1000 / floor;  // ms a frame may take
     const at = steps.findIndex((s) => s.lines === this.capLines);
     const index = at >= 0 ? at : 0;
@@ -148,10 +177,11 @@ export class AutoResolution {
       for (let i = index + 1; i < steps.length; i++) {
         if (estimate(steps[i]) <= budget) { next = i; break; }
       }
-      if (next === index) return null;  // the smallest step already
+      if (next <= index) return null;  // the smallest step already
       return this.step(steps[next].lines, now);
     }
-    if (index > 0 && now - this.changedAt >= this.holdMs && estimate(steps[index - 1]) * this.headroom <= budget) {
+    if (n >= this.frames && index > 0 && now - this.changedAt >= this.holdMs &&
+        estimate(steps[index - 1]) * this.headroom <= budget) {
       return this.step(steps[index - 1].lines, now);
     }
     return null;
@@ -161,12 +191,14 @@ export class AutoResolution {
     this.capLines = lines;
     this.samples = [];
     this.changedAt = now;
+    this.steppedAt = now;
     return lines;
   }
 
-  // "auto 540p" for the HUD: the step in effect ("auto" at the view's own size).
-  label() {
-    if (this.sharp) return `auto (still: full size; ≤${this.capLines}p moving)`;
-    return Number.isFinite(this.capLines) ? `auto ≤${this.capLines}p` : 'auto';
+  // What auto is doing, for the HUD: `shown` and `asked` are the pixels of
+  // the frame on the canvas and of the size asked for.
+  label(shown, asked) {
+    if (this.moving) return Number.isFinite(this.capLines) ? `auto ≤${this.capLines}p (moving)` : 'auto: full size (moving)';
+    return shown > 0 && asked > 0 && shown < asked ? 'auto: sharpening…' : 'auto: full size (still)';
   }
 }

@@ -552,7 +552,7 @@ try {
     check(during.length > 0 && during.every((r) => r.dimmed) &&
           during.some((r) => /preparing scene e2e-box/.test(r.title) && /(BRDF slice table|visibility) of /.test(r.stage)),
           'a build: the frame is dimmed and the stage of the scene being prepared is shown');
-    check(during.some((r) => r.bar >= 0 && r.bar <= 1 && /\d+ %/.test(r.stage)), 'a build: a progress bar and a percentage');
+    check(during.some((r) => r.bar >= 0 && r.bar <= 1 && /\d+ %/.test(r.title)), 'a build: a progress bar and the build\'s percentage');
     // The bar is the whole build's (BuildProgress.build_fraction against the
     // server's plan): it never goes back, and the steps count in the plan.
     const bars = during.map((r) => r.bar).filter((b) => b !== null);

@@ -19,7 +19,7 @@ const { DRAG_DEGREES_PER_PIXEL, dragOrbit, orbitEye, orbitFromCamera, pinchOrbit
   await import(pathToFileURL(join(web, 'orbit.js')));
 const { AutoResolution, FIRST_LIMITS, FPS_FLOOR, autoSteps, fpsFloor, frameSize, sizeWithin } =
   await import(pathToFileURL(join(web, 'stream_size.js')));
-const { describeBuild, formatSeconds, idleText } = await import(pathToFileURL(join(web, 'build_status.js')));
+const { describeBuild, describeFrame, formatSeconds, idleText } = await import(pathToFileURL(join(web, 'build_status.js')));
 const { takesTyping } = await import(pathToFileURL(join(web, 'shortcuts.js')));
 
 const tests = [];
@@ -345,22 +345,29 @@ test('size: a fixed resolution is that many lines with the view\'s aspect; auto\
   assert.equal(fpsFloor(10), 8);
 });
 
-// Auto's rule against a server whose frame time is `msPerMegapixel` per
-// million pixels (and 5 ms besides): frames every `interval` ms.
-function runAuto(auto, { msPerMegapixel, frames, start = 0, interval = 100, view = { cssWidth: 1280, cssHeight: 720, dpr: 1 } }) {
-  const steps = autoSteps(view.cssHeight * view.dpr).map((lines) => {
-    const s = frameSize('auto', view, LIMITS, lines);
-    return { lines, pixels: s.width * s.height };
-  });
+// Auto's steps for `view`, as the page computes them (resolution.js stepsNow).
+const VIEW = { cssWidth: 1280, cssHeight: 720, dpr: 1 };  // 1280×720: 0.92 Mpx
+const stepsOf = (view) => autoSteps(view.cssHeight * view.dpr).map((lines) => {
+  const s = frameSize('auto', view, LIMITS, lines);
+  return { lines, pixels: s.width * s.height };
+});
+// A made-up server: `msPerMegapixel` per million pixels, and 5 ms besides.
+const msAt = (msPerMegapixel, pixels) => 5 + msPerMegapixel * pixels / 1e6;
+
+// Auto's rule against that server while the view moves (a drag from
+// `start`), frames every `interval` ms; the size asked for after each.
+function runAuto(auto, { msPerMegapixel, frames, start = 0, interval = 100, view = VIEW }) {
+  const steps = stepsOf(view);
   let t = start;
   const sizes = [];
-  let size = frameSize('auto', view, LIMITS, auto.capLines);
+  auto.moved(t, steps, FPS_FLOOR);
+  let size = frameSize('auto', view, LIMITS, auto.wantedCap());
   auto.asked(size.width * size.height, t);
   for (let i = 0; i < frames; i++, t += interval) {
     const pixels = size.width * size.height;
-    const changed = auto.frame(t, { pixels, serverMs: 5 + msPerMegapixel * pixels / 1e6 }, steps, FPS_FLOOR);
+    const changed = auto.frame(t, { pixels, serverMs: msAt(msPerMegapixel, pixels) }, steps, FPS_FLOOR);
     if (changed !== null) {
-      size = frameSize('auto', view, LIMITS, changed);
+      size = frameSize('auto', view, LIMITS, auto.wantedCap());
       auto.asked(size.width * size.height, t);
     }
     sizes.push(size.height);
@@ -368,15 +375,16 @@ function runAuto(auto, { msPerMegapixel, frames, start = 0, interval = 100, view
   return { sizes, t };
 }
 
-test('auto: a server too slow for the floor at the view\'s size steps down to the largest size that holds it', () => {
+test('auto: while the view moves, a server too slow for the floor steps down to the largest size that holds it', () => {
   const auto = new AutoResolution();
-  // 1280×720 = 0.92 Mpx at 200 ms/Mpx: 189 ms, 5 fps. 360p (0.23 Mpx): 51 ms,
-  // 19.6 fps, the largest that holds 15 fps (540p: 108 ms).
+  // No frame before the move to estimate from. 1280×720 at 200 ms/Mpx:
+  // 189 ms, 5 fps. 360p (0.23 Mpx): 51 ms, 19.6 fps, the largest that
+  // holds 15 fps (540p: 108 ms).
   const { sizes } = runAuto(auto, { msPerMegapixel: 200, frames: 20 });
   assert.equal(sizes[0], 720);
   assert.equal(sizes.at(-1), 360, sizes.join(' '));
-  assert.equal(auto.label(), 'auto ≤360p');
-  assert.ok(sizes.indexOf(360) <= 4, `it steps after a few frames: ${sizes.join(' ')}`);
+  assert.equal(auto.label(), 'auto ≤360p (moving)');
+  assert.ok(sizes.indexOf(360) <= 1, `it steps after two frames: ${sizes.join(' ')}`);
   // It stays there: 360p holds the floor and 540p would not.
   assert.equal(new Set(sizes.slice(sizes.indexOf(360))).size, 1);
 });
@@ -385,13 +393,14 @@ test('auto: a fast server keeps the view\'s own size; one that gets faster is st
   const fast = new AutoResolution();
   const kept = runAuto(fast, { msPerMegapixel: 20, frames: 30 }).sizes;
   assert.ok(kept.every((h) => h === 720), kept.join(' '));
-  assert.equal(fast.label(), 'auto');
+  assert.equal(fast.label(), 'auto: full size (moving)');
 
   const auto = new AutoResolution();
   const slow = runAuto(auto, { msPerMegapixel: 500, frames: 20 });
   assert.equal(slow.sizes.at(-1), 180, slow.sizes.join(' '));
   const downAt = auto.changedAt;
-  // The server frees up (another session ended): 270p, then 360p, … back to the view's size.
+  // The server frees up (another session ended) during a long drag: 270p,
+  // then 360p, … back to the view's size.
   const start = slow.t + 100;
   const up = runAuto(auto, { msPerMegapixel: 20, frames: 200, start }).sizes;
   const steps = up.filter((h, i) => i === 0 || h !== up[i - 1]);
@@ -405,39 +414,108 @@ test('auto: a fast server keeps the view\'s own size; one that gets faster is st
   }
 });
 
-test('auto: a still view is asked for at its own size, and the next move goes back to the step', () => {
+test('auto: a move starts at the step one frame\'s time says holds the floor, before its first pose', () => {
+  const steps = stepsOf(VIEW);
+  const full = steps[0].pixels;
   const auto = new AutoResolution();
-  const { sizes, t } = runAuto(auto, { msPerMegapixel: 200, frames: 20 });
-  assert.equal(sizes.at(-1), 360, sizes.join(' '));
+  // A still view: slow frames at its own size step nothing (a scene switch,
+  // a setting: no move, no step).
+  auto.asked(full, 0);
+  for (let i = 0; i < 10; i++) assert.equal(auto.frame(500 * i, { pixels: full, serverMs: msAt(200, full) }, steps, FPS_FLOOR), null);
+  assert.equal(auto.wantedCap(), Infinity);
+  assert.equal(auto.capLines, Infinity);
+  // The move: the last frame (189 ms at 0.92 Mpx) says 360p holds 15 fps.
+  assert.equal(auto.moved(5000, steps, FPS_FLOOR), true, 'the step is asked for at the move\'s first event');
   assert.equal(auto.wantedCap(), 360);
-  // Still: the view's own size, whatever the server's time.
+  assert.equal(auto.moved(5016, steps, FPS_FLOOR), false, 'later events of the move ask nothing');
+  // A fresh page's one frame, 1.9 s: no step holds the floor, the smallest.
+  const fresh = new AutoResolution();
+  fresh.frame(0, { pixels: full, serverMs: 1870 }, steps, FPS_FLOOR);
+  assert.equal(fresh.moved(10, steps, FPS_FLOOR), true);
+  assert.equal(fresh.wantedCap(), 180);
+  // A fast server: the move keeps the view's own size.
+  const fast = new AutoResolution();
+  fast.frame(0, { pixels: full, serverMs: 30 }, steps, FPS_FLOOR);
+  assert.equal(fast.moved(10, steps, FPS_FLOOR), false);
+  assert.equal(fast.wantedCap(), Infinity);
+  // A frame with no time (the first) is nothing to estimate from: the move
+  // starts at the view's size, and its frames step it.
+  const blind = new AutoResolution();
+  blind.frame(0, { pixels: full, serverMs: NaN }, steps, FPS_FLOOR);
+  assert.equal(blind.moved(10, steps, FPS_FLOOR), false);
+  // Between moves, up only as the rule allows: after 180p, a full-size
+  // frame of 400 ms says 270p (56 ms) holds the floor, but not with 1.5×
+  // to spare: the next move stays at 180p. At 250 ms, 270p (35 ms) has the
+  // room, and is taken once 180p has held for 3 s.
+  assert.equal(fresh.still(), true);
+  fresh.frame(1000, { pixels: full, serverMs: 400 }, steps, FPS_FLOOR);
+  fresh.moved(5000, steps, FPS_FLOOR);
+  assert.equal(fresh.wantedCap(), 180);
+  fresh.still();
+  fresh.frame(6000, { pixels: full, serverMs: 250 }, steps, FPS_FLOOR);
+  fresh.moved(6500, steps, FPS_FLOOR);
+  assert.equal(fresh.wantedCap(), 270);
+  fresh.still();
+  fresh.frame(7000, { pixels: full, serverMs: 150 }, steps, FPS_FLOOR);
+  fresh.moved(7500, steps, FPS_FLOOR);
+  assert.equal(fresh.wantedCap(), 270, '360p has the room, but 270p was taken 1 s ago');
+});
+
+test('auto: still after any change, the view\'s own size; the next move back at its step', () => {
+  const steps = stepsOf(VIEW);
+  const full = steps[0].pixels;
+  const small = steps.at(-1).pixels;
+  const auto = new AutoResolution();
+  auto.frame(0, { pixels: full, serverMs: 1500 }, steps, FPS_FLOOR);
+  assert.equal(auto.label(full, full), 'auto: full size (still)');
+  assert.equal(auto.moved(100, steps, FPS_FLOOR), true);
+  assert.equal(auto.wantedCap(), 180);
+  auto.asked(small, 100);
+  assert.equal(auto.label(full, small), 'auto ≤180p (moving)');
+  // Right after the drag, a scene switch, a material and a setting are
+  // answered at the step (slow ones: the smallest step stays); a resize
+  // asks for the step of the new view.
+  for (const ms of [300, 250, 280]) assert.equal(auto.frame(900, { pixels: small, serverMs: ms }, steps, FPS_FLOOR), null);
+  auto.asked(small - 2 * 180, 1000);
+  // STILL_MS after the last move: the view's own size, whatever changed.
   assert.equal(auto.still(), true);
   assert.equal(auto.wantedCap(), Infinity);
-  assert.match(auto.label(), /still: full size; ≤360p moving/);
   assert.equal(auto.still(), false, 'still twice asks once');
-  // A move: back to 360p, not to the view's size, and the step is kept.
-  assert.equal(auto.moved(), true);
-  assert.equal(auto.wantedCap(), 360);
-  assert.equal(auto.capLines, 360);
-  assert.equal(auto.moved(), false, 'a second move changes nothing');
-  // At the view's own size already there is nothing to sharpen.
+  assert.equal(auto.label(small, full), 'auto: sharpening…', 'the full-size frame not shown yet');
+  assert.equal(auto.label(full, full), 'auto: full size (still)');
+  // Frames of the still view, however slow, keep its size.
+  auto.asked(full, 2000);
+  for (let i = 0; i < 8; i++) assert.equal(auto.frame(2000 + 100 * i, { pixels: full, serverMs: 2000 }, steps, FPS_FLOOR), null);
+  assert.equal(auto.wantedCap(), Infinity);
+  assert.equal(auto.samples.length, 0, 'not counted for the next move\'s rule');
+  // The next move goes back to a step before its pose (from the last frame).
+  assert.equal(auto.moved(5000, steps, FPS_FLOOR), true);
+  assert.equal(auto.wantedCap(), 180);
+  // A view never stepped down has nothing to sharpen.
   const fast = new AutoResolution();
-  runAuto(fast, { msPerMegapixel: 20, frames: 10, start: t });
+  fast.frame(0, { pixels: full, serverMs: 20 }, steps, FPS_FLOOR);
+  fast.moved(10, steps, FPS_FLOOR);
   assert.equal(fast.still(), false);
   assert.equal(fast.wantedCap(), Infinity);
 });
 
 test('auto: frames of another size, and frames with no time, are not counted', () => {
   const auto = new AutoResolution();
-  auto.asked(1000, 0);
   const steps = [{ lines: Infinity, pixels: 1000 }, { lines: 180, pixels: 250 }];
+  auto.moved(0, steps, 15);
+  auto.asked(1000, 0);
   for (let i = 0; i < 10; i++) {
     assert.equal(auto.frame(i, { pixels: 4000, serverMs: 500 }, steps, 15), null);  // an old size's
     assert.equal(auto.frame(i, { pixels: 1000, serverMs: NaN }, steps, 15), null);  // the first frame
   }
   assert.equal(auto.samples.length, 0);
-  // A median, so one slow frame among quick ones does not step.
-  for (const ms of [20, 20, 900, 20]) assert.equal(auto.frame(20, { pixels: 1000, serverMs: ms }, steps, 15), null);
+  // A (lower) median, so one slow frame among quick ones does not step.
+  for (const ms of [20, 20, 900, 20, 900, 20]) assert.equal(auto.frame(20, { pixels: 1000, serverMs: ms }, steps, 15), null);
+  const once = new AutoResolution();
+  once.moved(0, steps, 15);
+  once.asked(1000, 0);
+  assert.equal(once.frame(10, { pixels: 1000, serverMs: 900 }, steps, 15), null, 'one slow frame alone does not step');
+  assert.equal(once.frame(20, { pixels: 1000, serverMs: 900 }, steps, 15), 180, 'two do');
 });
 
 // ---- what the page says of a build and of an idle stream (build_status.js) -------------
@@ -461,6 +539,38 @@ test('build: the stage in words, its share, the time left, never 100 % before th
   assert.equal(u.title, 'preparing the renderer');
   // A Long (uint64) total and done.
   assert.equal(describeBuild({ stage: 'x', done: { toString: () => '5' }, total: { toString: () => '20' }, fraction: 0.25 }).percent, 25);
+});
+
+test('build with a plan: the build\'s share in the title, the step counted in the plan, the build\'s time left', () => {
+  const d = describeBuild({ stage: 'visibility bunny', stageIndex: 1, done: 14379, total: 35947, fraction: 0.4,
+                            elapsedSeconds: 12.3, estimatedStageSecondsLeft: 80, buildFraction: 0.55,
+                            stages: ['slices bunny', 'visibility bunny', 'slices ground', 'visibility ground'],
+                            estimatedBuildSecondsLeft: 95 }, 'level 6');
+  assert.equal(d.fraction, 0.55, 'the bar is the whole build\'s');
+  assert.equal(d.percent, 55);
+  assert.equal(d.title, 'preparing level 6: 55 %');
+  assert.equal(d.stageLine, 'visibility of bunny · this step 40 %');
+  assert.equal(d.detail, 'step 2 of 4 · about 1 min 35 s left · 12 s so far');
+  // Without a plan, the stage's own share on the stage line, as before.
+  assert.equal(describeBuild({ stage: 'slices ball', total: 10, done: 5, fraction: 0.5 }).stageLine, 'BRDF slice table of ball: 50 %');
+  // A stage outside the plan (warm-up): no step number in the plan.
+  assert.equal(describeBuild({ stage: 'warm-up', total: 1, done: 0, fraction: 0, buildFraction: 0.99,
+                               stages: ['slices a', 'visibility a'] }).detail, 'step 1');
+});
+
+test('frame progress: the frame\'s share, the stage in words, the time so far and left', () => {
+  const d = describeFrame({ stage: 'fused', stageFraction: 0.5, fraction: 0.456, elapsedSeconds: 2.04,
+                            estimatedSecondsLeft: 3.1, width: 964, height: 784 });
+  assert.equal(d.title, 'rendering the frame 964×784');
+  assert.equal(d.stage, 'shading');
+  assert.equal(d.percent, 45);
+  assert.equal(d.fraction, 0.456);
+  assert.equal(d.detail, '2.0 s so far · about 3.1 s left');
+  const q = describeFrame({ stage: 'queued', fraction: 0, elapsedSeconds: 0.6 });
+  assert.equal(q.stage, 'waiting for a render thread');
+  assert.equal(q.detail, '0.6 s so far');
+  assert.equal(describeFrame({ stage: 'tonemap', fraction: 1 }).percent, 99, 'never 100 % before the frame');
+  assert.equal(describeFrame({ stage: 'something-new', fraction: 0.2 }).stage, 'something-new');
 });
 
 test('idle: the HUD says the stream is up to date and how old the last frame is', () => {
