@@ -17,6 +17,8 @@
 //   ?resolution=auto|360p|540p|720p|1080p (or ?size=WxH, fixed)
 //   &encoding=jpeg|png|raw|h264&quality=85&fps=30&token=T
 //   &method=fused&level=4&k=256&exposure=auto|STOPS&scene=NAME
+//   &mat=SPEC,SPEC…&tone=reinhard|aces|agx&cam=AZ,EL,DIST&light=DEG&obj=I:X:Y:Z,…
+//   (the page keeps these up to date as the view changes: share_url.js)
 import './save_frame.js';  // the save button and s: the frame as a PNG
 import './view_input.js';  // drags, pinches, the wheel and the reset button steer the view
 import { endBuild, expectBuild, showBuildProgress } from './build_view.js';
@@ -28,10 +30,11 @@ import { orbitEye } from './orbit.js';
 import { parsePageParameters } from './page_params.js';
 import { choices, page, setPage, state } from './page_state.js';
 import { onSceneInfo, showScenes, undoSceneChoice } from './scene_panel.js';
-import { Encoding, loadSchema, methodNames } from './schema.js';
+import { Encoding, loadSchema, methodNames, toneNames } from './schema.js';
 import { connect, onServerMessages, send, stop } from './session.js';
 import { chooseEncoding, flushExposure, showWelcomeSettings, undoSettingsChange } from './settings_panel.js';
 import { granted, refit, showResolutionChoice } from './resolution.js';
+import { applyAddressView, startAddress } from './share_url.js';
 import { setStatus, showBanner } from './status.js';
 import { flushPose, objectRotation, orbit, scenePoseOf, view } from './view.js';
 
@@ -65,6 +68,7 @@ function onWelcome(w) {
   }
   view.pendingScene = null;
   onSceneInfo(w.sceneInfo || { name: w.scenes[0] || '', objects: [] }, true);
+  applyAddressView();  // the view the address named, once
   // The frame size is the HUD's to say: it follows the view.
   // Where its shadow rays are traced: on the GPU itself or by the server's CPU.
   const rays = w.rays === 'device' ? ', rays on the device' : w.rays === 'host' ? ', rays on the host' : '';
@@ -114,7 +118,7 @@ async function main() {
   await loadSchema();
 
   // The page's parameters first: a bad one is reported and nothing connects.
-  setPage(parsePageParameters(location.search, { methods: methodNames }));
+  setPage(parsePageParameters(location.search, { methods: methodNames, tones: toneNames }));
   if (page.errors.length) {
     for (const e of page.errors) state.errors.push({ code: 'PAGE_PARAMETER', message: e.message, fatal: true });
     showBanner(`${page.errors.map((e) => e.message).join('\n')}\nFix the address and reload.`);
@@ -123,7 +127,7 @@ async function main() {
     return;
   }
   Object.assign(choices, { scene: page.scene, method: page.method, level: page.level, k: page.k,
-                           exposure: page.exposure, resolution: page.resolution });
+                           exposure: page.exposure, resolution: page.resolution, tone: page.tone });
   showResolutionChoice();
   // The first build: the scene the Hello asks for.
   expectBuild(`scene ${page.scene || 'default'}`);
@@ -134,6 +138,7 @@ async function main() {
   await chooseEncoding(page.encoding);
   connect();
   setInterval(updateHud, 250);
+  startAddress();
   // The server closes sessions that send nothing for a while; a page left
   // alone (no drags) pings to stay connected.
   let nonce = 0;

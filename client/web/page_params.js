@@ -25,6 +25,13 @@ export const PARAMETERS = {
   k: 'light coefficients kept, a whole number > 0',
   exposure: '"auto" or stops, e.g. -1.5',
   scene: 'a scene the server offers, e.g. default',
+  // The view itself (share_url.js keeps them in the address as the user
+  // steers, so that the address opens the same view elsewhere).
+  cam: 'AZIMUTH,ELEVATION,DISTANCE: the camera\'s orbit about the scene\'s target in degrees and scene units, e.g. 30,15,4.2',
+  light: 'the light\'s turn about +Y in degrees, e.g. 90',
+  obj: 'objects\' turns, INDEX:X:Y:Z in degrees, comma-separated, e.g. 0:10:45:0',
+  mat: 'objects\' materials, INDEX:SPEC comma-separated, e.g. 0:phong:64,1:ggx:0.3 (with ?scene=)',
+  tone: '',  // filled from the schema's ToneCurve values
 };
 
 function wholeNumber(text) {
@@ -32,19 +39,25 @@ function wholeNumber(text) {
 }
 
 // search: location.search (or a URLSearchParams); methods: the rotation
-// method names the schema defines ("fused", "haar", …).
+// method names the schema defines ("fused", "haar", …); tones: its tone
+// curve names ("reinhard", …).
 // Returns the choices and `errors`, one line per bad parameter.
-export function parsePageParameters(search, { methods }) {
+export function parsePageParameters(search, { methods, tones = ['reinhard', 'aces', 'agx'] }) {
   const params = search instanceof URLSearchParams ? search : new URLSearchParams(search);
   const out = {
     width: 0, height: 0, resolution: 'auto', encoding: 'jpeg', quality: 0, fps: 0, token: '',
     method: '', level: 0, k: 0, exposure: { auto: true, stops: 0 }, scene: '',
+    camera: null,    // {azimuth, elevation, distance}: degrees, degrees, scene units
+    light: null,     // degrees about +Y
+    objects: [],     // [{index, x, y, z}] degrees
+    materials: [],   // [{index, spec}]
+    tone: '',
     errors: [],
   };
   const bad = (name, value, valid) => {
     out.errors.push({ parameter: name, value, message: `?${name}=${value} is not valid: ${valid}` });
   };
-  const valid = { ...PARAMETERS, method: `use one of ${methods.join(', ')}` };
+  const valid = { ...PARAMETERS, method: `use one of ${methods.join(', ')}`, tone: `use one of ${tones.join(', ')}` };
   for (const name of new Set(params.keys())) {
     if (!(name in valid)) {
       out.errors.push({ parameter: name, value: params.get(name),
@@ -115,5 +128,68 @@ export function parsePageParameters(search, { methods }) {
     if (scene === '') bad('scene', scene, 'name a scene the server offers, e.g. default');
     else out.scene = scene;
   }
+  const numbers = (text, count) => {
+    const parts = text.split(',');
+    const values = parts.map((p) => (p.trim() === '' ? NaN : Number(p)));
+    return parts.length === count && values.every(Number.isFinite) ? values : null;
+  };
+  const cam = get('cam');
+  if (cam !== null) {
+    const v = numbers(cam, 3);
+    if (!v || !(v[2] > 0) || Math.abs(v[1]) >= 90) bad('cam', cam, `${valid.cam}, the elevation within ±90 and the distance > 0`);
+    else out.camera = { azimuth: v[0], elevation: v[1], distance: v[2] };
+  }
+  const light = get('light');
+  if (light !== null) {
+    const v = numbers(light, 1);
+    if (!v) bad('light', light, `use ${valid.light}`);
+    else out.light = v[0];
+  }
+  const obj = get('obj');
+  if (obj !== null) {
+    const turns = obj.split(',').map((t) => t.split(':'));
+    const ok = turns.every((t) => t.length === 4 && /^\d+$/.test(t[0]) && t.slice(1).every((x) => x.trim() !== '' && Number.isFinite(Number(x))));
+    if (!ok || new Set(turns.map((t) => t[0])).size !== turns.length) bad('obj', obj, `use ${valid.obj}, each object once`);
+    else out.objects = turns.map((t) => ({ index: Number(t[0]), x: Number(t[1]), y: Number(t[2]), z: Number(t[3]) }));
+  }
+  const mat = get('mat');
+  if (mat !== null) {
+    const pairs = mat.split(',').map((m) => /^(\d+):(.+)$/.exec(m));
+    if (pairs.some((m) => !m) || new Set(pairs.map((m) => m[1])).size !== pairs.length) bad('mat', mat, `use ${valid.mat}, each object once`);
+    else if (scene === null) bad('mat', mat, 'give ?scene= too: the materials are the named scene\'s objects\'');
+    else out.materials = pairs.map((m) => ({ index: Number(m[1]), spec: m[2] }));
+  }
+  const tone = get('tone');
+  if (tone !== null) {
+    if (tones.includes(tone)) out.tone = tone;
+    else bad('tone', tone, valid.tone);
+  }
   return out;
+}
+
+// The other way: the parameters that say a view, for the address
+// (share_url.js); parsePageParameters reads them back.
+// Enough digits that the view comes back to well under a pixel.
+const fixed = (x, digits) => String(Number(x.toFixed(digits)));
+
+// The address's parameters for the view now (pure: `materials` [{index,
+// spec}], `snapshot` view.js viewSnapshot()).
+export function viewParameters({ scene, materials, method, level, k, exposure, tone, snapshot }) {
+  const p = {};
+  if (scene) p.scene = scene;
+  if (materials && materials.length) p.mat = materials.map((m) => `${m.index}:${m.spec}`).join(',');
+  if (method) p.method = method;
+  if (level > 0) p.level = String(level);
+  if (k > 0) p.k = String(k);
+  if (exposure) p.exposure = exposure.auto ? 'auto' : fixed(exposure.stops, 3);
+  if (tone) p.tone = tone;
+  if (snapshot.camera) {
+    const c = snapshot.camera;
+    p.cam = [fixed(c.azimuth, 4), fixed(c.elevation, 4), fixed(c.distance, 5)].join(',');
+  }
+  if (snapshot.light !== null) p.light = fixed(snapshot.light, 4);
+  if (snapshot.objects.length) {
+    p.obj = snapshot.objects.map((o) => [o.index, fixed(o.x, 4), fixed(o.y, 4), fixed(o.z, 4)].join(':')).join(',');
+  }
+  return p;
 }

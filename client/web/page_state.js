@@ -37,6 +37,7 @@ export const state = {
   buildsEnded: 0,      // builds shown and over
   progress: null,      // the waiting overlay: {title, stage, fraction (null: indeterminate), detail, shown}
   progressUpdates: 0,  // times it was redrawn
+  addressWrites: 0,    // times the address was brought up to date with the view (share_url.js)
   frameProgress: null, // the last FrameProgress shown: {stage, fraction, elapsedSeconds}
   frameProgressMessages: 0,
   hudFolded: false,    // the HUD shows its first line only

@@ -63,6 +63,9 @@ function hello() {
       for (const o of info.objects) {
         if (state.welcome.materials.includes(o.material)) h.scene.objectMaterials[o.index] = o.material;
       }
+    } else if (!state.welcome && choices.scene === page.scene) {
+      // The first Hello: the materials the address names (share_url.js).
+      for (const m of page.materials) h.scene.objectMaterials[m.index] = m.spec;
     }
   }
   return h;

@@ -58,6 +58,44 @@ export function resetView() {
   objectRotation.clear();
 }
 
+// What the user has steered, for the address (share_url.js): the camera's
+// orbit in degrees, the light's turn, each turned object's; null or empty
+// for what was not touched (the scene's own then).
+export function viewSnapshot() {
+  const deg = (r) => r * 180 / Math.PI;
+  return {
+    camera: touched.camera ? { azimuth: deg(orbit.azimuth), elevation: deg(orbit.elevation), distance: orbit.distance } : null,
+    light: touched.light ? lightY : null,
+    objects: [...touched.objects].sort((a, b) => a - b).map((i) => {
+      const r = objectRotation.get(i);
+      return { index: i, x: r.x, y: r.y, z: r.z };
+    }),
+  };
+}
+
+// A view from the address (page_params.js: camera, light, objects) over the
+// scene's own, sent as the next pose. Objects the scene does not have are
+// left out.
+export function applyView(v) {
+  const rad = (d) => d * Math.PI / 180;
+  if (v.camera) {
+    orbit.azimuth = rad(v.camera.azimuth);
+    orbit.elevation = rad(v.camera.elevation);
+    orbit.distance = v.camera.distance;
+    touched.camera = true;
+  }
+  if (v.light !== null && v.light !== undefined) {
+    lightY = v.light;
+    touched.light = true;
+  }
+  for (const o of v.objects || []) {
+    if (!state.sceneInfo || !state.sceneInfo.objects.some((x) => x.index === o.index)) continue;
+    objectRotation.set(o.index, { ...scenePoseOf(o.index), x: o.x, y: o.y, z: o.z });
+    touched.objects.add(o.index);
+  }
+  view.poseDirty = true;
+}
+
 // Until a scene is shown, or while another one is on its way, there is no
 // view to move.
 const steerable = () => state.sceneInfo && view.pendingScene === null;

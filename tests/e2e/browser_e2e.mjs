@@ -998,6 +998,69 @@ try {
     await p.close();
   }
 
+  // 19. The address says the whole view: a page opened at it shows the same
+  // picture (share_url.js). PNG frames and a fixed exposure: the two
+  // canvases can be compared pixel for pixel.
+  section('shareable address');
+  {
+    const a = await browser.newPage({ viewport: { width: 900, height: 700 } });
+    const problems = [];
+    a.on('pageerror', (e) => problems.push(e.message));
+    await a.goto(`${base}?size=160x120&encoding=png&exposure=-1`);
+    await waitFrames(a, 1);
+    const c = await a.locator('#frame').boundingBox();
+    const dragOn = async (p, box, modifier, dx, dy) => {
+      if (modifier) await p.keyboard.down(modifier);
+      await p.mouse.move(box.x + box.width / 2, box.y + box.height / 2);
+      await p.mouse.down();
+      await p.mouse.move(box.x + box.width / 2 + dx, box.y + box.height / 2 + dy, { steps: 4 });
+      await p.mouse.up();
+      if (modifier) await p.keyboard.up(modifier);
+    };
+    await dragOn(a, c, null, 70, 25);
+    await dragOn(a, c, 'Alt', 50, 0);
+    await dragOn(a, c, 'Shift', -40, 30);
+    await a.locator('#objects select').nth(1).selectOption('phong:16');
+    await a.waitForFunction(() => window.haarcast.sceneInfo.objects[1].material === 'phong:16', null, { timeout: 60000 });
+    await a.selectOption('#tone', 'aces');
+    // Settled: the frame answers the last pose, and no frame comes for a while.
+    const settle = async (p) => {
+      await p.waitForFunction(() => window.haarcast.lastFrame.poseSequence >= window.haarcast.posesSent, null, { timeout: 60000 });
+      let n = -1;
+      while (n !== (await p.evaluate(() => window.haarcast.framesShown))) {
+        n = await p.evaluate(() => window.haarcast.framesShown);
+        await p.waitForTimeout(1000);
+      }
+    };
+    await settle(a);
+    const shared = await a.evaluate(() => location.href);
+    const params = new URL(shared).searchParams;
+    check(['scene', 'mat', 'tone', 'cam', 'light', 'obj', 'exposure', 'size', 'encoding'].every((k) => params.has(k)) &&
+          /1:phong:16/.test(params.get('mat')) && params.get('tone') === 'aces',
+          `the address says the view (${decodeURIComponent(new URL(shared).search)})`);
+    const pixelsA = await canvasPixels(a);
+    const b = await browser.newPage({ viewport: { width: 900, height: 700 } });
+    b.on('pageerror', (e) => problems.push(e.message));
+    await b.goto(shared);
+    await waitFrames(b, 1);
+    await settle(b);
+    const pixelsB = await canvasPixels(b);
+    const diff = meanAbsDiff(pixelsA, pixelsB);
+    const sb = await b.evaluate(() => ({ material: window.haarcast.sceneInfo.objects[1].material, pose: window.haarcast.lastFrame.poseSequence }));
+    check(sb.material === 'phong:16' && sb.pose >= 1 && diff < 0.5,
+          `a second page opened at the address shows the same picture (mean |Δ| ${diff.toFixed(3)} per channel over ` +
+          `${pixelsA.length / 4} pixels; its material ${sb.material}, its frame answers pose ${sb.pose})`);
+    // And the comparison can fail: the scene's own view differs.
+    const c2 = await browser.newPage({ viewport: { width: 900, height: 700 } });
+    await c2.goto(`${base}?size=160x120&encoding=png&exposure=-1`);
+    await waitFrames(c2, 1);
+    const own = meanAbsDiff(pixelsA, await canvasPixels(c2));
+    check(own > 2, `the scene's own view is another picture (mean |Δ| ${own.toFixed(2)})`);
+    check(problems.length === 0, `address pages: no page errors (${problems.join('; ')})`);
+    if (opts.out) await b.screenshot({ path: join(opts.out, 'shared-address.png') });
+    await Promise.all([a.close(), b.close(), c2.close()]);
+  }
+
   // 10. A dropped connection: the page counts down and reconnects.
   section('reconnect');
   {

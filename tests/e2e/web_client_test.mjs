@@ -13,7 +13,7 @@ import { fileURLToPath, pathToFileURL } from 'node:url';
 
 const web = join(resolve(dirname(fileURLToPath(import.meta.url)), '..', '..'), 'client', 'web');
 const { FrameWindow, backoffMs, formatNumber, formatStops } = await import(pathToFileURL(join(web, 'frame_stats.js')));
-const { parsePageParameters } = await import(pathToFileURL(join(web, 'page_params.js')));
+const { parsePageParameters, viewParameters } = await import(pathToFileURL(join(web, 'page_params.js')));
 const { H264View, helloEncoding } = await import(pathToFileURL(join(web, 'h264_view.js')));
 const { DRAG_DEGREES_PER_PIXEL, dragOrbit, orbitEye, orbitFromCamera, pinchOrbit, v3, zoomOrbit } =
   await import(pathToFileURL(join(web, 'orbit.js')));
@@ -181,6 +181,30 @@ test('page parameters: each bad one is named with its valid values', () => {
   assert.match(one('?resolution=4k').message, /\?resolution=4k.*auto, 360p, 540p, 720p, 1080p/);
   assert.match(one('?resolution=720p&size=64x64').message, /\?size=.*or \?resolution=, not both/);
   assert.equal(parsePageParameters('?method=fast&encoding=exr', { methods }).errors.length, 2);
+});
+
+test('page parameters: a view written to the address reads back the same, and a bad one is named', () => {
+  const view = { scene: 'default', materials: [{ index: 0, spec: 'phong:64' }, { index: 1, spec: 'merl:alum-bronze-sgd' }],
+                 method: 'fused', level: 5, k: 128, exposure: { auto: false, stops: -1.25 }, tone: 'aces',
+                 snapshot: { camera: { azimuth: -35.123456, elevation: 22.5, distance: 4.874681 }, light: 25,
+                             objects: [{ index: 0, x: 15, y: -20, z: 0 }, { index: 2, x: 0, y: 90.5, z: 0 }] } };
+  const p = parsePageParameters(new URLSearchParams(viewParameters(view)), { methods: ['fused', 'haar'] });
+  assert.deepEqual(p.errors, []);
+  assert.equal(p.scene, 'default');
+  assert.deepEqual(p.materials, view.materials);
+  assert.equal(p.method, 'fused');
+  assert.equal(p.level, 5);
+  assert.equal(p.k, 128);
+  assert.deepEqual(p.exposure, { auto: false, stops: -1.25 });
+  assert.equal(p.tone, 'aces');
+  assert.deepEqual(p.camera, { azimuth: -35.1235, elevation: 22.5, distance: 4.87468 }, 'to 1e-4 degree, 1e-5 unit');
+  assert.equal(p.light, 25);
+  assert.deepEqual(p.objects, view.snapshot.objects);
+  // Nothing steered: no camera, light or objects in the address.
+  const still = viewParameters({ ...view, snapshot: { camera: null, light: null, objects: [] } });
+  assert.ok(!('cam' in still) && !('light' in still) && !('obj' in still));
+  const bad = parsePageParameters('?cam=1,95,3&obj=0:1:2:3,0:4:5:6&mat=0:lambert&tone=filmic', { methods: ['fused'] });
+  assert.deepEqual(bad.errors.map((e) => e.parameter), ['cam', 'obj', 'mat', 'tone']);
 });
 
 test('page parameters: ?encoding=h264', () => {
