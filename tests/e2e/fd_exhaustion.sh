@@ -3,7 +3,7 @@
 # more connections than it can hold, all kept open. While accept fails with
 # EMFILE it must pause (not retry at once: that spun a core and logged 153 MB
 # in 20 s) and log one line for the episode; once the connections go, it must
-# accept again and answer /healthz.
+# accept again and answer /healthz. Then the same against the gRPC port.
 #
 # usage: fd_exhaustion.sh HAARCAST_BINARY
 set -euo pipefail
@@ -92,4 +92,77 @@ rc=0
 wait "$server_pid" || rc=$?
 server_pid=""
 ((rc == 0)) || fail "the server exited $rc on SIGTERM"
+rm -f "$work/holding" "$work/release" "$work/server.out" "$work/server.err"
+
+# The gRPC port through the same exhaustion. gRPC 1.51 stops accepting on a
+# port for good after accept() failed with EMFILE (CVE-2023-4785): within
+# 12 s of the descriptors coming back, the port either answers an HTTP/2
+# preface again or /healthz answers 503 naming it (the server's own probe,
+# listener_probe.h), so that an orchestrator restarts it. Never a dead port
+# behind a 200.
+# --grpc-port 0 is no gRPC: a port free a moment ago.
+grpc_port="$(python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')"
+start_server prlimit --nofile=64:64 "$haarcast" serve --port 0 --grpc-port "$grpc_port" --backend cpu --cache-dir none \
+  --max-connections-per-address 10000 --handshake-timeout 30
+http2_answers() {
+  python3 - "$grpc_port" <<'PY'
+import socket, sys
+try:
+    s = socket.create_connection(("127.0.0.1", int(sys.argv[1])), timeout=0.5)
+    s.sendall(b"PRI * HTTP/2.0\r\n\r\nSM\r\n\r\n" + bytes(9)[:3] + b"\x04" + bytes(5))
+    header = s.recv(9)
+    sys.exit(0 if len(header) >= 4 and header[3] == 4 else 1)
+except Exception:
+    sys.exit(1)
+PY
+}
+http2_answers || fail "the gRPC port does not answer before the flood"
+healthz || fail "/healthz before the gRPC flood"
+python3 - "$grpc_port" "$work/holding" "$work/release" <<'PY' &
+import os, socket, sys, time
+port, holding, release = int(sys.argv[1]), sys.argv[2], sys.argv[3]
+held = [socket.create_connection(("127.0.0.1", port), timeout=5) for _ in range(150)]
+open(holding, "w").close()
+while not os.path.exists(release):
+    time.sleep(0.05)
+for s in held:
+    s.close()
+PY
+holder_pid=$!
+for ((i = 0; i < 200; i++)); do [[ -e "$work/holding" ]] && break; sleep 0.05; done
+[[ -e "$work/holding" ]] || fail "the 150 gRPC connections were not all made"
+sleep 3
+touch "$work/release"
+wait "$holder_pid" || true
+holder_pid=""
+verdict=""
+released=$SECONDS
+while ((SECONDS - released < 12)); do
+  if http2_answers; then verdict="the gRPC port accepts again"; break; fi
+  code="$(python3 - "$port" "$work/healthz.txt" <<'PY'
+import sys, urllib.request, urllib.error
+try:
+    with urllib.request.urlopen(f"http://127.0.0.1:{sys.argv[1]}/healthz", timeout=2) as r:
+        code, body = r.status, r.read()
+except urllib.error.HTTPError as e:
+    code, body = e.code, e.read()
+except Exception:
+    code, body = 0, b""
+open(sys.argv[2], "wb").write(body)
+print(code)
+PY
+)"
+  if [[ "$code" == 503 ]] && grep -q "gRPC port $grpc_port" "$work/healthz.txt"; then
+    verdict="/healthz 503: $(cat "$work/healthz.txt")"
+    break
+  fi
+  sleep 0.1
+done
+[[ -n "$verdict" ]] || fail "12 s after the gRPC flood the port does not answer and /healthz says $(cat "$work/healthz.txt" 2>/dev/null)"
+echo "after the gRPC flood: $verdict (within $((SECONDS - released)) s)"
+kill -TERM "$server_pid"
+rc=0
+wait "$server_pid" || rc=$?
+server_pid=""
+((rc == 0)) || fail "the server exited $rc on SIGTERM after the gRPC flood"
 echo "PASS"

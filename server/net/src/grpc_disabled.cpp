@@ -13,6 +13,7 @@ GrpcServer::GrpcServer(Server::Impl&) {
 }
 GrpcServer::~GrpcServer() = default;
 std::uint16_t GrpcServer::port() const { return 0; }
+std::optional<std::string> GrpcServer::listenerProblem() const { return std::nullopt; }
 std::size_t GrpcServer::sessionCount() const { return 0; }
 void GrpcServer::stopSessions() {}
 void GrpcServer::shutdownThen(std::function<void()> then) {

@@ -17,6 +17,7 @@
 
 #include "grpc_reflection.h"
 #include "grpc_session.h"
+#include "haarcast/net/listener_probe.h"
 #include "haarcast/proto/haarcast.grpc.pb.h"
 
 namespace haarcast::net {
@@ -24,6 +25,11 @@ namespace {
 
 // How often the health status is brought in line with atCapacity().
 constexpr auto kHealthPoll = std::chrono::milliseconds(200);
+// How often the port is probed (listener_probe.h), and how long a probe
+// waits for the server's SETTINGS: three silent probes in a row, 6 to 9 s,
+// mark the port dead. Short enough that SIGTERM waits at most one probe.
+constexpr auto kProbeEvery = std::chrono::seconds(2);
+constexpr auto kProbeTimeout = std::chrono::milliseconds(1000);
 // Past the drain, how long gRPC's Shutdown waits before it cancels the
 // streams still open (the drain has already given them drainSeconds).
 constexpr auto kShutdownGrace = std::chrono::milliseconds(500);
@@ -70,6 +76,10 @@ struct GrpcServer::State {
   std::condition_variable healthWake;
   bool healthStop = false;
   std::thread health;
+  // Whether the port still accepts: only the health thread writes it.
+  ListenerWatch listener;
+  std::atomic<bool> listenerDead{false};
+  std::string probeHost;  // where the probe connects: the bind address, loopback for a wildcard
 
   std::atomic<bool> shutdownBegun{false}, shutdownDone{false};
   std::thread stopper;
@@ -80,12 +90,30 @@ struct GrpcServer::State {
     h->SetServingStatus("", serving);
   }
 
-  // Until stopped: SERVING exactly when /readyz would answer 200.
+  // Until stopped: SERVING exactly when /readyz would answer 200 and the
+  // port accepts; the port probed every kProbeEvery.
   void watchHealth() {
     std::unique_lock lock(healthMutex);
     std::optional<bool> last;
+    auto nextProbe = std::chrono::steady_clock::now() + kProbeEvery;
     while (!healthStop) {
-      const bool serving = !server.atCapacity();
+      if (std::chrono::steady_clock::now() >= nextProbe) {
+        lock.unlock();
+        const ProbeResult result = probeHttp2Listener(probeHost, static_cast<std::uint16_t>(port), kProbeTimeout);
+        lock.lock();
+        nextProbe = std::chrono::steady_clock::now() + kProbeEvery;
+        if (listener.record(result)) {
+          listenerDead.store(listener.dead());
+          if (listener.dead()) {
+            server.log("the gRPC port %d stopped accepting (no answer to 3 probes in a row; gRPC 1.51 stops for good "
+                       "after an accept() failed for want of descriptors, CVE-2023-4785): /healthz answers 503, "
+                       "restart the process", port);
+          } else {
+            server.log("the gRPC port %d accepts again: /healthz answers 200", port);
+          }
+        }
+      }
+      const bool serving = !server.atCapacity() && !listenerDead.load();
       if (serving != last) setServing(serving);
       last = serving;
       healthWake.wait_for(lock, kHealthPoll, [this] { return healthStop; });
@@ -128,6 +156,8 @@ GrpcServer::GrpcServer(Server::Impl& server) : state_(std::make_unique<State>(se
   if (!state_->grpc || state_->port == 0) {
     throw std::runtime_error("cannot listen for gRPC on " + where + " (address in use, or not one of this machine's)");
   }
+  // A wildcard bind is probed on loopback, of the same family.
+  state_->probeHost = o.bindAddress == "0.0.0.0" ? "127.0.0.1" : o.bindAddress == "::" ? "::1" : o.bindAddress;
   state_->setServing(!server.atCapacity());
   state_->health = std::thread([s = state_.get()] { s->watchHealth(); });
   server.log("gRPC on %s (port %d): haarcast.v1.Render, grpc.health.v1.Health, reflection v1 and v1alpha", where.c_str(),
@@ -137,6 +167,12 @@ GrpcServer::GrpcServer(Server::Impl& server) : state_(std::make_unique<State>(se
 GrpcServer::~GrpcServer() { join(); }
 
 std::uint16_t GrpcServer::port() const { return static_cast<std::uint16_t>(state_->port); }
+
+std::optional<std::string> GrpcServer::listenerProblem() const {
+  if (!state_->listenerDead.load()) return std::nullopt;
+  return "the gRPC port " + std::to_string(state_->port) +
+         " stopped accepting (gRPC 1.51 after descriptor exhaustion, CVE-2023-4785): restart the process";
+}
 
 std::size_t GrpcServer::sessionCount() const {
   std::lock_guard lock(state_->mutex);

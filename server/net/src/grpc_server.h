@@ -17,6 +17,8 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
+#include <string>
 #include <utility>  // before Asio: its awaitable.hpp uses std::exchange
 
 #include "server_impl.h"
@@ -35,6 +37,10 @@ class GrpcServer {
   GrpcServer& operator=(const GrpcServer&) = delete;
 
   std::uint16_t port() const;
+  // Why the port is dead, once a few probes in a row went unanswered
+  // (listener_probe.h); nullopt while it accepts. /healthz answers 503 with
+  // it, and gRPC health says NOT_SERVING.
+  std::optional<std::string> listenerProblem() const;
   // Streams open now (from their first reaction until destroyed): the drain
   // waits for them as for WebSocket sessions.
   std::size_t sessionCount() const;

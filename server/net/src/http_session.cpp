@@ -140,7 +140,11 @@ void HttpSession::serve(const Request& request) {
     return;
   }
   if (path == "/healthz") {
-    respond(request, http::status::ok, "ok\n", "text/plain", keepAlive);
+    if (const auto reason = server_.unhealthyReason()) {
+      respond(request, http::status::service_unavailable, *reason + "\n", "text/plain", keepAlive);
+    } else {
+      respond(request, http::status::ok, "ok\n", "text/plain", keepAlive);
+    }
     return;
   }
   if (path == "/readyz") {

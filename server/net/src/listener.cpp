@@ -186,6 +186,10 @@ std::optional<std::string> Server::Impl::notReadyReason() const {
   return std::nullopt;
 }
 
+std::optional<std::string> Server::Impl::unhealthyReason() const {
+  return grpc ? grpc->listenerProblem() : std::nullopt;
+}
+
 std::string Server::Impl::metricsText() {
   metrics.pixelsInFlight.store(renderService->pixelsInFlight());
   metrics.pixelBudget.store(options.render.serverPixelBudget);

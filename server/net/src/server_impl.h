@@ -78,6 +78,9 @@ struct Server::Impl {
   std::size_t sessionCount();
   bool atCapacity() const;
   std::optional<std::string> notReadyReason() const;
+  // Why the process should be restarted (/healthz 503): a listener that no
+  // longer accepts (GrpcServer::listenerProblem); nullopt when healthy.
+  std::optional<std::string> unhealthyReason() const;
   // The render service stopped, its stop grace counted from stop(), and the
   // threads it left behind logged. After the I/O threads have been joined.
   void stopRenderService();

@@ -11,6 +11,7 @@
 
 #include "haarcast/proto/grpc/reflection/v1/reflection.grpc.pb.h"
 #include "haarcast/proto/haarcast.grpc.pb.h"
+#include "haarcast/net/listener_probe.h"
 #include "server_fixture.h"
 
 namespace haarcast::net::test {
@@ -214,6 +215,15 @@ TEST(GrpcServer, HealthIsServingUntilTheSessionBudgetIsFull) {
     client.finish();
   }
   EXPECT_TRUE(eventually([&] { return healthStatus(port) == 1; })) << "SERVING again once the slot is free";
+}
+
+// The port's own probe (listener_probe.h): a live gRPC server answers the
+// HTTP/2 preface with SETTINGS, so its /healthz stays 200.
+TEST(GrpcServer, ItsListenerProbeIsAnsweredAndHealthzIsOk) {
+  TestServer server(grpcOptions());
+  EXPECT_EQ(probeHttp2Listener("127.0.0.1", server.server().grpcPort(), std::chrono::milliseconds(2000)),
+            ProbeResult::Answered);
+  EXPECT_NE(httpGet(server.port(), "/healthz").find("ok"), std::string::npos);
 }
 
 // Reflection v1 (server/net/src/grpc_reflection.h), through its generated
