@@ -1,8 +1,10 @@
-// The scene controls: which of the server's scenes is shown, each object's
-// material, and the objects a drag can turn. They show the scene the server
-// says is in effect (SceneInfo), so a refused choice leaves them truthful;
-// a new scene's objects are listed once its first frame is on the canvas
-// (its renderer may take a while to build), not over the old scene's frame.
+// The scene controls: which of the server's scenes is shown, under which of
+// its probes, or which of its meshes instead of the scene's objects (and
+// which way up), each object's material, and the objects a drag can turn.
+// They show the scene the server says is in effect (SceneInfo), so a
+// refused choice leaves them truthful; a new scene's objects are listed
+// once its first frame is on the canvas (its renderer may take a while to
+// build), not over the old scene's frame.
 import { expectBuild } from './build_view.js';
 import { choices, state } from './page_state.js';
 import { send } from './session.js';
@@ -16,6 +18,70 @@ export function showScenes(names) {
   fillSelect($('scene'), names.map((s) => [s, s]));
 }
 
+// The server's probes and meshes (Welcome.probes, Welcome.meshes, from
+// `serve --data`): a select for each kind it offers, none for a kind it
+// does not (a control that cannot be used is not on the page).
+function showDataChoices(welcome) {
+  const lists = [['probe', welcome.probes || [], "the scene's own light", chooseProbe],
+    ['mesh', welcome.meshes || [], "the scene's own objects", chooseMesh]];
+  for (const [id, names, own, choose] of lists) {
+    const old = $(`${id}-choice`);
+    if (old) old.remove();
+    if (names.length === 0) continue;
+    const label = document.createElement('label');
+    label.id = `${id}-choice`;
+    label.className = 'wide';
+    const select = document.createElement('select');
+    select.id = id;
+    fillSelect(select, [['', own], ...names.map((n) => [n, n])]);
+    select.addEventListener('change', () => choose(select.value));
+    label.append(`${id} `, select);
+    $('objects').before(label);
+  }
+}
+
+// The up axis of the mesh shown: "up: y / z", only while a mesh is shown.
+function showUpChoice(info) {
+  let group = $('up-choice');
+  if (!info.mesh) {
+    if (group) group.remove();
+    return;
+  }
+  if (!group) {
+    group = document.createElement('div');
+    group.id = 'up-choice';
+    group.setAttribute('role', 'radiogroup');
+    group.setAttribute('aria-label', "the mesh's up axis in its file");
+    const title = document.createElement('span');
+    title.textContent = 'up';
+    group.append(title);
+    for (const axis of ['y', 'z']) {
+      const label = document.createElement('label');
+      label.className = 'inline';
+      const radio = document.createElement('input');
+      radio.type = 'radio';
+      radio.name = 'up';
+      radio.value = axis;
+      radio.addEventListener('change', () => { if (radio.checked) chooseUp(axis); });
+      label.append(radio, ` ${axis}`);
+      group.append(label);
+    }
+    const note = document.createElement('span');
+    note.id = 'up-note';
+    group.append(note);
+    $('objects').before(group);
+  }
+  for (const r of group.querySelectorAll('input')) r.checked = r.value === info.up;
+  $('up-note').textContent = upChosen ? '' : 'guessed from its shape';
+}
+
+// What is drawn: the scene, or the mesh shown instead of its objects (and
+// which way up). Another such answer means other objects and another view.
+const objectsOf = (info) => `${info.name}|${info.mesh || ''}|${info.up || ''}`;
+// A SceneChoice waiting for its answer (view.pendingScene): the scene and mesh.
+const pendingOf = (scene, mesh) => `${scene}|${mesh || ''}`;
+let upChosen = false;  // the user flipped the mesh's up axis: not the server's guess
+
 // The scene in effect: from Welcome, in answer to each accepted
 // SceneChoice, and again with the objects' levels when a renderer built
 // later has other levels than the client was told. Another scene resets the view to its own camera (the server
@@ -23,8 +89,11 @@ export function showScenes(names) {
 // keeps the view.
 export function onSceneInfo(info, fromWelcome) {
   const previous = state.sceneInfo;
-  const newScene = !previous || previous.name !== info.name;
+  const newScene = !previous || objectsOf(previous) !== objectsOf(info);
   state.sceneInfo = info;
+  if (fromWelcome && state.welcome) showDataChoices(state.welcome);
+  if (!info.mesh || (previous && previous.mesh !== info.mesh)) upChosen = false;
+  showDataChoice(info);
   choices.scene = info.name;
   if (newScene || (fromWelcome && !touched.camera)) resetView();
   if (newScene && !fromWelcome) {
@@ -33,12 +102,12 @@ export function onSceneInfo(info, fromWelcome) {
   } else if (fromWelcome) {
     state.scene = { name: info.name, firstPose: 0 };
   }
-  if (view.pendingScene === info.name) view.pendingScene = null;
+  if (view.pendingScene === pendingOf(info.name, info.mesh)) view.pendingScene = null;
   view.poseDirty = true;
   selectValue($('scene'), info.name);
   if (newScene && !fromWelcome) {
     state.sceneReady = false;
-    showPreparing(info.name);
+    showPreparing(info.mesh || info.name);
   } else if (!fromWelcome && !state.sceneReady) {
     // The same scene again before its first frame (the server names its
     // objects' levels once its renderer is built): still held back.
@@ -46,6 +115,14 @@ export function onSceneInfo(info, fromWelcome) {
     state.sceneReady = true;
     showObjects(info);
   }
+}
+
+// The probe, mesh and up axis in effect (SceneInfo), so a refused choice
+// shows what is drawn; the up control only for a mesh.
+function showDataChoice(info) {
+  if ($('probe')) selectValue($('probe'), info.probe || '');
+  if ($('mesh')) selectValue($('mesh'), info.mesh || '');
+  showUpChoice(info);
 }
 
 // A frame of the scene in effect is on the canvas: its objects are listed
@@ -127,24 +204,61 @@ export function undoSceneChoice() {
   if (state.sceneInfo) onSceneInfo(state.sceneInfo, false);
 }
 
-function chooseScene(name) {
-  if (state.sceneInfo && name === state.sceneInfo.name) return;
-  choices.scene = name;
-  view.pendingScene = name;
-  // Poses sent before the answer would move the new scene with the old
-  // scene's camera: none carry a view until SceneInfo comes.
+// A SceneChoice says the whole choice (an empty field is the scene's own):
+// what is in effect, with `change` on top.
+function sceneChoice(change) {
+  const info = state.sceneInfo || { name: choices.scene || '' };
+  return { scene: info.name, probe: info.probe || '', mesh: info.mesh || '', up: info.mesh ? info.up || '' : '',
+    ...change };
+}
+
+// Other objects: poses sent before the answer would move them with the old
+// objects' camera, so none carry a view until SceneInfo comes.
+function awaitObjects(choice) {
+  view.pendingScene = pendingOf(choice.scene, choice.mesh);
   touched.camera = false;
   touched.light = false;
   touched.objects.clear();
+}
+
+// Another scene: its own objects, under the probe chosen (if any).
+function chooseScene(name) {
+  if (state.sceneInfo && name === state.sceneInfo.name && !state.sceneInfo.mesh) return;
+  choices.scene = name;
+  const choice = sceneChoice({ scene: name, mesh: '', up: '' });
+  awaitObjects(choice);
   expectBuild(`scene ${name}`);
-  if (send({ scene: { scene: name } })) noteChange();
+  if (send({ scene: choice })) noteChange();
+}
+
+// Another probe: the same objects under its light ('' the scene's own).
+function chooseProbe(probe) {
+  expectBuild(probe ? `probe ${probe}` : 'the scene\'s own light');
+  if (send({ scene: sceneChoice({ probe }) })) noteChange();
+}
+
+// A mesh instead of the scene's objects ('' back to them), up as guessed.
+function chooseMesh(mesh) {
+  const choice = sceneChoice({ mesh, up: '' });
+  awaitObjects(choice);
+  expectBuild(mesh ? `mesh ${mesh}` : `scene ${choice.scene}`);
+  if (send({ scene: choice })) noteChange();
+}
+
+// The mesh the other way up: its file's Y or Z stood along the view's up.
+function chooseUp(up) {
+  upChosen = true;
+  const choice = sceneChoice({ up });
+  awaitObjects(choice);
+  expectBuild(`${choice.mesh} with ${up} up`);
+  if (send({ scene: choice })) noteChange();
 }
 
 function chooseMaterial(index, spec) {
   if (!state.sceneInfo) return;
   const o = state.sceneInfo.objects.find((x) => x.index === index);
   expectBuild(`${spec} on ${(o && o.name) || `object ${index}`}`);
-  if (send({ scene: { scene: state.sceneInfo.name, objectMaterials: { [index]: spec } } })) noteChange();
+  if (send({ scene: sceneChoice({ objectMaterials: { [index]: spec } }) })) noteChange();
 }
 
 $('scene').addEventListener('change', () => chooseScene($('scene').value));

@@ -60,6 +60,8 @@ function hello() {
     // After a reconnect: the materials in effect, where the server offers them.
     const info = state.sceneInfo;
     if (info && info.name === choices.scene && state.welcome) {
+      // The probe and mesh in effect too (SceneChoice says the whole choice).
+      Object.assign(h.scene, { probe: info.probe || '', mesh: info.mesh || '', up: info.mesh ? info.up || '' : '' });
       for (const o of info.objects) {
         if (state.welcome.materials.includes(o.material)) h.scene.objectMaterials[o.index] = o.material;
       }

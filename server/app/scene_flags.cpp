@@ -11,6 +11,7 @@
 #include "haarcast/render/exposure_meter.h"
 #include "haarcast/render/renderer.h"
 #include "haarcast/render/tonemap.h"
+#include "mesh_scene.h"
 
 namespace haarcast::app {
 
@@ -82,20 +83,14 @@ render::Scene sceneFromFlags(const SceneFlags& f) {
   }
   // Before any file is read: a bad --up fails at once.
   const render::UpAxis up = f.up.empty() ? render::UpAxis::Y : parseUp(f.up);
-  render::Scene scene = render::defaultScene();
-  scene.objects.clear();
-  if (!f.env.empty()) scene.environment = render::environmentFromFile(f.env, f.layout);
-  auto mesh = std::make_shared<Mesh>(io::loadMesh(f.mesh));
-  render::makeYUp(*mesh, up);
-  render::fitToUnitSphere(*mesh);
-  render::SceneObject object{fs::path(f.mesh).stem().string(), mesh, render::materialFromSpec(f.material.empty() ? kMeshMaterial : f.material), {}};
+  render::Pose pose;
   if (!f.rotate.empty()) {
     if (f.rotate.size() != 3) throw std::invalid_argument("--rotate takes X,Y,Z in degrees");
-    object.pose.rotateDegrees = {f.rotate[0], f.rotate[1], f.rotate[2]};
+    pose.rotateDegrees = {f.rotate[0], f.rotate[1], f.rotate[2]};
   }
-  scene.objects.push_back(object);
-  scene.camera.eye = {0.0, 0.3, 3.0};
-  if (f.ground) render::addGround(scene);
+  const render::Material material = render::materialFromSpec(f.material.empty() ? kMeshMaterial : f.material);
+  render::Scene scene = meshScene(io::loadMesh(f.mesh), fs::path(f.mesh).stem().string(), up, material, pose, f.ground);
+  if (!f.env.empty()) scene.environment = render::environmentFromFile(f.env, f.layout);
   return scene;
 }
 

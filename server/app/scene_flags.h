@@ -11,11 +11,9 @@
 
 #include "haarcast/io/image.h"
 #include "haarcast/render/scene.h"
+#include "mesh_scene.h"  // kMeshMaterial
 
 namespace haarcast::app {
-
-// The material of a --mesh object when --material is not given.
-inline constexpr const char* kMeshMaterial = "phong:64";
 
 struct SceneFlags {
   std::string scene, env, layout = "auto", mesh, material;

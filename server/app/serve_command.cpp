@@ -48,7 +48,7 @@ struct ServeArgs {
   std::string level = "auto";  // render::parseLevelChoice; auto: its cap at most --max-level
   std::size_t lightCoefficients = 256;
   std::vector<std::string> sceneFiles;
-  std::string materialsDir, webRoot, protoFile, cacheDir, vulkanDevice;
+  std::string materialsDir, dataDir, webRoot, protoFile, cacheDir, vulkanDevice;
   std::string rays = "auto";
   render::SceneLimits sceneLimits;
   bool vulkanValidation = false, quiet = false;
@@ -70,9 +70,15 @@ int run(ServeArgs& a) {
     }
     scenes.push_back({name, render::loadScene(file, a.sceneLimits)});
   }
-  ServeCatalog served = buildServeCatalog(scenes, a.materialsDir);
-  net::Catalog catalog = std::move(served.catalog);
-  auto materialFiles = std::make_shared<std::map<std::string, std::string>>(std::move(served.materialFiles));
+  // The names clients may choose; the files behind them stay here (servedScene).
+  const auto served = std::make_shared<const ServeCatalog>(buildServeCatalog(scenes, a.materialsDir, a.dataDir, a.sceneLimits));
+  net::Catalog catalog = served->catalog;
+  if (!a.dataDir.empty() && !a.quiet) {
+    std::string line = "[serve] --data offers " + std::to_string(catalog.probes.size()) + " probes, " +
+                       std::to_string(catalog.meshes.size()) + " meshes (up guessed:";
+    for (const auto& m : catalog.meshes) line += " " + m.name + " " + std::string(net::upAxisName(m.guessedUp));
+    std::fprintf(stderr, "%s)\n", line.c_str());
+  }
   // Backends: those built into this binary; clients may use only the ones
   // the operator enabled (--backends, else just --backend).
   const auto enable = [&](const std::string& flag, const std::string& name) {
@@ -195,18 +201,8 @@ int run(ServeArgs& a) {
     render::RenderOptions options;
     std::string backend;
   };
-  auto resolve = [sharedScenes, materialFiles, base, antialias](const net::SessionConfig& c) {
-    const auto it = std::find_if(sharedScenes->begin(), sharedScenes->end(),
-                                 [&](const SceneSource& s) { return s.name == c.scene; });
-    if (it == sharedScenes->end()) throw std::invalid_argument("unknown scene \"" + c.scene + "\"");
-    Resolved r{it->scene, base, std::string(net::backendName(c.backend))};
-    render::Scene& scene = r.scene;
-    for (std::size_t i = 0; i < scene.objects.size() && i < c.materials.size(); ++i) {
-      if (c.materials[i] == scene.objects[i].material.name) continue;  // the scene's own
-      const auto file = materialFiles->find(c.materials[i]);
-      scene.objects[i].material = render::materialFromSpec(file != materialFiles->end() ? file->second : c.materials[i]);
-      scene.objects[i].material.name = c.materials[i];
-    }
+  auto resolve = [sharedScenes, served, base, antialias](const net::SessionConfig& c) {
+    Resolved r{servedScene(*sharedScenes, *served, c), base, std::string(net::backendName(c.backend))};
     render::RenderOptions& options = r.options;
     options.method = c.method;
     render::applyLevelChoice(options, {c.level, c.automaticLevel});
@@ -335,6 +331,9 @@ std::function<int()> addServeCommand(CLI::App& app) {
   c->add_option("--encoding", a->encoding, "Default encoding: jpeg|png|raw|exr|h264")->capture_default_str();
   c->add_option("--scene", a->sceneFiles, "Scene files to offer besides the built-in \"default\" (named by file stem)");
   c->add_option("--materials-dir", a->materialsDir, "Offer the MERL .binary files of this folder (as merl:NAME)");
+  c->add_option("--data", a->dataDir,
+                "Offer the files of this folder by name: probes/ (EXR, HDR, PFM) as environments, meshes/ (PLY, OBJ) "
+                "as mesh scenes (the mesh on a ground), brdfs/ (MERL .binary) as merl:NAME; each file is read at start");
   c->add_option("--web-root", a->webRoot, "The browser client's files (default: the source tree's client/web)");
   c->add_option("--proto-file", a->protoFile, "Served at /haarcast.proto (default: the source tree's)");
   addSceneLimitFlags(*c, a->sceneLimits);

@@ -5,7 +5,9 @@
 # takes measurable time (about 3 s at level 5 on the 2-core development
 # machine). The client's stderr must have
 #   * plain lines (stderr is a file) "building: visibility blob  NN %", at
-#     least two, with nondecreasing percentages, one with "left in this stage";
+#     least two, with nondecreasing percentages, each with the whole build's
+#     share and its step in the server's plan ("· build NN % (step 2 of 2)"),
+#     nondecreasing too, and one with the build's estimated time left;
 #   * "building: ready after N s" before the first frame line;
 # then the same config again (the renderer is cached: no BuildProgress, and
 # the client works as against a server that never sends it), and on a
@@ -62,8 +64,13 @@ mapfile -t percents < <(sed -n 's/^building: visibility blob *\([0-9]*\) %.*/\1/
 for ((i = 1; i < ${#percents[@]}; i++)); do
   ((percents[i] >= percents[i - 1])) || fail "visibility went from ${percents[i - 1]} % to ${percents[i]} %"
 done
-grep -q '^building: visibility blob .*(~[0-9.]* s left in this stage)$' "$work/cold.err" ||
-  fail "no line with the stage's estimated time left"
+mapfile -t builds < <(sed -n 's/^building: .* · build *\([0-9]*\) % (step [0-9]* of 2).*/\1/p' "$work/cold.err")
+((${#builds[@]} >= 3)) || fail "${#builds[@]} lines with the build's share and step, want at least 3"
+for ((i = 1; i < ${#builds[@]}; i++)); do
+  ((builds[i] >= builds[i - 1])) || fail "the build went from ${builds[i - 1]} % to ${builds[i]} %"
+done
+grep -q '^building: visibility blob .* (step 2 of 2), ~[0-9.]* s left$' "$work/cold.err" ||
+  fail "no line with the build's estimated time left"
 ready_line="$(grep -n '^building: ready after [0-9.]* s$' "$work/cold.err" | head -1 | cut -d: -f1)"
 frame_line="$(grep -n '^\[#*\.*\] [0-9]*/3' "$work/cold.err" | head -1 | cut -d: -f1)"
 [[ -n "$ready_line" ]] || fail "no 'building: ready after N s' line"

@@ -19,6 +19,8 @@ std::string welcomeMessage(const SessionConfig& config, const Catalog& catalog, 
   w->set_fps_cap(config.fps);
   for (const auto& s : catalog.scenes) w->add_scenes(s.name);
   for (const auto& mat : catalog.materials) w->add_materials(mat);
+  for (const auto& probe : catalog.probes) w->add_probes(probe);
+  for (const auto& mesh : catalog.meshes) w->add_meshes(mesh.name);
   *w->mutable_settings() = settingsToWire(config);
   w->set_object_count(static_cast<std::uint32_t>(facts.objectCount));
   w->set_device(facts.device);

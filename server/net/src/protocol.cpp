@@ -213,15 +213,43 @@ std::optional<ProtocolError> mergeScene(SessionConfig& config, const v1::SceneCh
     return error(v1::ERROR_CODE_UNKNOWN_SCENE,
                  "unknown scene \"" + choice.scene() + "\" (this server offers " + joined(catalog.sceneNames()) + ")", fatal);
   }
-  std::vector<std::string> materials = scene->name == config.scene && !config.materials.empty()
-                                           ? config.materials
-                                           : scene->defaultMaterials;
+  // Probe, mesh and up: names the catalog offers, never paths (as materials).
+  const std::vector<std::string>& probes = catalog.probes;
+  if (!choice.probe().empty() && std::find(probes.begin(), probes.end(), choice.probe()) == probes.end()) {
+    return error(v1::ERROR_CODE_UNKNOWN_SCENE,
+                 "unknown probe \"" + choice.probe() + "\" (this server offers " + joined(probes) + ")", fatal);
+  }
+  const Catalog::MeshEntry* mesh = nullptr;
+  if (!choice.mesh().empty()) {
+    mesh = catalog.findMesh(choice.mesh());
+    if (!mesh) {
+      return error(v1::ERROR_CODE_UNKNOWN_SCENE,
+                   "unknown mesh \"" + choice.mesh() + "\" (this server offers " + joined(catalog.meshNames()) + ")", fatal);
+    }
+  }
+  render::UpAxis up = mesh ? mesh->guessedUp : render::UpAxis::Y;
+  if (!choice.up().empty()) {
+    if (choice.up() != "y" && choice.up() != "z") {
+      return error(v1::ERROR_CODE_BAD_SETTINGS, "unknown up \"" + choice.up() + "\" (valid: y, z)", fatal);
+    }
+    if (!mesh) {
+      return error(v1::ERROR_CODE_BAD_SETTINGS,
+                   "up \"" + choice.up() + "\" applies to a mesh, and no mesh is chosen (SceneChoice.mesh)", fatal);
+    }
+    up = render::parseUpAxis(choice.up());
+  }
+  // The objects drawn: the mesh scene's, else the scene's. Materials chosen
+  // before are kept while the objects stay the same ones.
+  const Catalog::SceneEntry& objects = mesh ? mesh->scene(up) : *scene;
+  const bool sameObjects = mesh ? mesh->name == config.mesh : scene->name == config.scene && config.mesh.empty();
+  std::vector<std::string> materials = sameObjects && !config.materials.empty() ? config.materials : objects.defaultMaterials;
   // Sorted for a deterministic first error.
   std::map<std::uint32_t, std::string> sorted(choice.object_materials().begin(), choice.object_materials().end());
   for (const auto& [object, spec] : sorted) {
     if (object >= materials.size()) {
       return error(v1::ERROR_CODE_UNKNOWN_MATERIAL,
-                   "object " + std::to_string(object) + " does not exist: scene \"" + scene->name + "\" has " +
+                   "object " + std::to_string(object) + " does not exist: " + (mesh ? "mesh" : "scene") + " \"" +
+                       (mesh ? mesh->name : scene->name) + "\" has " +
                        std::to_string(materials.size()) + " objects",
                    fatal);
     }
@@ -234,6 +262,9 @@ std::optional<ProtocolError> mergeScene(SessionConfig& config, const v1::SceneCh
     materials[object] = spec;
   }
   config.scene = scene->name;
+  config.probe = choice.probe();
+  config.mesh = mesh ? mesh->name : "";
+  config.up = up;
   config.materials = std::move(materials);
   return std::nullopt;
 }
@@ -259,6 +290,29 @@ const Catalog::SceneEntry* Catalog::findScene(std::string_view name) const {
   }
   return nullptr;
 }
+
+const Catalog::MeshEntry* Catalog::findMesh(std::string_view name) const {
+  for (const auto& m : meshes) {
+    if (m.name == name) return &m;
+  }
+  return nullptr;
+}
+
+std::vector<std::string> Catalog::meshNames() const {
+  std::vector<std::string> names;
+  for (const auto& m : meshes) names.push_back(m.name);
+  return names;
+}
+
+const Catalog::SceneEntry* sceneEntry(const SessionConfig& config, const Catalog& catalog) {
+  if (!config.mesh.empty()) {
+    const Catalog::MeshEntry* mesh = catalog.findMesh(config.mesh);
+    return mesh ? &mesh->scene(config.up) : nullptr;
+  }
+  return catalog.findScene(config.scene);
+}
+
+std::string_view upAxisName(render::UpAxis up) { return up == render::UpAxis::Z ? "z" : "y"; }
 
 std::vector<std::string> Catalog::sceneNames() const {
   std::vector<std::string> names;
@@ -297,7 +351,10 @@ std::optional<Backend> parseBackend(std::string_view name) {
 
 std::string SessionConfig::rendererKey() const {
   std::ostringstream key;
-  key << "scene=" << scene << ";materials=";
+  // Probe, mesh and up change what is drawn: another renderer. The up axis
+  // counts only with a mesh (it is Y, and means nothing, without one).
+  key << "scene=" << scene << ";probe=" << probe << ";mesh=" << mesh << ";up=" << (mesh.empty() ? "" : upAxisName(up))
+      << ";materials=";
   for (const auto& m : materials) key << m << ',';
   key << ";level=" << (automaticLevel ? "auto:" : "") << level << ";method=" << methodName(method)
       << ";backend=" << backendName(backend);
@@ -593,7 +650,10 @@ v1::ServerLimits limitsToWire(const Limits& limits) {
 v1::SceneInfo sceneInfo(const SessionConfig& config, const Catalog& catalog, const std::vector<int>& objectLevels) {
   v1::SceneInfo info;
   info.set_name(config.scene);
-  const Catalog::SceneEntry* scene = catalog.findScene(config.scene);
+  info.set_probe(config.probe);
+  info.set_mesh(config.mesh);
+  if (!config.mesh.empty()) info.set_up(std::string(upAxisName(config.up)));
+  const Catalog::SceneEntry* scene = sceneEntry(config, catalog);
   const auto vec = [](v1::Vec3* out, const glm::dvec3& v) {
     out->set_x(v.x);
     out->set_y(v.y);

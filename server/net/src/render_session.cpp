@@ -127,7 +127,7 @@ void RenderSession::onHello(const v1::Hello& hello, Clock::time_point now) {
   }
   hello_ = true;
   clientName_ = sanitizeForLog(hello.client_name());
-  const auto* scene = catalog_.findScene(std::get<SessionConfig>(config).scene);
+  const auto* scene = sceneEntry(std::get<SessionConfig>(config), catalog_);
   {
     std::lock_guard lock(mutex_);
     config_ = std::get<SessionConfig>(std::move(config));
@@ -169,8 +169,11 @@ void RenderSession::onPose(const v1::PoseUpdate& update, Clock::time_point now) 
 // view again when the scene did (the objects are others). An accepted
 // SceneChoice is answered with the scene's SceneInfo.
 void RenderSession::adopt(SessionConfig next, bool announceScene, Clock::time_point now) {
-  // Both read before `next` is moved from.
-  const bool newScene = next.scene != config_.scene;
+  // Both read before `next` is moved from. Other objects (another scene or
+  // mesh, a mesh turned up another way) start from their own poses; another
+  // probe lights the same objects, but meters afresh.
+  const bool newObjects = next.scene != config_.scene || next.mesh != config_.mesh || next.up != config_.up;
+  const bool newScene = newObjects || next.probe != config_.probe;
   const bool newRenderer = next.rendererKey() != config_.rendererKey();
   {
     std::lock_guard lock(mutex_);
@@ -178,8 +181,8 @@ void RenderSession::adopt(SessionConfig next, bool announceScene, Clock::time_po
     if (newScene || !next.autoExposure) lastExposure_.reset();
     config_ = std::move(next);
     requested_ = now;  // the next frame answers this change, whatever pose it shows
-    if (newScene) {
-      const auto* scene = catalog_.findScene(config_.scene);
+    if (newObjects) {
+      const auto* scene = sceneEntry(config_, catalog_);
       const auto sequence = pose_.sequence;
       pose_ = initialPose(scene->camera, scene->poses);
       pose_.sequence = sequence;  // later poses stay newer
@@ -351,7 +354,8 @@ void RenderSession::onRendered(const FrameContext& context, std::optional<Render
   renderErrorRepeats_ = 0;
   if (context.config.autoExposure) {
     std::lock_guard lock(mutex_);
-    if (config_.autoExposure && config_.scene == context.config.scene) {
+    if (config_.autoExposure && config_.scene == context.config.scene && config_.probe == context.config.probe &&
+        config_.mesh == context.config.mesh) {
       lastExposure_ = rendered->frame.exposureStops;
       lastExposureAt_ = now;
     }

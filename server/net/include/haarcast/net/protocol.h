@@ -20,6 +20,7 @@
 #include "haarcast/net/h264_encoder.h"
 #include "haarcast/proto/haarcast.pb.h"
 #include "haarcast/render/renderer.h"
+#include "haarcast/render/scene.h"
 
 namespace haarcast::net {
 
@@ -75,11 +76,24 @@ struct Catalog {
     std::vector<render::Pose> poses;            // per object
     std::vector<std::string> objectNames;       // per object (SceneInfo); empty = "object <i>"
   };
+  // A mesh a client may choose (SceneChoice.mesh): its "mesh scene" (the
+  // mesh on a ground) for each up axis, since the up axis moves the ground
+  // and so the scene's poses, and the up axis guessed from its bounds.
+  struct MeshEntry {
+    std::string name;  // the file's stem
+    render::UpAxis guessedUp = render::UpAxis::Y;
+    SceneEntry upY, upZ;  // objects: the mesh, then "ground"
+    const SceneEntry& scene(render::UpAxis up) const { return up == render::UpAxis::Z ? upZ : upY; }
+  };
   std::vector<SceneEntry> scenes;             // the first is the default
   std::vector<std::string> materials;         // offered specs: "lambert", "phong:64", MERL names …
   std::vector<Backend> backends;              // those the operator enabled
+  std::vector<std::string> probes;            // probe names a SceneChoice may name (serve --data)
+  std::vector<MeshEntry> meshes;              // meshes a SceneChoice may name (serve --data)
 
   const SceneEntry* findScene(std::string_view name) const;  // "" = the default
+  const MeshEntry* findMesh(std::string_view name) const;    // nullptr: not offered
+  std::vector<std::string> meshNames() const;
   std::vector<std::string> sceneNames() const;
   bool offersMaterial(std::string_view spec) const;
   bool offersBackend(Backend backend) const;
@@ -92,8 +106,9 @@ struct ProtocolError {
   bool fatal = false;
 };
 
-// Everything a session renders with. Changing scene, materials, level,
-// method or backend selects another renderer (rendererKey()).
+// Everything a session renders with. Changing scene, probe, mesh, up,
+// materials, level, method or backend selects another renderer
+// (rendererKey()).
 struct SessionConfig {
   int width = 0;
   int height = 0;
@@ -101,6 +116,9 @@ struct SessionConfig {
   int jpegQuality = 85;
   double fps = 30.0;
   std::string scene;                   // a Catalog scene name
+  std::string probe;                   // a Catalog probe replacing the scene's environment; "": none
+  std::string mesh;                    // a Catalog mesh scene replacing the scene's objects; "": none
+  render::UpAxis up = render::UpAxis::Y;  // the mesh's up axis (chosen, else guessed); Y without a mesh
   std::vector<std::string> materials;  // per object, offered specs
   RotationMethod method = RotationMethod::Haar;
   int level = 5;                // fixed: the level; automatic: the cap
@@ -135,6 +153,12 @@ std::optional<ProtocolError> applySettings(SessionConfig& config, const v1::Rend
                                            const Limits& limits, const Catalog& catalog);
 std::optional<ProtocolError> applySceneChoice(SessionConfig& config, const v1::SceneChoice& choice,
                                               const Catalog& catalog);
+
+// The objects, poses and camera a config draws: its mesh's scene when it
+// has a mesh, else its scene's (nullptr: neither is in the catalog).
+const Catalog::SceneEntry* sceneEntry(const SessionConfig& config, const Catalog& catalog);
+// "y" or "z", as SceneChoice.up and SceneInfo.up say it.
+std::string_view upAxisName(render::UpAxis up);
 
 // The view a session has asked for so far: every PoseUpdate field it set.
 struct PoseState {
