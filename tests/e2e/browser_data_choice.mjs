@@ -101,7 +101,8 @@ try {
   page.on('console', (m) => { if (m.type() === 'error') problems.push(m.text()); });
   // A fixed exposure: another probe shows as another brightness, and a
   // still page gets no frames while auto exposure settles.
-  await page.goto(`${base}?level=4&exposure=-1`);
+  // A small fixed size: each choice costs its build and a quick frame.
+  await page.goto(`${base}?level=4&exposure=-1&size=160x120`);
 
   // The canvas once frames have stopped coming for 1 s (at most 60 s), as
   // bytes; `seq` the last frame's sequence.
