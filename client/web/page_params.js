@@ -32,6 +32,9 @@ export const PARAMETERS = {
   obj: 'objects\' turns, INDEX:X:Y:Z in degrees, comma-separated, e.g. 0:10:45:0',
   mat: 'objects\' materials, INDEX:SPEC comma-separated, e.g. 0:phong:64,1:ggx:0.3 (with ?scene=)',
   tone: '',  // filled from the schema's ToneCurve values
+  probe: 'a probe the server offers (serve --data), by name',
+  mesh: 'a mesh the server offers (serve --data), by name',
+  up: 'the mesh\'s up axis, y or z (with ?mesh=)',
 };
 
 function wholeNumber(text) {
@@ -52,6 +55,7 @@ export function parsePageParameters(search, { methods, tones = ['reinhard', 'ace
     objects: [],     // [{index, x, y, z}] degrees
     materials: [],   // [{index, spec}]
     tone: '',
+    probe: '', mesh: '', up: '',
     errors: [],
   };
   const bad = (name, value, valid) => {
@@ -159,6 +163,19 @@ export function parsePageParameters(search, { methods, tones = ['reinhard', 'ace
     else if (scene === null) bad('mat', mat, 'give ?scene= too: the materials are the named scene\'s objects\'');
     else out.materials = pairs.map((m) => ({ index: Number(m[1]), spec: m[2] }));
   }
+  for (const name of ['probe', 'mesh']) {
+    const value = get(name);
+    if (value === null) continue;
+    if (value === '') bad(name, value, `name ${valid[name]}`);
+    else if (scene === null) bad(name, value, `give ?scene= too: the ${name} replaces part of a scene`);
+    else out[name] = value;
+  }
+  const up = get('up');
+  if (up !== null) {
+    if (up !== 'y' && up !== 'z') bad('up', up, 'use y or z');
+    else if (get('mesh') === null) bad('up', up, 'give ?mesh= too: the up axis is a mesh\'s');
+    else out.up = up;
+  }
   const tone = get('tone');
   if (tone !== null) {
     if (tones.includes(tone)) out.tone = tone;
@@ -174,9 +191,12 @@ const fixed = (x, digits) => String(Number(x.toFixed(digits)));
 
 // The address's parameters for the view now (pure: `materials` [{index,
 // spec}], `snapshot` view.js viewSnapshot()).
-export function viewParameters({ scene, materials, method, level, k, exposure, tone, snapshot }) {
+export function viewParameters({ scene, probe, mesh, up, materials, method, level, k, exposure, tone, snapshot }) {
   const p = {};
   if (scene) p.scene = scene;
+  if (probe) p.probe = probe;
+  if (mesh) p.mesh = mesh;
+  if (mesh && up) p.up = up;
   if (materials && materials.length) p.mat = materials.map((m) => `${m.index}:${m.spec}`).join(',');
   if (method) p.method = method;
   if (level > 0) p.level = String(level);

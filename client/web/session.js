@@ -66,7 +66,8 @@ function hello() {
         if (state.welcome.materials.includes(o.material)) h.scene.objectMaterials[o.index] = o.material;
       }
     } else if (!state.welcome && choices.scene === page.scene) {
-      // The first Hello: the materials the address names (share_url.js).
+      // The first Hello: the probe, mesh and materials the address names (share_url.js).
+      Object.assign(h.scene, { probe: page.probe, mesh: page.mesh, up: page.up });
       for (const m of page.materials) h.scene.objectMaterials[m.index] = m.spec;
     }
   }

@@ -11,12 +11,13 @@ import { choices, page, state } from './page_state.js';
 import { applyView, viewSnapshot } from './view.js';
 
 // The keys this module owns in the address.
-const OWNED = ['scene', 'mat', 'method', 'level', 'k', 'exposure', 'tone', 'cam', 'light', 'obj'];
+const OWNED = ['scene', 'probe', 'mesh', 'up', 'mat', 'method', 'level', 'k', 'exposure', 'tone', 'cam', 'light', 'obj'];
 
 function currentParameters() {
   const info = state.sceneInfo;
   return viewParameters({
     scene: info ? info.name : choices.scene,
+    probe: info ? info.probe : '', mesh: info ? info.mesh : '', up: info ? info.up : '',
     // Only what the server offers: an object's material that is not offered
     // is its scene's own (the page offers nothing else), which a Hello need
     // not ask for (and could not: only offered specs are taken).

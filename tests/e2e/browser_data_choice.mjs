@@ -171,6 +171,25 @@ try {
   await page.check('#up-choice input[value="y"]');
   const flipped = await answered('the mesh flipped to y up', { probe: 'warm', mesh: 'pillar', up: 'y' }, pillar);
   check(flipped.seq > pillar.seq, 'the flip was drawn');
+  // The address says the choice (share_url.js), and a page opened at it
+  // draws the same canvas.
+  await page.waitForTimeout(700);
+  const address = await page.evaluate(() => location.href);
+  const q = new URL(address).searchParams;
+  check(q.get('probe') === 'warm' && q.get('mesh') === 'pillar' && q.get('up') === 'y',
+        `the address names the probe, mesh and up (${decodeURIComponent(new URL(address).search)})`);
+  const second = await browser.newPage({ viewport: { width: 1000, height: 800 } });
+  await second.goto(address);
+  await second.waitForFunction(() => window.haarcast && window.haarcast.lastFrame && window.haarcast.sceneInfo &&
+                               window.haarcast.sceneInfo.mesh === 'pillar', null, { timeout: 60000 });
+  await second.waitForTimeout(1500);
+  const again = await second.evaluate(() => {
+    const c = document.getElementById('frame');
+    return { w: c.width, h: c.height, data: Array.from(c.getContext('2d').getImageData(0, 0, c.width, c.height).data) };
+  });
+  const same = difference(flipped, again);
+  check(same < 0.5, `a page opened at the address draws the same (mean difference ${same.toFixed(3)})`);
+  await second.close();
 
   // The new controls in a 400 px window: nothing in the panel is cut or outside it.
   await page.setViewportSize({ width: 400, height: 800 });

@@ -184,13 +184,14 @@ test('page parameters: each bad one is named with its valid values', () => {
 });
 
 test('page parameters: a view written to the address reads back the same, and a bad one is named', () => {
-  const view = { scene: 'default', materials: [{ index: 0, spec: 'phong:64' }, { index: 1, spec: 'merl:alum-bronze-sgd' }],
+  const view = { scene: 'default', probe: 'uffizi', mesh: 'lucy', up: 'z', materials: [{ index: 0, spec: 'phong:64' }, { index: 1, spec: 'merl:alum-bronze-sgd' }],
                  method: 'fused', level: 5, k: 128, exposure: { auto: false, stops: -1.25 }, tone: 'aces',
                  snapshot: { camera: { azimuth: -35.123456, elevation: 22.5, distance: 4.874681 }, light: 25,
                              objects: [{ index: 0, x: 15, y: -20, z: 0 }, { index: 2, x: 0, y: 90.5, z: 0 }] } };
   const p = parsePageParameters(new URLSearchParams(viewParameters(view)), { methods: ['fused', 'haar'] });
   assert.deepEqual(p.errors, []);
   assert.equal(p.scene, 'default');
+  assert.deepEqual([p.probe, p.mesh, p.up], ['uffizi', 'lucy', 'z']);
   assert.deepEqual(p.materials, view.materials);
   assert.equal(p.method, 'fused');
   assert.equal(p.level, 5);
@@ -203,8 +204,8 @@ test('page parameters: a view written to the address reads back the same, and a 
   // Nothing steered: no camera, light or objects in the address.
   const still = viewParameters({ ...view, snapshot: { camera: null, light: null, objects: [] } });
   assert.ok(!('cam' in still) && !('light' in still) && !('obj' in still));
-  const bad = parsePageParameters('?cam=1,95,3&obj=0:1:2:3,0:4:5:6&mat=0:lambert&tone=filmic', { methods: ['fused'] });
-  assert.deepEqual(bad.errors.map((e) => e.parameter), ['cam', 'obj', 'mat', 'tone']);
+  const bad = parsePageParameters('?cam=1,95,3&obj=0:1:2:3,0:4:5:6&mat=0:lambert&tone=filmic&probe=x&up=x', { methods: ['fused'] });
+  assert.deepEqual(bad.errors.map((e) => e.parameter), ['cam', 'obj', 'mat', 'probe', 'up', 'tone']);
 });
 
 test('page parameters: ?encoding=h264', () => {
