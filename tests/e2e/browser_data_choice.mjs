@@ -15,33 +15,15 @@
 //
 // usage: node browser_data_choice.mjs --haarcast BUILD/bin/haarcast [--chromium /usr/bin/chromium] [--out DIR]
 //        [-- extra `serve` args]
-import { spawn } from 'node:child_process';
 import { mkdirSync, mkdtempSync, rmSync, writeFileSync } from 'node:fs';
-import { createRequire } from 'node:module';
 import { tmpdir } from 'node:os';
-import { dirname, join, resolve } from 'node:path';
-import { fileURLToPath } from 'node:url';
+import { join } from 'node:path';
 
-const repo = resolve(dirname(fileURLToPath(import.meta.url)), '..', '..');
-const require = createRequire(join(repo, 'client', 'web', 'package.json'));
-const { chromium } = require('playwright-core');
+import { checks, launchChromium, parseArgs, playwright, startServer, stopServer } from './browser_harness.mjs';
 
-const args = process.argv.slice(2);
-const opts = { haarcast: '', chromium: '/usr/bin/chromium', out: '', serveArgs: [] };
-for (let i = 0; i < args.length; i++) {
-  if (args[i] === '--') { opts.serveArgs = args.slice(i + 1); break; }
-  const key = args[i].replace(/^--/, '');
-  if (!(key in opts) || i + 1 >= args.length) throw new Error(`unknown or incomplete argument "${args[i]}"`);
-  opts[key] = args[++i];
-}
-if (!opts.haarcast) throw new Error('--haarcast PATH (the haarcast binary) is required');
-if (opts.out) mkdirSync(opts.out, { recursive: true });
-
-const failures = [];
-function check(condition, what) {
-  console.log(`${condition ? 'ok  ' : 'FAIL'} ${what}`);
-  if (!condition) failures.push(what);
-}
+const { chromium } = playwright();
+const opts = parseArgs(process.argv.slice(2));
+const { check, failures } = checks();
 
 // A lat-long probe, 32×16, as a little-endian colour PFM (rows bottom to
 // top): a warm sky over a dark blue floor, unlike the built-in sky.
@@ -73,28 +55,14 @@ mkdirSync(join(dir, 'data', 'probes'), { recursive: true });
 mkdirSync(join(dir, 'data', 'meshes'), { recursive: true });
 writeFileSync(join(dir, 'data', 'probes', 'warm.pfm'), warmProbePfm());
 writeFileSync(join(dir, 'data', 'meshes', 'pillar.obj'), pillarObj());
-const server = spawn(opts.haarcast, ['serve', '--port', '0', '--backend', 'cpu', '--level', '4',
+const started = startServer(opts.haarcast, ['--backend', 'cpu', '--level', '4',
                                      '--data', join(dir, 'data'), '--cache-dir', join(dir, 'cache'), '--quiet',
-                                     ...opts.serveArgs],
-                     { stdio: ['ignore', 'pipe', 'pipe'] });
-let log = '';
-const exited = new Promise((r) => server.on('exit', (code, signal) => r({ code, signal })));
-const base = await new Promise((resolveUrl, reject) => {
-  const timer = setTimeout(() => reject(new Error(`the server printed no "listening on" line in 60 s:\n${log}`)), 60000);
-  const onData = (chunk) => {
-    log += chunk;
-    const m = /listening on (http:\/\/[^\s]+)/.exec(log);
-    if (m) { clearTimeout(timer); resolveUrl(m[1]); }
-  };
-  server.stdout.on('data', onData);
-  server.stderr.on('data', (chunk) => { log += chunk; });
-  server.on('exit', (code) => { clearTimeout(timer); reject(new Error(`the server exited early (${code}):\n${log}`)); });
-});
+                                     ...opts.serveArgs]);
+const base = await started.url;
 
 let browser = null;
 try {
-  browser = await chromium.launch({ executablePath: opts.chromium, headless: true,
-                                    args: ['--no-sandbox', '--disable-gpu', '--disable-dev-shm-usage'] });
+  browser = await launchChromium(chromium, opts.chromium);
   const problems = [];
   const page = await browser.newPage({ viewport: { width: 1000, height: 800 } });
   page.on('pageerror', (e) => problems.push(e.message));
@@ -212,12 +180,9 @@ try {
   check(problems.length === 0, `no page errors (${problems.join('; ')})`);
 } finally {
   if (browser) await browser.close();
-  server.kill('SIGTERM');
-  const exit = await Promise.race([exited, new Promise((r) => setTimeout(() => r(null), 15000))]);
-  if (exit === null) server.kill('SIGKILL');
-  check(exit !== null && exit.code === 0, `the server exits 0 on SIGTERM (${JSON.stringify(exit)})`);
+  await stopServer(started, check);
   rmSync(dir, { recursive: true, force: true });
-  if (failures.length) console.log(`--- server log ---\n${log.slice(-3000)}`);
+  if (failures.length) console.log(`--- server log ---\n${started.log().slice(-3000)}`);
 }
 console.log(failures.length ? `${failures.length} check(s) failed` : 'all data-choice checks passed');
 process.exit(failures.length ? 1 : 0);

@@ -45,37 +45,17 @@
 //
 // usage: node browser_e2e.mjs --haarcast BUILD/bin/haarcast [--chromium /usr/bin/chromium]
 //        [--out DIR] [--page-query 'size=96x96&encoding=jpeg'] [-- extra `serve` args]
-import { spawn } from 'node:child_process';
 import { mkdirSync, mkdtempSync, readFileSync, rmSync, symlinkSync, writeFileSync } from 'node:fs';
-import { createRequire } from 'node:module';
 import net from 'node:net';
 import { tmpdir } from 'node:os';
-import { dirname, join, resolve } from 'node:path';
-import { fileURLToPath } from 'node:url';
+import { join } from 'node:path';
 import { inflateSync } from 'node:zlib';
 
-const repo = resolve(dirname(fileURLToPath(import.meta.url)), '..', '..');
-// playwright-core is a devDependency of the browser client (client/web).
-const require = createRequire(join(repo, 'client', 'web', 'package.json'));
-const { chromium } = require('playwright-core');
+import { checks, launchChromium, parseArgs, playwright, startServer as serve } from './browser_harness.mjs';
 
-// ---- arguments ------------------------------------------------------------------
-
-const args = process.argv.slice(2);
-const opts = { haarcast: '', chromium: '/usr/bin/chromium', out: '', 'page-query': 'size=96x96&encoding=jpeg', serveArgs: [] };
-for (let i = 0; i < args.length; i++) {
-  if (args[i] === '--') { opts.serveArgs = args.slice(i + 1); break; }
-  const key = args[i].replace(/^--/, '');
-  if (!(key in opts) || i + 1 >= args.length) throw new Error(`unknown or incomplete argument "${args[i]}"`);
-  opts[key] = args[++i];
-}
-if (!opts.haarcast) throw new Error('--haarcast PATH (the haarcast binary) is required');
-
-const failures = [];
-function check(condition, what) {
-  console.log(`${condition ? 'ok  ' : 'FAIL'} ${what}`);
-  if (!condition) failures.push(what);
-}
+const { chromium } = playwright();
+const opts = parseArgs(process.argv.slice(2), { 'page-query': 'size=96x96&encoding=jpeg' });
+const { check, failures } = checks();
 const section = (what) => console.log(`--- ${what}`);
 
 // ---- a tiny PNG decoder (8-bit RGB/RGBA, not interlaced: what Chromium writes) ----
@@ -166,28 +146,7 @@ function clippedShare(rgba) {
 
 // ---- the server, and a proxy that can cut its connections ------------------------------
 
-function startServer(serveArgs) {
-  const child = spawn(opts.haarcast, ['serve', '--port', '0', ...serveArgs], {
-    stdio: ['ignore', 'pipe', 'pipe'],
-  });
-  let log = '';
-  const url = new Promise((resolveUrl, reject) => {
-    const timer = setTimeout(() => reject(new Error(`the server printed no "listening on" line in 60 s:\n${log}`)), 60000);
-    const onData = (chunk) => {
-      log += chunk;
-      const m = /listening on (http:\/\/[^\s]+)/.exec(log);
-      if (m) { clearTimeout(timer); resolveUrl(m[1]); }
-    };
-    child.stdout.on('data', onData);
-    child.stderr.on('data', (chunk) => { log += chunk; });
-    child.on('exit', (code, signal) => {
-      clearTimeout(timer);
-      reject(new Error(`the server exited early (code ${code}, signal ${signal}):\n${log}`));
-    });
-  });
-  const exited = new Promise((resolveExit) => child.on('exit', (code, signal) => resolveExit({ code, signal })));
-  return { child, url, exited, log: () => log };
-}
+const startServer = (serveArgs) => serve(opts.haarcast, serveArgs);
 
 // A TCP proxy to the server: `drop(ms)` resets every connection through it
 // (the page sees its WebSocket die without a close frame, as when a network
@@ -260,12 +219,7 @@ let proxy = null;
 try {
   const base = await server.url;
   console.log(`server at ${base}`);
-  browser = await chromium.launch({
-    executablePath: opts.chromium,
-    headless: true,
-    // Root in a container has no user namespace for the sandbox.
-    args: ['--no-sandbox', '--disable-gpu', '--disable-dev-shm-usage'],
-  });
+  browser = await launchChromium(chromium, opts.chromium);
 
   // A page whose console errors, page errors and requests outside `origin`
   // are collected. `networkErrors`: a page whose connection is cut on

@@ -15,52 +15,21 @@
 //
 // usage: node browser_h264.mjs --haarcast BUILD/bin/haarcast [--chromium /usr/bin/chromium] [--out DIR]
 //        [-- extra `serve` args]   (--out is accepted for run_browser_e2e.sh; nothing is written)
-import { spawn } from 'node:child_process';
-import { createRequire } from 'node:module';
-import { dirname, join, resolve } from 'node:path';
-import { fileURLToPath } from 'node:url';
+import { checks, launchChromium, parseArgs, playwright, repo, startServer } from './browser_harness.mjs';
 
-const repo = resolve(dirname(fileURLToPath(import.meta.url)), '..', '..');
-const require = createRequire(join(repo, 'client', 'web', 'package.json'));
-const { chromium } = require('playwright-core');
+const { chromium } = playwright();
+const opts = parseArgs(process.argv.slice(2));
+const { check, failures } = checks();
 
-const args = process.argv.slice(2);
-const opts = { haarcast: '', chromium: '/usr/bin/chromium', out: '', serveArgs: [] };
-for (let i = 0; i < args.length; i += 2) {
-  if (args[i] === '--') { opts.serveArgs = args.slice(i + 1); break; }  // run_browser_e2e.sh passes serve args after it
-  const key = args[i].replace(/^--/, '');
-  if (!(key in opts) || i + 1 >= args.length) throw new Error(`unknown or incomplete argument "${args[i]}"`);
-  opts[key] = args[i + 1];
-}
-if (!opts.haarcast) throw new Error('--haarcast PATH (the haarcast binary) is required');
-
-const failures = [];
-function check(condition, what) {
-  console.log(`${condition ? 'ok  ' : 'FAIL'} ${what}`);
-  if (!condition) failures.push(what);
-}
-
-const server = spawn(opts.haarcast, ['serve', '--port', '0', '--backend', process.env.HAARCAST_SMOKE_BACKEND || 'cpu',
-                                     ...opts.serveArgs],
-                     { stdio: ['ignore', 'pipe', 'pipe'] });
-let log = '';
-const base = await new Promise((resolveUrl, reject) => {
-  const timer = setTimeout(() => reject(new Error(`the server printed no "listening on" line in 60 s:\n${log}`)), 60000);
-  const onData = (chunk) => {
-    log += chunk;
-    const m = /listening on (http:\/\/[^\s]+)/.exec(log);
-    if (m) { clearTimeout(timer); resolveUrl(m[1]); }
-  };
-  server.stdout.on('data', onData);
-  server.stderr.on('data', (chunk) => { log += chunk; });
-  server.on('exit', (code) => { clearTimeout(timer); reject(new Error(`the server exited early (${code}):\n${log}`)); });
-});
+const started = startServer(opts.haarcast, ['--backend', process.env.HAARCAST_SMOKE_BACKEND || 'cpu',
+                                     ...opts.serveArgs]);
+const server = started.child;
+const base = await started.url;
 
 let exitCode = 0;
 let browser = null;
 try {
-  browser = await chromium.launch({ executablePath: opts.chromium, headless: true,
-                                    args: ['--no-sandbox', '--disable-gpu', '--disable-dev-shm-usage'] });
+  browser = await launchChromium(chromium, opts.chromium);
   const page = await browser.newPage({ viewport: { width: 900, height: 900 } });
   const problems = [];
   page.on('pageerror', (e) => problems.push(e.message));

@@ -21,34 +21,17 @@
 //
 // usage: node browser_view_size.mjs --haarcast BUILD/bin/haarcast [--chromium /usr/bin/chromium] [--out DIR]
 //        [-- extra `serve` args]
-import { spawn } from 'node:child_process';
-import { mkdirSync, mkdtempSync, rmSync, writeFileSync } from 'node:fs';
-import { createRequire } from 'node:module';
+import { mkdtempSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
-import { dirname, join, resolve } from 'node:path';
-import { fileURLToPath, pathToFileURL } from 'node:url';
+import { join } from 'node:path';
+import { pathToFileURL } from 'node:url';
 
-const repo = resolve(dirname(fileURLToPath(import.meta.url)), '..', '..');
-const require = createRequire(join(repo, 'client', 'web', 'package.json'));
-const { chromium } = require('playwright-core');
+import { checks, launchChromium, parseArgs, playwright, repo, startServer, stopServer } from './browser_harness.mjs';
+
+const { chromium } = playwright();
+const opts = parseArgs(process.argv.slice(2));
+const { check, failures } = checks();
 const { FPS_FLOOR, STILL_MS } = await import(pathToFileURL(join(repo, 'client', 'web', 'stream_size.js')));
-
-const args = process.argv.slice(2);
-const opts = { haarcast: '', chromium: '/usr/bin/chromium', out: '', serveArgs: [] };
-for (let i = 0; i < args.length; i++) {
-  if (args[i] === '--') { opts.serveArgs = args.slice(i + 1); break; }
-  const key = args[i].replace(/^--/, '');
-  if (!(key in opts) || i + 1 >= args.length) throw new Error(`unknown or incomplete argument "${args[i]}"`);
-  opts[key] = args[++i];
-}
-if (!opts.haarcast) throw new Error('--haarcast PATH (the haarcast binary) is required');
-if (opts.out) mkdirSync(opts.out, { recursive: true });
-
-const failures = [];
-function check(condition, what) {
-  console.log(`${condition ? 'ok  ' : 'FAIL'} ${what}`);
-  if (!condition) failures.push(what);
-}
 const STILL_LIMIT_MS = 2000;  // stillness → a full-size frame on the canvas
 const BUDGET_MS = 1000 / FPS_FLOOR;
 
@@ -63,22 +46,9 @@ writeFileSync(boxScene, JSON.stringify({
 }));
 // One render thread: a frame's time then scales with its pixels alike on a
 // 2-core and a 64-core machine, and the view's own size stays slow.
-const server = spawn(opts.haarcast, ['serve', '--port', '0', '--backend', 'cpu', '--render-threads', '1', '--level', '4',
-                                     '--scene', boxScene, '--cache-dir', join(dir, 'cache'), '--quiet', ...opts.serveArgs],
-                     { stdio: ['ignore', 'pipe', 'pipe'] });
-let log = '';
-const exited = new Promise((r) => server.on('exit', (code, signal) => r({ code, signal })));
-const base = await new Promise((resolveUrl, reject) => {
-  const timer = setTimeout(() => reject(new Error(`the server printed no "listening on" line in 60 s:\n${log}`)), 60000);
-  const onData = (chunk) => {
-    log += chunk;
-    const m = /listening on (http:\/\/[^\s]+)/.exec(log);
-    if (m) { clearTimeout(timer); resolveUrl(m[1]); }
-  };
-  server.stdout.on('data', onData);
-  server.stderr.on('data', (chunk) => { log += chunk; });
-  server.on('exit', (code) => { clearTimeout(timer); reject(new Error(`the server exited early (${code}):\n${log}`)); });
-});
+const started = startServer(opts.haarcast, ['--backend', 'cpu', '--render-threads', '1', '--level', '4',
+                                     '--scene', boxScene, '--cache-dir', join(dir, 'cache'), '--quiet', ...opts.serveArgs]);
+const base = await started.url;
 
 // Recorded in the page from its start, each with performance.now(): every
 // frame shown (polled each display frame), every size asked for, and each
@@ -116,8 +86,7 @@ function recorder() {
 
 let browser = null;
 try {
-  browser = await chromium.launch({ executablePath: opts.chromium, headless: true,
-                                    args: ['--no-sandbox', '--disable-gpu', '--disable-dev-shm-usage'] });
+  browser = await launchChromium(chromium, opts.chromium);
   const problems = [];
   // A fixed exposure: frames come only for a change, none while auto
   // exposure settles, so that a still page is quiet.
@@ -280,12 +249,9 @@ try {
   check(problems.length === 0, `no page errors (${problems.join('; ')})`);
 } finally {
   if (browser) await browser.close();
-  server.kill('SIGTERM');
-  const exit = await Promise.race([exited, new Promise((r) => setTimeout(() => r(null), 15000))]);
-  if (exit === null) server.kill('SIGKILL');
-  check(exit !== null && exit.code === 0, `the server exits 0 on SIGTERM (${JSON.stringify(exit)})`);
+  await stopServer(started, check);
   rmSync(dir, { recursive: true, force: true });
-  if (failures.length) console.log(`--- server log ---\n${log.slice(-3000)}`);
+  if (failures.length) console.log(`--- server log ---\n${started.log().slice(-3000)}`);
 }
 console.log(failures.length ? `${failures.length} check(s) failed` : 'all view-size checks passed');
 process.exit(failures.length ? 1 : 0);

@@ -37,15 +37,10 @@ except Exception:
 PY
 }
 
-# The per-address cap would close the flood at accept before descriptors ran
-# out; lift it so exhaustion is what is tested. A 30 s request timeout keeps
-# the idle connections open for the whole measurement.
-start_server prlimit --nofile=64:64 "$haarcast" serve --port 0 --backend cpu --cache-dir none \
-  --max-connections-per-address 10000 --handshake-timeout 30
-healthz || fail "/healthz before the flood"
-
-# 150 connections that send nothing and stay open until told to close.
-python3 - "$port" "$work/holding" "$work/release" <<'PY' &
+# 150 connections to port $1 that send nothing and stay open until
+# $work/release exists; returns once they are all made.
+hold_connections() {
+  python3 - "$1" "$work/holding" "$work/release" <<'PY' &
 import os, socket, sys, time
 port, holding, release = int(sys.argv[1]), sys.argv[2], sys.argv[3]
 held = [socket.create_connection(("127.0.0.1", port), timeout=5) for _ in range(150)]
@@ -55,9 +50,19 @@ while not os.path.exists(release):
 for s in held:
     s.close()
 PY
-holder_pid=$!
-for ((i = 0; i < 200; i++)); do [[ -e "$work/holding" ]] && break; sleep 0.05; done
-[[ -e "$work/holding" ]] || fail "the 150 connections were not all made"
+  holder_pid=$!
+  for ((i = 0; i < 200; i++)); do [[ -e "$work/holding" ]] && break; sleep 0.05; done
+  [[ -e "$work/holding" ]] || fail "the 150 connections to port $1 were not all made"
+}
+
+# The per-address cap would close the flood at accept before descriptors ran
+# out; lift it so exhaustion is what is tested. A 30 s request timeout keeps
+# the idle connections open for the whole measurement.
+start_server prlimit --nofile=64:64 "$haarcast" serve --port 0 --backend cpu --cache-dir none \
+  --max-connections-per-address 10000 --handshake-timeout 30
+healthz || fail "/healthz before the flood"
+
+hold_connections "$port"
 
 # Exhausted for 3 s: the server must be paused, not spinning on accept.
 for ((i = 0; i < 100; i++)); do grep -q "pausing accepts" "$work/server.err" && break; sleep 0.1; done
@@ -118,19 +123,7 @@ PY
 }
 http2_answers || fail "the gRPC port does not answer before the flood"
 healthz || fail "/healthz before the gRPC flood"
-python3 - "$grpc_port" "$work/holding" "$work/release" <<'PY' &
-import os, socket, sys, time
-port, holding, release = int(sys.argv[1]), sys.argv[2], sys.argv[3]
-held = [socket.create_connection(("127.0.0.1", port), timeout=5) for _ in range(150)]
-open(holding, "w").close()
-while not os.path.exists(release):
-    time.sleep(0.05)
-for s in held:
-    s.close()
-PY
-holder_pid=$!
-for ((i = 0; i < 200; i++)); do [[ -e "$work/holding" ]] && break; sleep 0.05; done
-[[ -e "$work/holding" ]] || fail "the 150 gRPC connections were not all made"
+hold_connections "$grpc_port"
 sleep 3
 touch "$work/release"
 wait "$holder_pid" || true
