@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <map>
 #include <set>
@@ -189,11 +190,6 @@ int run(ServeArgs& a) {
   const bool quiet = a.quiet;
   const std::string antialias = a.antialias;
   antialiasFor(antialias, a.backend);  // a bad flag fails at start, not in a session
-  // Abandonable: once nobody waits for the build (its sessions closed, or
-  // the server stops) the next progress step throws, so a SIGTERM during a
-  // build of seconds still exits at once. Every progress step also goes to
-  // the waiting clients (`toClients`: BuildProgress messages, throttled by
-  // the render service) besides the log.
   // A session's config → the scene with its materials and the render
   // options: what the builder builds and what the planner plans.
   struct Resolved {
@@ -210,8 +206,23 @@ int run(ServeArgs& a) {
     options.antialias = antialiasFor(antialias, r.backend);
     return r;
   };
-  a.server.render.planner = [resolve, quiet](const net::SessionConfig& c) {
-    const Resolved r = resolve(c);
+  // The planner and then the builder take the same config on the builder
+  // thread: the planner's resolved scene (its probe and MERL files read) is
+  // handed to the builder instead of being read again.
+  struct Handoff {
+    std::mutex mutex;
+    std::string key;
+    std::shared_ptr<const Resolved> resolved;
+  };
+  auto handoff = std::make_shared<Handoff>();
+  a.server.render.planner = [resolve, handoff, quiet](const net::SessionConfig& c) {
+    auto resolved = std::make_shared<const Resolved>(resolve(c));
+    {
+      std::lock_guard lock(handoff->mutex);
+      handoff->key = c.rendererKey();
+      handoff->resolved = resolved;
+    }
+    const Resolved& r = *resolved;
     render::BuildPlan plan = render::planBuild(r.scene, r.options, r.backend);
     if (!quiet) {
       // The plan beside the stages' own lines: how the estimate was made.
@@ -225,10 +236,22 @@ int run(ServeArgs& a) {
     }
     return plan;
   };
-  net::AbandonableRendererBuilder builder = [resolve, vulkanOptions, quiet](
+  // Abandonable: once nobody waits for the build (its sessions closed, or
+  // the server stops) the next progress step throws, so a SIGTERM during a
+  // build of seconds still exits at once. Every progress step also goes to
+  // the waiting clients (`toClients`: BuildProgress messages, throttled by
+  // the render service) besides the log.
+  net::AbandonableRendererBuilder builder = [resolve, handoff, vulkanOptions, quiet](
                                                 const net::SessionConfig& c, const std::function<bool()>& abandoned,
                                                 const render::RenderProgress& toClients) {
-    const Resolved r = resolve(c);
+    std::shared_ptr<const Resolved> planned;
+    {
+      std::lock_guard lock(handoff->mutex);
+      if (handoff->resolved && handoff->key == c.rendererKey()) planned = std::move(handoff->resolved);
+      handoff->resolved.reset();  // not kept past its build
+    }
+    if (!planned) planned = std::make_shared<const Resolved>(resolve(c));  // no plan was made for it
+    const Resolved& r = *planned;
     const render::Scene& scene = r.scene;
     const render::RenderOptions& options = r.options;
     const std::string& backend = r.backend;

@@ -15,11 +15,11 @@
 //
 // usage: node browser_data_choice.mjs --haarcast BUILD/bin/haarcast [--chromium /usr/bin/chromium] [--out DIR]
 //        [-- extra `serve` args]
-import { mkdirSync, mkdtempSync, rmSync, writeFileSync } from 'node:fs';
+import { mkdirSync, mkdtempSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 
-import { checks, launchChromium, parseArgs, playwright, startServer, stopServer } from './browser_harness.mjs';
+import { checks, finish, launchChromium, parseArgs, playwright, startServer } from './browser_harness.mjs';
 
 const { chromium } = playwright();
 const opts = parseArgs(process.argv.slice(2));
@@ -178,11 +178,8 @@ try {
   check(cut.length === 0, `400×800: the scene fieldset fits the panel (${cut.join('; ')})`);
   if (opts.out) await page.screenshot({ path: join(opts.out, 'data-choice-400x800.png'), fullPage: true });
   check(problems.length === 0, `no page errors (${problems.join('; ')})`);
+} catch (e) {
+  check(false, `the test stopped: ${e.stack || e}`);  // finish() exits: the error must count
 } finally {
-  if (browser) await browser.close();
-  await stopServer(started, check);
-  rmSync(dir, { recursive: true, force: true });
-  if (failures.length) console.log(`--- server log ---\n${started.log().slice(-3000)}`);
+  await finish({ browser, started, check, failures, dir, what: 'data-choice' });
 }
-console.log(failures.length ? `${failures.length} check(s) failed` : 'all data-choice checks passed');
-process.exit(failures.length ? 1 : 0);

@@ -2,7 +2,7 @@
 // siblings, run by run_browser_e2e.sh): their arguments, a `haarcast serve`
 // child whose printed URL they wait for, and the ok/FAIL lines they print.
 import { spawn } from 'node:child_process';
-import { mkdirSync } from 'node:fs';
+import { mkdirSync, rmSync } from 'node:fs';
 import { createRequire } from 'node:module';
 import { dirname, join, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -70,6 +70,18 @@ export async function stopServer(started, check) {
   const exit = await Promise.race([started.exited, new Promise((r) => setTimeout(() => r(null), 15000))]);
   if (exit === null) started.child.kill('SIGKILL');
   check(exit !== null && exit.code === 0, `the server exits 0 on SIGTERM (${JSON.stringify(exit)})`);
+}
+
+// The end of a test: the browser closed, the server stopped (its exit
+// checked), `dir` removed, the server's log shown after a failure, and the
+// process's exit status.
+export async function finish({ browser, started, check, failures, dir, what }) {
+  if (browser) await browser.close();
+  await stopServer(started, check);
+  if (dir) rmSync(dir, { recursive: true, force: true });
+  if (failures.length) console.log(`--- server log ---\n${started.log().slice(-3000)}`);
+  console.log(failures.length ? `${failures.length} check(s) failed` : `all ${what} checks passed`);
+  process.exit(failures.length ? 1 : 0);
 }
 
 // Debian's Chromium, headless; root in a container has no user namespace

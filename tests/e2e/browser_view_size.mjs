@@ -21,12 +21,12 @@
 //
 // usage: node browser_view_size.mjs --haarcast BUILD/bin/haarcast [--chromium /usr/bin/chromium] [--out DIR]
 //        [-- extra `serve` args]
-import { mkdtempSync, rmSync, writeFileSync } from 'node:fs';
+import { mkdtempSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { pathToFileURL } from 'node:url';
 
-import { checks, launchChromium, parseArgs, playwright, repo, startServer, stopServer } from './browser_harness.mjs';
+import { checks, finish, launchChromium, parseArgs, playwright, repo, startServer } from './browser_harness.mjs';
 
 const { chromium } = playwright();
 const opts = parseArgs(process.argv.slice(2));
@@ -247,11 +247,8 @@ try {
     await page.close();
   }
   check(problems.length === 0, `no page errors (${problems.join('; ')})`);
+} catch (e) {
+  check(false, `the test stopped: ${e.stack || e}`);  // finish() exits: the error must count
 } finally {
-  if (browser) await browser.close();
-  await stopServer(started, check);
-  rmSync(dir, { recursive: true, force: true });
-  if (failures.length) console.log(`--- server log ---\n${started.log().slice(-3000)}`);
+  await finish({ browser, started, check, failures, dir, what: 'view-size' });
 }
-console.log(failures.length ? `${failures.length} check(s) failed` : 'all view-size checks passed');
-process.exit(failures.length ? 1 : 0);
