@@ -4,12 +4,17 @@
 # Origin), 8 addresses of silent upgrades filling the pre-Hello budget, a
 # token spray from 200 addresses (and the log it writes), unknown transfer
 # codings, a FIFO given as each kind of input file, and corrupt cache files.
+# With the client binary too, the gRPC port (grpc_probe.py): rapid reset for
+# $HAARCAST_PROBE_GRPC_SECONDS (default 5; 60 for the figures in
+# docs/hardening.md) beside honest gRPC and WebSocket clients, 100 addresses
+# × 8 silent streams, a token spray, and a frame that never returns.
 # Prints one line of figures per attack; exits 1 at the first one not held.
 # 127.0.0.x are distinct client addresses on Linux loopback.
 #
-# usage: hostile_probe.sh HAARCAST_BINARY
+# usage: hostile_probe.sh HAARCAST_BINARY [HAARCAST_CLIENT]
 set -euo pipefail
-haarcast="${1:?usage: hostile_probe.sh HAARCAST_BINARY}"
+haarcast="${1:?usage: hostile_probe.sh HAARCAST_BINARY [HAARCAST_CLIENT]}"
+client="${2:-}"
 work="$(mktemp -d -t haarcast-hostile.XXXXXX)"
 server_pid=""
 cleanup() {
@@ -182,4 +187,16 @@ logged=$(grep -c "is corrupt" "$work/render.err" || true)
 named=$(grep -c "cache file $work/cache/.*hccache is corrupt" "$work/render.err" || true)
 echo "corrupt cache: ${#files[@]} files → rebuilt, $logged log lines naming them ($(grep -m1 'is corrupt' "$work/render.err"))"
 [[ "$logged" == "${#files[@]}" && "$named" == "$logged" ]] || fail "corrupt cache files: $logged logged for ${#files[@]}"
+
+# ---- the gRPC port (Debian's python3 has grpcio: python3-grpcio)
+if [[ -n "$client" ]]; then
+  rc=0
+  /usr/bin/python3 "$(dirname "${BASH_SOURCE[0]}")/grpc_probe.py" --haarcast "$haarcast" --client "$client" \
+    --seconds "${HAARCAST_PROBE_GRPC_SECONDS:-5}" || rc=$?
+  if ((rc == 77)); then
+    echo "gRPC: skipped (no grpc module in /usr/bin/python3)"
+  elif ((rc != 0)); then
+    exit 1
+  fi
+fi
 echo "PASS"

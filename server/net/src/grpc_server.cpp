@@ -14,7 +14,9 @@
 #include <grpcpp/ext/proto_server_reflection_plugin.h>
 #include <grpcpp/grpcpp.h>
 #include <grpcpp/health_check_service_interface.h>
+#include <grpcpp/server_posix.h>
 
+#include "grpc_front.h"
 #include "grpc_reflection.h"
 #include "grpc_session.h"
 #include "haarcast/net/listener_probe.h"
@@ -51,11 +53,6 @@ class RenderGrpcService final : public v1::Render::WithRawCallbackMethod_Session
   GrpcServer& owner_;
 };
 
-std::string listenAddress(const ServerOptions& o) {
-  const bool v6 = o.bindAddress.find(':') != std::string::npos;
-  return (v6 ? "[" + o.bindAddress + "]" : o.bindAddress) + ":" + std::to_string(*o.grpcPort);
-}
-
 }  // namespace
 
 struct GrpcServer::State {
@@ -67,6 +64,9 @@ struct GrpcServer::State {
   ReflectionV1Service reflection{{kServiceName, "grpc.health.v1.Health", "grpc.reflection.v1.ServerReflection",
                                   "grpc.reflection.v1alpha.ServerReflection"}};
   std::unique_ptr<grpc::Server> grpc;
+  // The port itself: accepted by the server's own loop and handed to gRPC
+  // (grpc_front.h). Declared after grpc: destroyed first.
+  std::unique_ptr<GrpcFront> front;
   int port = 0;
 
   mutable std::mutex mutex;
@@ -105,9 +105,8 @@ struct GrpcServer::State {
         if (listener.record(result)) {
           listenerDead.store(listener.dead());
           if (listener.dead()) {
-            server.log("the gRPC port %d stopped accepting (no answer to 3 probes in a row; gRPC 1.51 stops for good "
-                       "after an accept() failed for want of descriptors, CVE-2023-4785): /healthz answers 503, "
-                       "restart the process", port);
+            server.log("the gRPC port %d stopped answering (no HTTP/2 SETTINGS to 3 probes in a row): /healthz "
+                       "answers 503, restart the process", port);
           } else {
             server.log("the gRPC port %d accepts again: /healthz answers 200", port);
           }
@@ -135,9 +134,7 @@ GrpcServer::GrpcServer(Server::Impl& server) : state_(std::make_unique<State>(se
   // Both are process-wide switches read by the builder.
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
-  const std::string where = listenAddress(o);
   grpc::ServerBuilder builder;
-  builder.AddListeningPort(where, grpc::InsecureServerCredentials(), &state_->port);
   builder.RegisterService(&state_->service);
   builder.RegisterService(&state_->reflection);
   // As the WebSocket's read limit (upgrade.h): messages up to 4× the
@@ -145,23 +142,30 @@ GrpcServer::GrpcServer(Server::Impl& server) : state_(std::make_unique<State>(se
   // larger ones gRPC refuses before buffering (RESOURCE_EXHAUSTED).
   const std::size_t maxReceive = std::min<std::size_t>(4 * o.limits.maxMessageBytes, std::numeric_limits<int>::max());
   builder.SetMaxReceiveMessageSize(static_cast<int>(maxReceive));
+  // Client messages are poses of about 100 bytes: nothing to gain from
+  // compression, and gRPC 1.51 inflates a compressed message whole before
+  // it checks the size (a 63 KB gzip bomb became 64 MB). A compressed
+  // message is refused (UNIMPLEMENTED) before it is inflated.
+  builder.SetCompressionAlgorithmSupportStatus(GRPC_COMPRESS_DEFLATE, false);
+  builder.SetCompressionAlgorithmSupportStatus(GRPC_COMPRESS_GZIP, false);
   // Streams per HTTP/2 connection: what one address may hold anyway
   // (pre-Hello and session slots); the slots are the real limit.
   builder.AddChannelArgument(GRPC_ARG_MAX_CONCURRENT_STREAMS,
                              o.admission.pendingPerAddress + o.admission.sessionsPerAddress);
-  // gRPC sets SO_REUSEPORT by default on Linux, which would let a second
-  // server share the port silently: a port in use must be an error.
-  builder.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
+  // No listening port: the front accepts (grpc_front.h).
   state_->grpc = builder.BuildAndStart();
-  if (!state_->grpc || state_->port == 0) {
-    throw std::runtime_error("cannot listen for gRPC on " + where + " (address in use, or not one of this machine's)");
-  }
+  if (!state_->grpc) throw std::runtime_error("cannot start the gRPC server");
+  state_->front = std::make_unique<GrpcFront>(server, Http2Limits{}, [s = state_.get()](int fd) {
+    grpc::AddInsecureChannelFromFd(s->grpc.get(), fd);
+  });
+  state_->front->start();  // throws naming the address when it cannot listen
+  state_->port = state_->front->port();
   // A wildcard bind is probed on loopback, of the same family.
   state_->probeHost = o.bindAddress == "0.0.0.0" ? "127.0.0.1" : o.bindAddress == "::" ? "::1" : o.bindAddress;
   state_->setServing(!server.atCapacity());
   state_->health = std::thread([s = state_.get()] { s->watchHealth(); });
-  server.log("gRPC on %s (port %d): haarcast.v1.Render, grpc.health.v1.Health, reflection v1 and v1alpha", where.c_str(),
-             state_->port);
+  server.log("gRPC on %s port %d: haarcast.v1.Render, grpc.health.v1.Health, reflection v1 and v1alpha",
+             o.bindAddress.c_str(), state_->port);
 }
 
 GrpcServer::~GrpcServer() { join(); }
@@ -170,8 +174,11 @@ std::uint16_t GrpcServer::port() const { return static_cast<std::uint16_t>(state
 
 std::optional<std::string> GrpcServer::listenerProblem() const {
   if (!state_->listenerDead.load()) return std::nullopt;
-  return "the gRPC port " + std::to_string(state_->port) +
-         " stopped accepting (gRPC 1.51 after descriptor exhaustion, CVE-2023-4785): restart the process";
+  return "the gRPC port " + std::to_string(state_->port) + " stopped answering HTTP/2: restart the process";
+}
+
+std::string GrpcServer::peerGroup(std::string_view peer) const {
+  return state_->front ? state_->front->peerGroup(peer) : std::string(peer);
 }
 
 std::size_t GrpcServer::sessionCount() const {
@@ -208,6 +215,7 @@ void GrpcServer::shutdownThen(std::function<void()> then) {
     return;
   }
   state_->stopHealth();
+  if (state_->front) state_->front->close();
   state_->stopper = std::thread([s = state_.get(), then = std::move(then)] {
     s->grpc->Shutdown(std::chrono::system_clock::now() + kShutdownGrace);
     s->shutdownDone.store(true);
@@ -227,6 +235,10 @@ void GrpcServer::join() {
     }
   }
   if (state_->stopper.joinable()) state_->stopper.join();
+  // The front's acceptor belongs to the Server's io_context, which is
+  // destroyed before this object (server_impl.h): it goes now, while the
+  // io_context is alive. gRPC is shut down: no stream asks for a peer.
+  state_->front.reset();
 }
 
 }  // namespace haarcast::net

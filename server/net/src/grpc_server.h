@@ -3,8 +3,10 @@
 // carries one RenderSession (grpc_session.h); the standard health service
 // grpc.health.v1.Health, SERVING while /readyz would answer ready; and
 // server reflection, so that grpcurl and friends list and describe the
-// service. The Server builds it after its own port and stops it at the end
-// of its drain (listener.cpp).
+// service. gRPC listens on nothing: the port is the front's (grpc_front.h),
+// which accepts each connection, checks its HTTP/2 frame headers, and hands
+// it to gRPC. The Server builds it after its own port and stops it at the
+// end of its drain (listener.cpp).
 //
 // Threads: gRPC calls the service and the reactors on its own threads; a
 // reactor only posts to its session's strand on the Server's io_context,
@@ -19,6 +21,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <utility>  // before Asio: its awaitable.hpp uses std::exchange
 
 #include "server_impl.h"
@@ -37,6 +40,9 @@ class GrpcServer {
   GrpcServer& operator=(const GrpcServer&) = delete;
 
   std::uint16_t port() const;
+  // The client group of a stream's peer (context->peer()): the address
+  // the front accepted its connection from.
+  std::string peerGroup(std::string_view peer) const;
   // Why the port is dead, once a few probes in a row went unanswered
   // (listener_probe.h); nullopt while it accepts. /healthz answers 503 with
   // it, and gRPC health says NOT_SERVING.

@@ -41,7 +41,7 @@ GrpcSession::GrpcSession(Server::Impl& server, GrpcServer& registry, grpc::Callb
       ticker_(executor_),
       paceTimer_(executor_),
       id_("g" + std::to_string(server.nextSessionId.fetch_add(1))),
-      address_(grpcPeerGroup(context->peer())),
+      address_(registry.peerGroup(context->peer())),
       session_(server.options, server.catalog, server.metrics, *this, id_, Clock::now()) {}
 
 GrpcSession::~GrpcSession() {

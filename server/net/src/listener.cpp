@@ -47,12 +47,6 @@ RenderService::Options Server::Impl::withLog(RenderService::Options o) {
   return o;
 }
 
-std::string peerAddress(const tcp::socket& socket) {
-  beast::error_code ec;
-  const auto remote = socket.remote_endpoint(ec);
-  return ec ? std::string("?") : clientGroup(remote.address().to_string());
-}
-
 std::optional<std::string> exposureWarning(const ServerOptions& options) {
   if (!options.token.empty() || isLoopbackAddress(options.bindAddress)) return std::nullopt;
   return "WARNING: listening on " + options.bindAddress +
@@ -66,8 +60,7 @@ Server::Impl::Impl(ServerOptions o, Catalog c, AbandonableRendererBuilder builde
       admission(checkedAdmission(options.admission)),
       tokenGuard(options.tokenGuard),
       ioc(std::max(1, options.ioThreads)),
-      acceptor(asio::make_strand(ioc)),
-      acceptPause(acceptor.get_executor()),
+      accept(ioc, "", [this](const std::string& line) { log("%s", line.c_str()); }),
       drainTimer(ioc),
       refusalSummaryTimer(ioc),
       renderService(std::make_unique<RenderService>(std::move(builder), withLog(options.render), metrics)) {
@@ -105,48 +98,7 @@ void Server::Impl::scheduleRefusalSummary() {
   });
 }
 
-void Server::Impl::listen() {
-  beast::error_code ec;
-  const auto address = asio::ip::make_address(options.bindAddress, ec);
-  if (ec) throw std::runtime_error("--bind " + options.bindAddress + " is not an IP address: " + ec.message());
-  const tcp::endpoint endpoint(address, options.port);
-  const std::string where = options.bindAddress + ":" + std::to_string(options.port);
-  acceptor.open(endpoint.protocol(), ec);
-  if (!ec) acceptor.set_option(asio::socket_base::reuse_address(true), ec);
-  if (!ec) acceptor.bind(endpoint, ec);
-  if (!ec) acceptor.listen(asio::socket_base::max_listen_connections, ec);
-  if (ec) throw std::runtime_error("cannot listen on " + where + ": " + ec.message());
-  boundPort = acceptor.local_endpoint(ec).port();
-}
-
-void Server::Impl::doAccept() {
-  acceptor.async_accept(asio::make_strand(ioc), [this](beast::error_code ec, tcp::socket socket) {
-    onAccept(ec, std::move(socket));
-  });
-}
-
-void Server::Impl::onAccept(beast::error_code ec, tcp::socket socket) {
-  if (!acceptor.is_open()) return;
-  if (ec) {
-    const auto step = acceptBackoff.onError(ec.category() == boost::system::system_category() ? ec.value() : 0);
-    if (step.pause.count() == 0) {
-      log("accept: %s", ec.message().c_str());
-      doAccept();
-      return;
-    }
-    // Out of descriptors: a retry at once fails again. Pause, and say so
-    // once per episode rather than once per retry.
-    if (step.episodeStarted) log("accept: %s; pausing accepts (50 ms, doubling to 1 s) until one succeeds", ec.message().c_str());
-    acceptPause.expires_after(step.pause);
-    acceptPause.async_wait([this](beast::error_code waitEc) {
-      if (!waitEc) doAccept();
-    });
-    return;
-  }
-  if (const int errors = acceptBackoff.errorsInEpisode(); acceptBackoff.onSuccess()) {
-    log("accept: recovered after %d failed accepts", errors);
-  }
-  const std::string address = peerAddress(socket);
+void Server::Impl::onConnection(tcp::socket socket, std::string address) {
   Admission::Refusal refusal;
   if (auto slot = admission.take(SlotKind::Connection, address, &refusal)) {
     // Frames are small writes answered by small pose messages: without
@@ -162,7 +114,6 @@ void Server::Impl::onAccept(beast::error_code ec, tcp::socket socket) {
     beast::error_code ignored;
     socket.close(ignored);
   }
-  doAccept();
 }
 
 std::size_t Server::Impl::sessionCount() {
@@ -251,11 +202,9 @@ void Server::Impl::watchDrain() {
     for (std::size_t i = 0; i < left; ++i) metrics.addCut("drain_deadline");
     log("stopped (%zu sessions cut)", left);
     auto closeAndStop = [this] {
-      asio::post(acceptor.get_executor(), [this] {
-        beast::error_code ec;
-        acceptPause.cancel();
+      asio::post(accept.executor(), [this] {
         refusalSummaryTimer.cancel();
-        acceptor.close(ec);
+        accept.close();
         ioc.stop();
       });
     };
@@ -291,8 +240,10 @@ Server::Server(ServerOptions options, Catalog catalog, AbandonableRendererBuilde
       impl->stop();
     });
   }
-  impl_->listen();
-  impl_->doAccept();
+  impl_->accept.listen(impl_->options.bindAddress, impl_->options.port);
+  impl_->accept.start([impl = impl_.get()](tcp::socket socket, std::string address) {
+    impl->onConnection(std::move(socket), std::move(address));
+  });
   impl_->scheduleRefusalSummary();
   if (impl_->options.grpcPort) impl_->grpc = std::make_unique<GrpcServer>(*impl_);
 }
@@ -303,7 +254,7 @@ Server::~Server() {
   impl_->stopRenderService();
 }
 
-std::uint16_t Server::port() const { return impl_->boundPort; }
+std::uint16_t Server::port() const { return impl_->accept.port(); }
 
 std::uint16_t Server::grpcPort() const { return impl_->grpc ? impl_->grpc->port() : 0; }
 

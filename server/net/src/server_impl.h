@@ -14,6 +14,7 @@
 
 #include <boost/asio.hpp>
 
+#include "accept_loop.h"
 #include "haarcast/net/access.h"
 #include "haarcast/net/refusal_log.h"
 #include "haarcast/net/server.h"
@@ -47,17 +48,14 @@ struct Server::Impl {
   // the handlers the io_context destroys find them alive; the render service
   // after the io_context, so its threads (which post into it) stop first.
   boost::asio::io_context ioc;
-  boost::asio::ip::tcp::acceptor acceptor;
+  AcceptLoop accept;  // the WebSocket and HTTP port
   std::optional<boost::asio::signal_set> signals;
-  boost::asio::steady_timer acceptPause;
-  AcceptBackoff acceptBackoff;
   boost::asio::steady_timer drainTimer;
   boost::asio::steady_timer refusalSummaryTimer;
   Clock::time_point drainDeadline;
   // When stop() was first called: the render service's stop grace counts
   // from here, so SIGTERM's exit is bounded whatever the drain takes.
   Clock::time_point stopRequested;
-  std::uint16_t boundPort = 0;
   std::unique_ptr<RenderService> renderService;
 
   Impl(ServerOptions o, Catalog c, AbandonableRendererBuilder builder);
@@ -70,9 +68,8 @@ struct Server::Impl {
   void logRefusal(const std::string& address, const std::string& line);
   // Every RefusalLog::kPeriodSeconds: the summary line, when one is due.
   void scheduleRefusalSummary();
-  void listen();
-  void doAccept();
-  void onAccept(boost::system::error_code ec, boost::asio::ip::tcp::socket socket);
+  // A connection accepted on the WebSocket port: its slot, then HTTP.
+  void onConnection(boost::asio::ip::tcp::socket socket, std::string address);
   void stop();
   void watchDrain();
   std::size_t sessionCount();
@@ -87,10 +84,5 @@ struct Server::Impl {
   // /metrics: the render service's gauges copied into `metrics`, then the text.
   std::string metricsText();
 };
-
-// The client group of a connected socket's address (clientGroup: an IPv4
-// address or an IPv6 /64): the key of per-address limits and the address
-// the log names.
-std::string peerAddress(const boost::asio::ip::tcp::socket& socket);
 
 }  // namespace haarcast::net

@@ -1,7 +1,8 @@
-// Whether a listener still accepts. gRPC 1.51 (Debian 12's) stops accepting
-// on a port for good once accept() has failed with EMFILE (CVE-2023-4785):
-// the kernel still completes TCP handshakes into the backlog, so a connect
-// alone proves nothing. The probe speaks first, as an HTTP/2 client does
+// Whether a listener still accepts and an HTTP/2 server answers behind it:
+// the gRPC port is probed end to end, through its front (grpc_front.h) to
+// gRPC. The kernel completes TCP handshakes into the backlog of a port
+// that no longer accepts (as gRPC 1.51's own listener did after EMFILE,
+// CVE-2023-4785), so a connect alone proves nothing. The probe speaks first, as an HTTP/2 client does
 // (RFC 9113 §3.4: the preface, then SETTINGS), and a live server answers
 // with its own SETTINGS; a port that never accepts stays silent.
 //
