@@ -33,7 +33,7 @@ while (($# > 0)); do
       ;;
   esac
 done
-all=(fuzz_hdr fuzz_pfm fuzz_exr fuzz_ply fuzz_obj fuzz_merl fuzz_scene fuzz_protocol fuzz_websocket)
+all=(fuzz_hdr fuzz_pfm fuzz_exr fuzz_ply fuzz_obj fuzz_merl fuzz_scene fuzz_protocol fuzz_websocket fuzz_http2)
 ((${#targets[@]} > 0)) || targets=("${all[@]}")
 for t in "${targets[@]}"; do
   [[ " ${all[*]} " == *" $t "* ]] || { echo "error: unknown target '$t' (one of: ${all[*]})" >&2; exit 2; }

@@ -6,9 +6,11 @@
 #                                 then serve it: prints the browser client's URL and runs
 #                                 the CLI client against the server for a few seconds
 #                                 (on a terminal the server keeps running until Ctrl-C)
-#   deploy/run.sh test  [args]   ctest --test-dir build --output-on-failure [args]
+#   deploy/run.sh test  [args]   ctest --test-dir build --output-on-failure --parallel JOBS [args]
 #   deploy/run.sh test --sanitize  the fast unit tests (core, io, render, net) built with
-#                                 ASan + UBSan (clang) into build-sanitize/ (no GPU, no end-to-end)
+#                                 ASan + UBSan (clang) into build-sanitize/ (no GPU, no end-to-end),
+#                                 run in two lanes at once
+#   (HAARCAST_TEST_JOBS: tests at once, default nproc; 1 runs them one by one)
 #   deploy/run.sh fuzz [--seconds N]  deploy/fuzz.sh: builds the libFuzzer targets (clang)
 #                                 into build-sanitize/ and runs each N seconds (default 20)
 #   deploy/run.sh bench [args]   the speed table (bench-frame, fused: 128², 256², 512² at
@@ -273,16 +275,45 @@ esac
 # fatal), in a build folder of their own; the GPU and end-to-end tests are
 # left to the ordinary build.
 SANITIZE_TESTS=(haarcast_core_tests haarcast_io_tests haarcast_render_tests haarcast_wire_tests haarcast_net_tests)
+# One binary under ASan + UBSan, its output into $2: status 0 when it passed.
+# A limit per binary: a test that hangs on another machine fails the run
+# instead of holding it.
+sanitized_binary() {
+  local dir="${HAARCAST_SANITIZE_DIR:-build-sanitize}" t="$1" out="$2"
+  shift 2
+  ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
+    timeout --kill-after=10 1800 "$dir/bin/$t" "$@" >"$out" 2>&1 </dev/null
+}
+# Two lanes at once on two cores (the render tests, about 4 minutes here,
+# beside the other four, about 3½): each binary's output is printed whole
+# when it ends, with its time and status.
 sanitized_tests() {
-  local dir="${HAARCAST_SANITIZE_DIR:-build-sanitize}" failed=0 t
+  local dir="${HAARCAST_SANITIZE_DIR:-build-sanitize}" failed=0 t lane rc
   deploy/sanitize_build.sh "${SANITIZE_TESTS[@]}"
-  for t in "${SANITIZE_TESTS[@]}"; do
-    log "running $t (ASan + UBSan)"
-    # A limit per binary (the suite takes about 5 minutes here): a test that
-    # hangs on another machine fails the run instead of holding it.
-    ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
-      timeout --kill-after=10 1800 "$dir/bin/$t" "$@" </dev/null || failed=1
+  local logs
+  logs="$(mktemp -d -t haarcast-sanitize.XXXXXX)"
+  local -a lanes=("haarcast_render_tests" "haarcast_net_tests haarcast_core_tests haarcast_io_tests haarcast_wire_tests")
+  ((${HAARCAST_TEST_JOBS:-$(nproc)} >= 2)) || lanes=("${SANITIZE_TESTS[*]}")
+  local -a pids=()
+  for lane in "${lanes[@]}"; do
+    (
+      lane_failed=0
+      for t in $lane; do
+        start=$SECONDS
+        rc=0
+        sanitized_binary "$t" "$logs/$t.log" "$@" || rc=$?
+        {
+          echo "==> $t (ASan + UBSan): $( ((rc == 0)) && echo passed || echo "FAILED, status $rc") in $((SECONDS - start)) s"
+          ((rc == 0)) && tail -n 3 "$logs/$t.log" || cat "$logs/$t.log"
+        } | flock "$logs" cat
+        ((rc == 0)) || lane_failed=1
+      done
+      exit "$lane_failed"
+    ) &
+    pids+=($!)
   done
+  for lane in "${pids[@]}"; do wait "$lane" || failed=1; done
+  rm -rf "$logs"
   return "$failed"
 }
 
@@ -388,8 +419,11 @@ case "$command" in
       export HAARCAST_REQUIRE_RAY_TRACING=1
     fi
     # --timeout: the limit of a test that sets none of its own (each suite
-    # sets one; this catches a test added without).
-    exec ctest --test-dir "$BUILD_DIR" --output-on-failure --timeout 600 "$@" </dev/null
+    # sets one; this catches a test added without). Tests run in parallel,
+    # one per core (HAARCAST_TEST_JOBS): the suite is checked that way on
+    # the 2-core machines it runs on.
+    exec ctest --test-dir "$BUILD_DIR" --output-on-failure --timeout 600 \
+      --parallel "${HAARCAST_TEST_JOBS:-$(nproc)}" "$@" </dev/null
     ;;
   bench)
     bench_backend="${HAARCAST_BENCH_BACKEND:-both}"
