@@ -194,6 +194,14 @@ class Honest(threading.Thread):
             if not self.stop.is_set() and self.error is None:
                 self.error = f"{e.code()}: {e.details()}"
 
+    def wait_frames(self, n, limit):
+        """True once `n` frames have come, within `limit` seconds (the first
+        waits for the session's renderer: a build, slower on a busy machine)."""
+        end = time.monotonic() + limit
+        while len(self.frames) < n and self.error is None and time.monotonic() < end:
+            time.sleep(0.05)
+        return len(self.frames) >= n
+
     def fps(self, since, until):
         return sum(1 for t in self.frames if since <= t < until) / (until - since)
 
@@ -288,7 +296,8 @@ def main():
         # ---- rapid reset
         honest = Honest(grpc_port)
         honest.start()
-        time.sleep(2)  # its renderer built, its frames flowing
+        if not honest.wait_frames(3, 120):  # its renderer built, its frames flowing
+            fail(f"the honest gRPC client got no frames within 120 s ({honest.error})")
         measure = max(3.0, min(10.0, args.seconds / 3))
         t0 = time.monotonic()
         ws_before, problem = ws_fps(args.client, port, measure)
@@ -353,7 +362,7 @@ def main():
         # A known client shows the right token once.
         known = Honest(grpc_port)
         known.start()
-        time.sleep(2)
+        known.wait_frames(1, 120)
         known.stop.set()
         if not known.frames:
             fail(f"the known client got no frame before the spray ({known.error})")
@@ -396,7 +405,7 @@ def main():
                 pass
         known = Honest(grpc_port)
         known.start()
-        time.sleep(3)
+        known.wait_frames(10, 60)
         known.stop.set()
         newcomer_refused = metric(port, 'haarcast_refusals_total{reason="token_rate_server"}')
         print(f"spray: 1,000 wrong gRPC tokens from 200 addresses ({answered} answered); refusals token_rate_server "
@@ -416,7 +425,7 @@ def main():
         stuck = Honest(grpc_port)
         stuck.start()
         waited = time.monotonic()
-        while stuck.error is None and time.monotonic() - waited < 15:
+        while stuck.error is None and time.monotonic() - waited < 60:
             time.sleep(0.1)
         time.sleep(0.5)  # the health status follows within its 200 ms poll
         serving = health(grpc_port)

@@ -3,6 +3,8 @@
 // blocks, frames split anywhere, and the GOAWAY it sends.
 #include "haarcast/net/http2_guard.h"
 
+#include "http2_frames.h"
+
 #include <gtest/gtest.h>
 
 #include <string>
@@ -14,15 +16,7 @@ namespace {
 using namespace std::chrono_literals;
 
 std::string frame(std::uint8_t type, std::uint8_t flags, std::uint32_t stream, std::size_t length) {
-  std::string f;
-  f.push_back(static_cast<char>((length >> 16) & 0xff));
-  f.push_back(static_cast<char>((length >> 8) & 0xff));
-  f.push_back(static_cast<char>(length & 0xff));
-  f.push_back(static_cast<char>(type));
-  f.push_back(static_cast<char>(flags));
-  for (int shift = 24; shift >= 0; shift -= 8) f.push_back(static_cast<char>((stream >> shift) & 0xff));
-  f.append(length, '\x01');
-  return f;
+  return test::http2FrameHeader(length, type, flags, stream) + std::string(length, '\x01');
 }
 
 std::string headers(std::uint32_t stream) { return frame(http2::kHeaders, http2::kEndHeaders, stream, 20); }
