@@ -9,7 +9,7 @@
 # (build-sanitize/artifacts/<target>/). A target stops at its first crash; rerun
 # one input with build-sanitize/fuzz/<target> <file>. New inputs the fuzzer finds
 # go to build-sanitize/corpus/<target>/, never into the committed corpus.
-# Environment: HAARCAST_JOBS (build jobs, default nproc), HAARCAST_SANITIZE_DIR
+# Environment: HAARCAST_JOBS (build jobs, and targets run at once; default nproc), HAARCAST_SANITIZE_DIR
 # (default build-sanitize). Exits 1 when any target crashed.
 set -euo pipefail
 
@@ -46,17 +46,32 @@ deploy/sanitize_build.sh "${targets[@]}"
 
 # A single request over 2 GiB is a finding (a header trusted before the data),
 # as are 10 s on one input and a leak.
-failed=0
-printf '%-15s %12s %8s  %s\n' target executions crashes "crash inputs"
-for t in "${targets[@]}"; do
-  work="$dir/corpus/$t" artifacts="$dir/artifacts/$t"
+fuzz_one() {
+  local t="$1" work="$dir/corpus/$1" artifacts="$dir/artifacts/$1"
   # Crash inputs of this run only: an earlier run's would be counted again.
   rm -rf "$artifacts"
   mkdir -p "$work" "$artifacts"
-  log="$dir/artifacts/$t.log"
   "$dir/fuzz/$t" -max_total_time="$seconds" -rss_limit_mb=2560 -malloc_limit_mb=2048 -timeout=10 \
-    -print_final_stats=1 -artifact_prefix="$artifacts/" "$work" "tests/fuzz/corpus/$t" >"$log" 2>&1 </dev/null || true
-  execs="$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -n 1)"
+    -print_final_stats=1 -artifact_prefix="$artifacts/" "$work" "tests/fuzz/corpus/$t" >"$dir/artifacts/$t.log" 2>&1 </dev/null || true
+}
+# One target per core at a time (each fuzzer is one process, one thread);
+# the table is printed in the targets' order once they have all run.
+jobs="${HAARCAST_JOBS:-$(nproc)}"
+running=0
+for t in "${targets[@]}"; do
+  if ((running >= jobs)); then
+    wait -n || true
+    running=$((running - 1))
+  fi
+  fuzz_one "$t" &
+  running=$((running + 1))
+done
+wait || true
+failed=0
+printf '%-15s %12s %8s  %s\n' target executions crashes "crash inputs"
+for t in "${targets[@]}"; do
+  artifacts="$dir/artifacts/$t"
+  execs="$(sed -n 's/^stat::number_of_executed_units: *//p' "$dir/artifacts/$t.log" | tail -n 1)"
   crashes=("$artifacts"/*)
   [[ -e "${crashes[0]}" ]] || crashes=()
   ((${#crashes[@]} == 0)) || failed=1
