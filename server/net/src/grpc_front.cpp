@@ -33,7 +33,6 @@ struct GrpcFront::Shared {
   std::function<void(int)> handOff;
   mutable std::mutex mutex;
   std::map<int, std::string> fdAddress;  // gRPC's descriptor → client group
-  std::size_t connections = 0;
   bool closed = false;
 };
 
@@ -50,16 +49,9 @@ class FrontConnection : public std::enable_shared_from_this<FrontConnection> {
         timer_(client_.get_executor()),
         slot_(std::move(slot)),
         address_(std::move(address)),
-        guard_(shared_->rates, address_) {
-    std::lock_guard lock(shared_->mutex);
-    ++shared_->connections;
-  }
+        guard_(shared_->rates, address_) {}
 
-  ~FrontConnection() {
-    shared_->rates.disconnected(address_);
-    std::lock_guard lock(shared_->mutex);
-    --shared_->connections;
-  }
+  ~FrontConnection() { shared_->rates.disconnected(address_); }
 
   void run() {
     // The preface within the handshake time, as a WebSocket's HTTP request.
@@ -242,11 +234,6 @@ void GrpcFront::close() {
     shared_->closed = true;
   }
   asio::post(accept_.executor(), [this] { accept_.close(); });
-}
-
-std::size_t GrpcFront::connections() const {
-  std::lock_guard lock(shared_->mutex);
-  return shared_->connections;
 }
 
 std::string GrpcFront::peerGroup(std::string_view peer) const {

@@ -44,8 +44,6 @@ class GrpcFront {
   std::uint16_t port() const { return accept_.port(); }
   // No new connection from now on (the open ones end with gRPC's).
   void close();
-  // Connections still handed on (stop() waits for gRPC's own shutdown).
-  std::size_t connections() const;
 
   // The client group behind a gRPC peer string: "fd:N" is a connection this
   // front handed to gRPC as descriptor N; anything else as grpcPeerGroup.
