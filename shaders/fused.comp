@@ -81,7 +81,8 @@ layout(std430, set = 0, binding = kFusedSliceEnergyBinding) readonly buffer Slic
 layout(std430, set = 0, binding = kFusedLobesBinding) readonly buffer Lobes { SliceLobe lobes[]; };          // global slice: its lobe
 // Level l of the prefiltered light at prefilterOffset(l), RGB0 (core PrefilteredLight).
 layout(set = 0, binding = kFusedLobeLightTexelsBinding) uniform textureBuffer lobeLight;
-// The slices as point values at the texel centres (core PixelSlices::pointSlice), laid out as `texels`.
+// The slices as point values at the texel centres (core PixelSlices::pointSlice), at each object's
+// pointLevel: object o's slice t, direction k at o.pointTexelBase + t·N + k.
 layout(set = 0, binding = kFusedPointSliceTexelsBinding) uniform textureBuffer pointTexels;
 // Per object: its samples shaded from one slice (2·object; the ground's
 // samples, which read none, too) and from two (2·object + 1), cleared before
@@ -109,11 +110,25 @@ struct PixelSetup {
   float sinA, cosA, sinB, cosB;
   int shift;               // whole source columns of γ
   float fraction;          // and the fraction
+  uint pointM;             // the point slices': M of their level,
+  uint pointBase0, pointBase1;  // the two slices' texel 0,
+  int pointShift;          // and γ's offset at that level
+  float pointFraction;
   float skipBelowY;
   uint firstRow, endRow;   // the rows that can reach the slice's non-zero cap
   vec3 axis;               // the lobe's axis before R_y(−γ), and the lobe path's core (fused.cpp setCore)
   float coreCos;
 };
+
+// γ as a column offset of a map of M = m (core fused.cpp columnOffset):
+// source column = φ'·M/2π − (γ·M/2π + ½); the offset's whole part (x)
+// shifts the integer column, its fraction (y) the float coordinate.
+vec2 columnOffset(float gamma, uint m) {
+  float offset = gamma * (float(m) / kTwoPiF) + 0.5;
+  offset -= floor(offset / float(m)) * float(m);
+  const float whole = floor(offset);
+  return vec2(whole, offset - whole);
+}
 
 // Texel `index` of ρ: the slice's own, or the blend of the two slices.
 vec3 texel(const bool blended, PixelSetup p, uint index) {
@@ -123,11 +138,12 @@ vec3 texel(const bool blended, PixelSetup p, uint index) {
   return a + p.weight * (b - a);
 }
 
-// Where the object-frame direction w0 falls in the slice: Rᵀw0, θ', φ' as
-// continuous texel coordinates (row, column before γ's whole columns), as
-// the CPU kernel computes them. False where every tap reads zero: cos θ'
-// below the slices' cut, or inside the lobe path's core.
-bool slicePosition(PixelSetup p, vec3 w0, out vec2 pos) {
+// Where the object-frame direction w0 falls in a slice of M = m: Rᵀw0, θ',
+// φ' as continuous texel coordinates (row, column before γ's whole
+// columns; `fraction` its fraction at that M), as the CPU kernel computes
+// them. False where every tap reads zero: cos θ' below the slices' cut, or
+// inside the lobe path's core.
+bool slicePosition(PixelSetup p, vec3 w0, uint m, float fraction, out vec2 pos) {
   const float x1 = p.cosA * w0.x - p.sinA * w0.z;  // R_y(−α)
   const float z1 = p.sinA * w0.x + p.cosA * w0.z;
   const float y2 = p.cosB * w0.y + p.sinB * z1;    // R_x(−β)
@@ -136,7 +152,7 @@ bool slicePosition(PixelSetup p, vec3 w0, out vec2 pos) {
   if (x1 * p.axis.x + y2 * p.axis.y + z2 * p.axis.z > p.coreCos) return false;  // the lobe path's core
   const float theta = atan2Fast(sqrt(x1 * x1 + z2 * z2), y2);
   const float phi = atan2Fast(x1, z2);
-  pos = vec2(min(max(theta * (float(p.m) / kPiF) - 0.5, 0.0), float(p.m - 1u)), phi * (float(p.m) / kTwoPiF) - p.fraction);
+  pos = vec2(min(max(theta * (float(m) / kPiF) - 0.5, 0.0), float(m - 1u)), phi * (float(m) / kTwoPiF) - fraction);
   return true;
 }
 
@@ -144,7 +160,7 @@ bool slicePosition(PixelSetup p, vec3 w0, out vec2 pos) {
 // fused_kernel.cpp, the pass's lookup).
 vec3 rhoAt(const bool blended, PixelSetup p, vec3 w0) {
   vec2 pos;
-  if (!slicePosition(p, w0, pos)) return vec3(0.0);
+  if (!slicePosition(p, w0, p.m, p.fraction, pos)) return vec3(0.0);
   const int mask = int(p.m) - 1;
   const float rowFloor = floor(pos.x), colFloor = floor(pos.y);
   const float tRow = pos.x - rowFloor, tCol = pos.y - colFloor;
@@ -161,27 +177,27 @@ vec3 rhoAt(const bool blended, PixelSetup p, vec3 w0) {
   return tRow * (bottom - top) + top;
 }
 
-// ρ_c at the object-frame direction w0 for a point light: slicePosition,
-// then Catmull-Rom over 4 × 4 taps of the point slices (rows
-// clamped, columns wrapped), each tap blended between the two slices
-// (core fused.cpp pointRhoAt; shared_layout.h catmullRomWeights).
+// ρ_c at the object-frame direction w0 for a point light: slicePosition at
+// the point slices' level, then Catmull-Rom over 4 × 4 taps of the point
+// slices (rows clamped, columns wrapped), each tap blended between the two
+// slices (core fused.cpp pointRhoAt; shared_layout.h catmullRomWeights).
 vec3 pointRhoAt(PixelSetup p, vec3 w0) {
   vec2 pos;
-  if (!slicePosition(p, w0, pos)) return vec3(0.0);
-  const int mask = int(p.m) - 1;
+  if (!slicePosition(p, w0, p.pointM, p.pointFraction, pos)) return vec3(0.0);
+  const int mask = int(p.pointM) - 1;
   const float rowFloor = floor(pos.x), colFloor = floor(pos.y);
   const vec4 wr = catmullRomWeights(pos.x - rowFloor);
   const vec4 wc = catmullRomWeights(pos.y - colFloor);
   const int r0 = int(rowFloor);
-  const int c0 = (int(colFloor) - p.shift) & mask;
+  const int c0 = (int(colFloor) - p.pointShift) & mask;
   vec3 sum = vec3(0.0);
   for (int i = 0; i < 4; ++i) {
-    const uint row = uint(clamp(r0 - 1 + i, 0, int(p.m) - 1));
+    const uint row = uint(clamp(r0 - 1 + i, 0, int(p.pointM) - 1));
     vec3 across = vec3(0.0);
     for (int j = 0; j < 4; ++j) {
-      const uint k = row * p.m + uint((c0 - 1 + j) & mask);
-      const vec3 a = texelFetch(pointTexels, int(p.base0 + k)).rgb;
-      const vec3 b = texelFetch(pointTexels, int(p.base1 + k)).rgb;
+      const uint k = row * p.pointM + uint((c0 - 1 + j) & mask);
+      const vec3 a = texelFetch(pointTexels, int(p.pointBase0 + k)).rgb;
+      const vec3 b = texelFetch(pointTexels, int(p.pointBase1 + k)).rgb;
       across += wc[j] * (a + p.weight * (b - a));
     }
     sum += wr[i] * across;
@@ -303,13 +319,15 @@ void shadePixel(uint s) {
   p.cosA = sa.y;
   p.sinB = sb.x;
   p.cosB = sb.y;
-  // Source column = φ'·M/2π − (γ·M/2π + ½): the offset's whole part shifts
-  // the integer column, its fraction the float coordinate.
-  float offset = rs.gamma * (float(p.m) / kTwoPiF) + 0.5;
-  offset -= floor(offset / float(p.m)) * float(p.m);
-  const float whole = floor(offset);
-  p.shift = int(whole);
-  p.fraction = offset - whole;
+  const vec2 column = columnOffset(rs.gamma, p.m);
+  p.shift = int(column.x);
+  p.fraction = column.y;
+  p.pointM = 1u << o.pointLevel;
+  p.pointBase0 = o.pointTexelBase + blend.first * p.pointM * p.pointM;
+  p.pointBase1 = o.pointTexelBase + blend.second * p.pointM * p.pointM;
+  const vec2 pointColumn = columnOffset(rs.gamma, p.pointM);
+  p.pointShift = int(pointColumn.x);
+  p.pointFraction = pointColumn.y;
   p.skipBelowY = o.skipBelowY;
   p.axis = vec3(0.0, 1.0, 0.0);
   p.coreCos = 2.0;

@@ -74,7 +74,7 @@ SharedStorage sharedStorage(const render::PreparedScene& prepared) {
     const Mesh& m = *o.mesh;
     s.meshBytes += m.positions.size() * sizeof(m.positions[0]) + m.normals.size() * sizeof(m.normals[0]) +
                    m.triangles.size() * sizeof(m.triangles[0]);
-    s.sliceTableBytes += o.table.storedBytes();
+    s.sliceTableBytes += o.table.storedBytes() + o.pointTable.storedBytes();  // an empty point table has none
   }
   for (const SphereMap& channel : prepared.light) {
     s.level = channel.level();

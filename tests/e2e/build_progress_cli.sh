@@ -6,7 +6,8 @@
 # machine). The client's stderr must have
 #   * plain lines (stderr is a file) "building: visibility blob  NN %", at
 #     least two, with nondecreasing percentages, each with the whole build's
-#     share and its step in the server's plan ("· build NN % (step 2 of 2)"),
+#     share and its step in the server's plan ("· build NN % (step 2 of 3)":
+#     slices, visibility, and the point lights' finer slices),
 #     nondecreasing too, and one with the build's estimated time left;
 #   * "building: ready after N s" before the first frame line;
 # then the same config again (the renderer is cached: no BuildProgress, and
@@ -64,12 +65,12 @@ mapfile -t percents < <(sed -n 's/^building: visibility blob *\([0-9]*\) %.*/\1/
 for ((i = 1; i < ${#percents[@]}; i++)); do
   ((percents[i] >= percents[i - 1])) || fail "visibility went from ${percents[i - 1]} % to ${percents[i]} %"
 done
-mapfile -t builds < <(sed -n 's/^building: .* · build *\([0-9]*\) % (step [0-9]* of 2).*/\1/p' "$work/cold.err")
+mapfile -t builds < <(sed -n 's/^building: .* · build *\([0-9]*\) % (step [0-9]* of [0-9]*).*/\1/p' "$work/cold.err")
 ((${#builds[@]} >= 3)) || fail "${#builds[@]} lines with the build's share and step, want at least 3"
 for ((i = 1; i < ${#builds[@]}; i++)); do
   ((builds[i] >= builds[i - 1])) || fail "the build went from ${builds[i - 1]} % to ${builds[i]} %"
 done
-grep -q '^building: visibility blob .* (step 2 of 2), ~[0-9.]* s left$' "$work/cold.err" ||
+grep -q '^building: visibility blob .* (step 2 of [0-9]*), ~[0-9.]* s left$' "$work/cold.err" ||
   fail "no line with the build's estimated time left"
 ready_line="$(grep -n '^building: ready after [0-9.]* s$' "$work/cold.err" | head -1 | cut -d: -f1)"
 frame_line="$(grep -n '^\[#*\.*\] [0-9]*/3' "$work/cold.err" | head -1 | cut -d: -f1)"

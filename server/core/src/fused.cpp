@@ -8,6 +8,7 @@
 #include <string>
 
 #include "fused_kernel.h"
+#include "haarcast/core/check.h"
 
 namespace haarcast {
 namespace {
@@ -83,32 +84,32 @@ const PixelDirections& pixelDirections(int level) {
 }
 }  // namespace detail
 
-PixelSlices PixelSlices::synthesize(const BrdfSliceTable& table) {
-  checkFusedLevel(table.level());
-  PixelSlices out;
-  out.level_ = table.level();
-  out.thetaSamples_ = table.thetaSamples();
-  const std::size_t n = static_cast<std::size_t>(mapSize(out.level_)) * static_cast<std::size_t>(mapSize(out.level_));
-  out.texels_.assign(static_cast<std::size_t>(out.thetaSamples_) * n * shared::kTexelFloats, 0.0f);
-  out.energy_.assign(static_cast<std::size_t>(out.thetaSamples_), {});
-  const int m = mapSize(out.level_);
-  for (int t = 0; t < out.thetaSamples_; ++t) {
+namespace {
+
+// Every slice of a table in pixel form: (t, row, col) at ((t·M + row)·M + col)·4.
+std::vector<float> sliceTexels(const BrdfSliceTable& table) {
+  const std::size_t n = static_cast<std::size_t>(mapSize(table.level())) * static_cast<std::size_t>(mapSize(table.level()));
+  std::vector<float> texels(static_cast<std::size_t>(table.thetaSamples()) * n * shared::kTexelFloats, 0.0f);
+  for (int t = 0; t < table.thetaSamples(); ++t) {
+    float* dst = texels.data() + static_cast<std::size_t>(t) * n * shared::kTexelFloats;
     for (int c = 0; c < BrdfSliceTable::kChannels; ++c) {
       const SphereMap pixels = inverseHaar(table.slice(c, t));
       const std::span<const float> values = pixels.values();
-      float* dst = out.texels_.data() + static_cast<std::size_t>(t) * n * shared::kTexelFloats;
-      for (std::size_t p = 0; p < n; ++p) {
-        dst[p * shared::kTexelFloats + static_cast<std::size_t>(c)] = values[p];
-        if (values[p] != 0.0f) out.lastNonZeroRow_ = std::max(out.lastNonZeroRow_, static_cast<int>(p) / m);
-      }
-      out.energy_[static_cast<std::size_t>(t)][static_cast<std::size_t>(c)] = static_cast<float>(pixels.integral());
+      for (std::size_t p = 0; p < n; ++p) dst[p * shared::kTexelFloats + static_cast<std::size_t>(c)] = values[p];
     }
   }
-  // The point table: each texel's mean turned into its centre's value.
-  out.pointTexels_.assign(out.texels_.size(), 0.0f);
-  for (int t = 0; t < out.thetaSamples_; ++t) {
-    const float* mean = out.texels_.data() + static_cast<std::size_t>(t) * n * shared::kTexelFloats;
-    float* point = out.pointTexels_.data() + static_cast<std::size_t>(t) * n * shared::kTexelFloats;
+  return texels;
+}
+
+// Each texel's mean turned into its centre's value (shared::pointFromMean),
+// the same layout.
+std::vector<float> pointValues(const std::vector<float>& means, int level, int thetaSamples) {
+  const int m = mapSize(level);
+  const std::size_t n = static_cast<std::size_t>(m) * static_cast<std::size_t>(m);
+  std::vector<float> points(means.size(), 0.0f);
+  for (int t = 0; t < thetaSamples; ++t) {
+    const float* mean = means.data() + static_cast<std::size_t>(t) * n * shared::kTexelFloats;
+    float* point = points.data() + static_cast<std::size_t>(t) * n * shared::kTexelFloats;
     auto at = [&](int row, int col, int c) {
       return mean[static_cast<std::size_t>(row * m + (col & (m - 1))) * shared::kTexelFloats + static_cast<std::size_t>(c)];
     };
@@ -122,6 +123,45 @@ PixelSlices PixelSlices::synthesize(const BrdfSliceTable& table) {
       }
     }
   }
+  return points;
+}
+
+}  // namespace
+
+PixelSlices PixelSlices::synthesize(const BrdfSliceTable& table, const BrdfSliceTable* pointTable) {
+  checkFusedLevel(table.level());
+  if (pointTable) {
+    checkFusedLevel(pointTable->level());
+    HC_CHECK_LE(table.level(), pointTable->level());
+    HC_CHECK_EQ(pointTable->thetaSamples(), table.thetaSamples());
+  }
+  PixelSlices out;
+  out.level_ = table.level();
+  out.pointLevel_ = pointTable ? pointTable->level() : table.level();
+  out.thetaSamples_ = table.thetaSamples();
+  out.texels_ = sliceTexels(table);
+  const int m = mapSize(out.level_);
+  const std::size_t n = static_cast<std::size_t>(m) * static_cast<std::size_t>(m);
+  out.energy_.assign(static_cast<std::size_t>(out.thetaSamples_), {});
+  for (int t = 0; t < out.thetaSamples_; ++t) {
+    const float* texels = out.texels_.data() + static_cast<std::size_t>(t) * n * shared::kTexelFloats;
+    for (std::size_t c = 0; c < static_cast<std::size_t>(BrdfSliceTable::kChannels); ++c) {
+      double energy = 0.0;  // SphereMap::integral's sum: rows, then their solid angles
+      for (int row = 0; row < m; ++row) {
+        double sum = 0.0;
+        for (int col = 0; col < m; ++col) {
+          const float v = texels[static_cast<std::size_t>(row * m + col) * shared::kTexelFloats + c];
+          if (v != 0.0f) out.lastNonZeroRow_ = std::max(out.lastNonZeroRow_, row);
+          sum += v;
+        }
+        energy += sum * pixelSolidAngle(out.level_, row);
+      }
+      out.energy_[static_cast<std::size_t>(t)][c] = static_cast<float>(energy);
+    }
+  }
+  // The point lights' lookup reads a finer table where one is given: one
+  // Catmull-Rom read a light, so its texels cost memory only.
+  out.pointTexels_ = pointValues(pointTable ? sliceTexels(*pointTable) : out.texels_, out.pointLevel_, out.thetaSamples_);
   return out;
 }
 
@@ -129,7 +169,7 @@ const float* PixelSlices::pointSlice(int t) const {
   if (t < 0 || t >= thetaSamples_) {
     throw std::out_of_range("PixelSlices: point slice " + std::to_string(t) + " of " + std::to_string(thetaSamples_));
   }
-  const std::size_t n = static_cast<std::size_t>(mapSize(level_)) * static_cast<std::size_t>(mapSize(level_));
+  const std::size_t n = static_cast<std::size_t>(mapSize(pointLevel_)) * static_cast<std::size_t>(mapSize(pointLevel_));
   return pointTexels_.data() + static_cast<std::size_t>(t) * n * shared::kTexelFloats;
 }
 
@@ -199,30 +239,42 @@ const float* blendedSlice(const PixelSlices& slices, const shared::SliceBlend& b
   return scratch.blended.data();
 }
 
+// γ as a column offset of a level's map: source column = φ'·M/2π − (γ·M/2π
+// + ½); the offset's whole part is applied to the integer column, its
+// fraction to the float coordinate.
+struct ColumnOffset {
+  int shift = 0;
+  float fraction = 0.0f;
+};
+ColumnOffset columnOffset(double gamma, int level) {
+  const int m = mapSize(level);
+  double offset = gamma / kTwoPi * m + 0.5;
+  offset -= std::floor(offset / m) * m;  // [0, M): whole turns change nothing
+  const double whole = std::floor(offset);
+  return {static_cast<int>(whole), static_cast<float>(offset - whole)};
+}
+
 // The rotation's part of a pass: Rᵀ's angles, and γ as a column offset.
 void setRotation(detail::FusedPass& pass, const EulerYXY& r) {
   pass.cosAlpha = static_cast<float>(std::cos(r.alpha));
   pass.sinAlpha = static_cast<float>(std::sin(r.alpha));
   pass.cosBeta = static_cast<float>(std::cos(r.beta));
   pass.sinBeta = static_cast<float>(std::sin(r.beta));
-  // Source column = φ'·M/2π − (γ·M/2π + ½); the offset's whole part is
-  // applied to the integer column, its fraction to the float coordinate.
-  const int m = mapSize(pass.level);
-  double offset = r.gamma / kTwoPi * m + 0.5;
-  offset -= std::floor(offset / m) * m;  // [0, M): whole turns change nothing
-  const double whole = std::floor(offset);
-  pass.columnShift = static_cast<int>(whole);
-  pass.columnFraction = static_cast<float>(offset - whole);
+  const ColumnOffset column = columnOffset(r.gamma, pass.level);
+  pass.columnShift = column.shift;
+  pass.columnFraction = column.fraction;
 }
 
 // ρ_c at one object-frame direction for a point light: Rᵀω, θ', φ' as the
 // kernel computes them (fused_kernel.cpp), then Catmull-Rom over 4 × 4 taps
-// of the point slices (shared::catmullRomWeights; rows clamped, columns
-// wrapped), the two slices of the blend taken tap by tap. Zero below the
-// slices' cut and inside the lobe path's core, as the pass reads them.
+// of the point slices at their level, γ's offset `column` at that level
+// (shared::catmullRomWeights; rows clamped, columns wrapped), the two slices
+// of the blend taken tap by tap. Zero below the slices' cut and inside the
+// lobe path's core, as the pass reads them.
 std::array<float, 3> pointRhoAt(const detail::FusedPass& p, const PixelSlices& slices, const shared::SliceBlend& blend,
-                                const glm::vec3& w) {
-  const int m = 1 << p.level;
+                                const ColumnOffset& column, const glm::vec3& w) {
+  const int level = slices.pointLevel();
+  const int m = 1 << level;
   const float x1 = p.cosAlpha * w.x - p.sinAlpha * w.z;  // R_y(−α)
   const float z1 = p.sinAlpha * w.x + p.cosAlpha * w.z;
   const float y2 = p.cosBeta * w.y + p.sinBeta * z1;     // R_x(−β)
@@ -232,12 +284,12 @@ std::array<float, 3> pointRhoAt(const detail::FusedPass& p, const PixelSlices& s
   const float theta = std::atan2(std::sqrt(x1 * x1 + z2 * z2), y2);
   const float phi = std::atan2(x1, z2);
   const float rowPos = std::min(std::max(theta * (static_cast<float>(m) / shared::kPiF) - 0.5f, 0.0f), static_cast<float>(m - 1));
-  const float colPos = phi * (static_cast<float>(m) / (2.0f * shared::kPiF)) - p.columnFraction;
+  const float colPos = phi * (static_cast<float>(m) / (2.0f * shared::kPiF)) - column.fraction;
   const float rowFloor = std::floor(rowPos), colFloor = std::floor(colPos);
   const glm::vec4 wr = shared::catmullRomWeights(rowPos - rowFloor);
   const glm::vec4 wc = shared::catmullRomWeights(colPos - colFloor);
   const int r0 = static_cast<int>(rowFloor);
-  const int c0 = (static_cast<int>(colFloor) - p.columnShift) & (m - 1);
+  const int c0 = (static_cast<int>(colFloor) - column.shift) & (m - 1);
   const float* first = slices.pointSlice(static_cast<int>(blend.first));
   const float* second = blend.weight != 0.0f ? slices.pointSlice(static_cast<int>(blend.second)) : first;
   glm::vec3 sum(0.0f);
@@ -245,7 +297,7 @@ std::array<float, 3> pointRhoAt(const detail::FusedPass& p, const PixelSlices& s
     const int row = std::min(std::max(r0 - 1 + i, 0), m - 1);
     glm::vec3 across(0.0f);
     for (int j = 0; j < 4; ++j) {
-      const std::size_t k = static_cast<std::size_t>((row << p.level) | ((c0 - 1 + j) & (m - 1))) * shared::kTexelFloats;
+      const std::size_t k = static_cast<std::size_t>((row << level) | ((c0 - 1 + j) & (m - 1))) * shared::kTexelFloats;
       const glm::vec3 a(first[k], first[k + 1], first[k + 2]);
       const glm::vec3 b(second[k], second[k + 1], second[k + 2]);
       across += wc[j] * (a + blend.weight * (b - a));
@@ -342,9 +394,10 @@ std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBl
     for (std::size_t c = 0; c < 3; ++c) energy[c] = std::max(0.0f, core.energy[static_cast<int>(c)] - core.core[static_cast<int>(c)]);
   }
   std::array<float, 3> out = energyKept(pass, energy);
+  const ColumnOffset pointColumn = columnOffset(r.gamma, slices.pointLevel());
   for (std::size_t k = 0; k < lights.size(); ++k) {
     if (((visibleLights >> k) & 1u) == 0) continue;
-    const std::array<float, 3> rho = pointRhoAt(pass, slices, blend, lights[k].direction);
+    const std::array<float, 3> rho = pointRhoAt(pass, slices, blend, pointColumn, lights[k].direction);
     for (std::size_t c = 0; c < 3; ++c) out[c] += lights[k].power[c] * rho[c];
   }
   if (hidden) {

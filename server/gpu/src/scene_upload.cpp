@@ -56,11 +56,13 @@ void VulkanRenderer::Impl::uploadScene() {
       // The slices in pixel form, RGB0 texels (core PixelSlices), the
       // object's slice t at texelBase + t·N of its level; its energies and
       // lobes at global slice sliceBase + t; its light at lightBase.
-      const PixelSlices pixelSlices = PixelSlices::synthesize(p.table);
+      const PixelSlices pixelSlices = PixelSlices::synthesize(p.table, p.finerPointTable());
       const std::size_t objectN = static_cast<std::size_t>(mapSize(p.level)) * static_cast<std::size_t>(mapSize(p.level));
       info.level = static_cast<std::uint32_t>(p.level);
       info.sliceBase = static_cast<std::uint32_t>(energies.size());
       info.texelBase = static_cast<std::uint32_t>(sliceData.size() / shared::kTexelFloats);
+      info.pointLevel = static_cast<std::uint32_t>(pixelSlices.pointLevel());
+      info.pointTexelBase = static_cast<std::uint32_t>(pointData.size() / shared::kTexelFloats);
       info.lightBase = static_cast<std::uint32_t>(fusedLightTexelCount);
       info.directionBase = directionTable.base[static_cast<std::size_t>(p.level)];
       fusedLightTexelCount += objectN;

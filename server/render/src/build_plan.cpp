@@ -73,6 +73,16 @@ BuildPlan planBuild(const Scene& scene, const RenderOptions& options, std::strin
     plan.stages.push_back({"visibility " + object.name,
                            static_cast<double>(vertices) * pixels(level) * rays * kSecondsPerVisibilityRay});
   }
+  // fused: the point lights' finer tables, where a lobe needs one (an
+  // environment without point lights skips them, and the fraction jumps).
+  for (std::size_t k = 0; fused && k < scene.objects.size(); ++k) {
+    const SceneObject& object = scene.objects[k];
+    const int level = pointLightLevel(levels[k].lobes, levels[k].level);
+    if (object.ground || level == levels[k].level) continue;
+    const double work = static_cast<double>(options.thetaSamples) * pixels(level) * supersamples * kSecondsPerBrdfSample;
+    plan.stages.push_back({std::string(kPointSlicesStage) + " " + object.name,
+                           work * (sliceTableCached(object, options, level) ? kCachedSliceShare : 1.0)});
+  }
   if (backend == kCpuBackend && !fused && !splitsum) {
     // The CPU renderer's rotators, after prepareScene (cpu_backend.cpp).
     const bool heavy = options.method == RotationMethod::Matrix || options.method == RotationMethod::Table;

@@ -28,6 +28,11 @@ std::vector<ObjectLevel> chooseObjectLevels(const Scene& scene, const RenderOpti
   return out;
 }
 
+int pointLightLevel(std::span<const shared::SliceLobe> lobes, int level) {
+  if (lobes.empty()) return level;
+  return std::max(level, chooseLevel(lobes, static_cast<int>(shared::kFusedMaxLevel), level));
+}
+
 std::string LevelChoice::name() const {
   if (!automatic) return std::to_string(level);
   return level == kDefaultLevelCap ? "auto" : "auto:" + std::to_string(level);

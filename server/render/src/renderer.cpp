@@ -12,6 +12,7 @@
 #include "haarcast/core/lobe.h"
 #include "haarcast/core/splitsum.h"
 #include "haarcast/io/slice_cache.h"
+#include "haarcast/render/build_plan.h"
 #include "haarcast/render/object_levels.h"
 #include "haarcast/render/shading.h"
 #include "haarcast/render/visibility_cache.h"
@@ -25,13 +26,14 @@ BrdfSliceTable objectSliceTable(const SceneObject& object, const RenderOptions& 
 }
 
 BrdfSliceTable objectSliceTable(const SceneObject& object, const RenderOptions& options, int level,
-                                const RenderProgress& progress) {
+                                const RenderProgress& progress, std::string_view stage) {
   SliceTableOptions table;
   table.level = level;
   table.thetaSamples = options.thetaSamples;
   table.supersampling = options.sliceSupersampling;
+  const std::string name = std::string(stage) + " " + object.name;
   auto tableProgress = [&](int done, int total) {
-    if (progress) progress("slices " + object.name, static_cast<std::size_t>(done), static_cast<std::size_t>(total));
+    if (progress) progress(name, static_cast<std::size_t>(done), static_cast<std::size_t>(total));
   };
   return options.cacheDir.empty() ? BrdfSliceTable::build(*object.material.brdf, table, tableProgress)
                                   : io::loadOrBuildSliceTable(*object.material.brdf, table, options.cacheDir,
@@ -97,6 +99,7 @@ PreparedScene prepareScene(const Scene& scene, const RenderOptions& options, con
     p.name = object.name;
     p.pose = object.pose;
     p.level = levels[k].level;
+    p.pointLevel = p.level;
     object.mesh->validate();
     p.mesh = withNormals(object.mesh);  // a mesh built in code may come without them
     // splitsum's only precompute is its lobes (below): no slice table.
@@ -155,6 +158,14 @@ PreparedScene prepareScene(const Scene& scene, const RenderOptions& options, con
       if (p.ground) continue;  // shaded in closed form
       std::vector<double> thetaOut;
       for (int t = 0; t < p.table.thetaSamples(); ++t) thetaOut.push_back(p.table.thetaOut(t));
+      // Point lights read the slices at one direction each: a finer table
+      // where the lobe is narrow costs memory and build time only.
+      if (!prepared.pointLights.empty()) {
+        p.pointLevel = pointLightLevel(levels[k].lobes, p.level);
+        if (p.pointLevel != p.level) {
+          p.pointTable = objectSliceTable(scene.objects[k], options, p.pointLevel, progress, kPointSlicesStage);
+        }
+      }
       LobeCore core = chooseLobeCore(*scene.objects[k].material.brdf, thetaOut, p.level, std::move(levels[k].lobes));
       p.lobes = std::move(core.lobes);
       p.lobeCore = core.angle;

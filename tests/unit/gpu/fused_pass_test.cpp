@@ -90,13 +90,23 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
   for (std::size_t o = 0; o < kObjects; ++o) {
     const int l = levels[o];
     const std::size_t n = directionsOf(l);
-    slices.push_back(PixelSlices::synthesize(randomTable(l, kThetaSamples, o == 1, rng)));
+    // The plain object's point lights read a finer table than its pass
+    // (render::pointLightLevel), where its level allows one.
+    const BrdfSliceTable table = randomTable(l, kThetaSamples, o == 1, rng);
+    if (o == 2 && l < static_cast<int>(shared::kFusedMaxLevel)) {
+      const BrdfSliceTable fine = randomTable(l + 1, kThetaSamples, false, rng);
+      slices.push_back(PixelSlices::synthesize(table, &fine));
+    } else {
+      slices.push_back(PixelSlices::synthesize(table));
+    }
     std::array<SphereMap, 3> weighted;
     for (auto& map : weighted) map = randomMap(l, 0.0, 0.02, rng);
     lights.push_back(FusedLight::fromWeightedMaps(weighted));
     objects[o].level = static_cast<std::uint32_t>(l);
     objects[o].sliceBase = static_cast<std::uint32_t>(o * kThetaSamples);
     objects[o].texelBase = static_cast<std::uint32_t>(texels.size() / shared::kTexelFloats);
+    objects[o].pointLevel = static_cast<std::uint32_t>(slices[o].pointLevel());
+    objects[o].pointTexelBase = static_cast<std::uint32_t>(pointTexels.size() / shared::kTexelFloats);
     objects[o].lightBase = static_cast<std::uint32_t>(lightTexels.size());
     objects[o].directionBase = directionTable.base[static_cast<std::size_t>(l)];
     objects[o].thetaSamples = kThetaSamples;

@@ -116,6 +116,27 @@ TEST(ObjectLevels, EachObjectIsDrawnAsAtItsOwnLevelAlone) {
   EXPECT_GT(differs, (left + right) / 2) << "levels 5 and 6 differ: the test can tell which one drew a pixel";
 }
 
+// The point lights read a narrow lobe from a finer table (object_levels.h
+// pointLightLevel): the phong:64 sphere at level 6 from level 7's, which
+// is built beside its own; the ggx:0.3 torus, whose lobe its own level
+// resolves, and the ground (closed form) from their own.
+TEST(ObjectLevels, PointLightsReadAFinerTableWhereTheLobeIsNarrow) {
+  const Scene scene = defaultScene();  // phong:64 sphere, ggx:0.3 torus, ground
+  const PreparedScene p = prepareScene(scene, options(6, true));
+  ASSERT_FALSE(p.pointLights.empty()) << "the default sky has a sun";
+  EXPECT_EQ(p.objects[0].level, 6);
+  EXPECT_EQ(p.objects[0].pointLevel, 7);
+  EXPECT_EQ(p.objects[0].pointTable.level(), 7);
+  EXPECT_EQ(p.objects[0].pointTable.thetaSamples(), p.objects[0].table.thetaSamples());
+  EXPECT_EQ(p.objects[1].pointLevel, p.objects[1].level);
+  EXPECT_EQ(p.objects[1].pointTable.storedBytes(), 0u) << "no second table where the first serves";
+  EXPECT_EQ(p.objects[2].pointLevel, p.objects[2].level);
+  EXPECT_EQ(pointLightLevel({}, 5), 5) << "no lobes measured";
+  const std::vector<ObjectLevel> levels = chooseObjectLevels(scene, options(7, false));
+  EXPECT_EQ(pointLightLevel(levels[0].lobes, 7), 7) << "never past the finest level";
+  EXPECT_EQ(pointLightLevel(levels[1].lobes, 4), 6) << "a coarse object's lights read the level its lobe needs";
+}
+
 TEST(ObjectLevels, TheRestLightIsKeptAtTheLevelsInUseOnly) {
   const PreparedScene p = prepareScene(twoObjects(), options(6, true));
   // The objects' levels, and those their light is turned from (two finer).

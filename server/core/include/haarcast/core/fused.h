@@ -47,15 +47,20 @@ void checkFusedLevel(int level);
 class PixelSlices {
  public:
   PixelSlices() = default;
-  // Synthesises every slice of the table (inverse Haar per channel).
-  static PixelSlices synthesize(const BrdfSliceTable& table);
+  // Synthesises every slice of the table (inverse Haar per channel). The
+  // point slices come from `pointTable` when given (the same BRDF and θₒ
+  // at a level as fine or finer: render::pointLightLevel), else from `table`.
+  static PixelSlices synthesize(const BrdfSliceTable& table, const BrdfSliceTable* pointTable = nullptr);
 
   int level() const { return level_; }
+  // The point slices' level: level() or finer.
+  int pointLevel() const { return pointLevel_; }
   int thetaSamples() const { return thetaSamples_; }
   std::span<const float> texels() const { return texels_; }
   const float* slice(int t) const;
   // Slice t as point values at the texel centres (shared::pointFromMean),
-  // in the same layout: what the point lights read (shared::catmullRomWeights).
+  // in the same layout at pointLevel(): what the point lights read
+  // (shared::catmullRomWeights).
   const float* pointSlice(int t) const;
   std::span<const float> pointTexels() const { return pointTexels_; }
   // The last map row with a non-zero texel in any slice: below it every
@@ -68,6 +73,7 @@ class PixelSlices {
 
  private:
   int level_ = 0;
+  int pointLevel_ = 0;
   int thetaSamples_ = 0;
   int lastNonZeroRow_ = -1;
   std::vector<float> texels_;

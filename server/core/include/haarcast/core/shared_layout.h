@@ -268,13 +268,13 @@ struct ObjectInfo {
   vec4 toLight[3];     // `fused`'s lobe path: object frame → the environment's, this frame (columns)
   vec4 lobeCore;       // x: cos of the lobe path's core angle (core fused.h LobePath::coreAngle), −1: the path takes all; yzw: 0
   uint level;          // `fused`: its map level n (M = 2^n, N = M² directions)
-  uint texelBase;      // `fused`: texel of its slice 0 (slice texels and point texels); slice t at texelBase + t·N
+  uint texelBase;      // `fused`: texel of its slice 0 in the slice texels; slice t at texelBase + t·N
   uint lightBase;      // `fused`: texel of its light's direction 0 this frame
   uint directionBase;  // `fused`: its level's pixel-centre directions in the table of every level in use
   uint visibilityBase; // `fused`: word of its vertex 0's bits; global vertex v at visibilityBase + (v − vertexBase)·visibilityWords(level)
+  uint pointLevel;     // `fused`: its point slices' level (core PixelSlices::pointLevel), ≥ level
+  uint pointTexelBase; // `fused`: texel of its point slice 0 in the point texels; slice t at pointTexelBase + t·N of pointLevel
   uint levelPad0;
-  uint levelPad1;
-  uint levelPad2;
 };
 
 // ObjectInfo::flags: the object is the scene's ground, a Lambert plane that

@@ -22,6 +22,10 @@
 
 namespace haarcast::render {
 
+// The stage of an object's point-light slices (PreparedObject::pointTable),
+// built after every object's slices and visibility, once the light is split.
+inline constexpr std::string_view kPointSlicesStage = "point slices";
+
 struct PlannedStage {
   std::string name;   // as RenderProgress names it: "slices bunny", "visibility bunny" …
   double work = 0.0;  // estimated seconds on the reference machine, > 0

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -30,6 +31,15 @@ struct ObjectLevel {
 // chooseLevel within [kAutoLevelFloor, options.level], the ground at the
 // floor (its map light is one closed form, its pixels read no map).
 std::vector<ObjectLevel> chooseObjectLevels(const Scene& scene, const RenderOptions& options);
+
+// The level of an object's point-light slices (PreparedObject::pointLevel):
+// a point light reads its slice at one direction, by Catmull-Rom over the
+// texels' centres, so a lobe only two or three texels wide is read off its
+// peak, and its highlight is misplaced and misshapen. The level of
+// chooseLevel's step 1 up to shared::kFusedMaxLevel, at least the object's
+// own `level`: a ggx:0.1 ball at level 6 reads its lights from level 7
+// (docs/design.md, "Point lights read a narrow lobe from a finer table").
+int pointLightLevel(std::span<const shared::SliceLobe> lobes, int level);
 
 // The distinct levels of the objects, ascending.
 std::vector<int> levelsInUse(const std::vector<int>& objectLevels);

@@ -30,6 +30,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <glm/mat3x3.hpp>
@@ -141,6 +142,15 @@ struct PreparedObject {
   int level = 0;
   std::shared_ptr<const Mesh> mesh;    // with normals, object frame
   BrdfSliceTable table;                // unrotated slices: the only BRDF data kept
+  // `fused` with point lights: the point lights' slices (core PixelSlices::
+  // pointSlice) at pointLevel, finer than `level` where the lobe is narrow
+  // (object_levels.h pointLightLevel); the same BRDF's unrotated slices.
+  // Empty when pointLevel is `level`: the point lights read `table`.
+  int pointLevel = 0;
+  BrdfSliceTable pointTable;
+  // What core PixelSlices::synthesize takes for the point slices: the finer
+  // table, or null where `table` serves.
+  const BrdfSliceTable* finerPointTable() const { return pointLevel != level ? &pointTable : nullptr; }
   // Per vertex, object frame: the Haar methods' top-k lists (empty for
   // fused), and fused's bits at map resolution (empty for the others).
   std::vector<SparseHaar> visibility;
@@ -235,13 +245,14 @@ inline constexpr int kLightTurnFinest = 7;
 inline int lightTurnLevel(int level) { return std::max(level, std::min(level + 2, kLightTurnFinest)); }
 
 // One object's slice table at options.level (or at `level`), from
-// options.cacheDir when cached there; progress as stage "slices NAME".
+// options.cacheDir when cached there; progress as stage "slices NAME" (or
+// "STAGE NAME": prepareScene's point tables are "point slices NAME").
 // prepareScene uses it, and so does whatever sizes the tables without
 // preparing the rest (loadtest).
 BrdfSliceTable objectSliceTable(const SceneObject& object, const RenderOptions& options,
                                 const RenderProgress& progress = {});
 BrdfSliceTable objectSliceTable(const SceneObject& object, const RenderOptions& options, int level,
-                                const RenderProgress& progress = {});
+                                const RenderProgress& progress = {}, std::string_view stage = "slices");
 
 // Slice tables (cached in options.cacheDir), visibility (cached), light and
 // backdrop maps. Validates the scene's meshes; progress per long stage.
