@@ -210,6 +210,8 @@ def main():
         except subprocess.TimeoutExpired:
             server.kill()
             fail("the server did not exit within 10 s of SIGTERM")
+        finally:
+            shutil.rmtree(work, ignore_errors=True)  # the reader's folder, stubs and frames
     if code != 0:
         fail(f"the server exited {code} after SIGTERM")
     print(f"PASS: the docs' blocks run as written; {STEPS} frames of the orbit decode ({len(pictures)} different), "

@@ -12,18 +12,34 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <system_error>
 
 namespace haarcast::fuzz {
 
-inline std::string inputFile(const std::string& name, const std::uint8_t* data, std::size_t size) {
-  static const std::filesystem::path dir = [] {
+// The process's directory, removed when the process exits normally (the
+// fuzzer's end of run; a crash leaves it, beside the crashing input).
+class InputDirectory {
+ public:
+  InputDirectory() {
     const char* base = std::getenv("TMPDIR");
-    std::filesystem::path d = std::filesystem::path(base != nullptr ? base : "/tmp") /
-                              ("haarcast-fuzz-" + std::to_string(::getpid()));
-    std::filesystem::create_directories(d);
-    return d;
-  }();
-  const std::filesystem::path path = dir / name;
+    path_ = std::filesystem::path(base != nullptr ? base : "/tmp") / ("haarcast-fuzz-" + std::to_string(::getpid()));
+    std::filesystem::create_directories(path_);
+  }
+  ~InputDirectory() {
+    std::error_code ignored;
+    std::filesystem::remove_all(path_, ignored);
+  }
+  InputDirectory(const InputDirectory&) = delete;
+  InputDirectory& operator=(const InputDirectory&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+inline std::string inputFile(const std::string& name, const std::uint8_t* data, std::size_t size) {
+  static const InputDirectory dir;
+  const std::filesystem::path path = dir.path() / name;
   std::ofstream(path, std::ios::binary | std::ios::trunc)
       .write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
   return path.string();
