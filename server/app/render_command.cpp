@@ -87,6 +87,13 @@ int run(RenderArgs& a) {
     levelText += ")";
   }
   if (a.options.automaticLevel) levelText += " [" + level->name() + "]";
+  // Objects whose point lights read a finer table (object_levels.h pointLightLevel).
+  const std::vector<int> pointLevels = renderer->pointLightLevels();
+  std::string finer;
+  for (std::size_t k = 0; k < pointLevels.size() && k < levels.size(); ++k) {
+    if (pointLevels[k] > levels[k]) finer += (finer.empty() ? "" : ", ") + scene.objects[k].name + " " + std::to_string(pointLevels[k]);
+  }
+  if (!finer.empty()) levelText += ", point lights' slices at " + finer;
   std::fprintf(stderr, "%s on %s: %d×%d, %s, %s, k = %zu, rays %s: precompute %.2f s, frame %.3f s (%s)\n",
                renderer->backend().c_str(), renderer->deviceName().c_str(), a.options.width, a.options.height,
                levelText.c_str(), a.method.c_str(), a.options.lightCoefficients, renderer->rays().c_str(), prepare,

@@ -101,6 +101,7 @@ class CpuRenderer final : public Renderer {
   const RenderOptions& options() const override { return options_; }
   std::size_t objectCount() const override { return prepared_.objects.size(); }
   std::vector<int> objectLevels() const override { return prepared_.objectLevels(); }
+  std::vector<int> pointLightLevels() const override { return prepared_.pointLightLevels(); }
   bool concurrentRenders() const override { return true; }
 
   Frame render(const FrameRequest& request) override;

@@ -146,6 +146,7 @@ std::string VulkanRenderer::rays() const {
 const render::RenderOptions& VulkanRenderer::options() const { return slots_.front()->options; }
 std::size_t VulkanRenderer::objectCount() const { return slots_.front()->prepared.objects.size(); }
 std::vector<int> VulkanRenderer::objectLevels() const { return slots_.front()->prepared.objectLevels(); }
+std::vector<int> VulkanRenderer::pointLightLevels() const { return slots_.front()->prepared.pointLightLevels(); }
 Context& VulkanRenderer::context() { return last().context; }
 const render::PreparedScene& VulkanRenderer::prepared() const { return *slots_.front()->preparedScene; }
 std::size_t VulkanRenderer::batchSamples() const { return last().batch; }

@@ -190,6 +190,12 @@ const std::array<SphereMap, 3>& PreparedScene::restLightAt(int level) const {
   return restLight[static_cast<std::size_t>(level)];
 }
 
+std::vector<int> PreparedScene::pointLightLevels() const {
+  std::vector<int> out;
+  for (const PreparedObject& p : objects) out.push_back(p.pointLevel);
+  return out;
+}
+
 std::vector<int> PreparedScene::objectLevels() const {
   std::vector<int> out;
   for (const PreparedObject& p : objects) out.push_back(p.level);

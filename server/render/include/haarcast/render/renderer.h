@@ -117,6 +117,9 @@ class Renderer {
   // Each object's map level (PreparedObject::level), in scene order; empty
   // where a renderer does not say.
   virtual std::vector<int> objectLevels() const { return {}; }
+  // Each object's point-light slices' level (PreparedObject::pointLevel),
+  // in scene order; empty where a renderer does not say.
+  virtual std::vector<int> pointLightLevels() const { return {}; }
   // Whether render() may run on several threads at once. The CPU backend's
   // prepared data is immutable and each call keeps its own scratch, so it
   // may; a Vulkan renderer owns one set of device buffers per frame in
@@ -222,6 +225,7 @@ struct PreparedScene {
   std::size_t standingObjects() const { return objects.size() - (ground ? 1 : 0); }
   // Each object's level, in scene order (PreparedObject::level).
   std::vector<int> objectLevels() const;
+  std::vector<int> pointLightLevels() const;  // PreparedObject::pointLevel, in scene order
   PrefilteredLight lobeLight;           // `fused`, `splitsum`: the backdrop's maps at every level, for the lobe path (empty when no object has one)
   std::optional<std::size_t> ground;    // index of the ground object, if any
   std::shared_ptr<FusedLightCache> fusedLightCache = std::make_shared<FusedLightCache>();
