@@ -55,7 +55,7 @@ void VulkanRenderer::Impl::setUpDeviceRays() {
   std::vector<const Mesh*> meshes;
   for (const render::PreparedObject& p : prepared.objects) meshes.push_back(p.mesh.get());
   accelerationStructures = std::make_unique<AccelerationStructures>(context, meshes);
-  shadowRays = std::make_unique<RayTracingPipeline>(context, "shadow_rays.rgen", "shadow_rays.rmiss",
+  shadowRays = std::make_unique<RayTracingPipeline>(context, RayShaders{"shadow_rays.rgen", {"shadow_rays.rmiss", "shadow_rays_hit.rmiss"}, "shadow_rays.rchit"},
                                                     shared::kRaysStorageBindings, shared::kRaysSceneBinding,
                                                     sizeof(RaysPush));
   rayObjectData.assign(prepared.objects.size(), RayObject{});

@@ -219,17 +219,18 @@ void AccelerationStructures::recordTopLevel(VkCommandBuffer cb, std::span<const 
 
 // ---------------------------------------------------------------- RayTracingPipeline
 
-RayTracingPipeline::RayTracingPipeline(Context& context, std::string_view raygen, std::string_view miss,
-                                       std::uint32_t storageBuffers, std::uint32_t sceneBinding,
-                                       std::uint32_t pushConstantBytes)
+RayTracingPipeline::RayTracingPipeline(Context& context, const RayShaders& shaders, std::uint32_t storageBuffers,
+                                       std::uint32_t sceneBinding, std::uint32_t pushConstantBytes)
     : context_(context),
       fn_((requireRayTracing(context, "RayTracingPipeline"), context.device())),
       storageBuffers_(storageBuffers),
       sceneBinding_(sceneBinding),
       pushBytes_(pushConstantBytes) {
   HC_CHECK_LE(sceneBinding, storageBuffers);  // the storage buffers are the other bindings, 0 … storageBuffers
+  HC_CHECK_LT(0u, shaders.misses.size());
   const VkDevice device = context.device();
-  VkShaderModule raygenModule = VK_NULL_HANDLE, missModule = VK_NULL_HANDLE;
+  // The stages in order: raygen, the misses, the closest hit if any.
+  std::vector<VkShaderModule> modules;
   try {
     std::vector<VkDescriptorSetLayoutBinding> bindings(storageBuffers + 1);
     for (std::uint32_t i = 0; i <= storageBuffers; ++i) {
@@ -268,40 +269,48 @@ RayTracingPipeline::RayTracingPipeline(Context& context, std::string_view raygen
     ds.pSetLayouts = &setLayout_;
     vkCheck(vkAllocateDescriptorSets(device, &ds, &set_), "vkAllocateDescriptorSets");
 
-    raygenModule = createShaderModule(context, raygen);
-    missModule = createShaderModule(context, miss);
-    VkPipelineShaderStageCreateInfo stages[2]{};
-    stages[0].sType = stages[1].sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
-    stages[0].stage = VK_SHADER_STAGE_RAYGEN_BIT_KHR;
-    stages[0].module = raygenModule;
-    stages[0].pName = "main";
-    stages[1].stage = VK_SHADER_STAGE_MISS_BIT_KHR;
-    stages[1].module = missModule;
-    stages[1].pName = "main";
-    // Groups: 0 raygen, 1 miss, 2 an empty triangle hit group (opaque
-    // geometry and no hit shader: any hit ends the ray, the payload stays "blocked").
-    VkRayTracingShaderGroupCreateInfoKHR groups[3]{};
+    const std::uint32_t misses = static_cast<std::uint32_t>(shaders.misses.size());
+    const bool closestHit = !shaders.closestHit.empty();
+    std::vector<VkPipelineShaderStageCreateInfo> stages;
+    auto stage = [&](VkShaderStageFlagBits kind, std::string_view name) {
+      modules.push_back(createShaderModule(context, name));
+      VkPipelineShaderStageCreateInfo s{};
+      s.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
+      s.stage = kind;
+      s.module = modules.back();
+      s.pName = "main";
+      stages.push_back(s);
+    };
+    stage(VK_SHADER_STAGE_RAYGEN_BIT_KHR, shaders.raygen);
+    for (const std::string_view miss : shaders.misses) stage(VK_SHADER_STAGE_MISS_BIT_KHR, miss);
+    if (closestHit) stage(VK_SHADER_STAGE_CLOSEST_HIT_BIT_KHR, shaders.closestHit);
+    // Groups: raygen, each miss, then one triangle hit group: opaque
+    // geometry, so a ray that skips closest hits ends at any hit with its
+    // payload as it set it ("blocked"); the closest-hit shader, when there
+    // is one, runs for the rays that do not skip it.
+    std::vector<VkRayTracingShaderGroupCreateInfoKHR> groups(2 + misses);
     for (VkRayTracingShaderGroupCreateInfoKHR& g : groups) {
       g.sType = VK_STRUCTURE_TYPE_RAY_TRACING_SHADER_GROUP_CREATE_INFO_KHR;
       g.generalShader = g.closestHitShader = g.anyHitShader = g.intersectionShader = VK_SHADER_UNUSED_KHR;
     }
-    groups[0].type = groups[1].type = VK_RAY_TRACING_SHADER_GROUP_TYPE_GENERAL_KHR;
-    groups[0].generalShader = 0;
-    groups[1].generalShader = 1;
-    groups[2].type = VK_RAY_TRACING_SHADER_GROUP_TYPE_TRIANGLES_HIT_GROUP_KHR;
+    for (std::uint32_t g = 0; g <= misses; ++g) {
+      groups[g].type = VK_RAY_TRACING_SHADER_GROUP_TYPE_GENERAL_KHR;
+      groups[g].generalShader = g;
+    }
+    groups[1 + misses].type = VK_RAY_TRACING_SHADER_GROUP_TYPE_TRIANGLES_HIT_GROUP_KHR;
+    if (closestHit) groups[1 + misses].closestHitShader = 1 + misses;
     VkRayTracingPipelineCreateInfoKHR rp{};
     rp.sType = VK_STRUCTURE_TYPE_RAY_TRACING_PIPELINE_CREATE_INFO_KHR;
-    rp.stageCount = 2;
-    rp.pStages = stages;
-    rp.groupCount = 3;
-    rp.pGroups = groups;
+    rp.stageCount = static_cast<std::uint32_t>(stages.size());
+    rp.pStages = stages.data();
+    rp.groupCount = static_cast<std::uint32_t>(groups.size());
+    rp.pGroups = groups.data();
     rp.maxPipelineRayRecursionDepth = 1;
     rp.layout = layout_;
     vkCheck(fn_.createPipelines(device, VK_NULL_HANDLE, VK_NULL_HANDLE, 1, &rp, nullptr, &pipeline_),
             "vkCreateRayTracingPipelinesKHR");
-    vkDestroyShaderModule(device, raygenModule, nullptr);
-    vkDestroyShaderModule(device, missModule, nullptr);
-    raygenModule = missModule = VK_NULL_HANDLE;
+    for (const VkShaderModule m : modules) vkDestroyShaderModule(device, m, nullptr);
+    modules.clear();
 
     // The shader binding table: each group's handle at the start of its
     // region, regions aligned to baseAlignment, records to handleAlignment.
@@ -309,20 +318,25 @@ RayTracingPipeline::RayTracingPipeline(Context& context, std::string_view raygen
     const VkDeviceSize handle = rt.handleSize;
     const VkDeviceSize stride = alignUp(handle, rt.handleAlignment);
     const VkDeviceSize region = alignUp(stride, rt.baseAlignment);
-    std::vector<std::uint8_t> handles(3 * handle);
-    vkCheck(fn_.getGroupHandles(device, pipeline_, 0, 3, handles.size(), handles.data()),
+    const VkDeviceSize missRegion = alignUp(misses * stride, rt.baseAlignment);
+    const std::size_t groupCount = groups.size();
+    std::vector<std::uint8_t> handles(groupCount * handle);
+    vkCheck(fn_.getGroupHandles(device, pipeline_, 0, static_cast<std::uint32_t>(groupCount), handles.size(), handles.data()),
             "vkGetRayTracingShaderGroupHandlesKHR");
-    table_ = Buffer(context, 3 * region + rt.baseAlignment,
+    // Regions: raygen; the misses, `stride` apart; the hit group.
+    table_ = Buffer(context, 2 * region + missRegion + rt.baseAlignment,
                     VK_BUFFER_USAGE_SHADER_BINDING_TABLE_BIT_KHR | kAddressed, MemoryUse::Host);
     const VkDeviceAddress base = alignUp(table_.deviceAddress(), rt.baseAlignment);
     const std::size_t offset = static_cast<std::size_t>(base - table_.deviceAddress());
-    for (std::size_t g = 0; g < 3; ++g) table_.write(handles.data() + g * handle, handle, offset + g * region);
+    table_.write(handles.data(), handle, offset);
+    for (std::uint32_t m = 0; m < misses; ++m)
+      table_.write(handles.data() + (1 + m) * handle, handle, offset + region + m * stride);
+    table_.write(handles.data() + (1 + misses) * handle, handle, offset + region + missRegion);
     raygenRegion_ = {base, region, region};  // the raygen region's size equals its stride
-    missRegion_ = {base + region, stride, stride};
-    hitRegion_ = {base + 2 * region, stride, stride};
+    missRegion_ = {base + region, stride, misses * stride};
+    hitRegion_ = {base + region + missRegion, stride, stride};
   } catch (...) {
-    if (raygenModule) vkDestroyShaderModule(device, raygenModule, nullptr);
-    if (missModule) vkDestroyShaderModule(device, missModule, nullptr);
+    for (const VkShaderModule m : modules) vkDestroyShaderModule(device, m, nullptr);
     destroy();
     throw;
   }

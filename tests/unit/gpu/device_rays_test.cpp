@@ -24,6 +24,7 @@
 
 #include "frame_compare.h"
 #include "gpu_test_util.h"
+#include "haarcast/assets/procedural_mesh.h"
 #include "haarcast/core/brdf.h"
 #include "haarcast/core/rotation.h"
 #include "haarcast/core/shared_layout.h"
@@ -151,6 +152,10 @@ struct RaysCase {
   RotationMethod method;
   bool mirror;     // the first object a near-mirror (the lobe path), the second a hazy one
   bool antialias;
+  // Ten objects: seven small spheres more, the last (object 9, whose
+  // instance mask bit is the torus's, object 1: shared_rays.h rayMaskOf)
+  // just above the torus, so that it hides sky from it.
+  bool crowded = false;
 };
 
 void PrintTo(const RaysCase& c, std::ostream* os) { *os << c.name; }
@@ -168,6 +173,21 @@ TEST_P(DeviceRays, ShadowWordsMatchTheHostsRays) {
   if (c.mirror) {
     scene.objects[0].material = {"ggx:0.002", "test-mirror", makeGgx(glm::dvec3(0.0), glm::dvec3(0.9), 0.002), ""};
     scene.objects[1].material = {"hazy mirror", "test-hazy", makeGgx(glm::dvec3(0.3), glm::dvec3(0.9), 0.005), ""};
+  }
+  if (c.crowded) {
+    const auto ball = std::make_shared<Mesh>(assets::makeSphere(16));
+    for (int k = 0; k < 6; ++k) {
+      render::SceneObject s{"ball " + std::to_string(k), ball, render::materialFromSpec("lambert"), {}};
+      s.pose.scale = 0.08;
+      s.pose.translate = {-1.9 + 0.3 * k, -0.5, -1.2};
+      scene.objects.push_back(std::move(s));
+    }
+    render::SceneObject above{"above the torus", ball, render::materialFromSpec("lambert"), {}};
+    above.pose.scale = 0.3;
+    above.pose.translate = {0.8, 0.75, 0.1};
+    scene.objects.push_back(std::move(above));
+    ASSERT_EQ(scene.objects.size(), 10u);
+    ASSERT_EQ(shared::rayMaskOf(9u), shared::rayMaskOf(1u));
   }
   render::RenderOptions o = frameOptions(c.method, true);
   o.width = 96;
@@ -217,7 +237,8 @@ INSTANTIATE_TEST_SUITE_P(Cases, DeviceRays,
                          ::testing::Values(RaysCase{"fused", RotationMethod::Fused, false, false},
                                            RaysCase{"fused-antialiased", RotationMethod::Fused, false, true},
                                            RaysCase{"fused-mirrors", RotationMethod::Fused, true, false},
-                                           RaysCase{"splitsum", RotationMethod::Splitsum, false, false}),
+                                           RaysCase{"splitsum", RotationMethod::Splitsum, false, false},
+                                           RaysCase{"fused-ten-objects", RotationMethod::Fused, false, false, true}),
                          [](const ::testing::TestParamInfo<RaysCase>& param) {
                            std::string name = param.param.name;
                            for (char& ch : name) ch = ch == '-' ? '_' : ch;

@@ -136,7 +136,8 @@ struct RayFrame {
 
 // Object i's instance mask in the top level: a bit of its own while there
 // are at most 8 objects (a ray with that cull mask sees it alone); beyond,
-// objects i and i + 8 share one, and each counts the other as itself.
+// objects i and i + 8 share one, and a ray asking what object i alone
+// blocks steps past the others' hits (shadow_rays.rgen occludedBySelf).
 HC_FUNCTION uint rayMaskOf(uint object) { return 1u << (object & 7u); }
 
 struct RaysPush {

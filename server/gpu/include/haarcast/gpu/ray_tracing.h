@@ -91,13 +91,22 @@ class AccelerationStructures {
   VkDeviceAddress scratchAddress_ = 0;
 };
 
-// A ray-tracing pipeline: one ray-generation shader, one miss shader, one
-// empty triangle hit group (opaque geometry, any hit ends the ray), storage
-// buffers at set 0 bindings 0 … storageBuffers − 1 and the top level at
-// `sceneBinding`, an optional push block; its shader binding table.
+// The shaders of a RayTracingPipeline, by file name (gpu/shaders.h).
+struct RayShaders {
+  std::string_view raygen;
+  std::vector<std::string_view> misses;  // miss index i: misses[i]
+  std::string_view closestHit;           // empty: none (the hit group is empty)
+};
+
+// A ray-tracing pipeline: one ray-generation shader, its miss shaders, one
+// triangle hit group (opaque geometry; empty, so that any hit ends a ray
+// that skips closest hits, or with a closest-hit shader for the rays that
+// ask which instance they hit), storage buffers at set 0 bindings 0 …
+// storageBuffers − 1 and the top level at `sceneBinding`, an optional push
+// block; its shader binding table.
 class RayTracingPipeline {
  public:
-  RayTracingPipeline(Context& context, std::string_view raygen, std::string_view miss, std::uint32_t storageBuffers,
+  RayTracingPipeline(Context& context, const RayShaders& shaders, std::uint32_t storageBuffers,
                      std::uint32_t sceneBinding, std::uint32_t pushConstantBytes);
   ~RayTracingPipeline();
   RayTracingPipeline(const RayTracingPipeline&) = delete;
