@@ -84,10 +84,12 @@ layout(set = 0, binding = kFusedLobeLightTexelsBinding) uniform textureBuffer lo
 // The slices as point values at the texel centres (core PixelSlices::pointSlice), at each object's
 // pointLevel: object o's slice t, direction k at o.pointTexelBase + t·N + k.
 layout(set = 0, binding = kFusedPointSliceTexelsBinding) uniform textureBuffer pointTexels;
-// Per object: its samples shaded from one slice (2·object; the ground's
-// samples, which read none, too) and from two (2·object + 1), cleared before
-// the pass; the host counts the coefficient bytes read from them (core
-// fusedPixelBytes) without reading any sample back.
+// Per object (kSliceCountsPerObject words from 4·object): its samples shaded
+// from one slice (the ground's samples, which read none, too) and from two,
+// the pass's rows summed over its samples and the most for one, cleared
+// before the pass; the host counts the coefficient bytes read (core
+// fusedPixelBytes) and the directions summed from them without reading any
+// sample back.
 layout(std430, set = 0, binding = kFusedSliceCountsBinding) buffer SliceCounts { uint sliceCounts[]; };
 
 shared vec3 partial[LOCAL];
@@ -279,7 +281,7 @@ void shadePixel(uint s) {
   // point lights' shadow bits vary.
   if ((o.flags & kObjectGround) != 0u) {
     if (lid == 0u) {
-      atomicAdd(sliceCounts[2u * sh.object], 1u);  // read no slice: counted so that every sample is
+      atomicAdd(sliceCounts[kSliceCountsPerObject * sh.object], 1u);  // read no slice: counted so that every sample is
       vec3 sum = groundSkyKept(seen) * o.groundRadiance.rgb;
       for (uint k = 0u; k < o.pointLights; ++k) {
         if (((seen >> k) & 1u) != 0u) sum += pointLights[sh.object * kMaxPointLights + k].power.rgb;
@@ -292,7 +294,7 @@ void shadePixel(uint s) {
   const RotationSample rs = samples[s];
   const SliceBlend blend = sliceBlendAt(rs.thetaOut, o.thetaSamples, INTERPOLATE);
   const bool blended = blend.weight != 0.0 && blend.second != blend.first;
-  if (lid == 0u) atomicAdd(sliceCounts[2u * sh.object + (blended ? 1u : 0u)], 1u);
+  if (lid == 0u) atomicAdd(sliceCounts[kSliceCountsPerObject * sh.object + (blended ? 1u : 0u)], 1u);
 
   // The lobe path (fused.h LobePath): all of the lobe, with no pass, or
   // its core, with the pass over the rest.
@@ -346,20 +348,16 @@ void shadePixel(uint s) {
     energy = e0 + blend.weight * (e1 - e0);
   }
 
-  // Only rows that can reach the slice's non-zero cap: y2 = ω·a with
-  // a = (sin β sin α, cos β, sin β cos α) at angle β from +Y, so y2 ≥
-  // skipBelowY needs ω within δ = acos(skipBelowY) of a, and a pixel centre
-  // at θᵢ is at least |θᵢ − β| from it. The margin covers float rounding.
-  // The range is uniform over the workgroup, so every device skips the rows
-  // outside it for real (the test in rhoAt only masks lanes on SIMD devices).
-  p.firstRow = 0u;
-  p.endRow = p.m;
-  if (p.skipBelowY > -1.0) {
-    const float rowScale = float(p.m) / kPiF;
-    const float axis = acosPrecise(clamp(p.cosB, -1.0, 1.0));
-    const float reach = acosPrecise(min(p.skipBelowY, 1.0)) + 2e-3;
-    p.firstRow = uint(clamp(floor((axis - reach) * rowScale - 0.5), 0.0, float(p.m)));
-    p.endRow = uint(clamp(ceil((axis + reach) * rowScale - 0.5) + 1.0, 0.0, float(p.m)));
+  // Only rows that can reach the slice's non-zero cap (shared_layout.h
+  // passRows). The range is uniform over the workgroup, so every device
+  // skips the rows outside it for real (the test in rhoAt only masks lanes
+  // on SIMD devices).
+  const uvec2 rows = passRows(p.m, p.cosB, p.skipBelowY);
+  p.firstRow = rows.x;
+  p.endRow = rows.y;
+  if (lid == 0u) {
+    atomicAdd(sliceCounts[kSliceCountsPerObject * sh.object + 2u], rows.y - rows.x);
+    atomicMax(sliceCounts[kSliceCountsPerObject * sh.object + 3u], rows.y - rows.x);
   }
 
   // Two slices: each tap blends its two texels (ρ is linear in the slice),

@@ -54,6 +54,10 @@ struct Measured {
   double frameSeconds = 0.0;
   std::size_t coefficientBytes = 0;
   std::size_t covered = 0;
+  // `fused`: the map directions its pass visits per object sample, the mean
+  // and the most for one (render::Frame::passDirections).
+  double directionsMean = 0.0;
+  std::size_t directionsMax = 0;
   render::Frame first;  // an untimed frame with its linear image, for the comparison
 };
 
@@ -77,6 +81,8 @@ Measured measure(render::Renderer& r, const render::FrameRequest& request, int f
     for (std::size_t k = 0; k < f.stages.size() && k < m.stages.size(); ++k) m.stages[k].second += f.stages[k].seconds / frames;
     m.frameSeconds += f.seconds / frames;
     m.coefficientBytes = f.coefficientBytes;
+    m.directionsMean = f.passSamples ? static_cast<double>(f.passDirections) / static_cast<double>(f.passSamples) : 0.0;
+    m.directionsMax = f.passDirectionsMax;
   }
   for (std::uint8_t b : m.first.objectMask) m.covered += b;
   return m;
@@ -151,8 +157,9 @@ int run(const BenchArgs& a) {
     std::fflush(stdout);
   };
   // "fused / splitsum": the one pass of either, in place of rotation and triple product.
-  line("| level | method | size | backend | light | gbuffer | rotation-input | shadow-rays | rotation | triple-product | fused / splitsum | tonemap | frame (s) | fps | coeff. bytes/frame | vs cpu |");
-  line("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+  // "directions": what fused's pass visits per object sample, mean / most.
+  line("| level | method | size | backend | light | gbuffer | rotation-input | shadow-rays | rotation | triple-product | fused / splitsum | tonemap | frame (s) | fps | coeff. bytes/frame | directions / sample (mean, max) | vs cpu |");
+  line("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
   const std::size_t rows = levels.size() * methods.size() * sizes.size() * ((cpu ? 1 : 0) + (vulkan ? 1 : 0));
   std::size_t rowsDone = 0;
   const auto started = std::chrono::steady_clock::now();
@@ -216,6 +223,10 @@ int run(const BenchArgs& a) {
                              {"height", height},         {"frame_seconds", m.frameSeconds},
                              {"fps", m.frameSeconds > 0.0 ? 1.0 / m.frameSeconds : 0.0},
                              {"coefficient_bytes", m.coefficientBytes}, {"covered_pixels", m.covered}};
+          if (method == RotationMethod::Fused) {
+            run["directions_per_sample_mean"] = m.directionsMean;
+            run["directions_per_sample_max"] = m.directionsMax;
+          }
           nlohmann::json stages = nlohmann::json::object();
           for (const auto& [name, seconds] : m.stages) stages[name] = seconds;
           run["stages"] = stages;
@@ -255,9 +266,11 @@ int run(const BenchArgs& a) {
             std::snprintf(buf, sizeof buf, " %.4f |", seconds);
             row += buf;
           }
-          char buf[96];
-          std::snprintf(buf, sizeof buf, " %.4f | %.2f | %zu | %s |", m.frameSeconds,
-                        m.frameSeconds > 0.0 ? 1.0 / m.frameSeconds : 0.0, m.coefficientBytes, ratio.c_str());
+          char directions[48] = "";
+          if (method == RotationMethod::Fused) std::snprintf(directions, sizeof directions, "%.0f, %zu", m.directionsMean, m.directionsMax);
+          char buf[160];
+          std::snprintf(buf, sizeof buf, " %.4f | %.2f | %zu | %s | %s |", m.frameSeconds,
+                        m.frameSeconds > 0.0 ? 1.0 / m.frameSeconds : 0.0, m.coefficientBytes, directions, ratio.c_str());
           line(row + buf);
           rowDone("level " + level + ", " + std::string(methodName(method)) + ", " +
                       std::to_string(width) + "×" + std::to_string(height) + ", " + backend,

@@ -320,6 +320,9 @@ detail::FusedPass makePass(const PixelSlices& slices, const float* slice, const 
   const int m = mapSize(pass.level);
   const int cutRow = slices.lastNonZeroRow() + 2;
   pass.skipBelowY = cutRow < m ? static_cast<float>(std::cos(cutRow * kPi / m)) : -2.0f;
+  const shared::uvec2 rows = shared::passRows(static_cast<shared::uint>(m), pass.cosBeta, pass.skipBelowY);
+  pass.firstRow = static_cast<int>(rows.x);
+  pass.endRow = static_cast<int>(rows.y);
   return pass;
 }
 
@@ -362,6 +365,7 @@ std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBl
                                 std::span<const FusedPointLight> lights, std::uint32_t visibleLights,
                                 FusedScratch& scratch, const LobePath* lobe, const std::array<float, 3>* hidden) {
   const int level = slices.level();
+  scratch.passDirections = 0;
   if (lobe && lobe->coreAngle >= static_cast<float>(kPi)) return lobeShade(*lobe, blend, r, visibleLights);
   checkSameLevel(light.level, level, "the light");
   const std::size_t n = static_cast<std::size_t>(mapSize(level)) * static_cast<std::size_t>(mapSize(level));
@@ -375,6 +379,7 @@ std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBl
   }
 
   detail::FusedPass pass = makePass(slices, blendedSlice(slices, blend, scratch), r);
+  scratch.passDirections = static_cast<std::size_t>(pass.endRow - pass.firstRow) * static_cast<std::size_t>(mapSize(level));
   pass.light = light.planes.data();
   if (inPass) {
     pass.visibility = nullptr;
@@ -428,6 +433,7 @@ std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBl
   synthesizeInPlace(scratch.visibility, level, scratch.synthesis);
 
   detail::FusedPass pass = makePass(slices, blendedSlice(slices, blend, scratch), r);
+  scratch.passDirections = static_cast<std::size_t>(pass.endRow - pass.firstRow) * static_cast<std::size_t>(mapSize(level));
   pass.light = light.planes.data();
   pass.visibility = scratch.visibility.data();
   return energyKept(pass, sliceEnergy(slices, blend));

@@ -84,8 +84,13 @@ void FusedSampleWith(const FusedPass& p, float* HWY_RESTRICT out) {
   VF accR = zero, accG = zero, accB = zero;
   VF sumR = zero, sumG = zero, sumB = zero;
   const float* HWY_RESTRICT omega = p.directions.solidAngle;
-  // n ≥ 16 ≥ lanes on every target for level ≥ 2, and both are powers of two.
-  for (std::size_t i = 0; i < n; i += lanes) {
+  // n ≥ 16 ≥ lanes on every target for level ≥ 2, and both are powers of
+  // two. The rows' range, rounded out to whole vectors where a row is
+  // narrower than one (levels 2 and 3): the directions of the other rows
+  // read zero texels, so the sums are those of the whole map.
+  const std::size_t begin = (static_cast<std::size_t>(p.firstRow) * static_cast<std::size_t>(m)) / lanes * lanes;
+  const std::size_t end = std::min(n, (static_cast<std::size_t>(p.endRow) * static_cast<std::size_t>(m) + lanes - 1) / lanes * lanes);
+  for (std::size_t i = begin; i < end; i += lanes) {
     const VF x0 = hn::LoadU(d, p.directions.x + i);
     const VF y0 = hn::LoadU(d, p.directions.y + i);
     const VF z0 = hn::LoadU(d, p.directions.z + i);

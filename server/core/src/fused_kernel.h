@@ -34,6 +34,9 @@ struct FusedPass {
   int columnShift = 0;        // whole columns of γ·M/2π + ½
   float columnFraction = 0.0f;
   float skipBelowY = -2.0f;   // directions with cos θ' below this read only zero texels
+  // The rows that can reach the slices' non-zero cap (shared::passRows);
+  // the pass visits only theirs.
+  int firstRow = 0, endRow = 0;
   // The lobe path's core (fused.h LobePath): directions whose R_x(−β)R_y(−α)ω
   // is within it of `axis` (the lobe's axis turned by R_y(γ)), cos > coreCos,
   // read ρ = 0; they are the lobe path's. coreCos > 1: no core.
@@ -42,7 +45,7 @@ struct FusedPass {
 };
 
 // out[0..2]: Σ W_c·ρ_c; out[3..5]: Σ ΔΩ·ρ_c, the lobe's energy as the map's
-// directions sample it.
+// directions sample it, over the rows firstRow … endRow − 1.
 void fusedSample(const FusedPass& pass, float out[6]);
 const char* fusedTarget();
 // The target's float lanes: the pass forms V from the bits only where a

@@ -588,6 +588,8 @@ std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const RayScen
     pointLightMasks(rays, row, resolved.pointLightDirections, masks);
     for (std::size_t j = 0; j < slots.size(); ++j) lightsSeen[slots[j]] = masks[j];
   }, {}, options_.threads);
+  // What the pass visited (Frame::passDirections), over the object samples.
+  std::atomic<std::size_t> passSamples{0}, passDirections{0}, passDirectionsMax{0};
   const std::size_t bytes = shadePixels(g, request, camera, frame, [&](const Sample& sample, std::size_t slot, std::array<float, 3>& rgb) {
     // Per worker thread, kept across pixels: no allocation per pixel.
     thread_local FusedScratch scratch;
@@ -618,9 +620,17 @@ std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const RayScen
     const std::optional<std::array<float, 3>> hiddenSky = hidden.empty() ? std::nullopt : hiddenIrradiance(hidden[slot]);
     rgb = fusedShade(slices, blend, in.rotation.euler, o.fusedLight, vis, o.pointLights, seen, scratch,
                      p.lobePath ? &lobe : nullptr, hiddenSky ? &*hiddenSky : nullptr);
+    passSamples.fetch_add(1, std::memory_order_relaxed);
+    passDirections.fetch_add(scratch.passDirections, std::memory_order_relaxed);
+    for (std::size_t most = passDirectionsMax.load(std::memory_order_relaxed);
+         scratch.passDirections > most && !passDirectionsMax.compare_exchange_weak(most, scratch.passDirections);) {
+    }
     return fusedPixelBytes(slices.level(), blend.weight != 0.0f, 3 * p.visibilityBits.wordsPerPoint() * sizeof(std::uint32_t));
   }, cancelPoint);
   frame.stages.push_back({"fused", since(t0)});
+  frame.passSamples = passSamples.load();
+  frame.passDirections = passDirections.load();
+  frame.passDirectionsMax = passDirectionsMax.load();
   return bytes;
 }
 

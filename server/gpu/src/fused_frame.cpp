@@ -229,16 +229,23 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
     frame.seconds = secondsSince(start);
     return frame;
   }
-  std::vector<std::uint32_t> counts(2 * objectCount);
+  constexpr std::size_t kWords = shared::kSliceCountsPerObject;
+  std::vector<std::uint32_t> counts(kWords * objectCount);
   sliceCountsOut.read(counts.data(), counts.size() * sizeof(std::uint32_t));
   std::size_t counted = 0;
   for (std::size_t i = 0; i < objectCount; ++i) {
-    counted += std::size_t{counts[2 * i]} + counts[2 * i + 1];
+    const std::uint32_t* c = counts.data() + kWords * i;
+    counted += std::size_t{c[0]} + c[1];
     if (prepared.objects[i].ground) continue;
     const int objectLevel = prepared.objects[i].level;
     const std::size_t visibilityBytes = 3 * shared::visibilityWords(static_cast<shared::uint>(objectLevel)) * sizeof(std::uint32_t);
-    bytes += counts[2 * i] * fusedPixelBytes(objectLevel, false, visibilityBytes) +
-             counts[2 * i + 1] * fusedPixelBytes(objectLevel, true, visibilityBytes);
+    bytes += c[0] * fusedPixelBytes(objectLevel, false, visibilityBytes) +
+             c[1] * fusedPixelBytes(objectLevel, true, visibilityBytes);
+    // The pass's directions: its rows × M (shared_layout.h passRows).
+    const std::size_t m = static_cast<std::size_t>(mapSize(objectLevel));
+    frame.passSamples += std::size_t{c[0]} + c[1];
+    frame.passDirections += std::size_t{c[2]} * m;
+    frame.passDirectionsMax = std::max(frame.passDirectionsMax, std::size_t{c[3]} * m);
   }
   HC_CHECK_EQ(counted, std::size_t{covered});  // the pass shaded every covered sample once
   frame.coefficientBytes = bytes;

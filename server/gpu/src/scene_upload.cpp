@@ -224,8 +224,10 @@ void VulkanRenderer::Impl::uploadScene() {
     pointLights = Buffer(context, pointLightData.size() * sizeof(PointLight), kStorageUsage, MemoryUse::DeviceInput);
     pointLightUpload = BufferUpload(context, pointLights);
     // Per object, its samples shaded from one slice and from two (fused.comp).
-    sliceCounts = Buffer(context, 2 * objectCount * sizeof(std::uint32_t), kStorageUsage, MemoryUse::DeviceOnly);
-    sliceCountsOut = Buffer(context, 2 * objectCount * sizeof(std::uint32_t), kStorageUsage, MemoryUse::Readback);
+    sliceCounts = Buffer(context, shared::kSliceCountsPerObject * objectCount * sizeof(std::uint32_t), kStorageUsage,
+                         MemoryUse::DeviceOnly);
+    sliceCountsOut = Buffer(context, shared::kSliceCountsPerObject * objectCount * sizeof(std::uint32_t), kStorageUsage,
+                            MemoryUse::Readback);
     if (!deviceRays) createHostRays();
   }
   frameParams = Buffer(context, sizeof(FrameParams));

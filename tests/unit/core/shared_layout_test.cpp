@@ -1,14 +1,19 @@
 // The Haar numbers of core/shared_layout.h (one definition for C++ and GLSL)
 // against what they stand for: the quadrant layout of HaarMap, the signs of
-// inverseHaar's synthesis, and the pre-order walk of the block quadtree.
+// inverseHaar's synthesis, and the pre-order walk of the block quadtree;
+// and `fused`'s row range (passRows) against the directions it leaves out.
 // (tests/unit/gpu/shared_layout_test.cpp checks the GLSL reading against these.)
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdint>
+#include <cstdio>
+#include <random>
 #include <vector>
 
 #include "haarcast/core/haar.h"
 #include "haarcast/core/shared_layout.h"
+#include "haarcast/core/sphere_map.h"
 
 namespace haarcast {
 namespace {
@@ -87,6 +92,52 @@ TEST(SharedLayout, PreorderKeysFollowTheQuadtreeWalk) {
   EXPECT_EQ(b.j, last);
   EXPECT_EQ(b.level, finest);
   static_assert(shared::haarPreorderKey(3, 0, 0, 0) == 0u && shared::haarPreorderKey(3, 3, 0, 1) == ((1u << 4) | 3u));
+}
+
+}  // namespace
+}  // namespace haarcast
+
+namespace haarcast {
+namespace {
+
+// passRows may leave out only rows every direction of which is below the
+// slices' cut (y₂ = cos θ' < skipBelowY, so it reads zero texels): the
+// pass's sums are then those of the whole map. For rotations and cuts all
+// over, every direction of a left-out row is checked; and the range is
+// much less than the map where the cut is high.
+TEST(SharedLayout, PassRowsLeaveOutOnlyRowsBelowTheCut) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  std::size_t leftOut = 0, checked = 0;
+  for (int level : {2, 4, 6}) {
+    const int m = mapSize(level);
+    for (int trial = 0; trial < 200; ++trial) {
+      const float alpha = 6.2831853f * u(rng), beta = 3.1415927f * u(rng);
+      const float skipBelowY = trial % 10 == 0 ? -2.0f : 2.0f * u(rng) - 1.0f;
+      const shared::uvec2 rows = shared::passRows(static_cast<shared::uint>(m), std::cos(beta), skipBelowY);
+      ASSERT_LE(rows.x, rows.y);
+      ASSERT_LE(rows.y, static_cast<shared::uint>(m));
+      if (!(skipBelowY > -1.0f)) {
+        EXPECT_EQ(rows.x, 0u);
+        EXPECT_EQ(rows.y, static_cast<shared::uint>(m));
+      }
+      for (int r = 0; r < m; ++r) {
+        if (r >= static_cast<int>(rows.x) && r < static_cast<int>(rows.y)) continue;
+        ++leftOut;
+        for (int c = 0; c < m; ++c) {
+          const glm::dvec3 w = sphericalToDirection(rowTheta(level, r), colPhi(level, c));
+          // y₂ of R_x(−β)R_y(−α)ω, as fused_kernel.cpp forms it.
+          const double z1 = std::sin(alpha) * w.x + std::cos(alpha) * w.z;
+          const double y2 = std::cos(beta) * w.y + std::sin(beta) * z1;
+          ++checked;
+          ASSERT_LT(y2, skipBelowY) << "level " << level << " row " << r << " column " << c << ", rows " << rows.x << "…"
+                                    << rows.y;
+        }
+      }
+    }
+  }
+  std::printf("%zu rows left out, %zu directions checked\n", leftOut, checked);
+  EXPECT_GT(leftOut, 1000u) << "the test must see rows left out";
 }
 
 }  // namespace

@@ -137,6 +137,17 @@ TEST_P(FusedFrame, VulkanMatchesTheCpuBackend) {
   EXPECT_GE(c.psnr, testing::fusedPsnrFloor(gpu.context()));
   EXPECT_EQ(c.mismatched, 0u);
   EXPECT_GT(c.objectPixels, 500u);
+  // The directions the pass visits (shared passRows, rows × M): the same
+  // object samples on both; the rows may differ by one where acos rounds
+  // differently at a row's edge, a few in a thousand.
+  std::printf("  directions per sample: cpu %zu / %zu, vulkan %zu / %zu (most %zu, %zu)\n", a.passDirections, a.passSamples,
+              b.passDirections, b.passSamples, a.passDirectionsMax, b.passDirectionsMax);
+  EXPECT_EQ(a.passSamples, b.passSamples);
+  EXPECT_GT(a.passSamples, 500u);
+  EXPECT_NEAR(static_cast<double>(b.passDirections), static_cast<double>(a.passDirections), 1e-3 * a.passDirections);
+  EXPECT_EQ(a.passDirectionsMax, b.passDirectionsMax);
+  EXPECT_LE(a.passDirectionsMax, std::size_t{1} << (2 * o.level));
+  EXPECT_LT(a.passDirections, a.passSamples * (std::size_t{1} << (2 * o.level))) << "some rows are below every sample's cut";
   // The GPU counts what it reads: with the vertices' pixel forms (levels
   // 4–6 here), three planes of N floats per pixel instead of the lists.
   expectStagesAndRgba8(b, kFusedStages, request.exposure.stops);

@@ -115,6 +115,9 @@ struct FusedScratch {
   std::vector<float> synthesis;   // one inverse-Haar step
   std::vector<float> blended;     // the θₒ-blended slice, when the blend weight is not 0
   std::size_t blendedRows = 0;    // rows of `blended` that may be non-zero
+  // The last fusedShade's pass: the map directions it visited, its rows × M
+  // (shared::passRows); 0 where the lobe path took all.
+  std::size_t passDirections = 0;
 };
 
 // One object's lobe path (shared_layout.h, "The lobe path"): its slices'

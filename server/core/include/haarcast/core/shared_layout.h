@@ -359,6 +359,22 @@ HC_FUNCTION float lobeAzimuthSectors(uint k, uint j) { return float(j) + 0.5f + 
 HC_CONST uint kPrefilterLevels = 11u;
 HC_FUNCTION uint prefilterOffset(uint level) { return ((1u << (2u * level)) - 1u) / 3u; }
 
+// The rows of `fused`'s pass (fused_kernel.cpp, fused.comp): only those
+// that can reach the slices' non-zero cap. y2 = ω·a with a = (sin β sin α,
+// cos β, sin β cos α) at angle β from +Y, so y2 ≥ skipBelowY needs ω within
+// δ = acos(skipBelowY) of a, and a pixel centre at θᵢ is at least |θᵢ − β|
+// from it; the margin covers float rounding, so every direction of the
+// other rows reads zero texels. x: the first row, y: the end (exclusive).
+// The pass's directions per sample are (y − x)·M (bench-frame reports them).
+HC_FUNCTION uvec2 passRows(uint m, float cosBeta, float skipBelowY) {
+  if (!(skipBelowY > -1.0f)) return uvec2(0u, m);
+  const float rowScale = float(m) / kPiF;
+  const float axis = HC_ACOS(clamp(cosBeta, -1.0f, 1.0f));
+  const float reach = HC_ACOS(min(skipBelowY, 1.0f)) + 2e-3f;
+  return uvec2(uint(clamp(floor((axis - reach) * rowScale - 0.5f), 0.0f, float(m))),
+               uint(clamp(ceil((axis + reach) * rowScale - 0.5f) + 1.0f, 0.0f, float(m))));
+}
+
 // Bilinear taps at (θ, φ) on a level-`level` lat-long map (core
 // bilinearTaps, in float): θ clamps at the poles, φ wraps.
 struct LatLongTaps {

@@ -187,6 +187,10 @@ HC_CONST uint kFusedLobesBinding = 12u;
 HC_CONST uint kFusedLobeLightTexelsBinding = 13u;
 HC_CONST uint kFusedPointSliceTexelsBinding = 14u;
 HC_CONST uint kFusedSliceCountsBinding = 15u;
+// kFusedSliceCountsBinding's words per object: its samples of one slice (the
+// ground's too) and of two, the pass's rows summed over its samples and the
+// most for one sample (passRows).
+HC_CONST uint kSliceCountsPerObject = 4u;
 HC_CONST uint kFusedHiddenBinding = 16u;
 HC_CONST uint kFusedBindings = 17u;
 

@@ -96,6 +96,13 @@ struct Frame {
   std::vector<StageTime> stages;      // in pipeline order
   double seconds = 0.0;               // wall time of render()
   std::size_t coefficientBytes = 0;   // coefficient data read this frame (slices, light, visibility, method tables)
+  // `fused`: the object samples shaded (those the lobe path takes whole
+  // count, with no directions), the map directions the pass visited over
+  // all of them (its rows × M, core/shared_layout.h passRows) and the most
+  // for one sample. What a sum over fewer directions brings down.
+  std::size_t passSamples = 0;
+  std::size_t passDirections = 0;
+  std::size_t passDirectionsMax = 0;
   double exposureStops = 0.0;         // the exposure rgba8 was made with
   double logAverageLuminance = 0.0;   // auto exposure's weighted log-average (exposure_meter.h); 0: none lit
   // The request's `cancelled` turned true mid-frame: the render stopped at
