@@ -42,6 +42,7 @@ struct BenchArgs {
   std::string device;
   std::string rays = "auto";
   bool objectSky = true;  // fused: objects hide sky from each other (RenderOptions::objectSky)
+  std::string sumTolerances = "0";  // fused: RenderOptions::sumTolerance, one run each
   std::string cacheDir;
   int frames = 3;
   int warmup = 1;
@@ -126,6 +127,19 @@ int run(const BenchArgs& a) {
     levels.push_back(*choice);
   }
   const std::vector<RotationMethod> methods = parseMethodList(a.methods, "--method", true);
+  std::vector<float> tolerances;
+  for (const std::string& item : splitList(a.sumTolerances, "--sum-tolerance")) {
+    std::size_t used = 0;
+    float t = -1.0f;
+    try {
+      t = std::stof(item, &used);
+    } catch (const std::exception&) {
+    }
+    if (used != item.size() || !(t >= 0.0f && t <= 1.0f)) {
+      throw std::invalid_argument("--sum-tolerance: \"" + item + "\" is not a number in 0..1");
+    }
+    tolerances.push_back(t);
+  }
   const std::string cpuName(render::kCpuBackend), vulkanName(render::kVulkanBackend);
   const bool cpu = a.backend != vulkanName, vulkan = a.backend != cpuName;
   if (a.antialias != "on" && a.antialias != "off") {
@@ -160,7 +174,8 @@ int run(const BenchArgs& a) {
   // "directions": what fused's pass visits per object sample, mean / most.
   line("| level | method | size | backend | light | gbuffer | rotation-input | shadow-rays | rotation | triple-product | fused / splitsum | tonemap | frame (s) | fps | coeff. bytes/frame | directions / sample (mean, max) | vs cpu |");
   line("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
-  const std::size_t rows = levels.size() * methods.size() * sizes.size() * ((cpu ? 1 : 0) + (vulkan ? 1 : 0));
+  const std::size_t rows =
+      levels.size() * tolerances.size() * methods.size() * sizes.size() * ((cpu ? 1 : 0) + (vulkan ? 1 : 0));
   std::size_t rowsDone = 0;
   const auto started = std::chrono::steady_clock::now();
   StderrProgress progress("[bench-frame] ");
@@ -174,107 +189,115 @@ int run(const BenchArgs& a) {
   };
 
   for (const render::LevelChoice& choice : levels) {
-    const std::string level = choice.name();
-    for (const RotationMethod method : methods) {
-      render::RenderOptions options;
-      options.method = method;
-      render::applyLevelChoice(options, choice);
-      options.interpolateSlices = a.slices == "blend";
-      options.antialias = antialias;
-      options.objectSky = a.objectSky;
-      options.cacheDir = a.cacheDir == "none" ? "" : a.cacheDir;
-      progress.message("level " + level + ", " + std::string(methodName(method)) + ": preparing");
-      std::unique_ptr<render::Renderer> cpuRenderer, gpuRenderer;
-      // Slice tables, visibility, rotators: the same progress lines as `render`.
-      if (cpu) cpuRenderer = backends::makeRenderer(render::kCpuBackend, scene, options, {}, progress.callback());
-      if (vulkan) {
-        // Timing: validation layers would dominate.
-        gpuRenderer = backends::makeRenderer(render::kVulkanBackend, scene, options,
-                                             {a.device, false, 0, rays}, progress.callback());
-        out["vulkan_device"] = gpuRenderer->deviceName();
-        out["vulkan_rays"] = gpuRenderer->rays();
-      }
-      if (cpuRenderer) out["cpu_device"] = cpuRenderer->deviceName();
-      // Each object's level: the choice's, or under `auto` each one's own.
-      const render::Renderer* first = cpuRenderer ? cpuRenderer.get() : gpuRenderer.get();
-      HC_CHECK_EQ(first != nullptr, true);  // --backend names at least one
-      const render::Renderer& any = *first;
-      std::vector<int> objectLevels = any.objectLevels();
-      if (objectLevels.empty()) objectLevels.assign(any.objectCount(), options.level);
-      const std::string levelCell = choice.automatic ? level + " (" + render::describeLevels(objectLevels) + ")" : level;
-      for (const auto& [width, height] : sizes) {
-        render::FrameRequest request;
-        request.width = width;
-        request.height = height;
-        request.camera = scene.camera;
-        std::map<std::string, Measured> results;
-        for (render::Renderer* r : {cpuRenderer.get(), gpuRenderer.get()}) {
-          if (!r) continue;
-          progress.message("level " + level + ", " + std::string(methodName(method)) + ", " +
-                           std::to_string(width) + "×" + std::to_string(height) + ", " + r->backend() + ": " +
-                           std::to_string(a.frames) + " frames + " + std::to_string(a.warmup) + " warm-up");
-          results[r->backend()] = measure(*r, request, a.frames, a.warmup);
+    for (const float tolerance : tolerances) {
+      // The level's name, and the sum's tolerance where one is set (fused only).
+      char tauText[32] = "";
+      if (tolerance > 0.0f) std::snprintf(tauText, sizeof tauText, ", τ %g", static_cast<double>(tolerance));
+      const std::string level = choice.name() + tauText;
+      for (const RotationMethod method : methods) {
+        render::RenderOptions options;
+        options.method = method;
+        render::applyLevelChoice(options, choice);
+        options.interpolateSlices = a.slices == "blend";
+        options.antialias = antialias;
+        options.objectSky = a.objectSky;
+        options.sumTolerance = tolerance;
+        options.cacheDir = a.cacheDir == "none" ? "" : a.cacheDir;
+        progress.message("level " + level + ", " + std::string(methodName(method)) + ": preparing");
+        std::unique_ptr<render::Renderer> cpuRenderer, gpuRenderer;
+        // Slice tables, visibility, rotators: the same progress lines as `render`.
+        if (cpu) cpuRenderer = backends::makeRenderer(render::kCpuBackend, scene, options, {}, progress.callback());
+        if (vulkan) {
+          // Timing: validation layers would dominate.
+          gpuRenderer = backends::makeRenderer(render::kVulkanBackend, scene, options,
+                                               {a.device, false, 0, rays}, progress.callback());
+          out["vulkan_device"] = gpuRenderer->deviceName();
+          out["vulkan_rays"] = gpuRenderer->rays();
         }
-        std::optional<std::pair<double, std::size_t>> agree;
-        if (results.count(cpuName) && results.count(vulkanName)) agree = agreement(results[cpuName].first, results[vulkanName].first);
-        for (const auto& [backend, m] : results) {
-          nlohmann::json run{{"backend", backend},       {"level", level}, {"object_levels", objectLevels},
-                             {"method", methodName(method)}, {"width", width},
-                             {"height", height},         {"frame_seconds", m.frameSeconds},
-                             {"fps", m.frameSeconds > 0.0 ? 1.0 / m.frameSeconds : 0.0},
-                             {"coefficient_bytes", m.coefficientBytes}, {"covered_pixels", m.covered}};
-          if (method == RotationMethod::Fused) {
-            run["directions_per_sample_mean"] = m.directionsMean;
-            run["directions_per_sample_max"] = m.directionsMax;
+        if (cpuRenderer) out["cpu_device"] = cpuRenderer->deviceName();
+        // Each object's level: the choice's, or under `auto` each one's own.
+        const render::Renderer* first = cpuRenderer ? cpuRenderer.get() : gpuRenderer.get();
+        HC_CHECK_EQ(first != nullptr, true);  // --backend names at least one
+        const render::Renderer& any = *first;
+        std::vector<int> objectLevels = any.objectLevels();
+        if (objectLevels.empty()) objectLevels.assign(any.objectCount(), options.level);
+        const std::string levelCell =
+            choice.automatic ? choice.name() + " (" + render::describeLevels(objectLevels) + ")" + tauText : level;
+        for (const auto& [width, height] : sizes) {
+          render::FrameRequest request;
+          request.width = width;
+          request.height = height;
+          request.camera = scene.camera;
+          std::map<std::string, Measured> results;
+          for (render::Renderer* r : {cpuRenderer.get(), gpuRenderer.get()}) {
+            if (!r) continue;
+            progress.message("level " + level + ", " + std::string(methodName(method)) + ", " +
+                             std::to_string(width) + "×" + std::to_string(height) + ", " + r->backend() + ": " +
+                             std::to_string(a.frames) + " frames + " + std::to_string(a.warmup) + " warm-up");
+            results[r->backend()] = measure(*r, request, a.frames, a.warmup);
           }
-          nlohmann::json stages = nlohmann::json::object();
-          for (const auto& [name, seconds] : m.stages) stages[name] = seconds;
-          run["stages"] = stages;
-          std::string ratio = "";
-          if (backend == vulkanName && results.count(cpuName)) {
-            const double r = results[cpuName].frameSeconds / m.frameSeconds;
-            run["cpu_over_vulkan"] = r;
-            nlohmann::json perStage = nlohmann::json::object();
-            for (const auto& [name, seconds] : m.stages) {
-              for (const auto& [cname, cseconds] : results[cpuName].stages) {
-                if (cname == name && seconds > 0.0) perStage[name] = cseconds / seconds;
+          std::optional<std::pair<double, std::size_t>> agree;
+          if (results.count(cpuName) && results.count(vulkanName)) agree = agreement(results[cpuName].first, results[vulkanName].first);
+          for (const auto& [backend, m] : results) {
+            nlohmann::json run{{"backend", backend},       {"level", level}, {"object_levels", objectLevels},
+                               {"method", methodName(method)}, {"width", width},
+                               {"height", height},         {"frame_seconds", m.frameSeconds},
+                               {"fps", m.frameSeconds > 0.0 ? 1.0 / m.frameSeconds : 0.0},
+                               {"coefficient_bytes", m.coefficientBytes}, {"covered_pixels", m.covered}};
+            if (method == RotationMethod::Fused) {
+              run["sum_tolerance"] = tolerance;
+              run["directions_per_sample_mean"] = m.directionsMean;
+              run["directions_per_sample_max"] = m.directionsMax;
+            }
+            nlohmann::json stages = nlohmann::json::object();
+            for (const auto& [name, seconds] : m.stages) stages[name] = seconds;
+            run["stages"] = stages;
+            std::string ratio = "";
+            if (backend == vulkanName && results.count(cpuName)) {
+              const double r = results[cpuName].frameSeconds / m.frameSeconds;
+              run["cpu_over_vulkan"] = r;
+              nlohmann::json perStage = nlohmann::json::object();
+              for (const auto& [name, seconds] : m.stages) {
+                for (const auto& [cname, cseconds] : results[cpuName].stages) {
+                  if (cname == name && seconds > 0.0) perStage[name] = cseconds / seconds;
+                }
               }
+              run["cpu_over_vulkan_stages"] = perStage;
+              if (agree) {
+                run["psnr_vs_cpu"] = std::isfinite(agree->first) ? nlohmann::json(agree->first) : nlohmann::json("inf");
+                run["coverage_mismatched"] = agree->second;
+              }
+              char buf[96];
+              std::snprintf(buf, sizeof buf, "×%.2f, %.1f dB, %zu px mismatched", r, agree ? agree->first : 0.0,
+                            agree ? agree->second : 0);
+              ratio = buf;
             }
-            run["cpu_over_vulkan_stages"] = perStage;
-            if (agree) {
-              run["psnr_vs_cpu"] = std::isfinite(agree->first) ? nlohmann::json(agree->first) : nlohmann::json("inf");
-              run["coverage_mismatched"] = agree->second;
+            if (method == RotationMethod::Fused || method == RotationMethod::Splitsum) run["slices"] = a.slices;
+            run["antialias"] = antialias;
+            out["runs"].push_back(run);
+            std::string row = "| " + levelCell + " | " + std::string(methodName(method)) + " | " +
+                              std::to_string(width) + "×" + std::to_string(height) + " | " + backend +
+                              (backend == vulkanName && gpuRenderer ? " (rays " + gpuRenderer->rays() + ")" : "") + " |";
+            for (const char* name :
+                 {"light", "gbuffer", "rotation-input", "shadow-rays", "rotation", "triple-product", "fused", "tonemap"}) {
+              double seconds = 0.0;
+              for (const auto& [sname, s] : m.stages) {
+                if (sname == name || (sname == "splitsum" && std::string(name) == "fused")) seconds = s;
+              }
+              char buf[32];
+              std::snprintf(buf, sizeof buf, " %.4f |", seconds);
+              row += buf;
             }
-            char buf[96];
-            std::snprintf(buf, sizeof buf, "×%.2f, %.1f dB, %zu px mismatched", r, agree ? agree->first : 0.0,
-                          agree ? agree->second : 0);
-            ratio = buf;
+            char directions[48] = "";
+            if (method == RotationMethod::Fused) std::snprintf(directions, sizeof directions, "%.0f, %zu", m.directionsMean, m.directionsMax);
+            char buf[160];
+            std::snprintf(buf, sizeof buf, " %.4f | %.2f | %zu | %s | %s |", m.frameSeconds,
+                          m.frameSeconds > 0.0 ? 1.0 / m.frameSeconds : 0.0, m.coefficientBytes, directions, ratio.c_str());
+            line(row + buf);
+            rowDone("level " + level + ", " + std::string(methodName(method)) + ", " +
+                        std::to_string(width) + "×" + std::to_string(height) + ", " + backend,
+                    m.frameSeconds > 0.0 ? 1.0 / m.frameSeconds : 0.0);
           }
-          if (method == RotationMethod::Fused || method == RotationMethod::Splitsum) run["slices"] = a.slices;
-          run["antialias"] = antialias;
-          out["runs"].push_back(run);
-          std::string row = "| " + levelCell + " | " + std::string(methodName(method)) + " | " +
-                            std::to_string(width) + "×" + std::to_string(height) + " | " + backend +
-                            (backend == vulkanName && gpuRenderer ? " (rays " + gpuRenderer->rays() + ")" : "") + " |";
-          for (const char* name :
-               {"light", "gbuffer", "rotation-input", "shadow-rays", "rotation", "triple-product", "fused", "tonemap"}) {
-            double seconds = 0.0;
-            for (const auto& [sname, s] : m.stages) {
-              if (sname == name || (sname == "splitsum" && std::string(name) == "fused")) seconds = s;
-            }
-            char buf[32];
-            std::snprintf(buf, sizeof buf, " %.4f |", seconds);
-            row += buf;
-          }
-          char directions[48] = "";
-          if (method == RotationMethod::Fused) std::snprintf(directions, sizeof directions, "%.0f, %zu", m.directionsMean, m.directionsMax);
-          char buf[160];
-          std::snprintf(buf, sizeof buf, " %.4f | %.2f | %zu | %s | %s |", m.frameSeconds,
-                        m.frameSeconds > 0.0 ? 1.0 / m.frameSeconds : 0.0, m.coefficientBytes, directions, ratio.c_str());
-          line(row + buf);
-          rowDone("level " + level + ", " + std::string(methodName(method)) + ", " +
-                      std::to_string(width) + "×" + std::to_string(height) + ", " + backend,
-                  m.frameSeconds > 0.0 ? 1.0 / m.frameSeconds : 0.0);
         }
       }
     }
@@ -308,6 +331,9 @@ std::function<int()> addBenchFrameCommand(CLI::App& app) {
   c->add_option("--scene", args->scene, "Scene file (default: the built-in scene)");
   c->add_option("--device", args->device, "Vulkan device: an index or a name substring");
   c->add_option("--rays", args->rays, rayModeHelp())->capture_default_str();
+  c->add_option("--sum-tolerance", args->sumTolerances,
+                "fused: the adaptive sum's tolerances, comma-separated (0 = every direction); e.g. 0,0.02 times both in one run")
+      ->capture_default_str();
   c->add_option("--object-sky", args->objectSky, "fused: objects hide sky from each other (true|false: its cost, side by side)")
       ->capture_default_str();
   c->add_option("--cache-dir", args->cacheDir, "Cache of slice tables and visibility ('none' or empty: no cache)");

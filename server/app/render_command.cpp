@@ -122,6 +122,11 @@ std::function<int()> addRenderCommand(CLI::App& app) {
   c->add_option("--object-sky", args->options.objectSky,
                 "fused: objects hide sky from each other (true|false; false: each meets its own visibility alone)")
       ->capture_default_str();
+  c->add_option("--sum-tolerance", args->options.sumTolerance,
+                "fused: sum a cell of 4×4 directions at one where its visibility is whole and the BRDF slice's detail "
+                "is at most this fraction of its mean (0 = every direction)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
   c->add_option("--backend", args->backend, "The backend: " + backends::availableText())->capture_default_str();
   c->add_option("--antialias", args->antialias, "auto|on|off: edge pixels as the mean of 4 sub-samples (auto: on)")
       ->capture_default_str();

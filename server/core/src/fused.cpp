@@ -9,6 +9,7 @@
 
 #include "fused_kernel.h"
 #include "haarcast/core/check.h"
+#include "haarcast/core/shared_cells.h"
 
 namespace haarcast {
 namespace {
@@ -162,7 +163,21 @@ PixelSlices PixelSlices::synthesize(const BrdfSliceTable& table, const BrdfSlice
   // The point lights' lookup reads a finer table where one is given: one
   // Catmull-Rom read a light, so its texels cost memory only.
   out.pointTexels_ = pointValues(pointTable ? sliceTexels(*pointTable) : out.texels_, out.pointLevel_, out.thetaSamples_);
+  if (out.level_ >= static_cast<int>(shared::kCellMinLevel)) {
+    for (int t = 0; t < out.thetaSamples_; ++t) {
+      const std::vector<float> d = sliceDetail(out.slice(t), out.level_, out.energy_[static_cast<std::size_t>(t)].data());
+      out.detail_.insert(out.detail_.end(), d.begin(), d.end());
+    }
+  }
   return out;
+}
+
+const float* PixelSlices::detail(int t) const {
+  if (detail_.empty()) return nullptr;
+  if (t < 0 || t >= thetaSamples_) {
+    throw std::out_of_range("PixelSlices: detail map " + std::to_string(t) + " of " + std::to_string(thetaSamples_));
+  }
+  return detail_.data() + detail_.size() / static_cast<std::size_t>(thetaSamples_) * static_cast<std::size_t>(t);
 }
 
 const float* PixelSlices::pointSlice(int t) const {
@@ -197,7 +212,7 @@ FusedLight FusedLight::synthesize(const std::array<SparseHaar, 3>& light) {
   return out;
 }
 
-FusedLight FusedLight::fromWeightedMaps(const std::array<SphereMap, 3>& weighted) {
+FusedLight FusedLight::fromWeightedMaps(const std::array<SphereMap, 3>& weighted, float sumTolerance) {
   FusedLight out;
   out.level = weighted[0].level();
   checkFusedLevel(out.level);
@@ -207,6 +222,9 @@ FusedLight FusedLight::fromWeightedMaps(const std::array<SphereMap, 3>& weighted
     checkSameLevel(weighted[c].level(), out.level, "a light channel");
     std::copy(weighted[c].values().begin(), weighted[c].values().end(), out.planes.begin() + static_cast<std::ptrdiff_t>(c * n));
   }
+  if (!(sumTolerance >= 0.0f)) throw std::invalid_argument("fused: the sum tolerance must be ≥ 0");
+  out.sumTolerance = sumTolerance;
+  if (shared::sumsByCells(static_cast<shared::uint>(out.level), sumTolerance)) out.cells = CellLight::fromPlanes(out.level, out.planes);
   return out;
 }
 
@@ -331,12 +349,15 @@ detail::FusedPass makePass(const PixelSlices& slices, const float* slice, const 
 // under-counted depending on where it falls between them — rings as R turns
 // across a surface. Σ ΔΩ·ρ(Rᵀω) measures that count in the same pass, and
 // ∫ρ of the slice is what it should be.
-std::array<float, 3> energyKept(const detail::FusedPass& pass, const std::array<float, 3>& energy) {
-  float sums[6] = {};
-  detail::fusedSample(pass, sums);
+std::array<float, 3> energyRatio(const float sums[6], const std::array<float, 3>& energy) {
   std::array<float, 3> out{};
   for (std::size_t c = 0; c < 3; ++c) out[c] = sums[3 + c] > 0.0f ? sums[c] * (energy[c] / sums[3 + c]) : sums[c];
   return out;
+}
+std::array<float, 3> energyKept(const detail::FusedPass& pass, const std::array<float, 3>& energy) {
+  float sums[6] = {};
+  detail::fusedSample(pass, sums);
+  return energyRatio(sums, energy);
 }
 
 // ∫ρ_c of the slice between the blend's two slices.
@@ -398,7 +419,29 @@ std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBl
     setCore(pass, r, core.energy.w, lobe->coreAngle);
     for (std::size_t c = 0; c < 3; ++c) energy[c] = std::max(0.0f, core.energy[static_cast<int>(c)] - core.core[static_cast<int>(c)]);
   }
-  std::array<float, 3> out = energyKept(pass, energy);
+  std::array<float, 3> out{};
+  if (inPass && light.sumsByCells() && slices.detail(0)) {
+    // By cells (shared_cells.h): coarse where the visibility is whole and
+    // the slice smooth, the rest direction by direction.
+    detail::FusedCellPass cells;
+    cells.pass = pass;
+    cells.cells = &cellDirections(level);
+    cells.light = &light.cells;
+    cells.detail[0] = slices.detail(static_cast<int>(blend.first));
+    cells.detail[1] = slices.detail(static_cast<int>(blend.weight != 0.0f ? blend.second : blend.first));
+    cells.tolerance = light.sumTolerance;
+    if (lobe) {
+      const float reach = shared::cellReach(static_cast<shared::uint>(mapSize(level)));
+      cells.coreCellCos = std::cos(std::min(lobe->coreAngle + reach, static_cast<float>(kPi)));
+    }
+    float sums[6] = {};
+    scratch.cellCounts = {};
+    detail::fusedSampleCells(cells, scratch.cells, sums, scratch.cellCounts);
+    scratch.passDirections = scratch.cellCounts.coarse + shared::kCellDirections * scratch.cellCounts.fine;
+    out = energyRatio(sums, energy);
+  } else {
+    out = energyKept(pass, energy);
+  }
   const ColumnOffset pointColumn = columnOffset(r.gamma, slices.pointLevel());
   for (std::size_t k = 0; k < lights.size(); ++k) {
     if (((visibleLights >> k) & 1u) == 0) continue;

@@ -5,6 +5,13 @@
 #include <cstddef>
 #include <cstdint>
 
+namespace haarcast {
+struct CellDirections;
+struct CellLight;
+struct CellScratch;
+struct CellCounts;
+}  // namespace haarcast
+
 namespace haarcast::detail {
 
 // Unit directions of the pixel centres of a level's map, planar (N each).
@@ -47,6 +54,23 @@ struct FusedPass {
 // out[0..2]: Σ W_c·ρ_c; out[3..5]: Σ ΔΩ·ρ_c, the lobe's energy as the map's
 // directions sample it, over the rows firstRow … endRow − 1.
 void fusedSample(const FusedPass& pass, float out[6]);
+
+// The adaptive pass (shared_cells.h, fused_cells_kernel.cpp): the full
+// pass's rotation, slice, rows, bits and core (`pass.light` and
+// `pass.visibility` unused: V is the three vertices' bits), and what the
+// cells read.
+struct FusedCellPass {
+  FusedPass pass;
+  const CellDirections* cells = nullptr;
+  const CellLight* light = nullptr;
+  const float* detail[2] = {nullptr, nullptr};  // the blend's two slices' detail maps
+  float tolerance = 0.0f;
+  // cos(core angle + cellReach): a cell whose turned centre is nearer the
+  // lobe's axis may hold core directions and is summed fine; > 1: no core.
+  float coreCellCos = 2.0f;
+};
+// out as fusedSample's, over the cells of rows firstRow … endRow − 1.
+void fusedSampleCells(const FusedCellPass& pass, CellScratch& scratch, float out[6], CellCounts& counts);
 const char* fusedTarget();
 // The target's float lanes: the pass forms V from the bits only where a
 // vector's lanes lie in one word (≤ 32).

@@ -30,6 +30,7 @@
 #include <vector>
 
 #include "haarcast/core/brdf_slices.h"
+#include "haarcast/core/fused_cells.h"
 #include "haarcast/core/haar.h"
 #include "haarcast/core/prefiltered_light.h"
 #include "haarcast/core/rotation.h"
@@ -67,7 +68,10 @@ class PixelSlices {
   // lookup reads zeros (a slice is ρ·max(cos θᵢ, 0), so this is about the
   // equator), which lets the pass skip directions that cannot contribute.
   int lastNonZeroRow() const { return lastNonZeroRow_; }
-  std::size_t storedBytes() const { return (texels_.size() + pointTexels_.size()) * sizeof(float); }
+  // Slice t's detail map at the cell level (fused_cells.h sliceDetail):
+  // what the adaptive sum reads; empty (nullptr) below shared::kCellMinLevel.
+  const float* detail(int t) const;
+  std::size_t storedBytes() const { return (texels_.size() + pointTexels_.size() + detail_.size()) * sizeof(float); }
   // ∫ ρ_c dω of slice t (the directional albedo, cos θᵢ included), R, G, B.
   const std::array<float, 3>& energy(int t) const { return energy_.at(static_cast<std::size_t>(t)); }
 
@@ -78,18 +82,26 @@ class PixelSlices {
   int lastNonZeroRow_ = -1;
   std::vector<float> texels_;
   std::vector<float> pointTexels_;
+  std::vector<float> detail_;  // slice t's at t·(M/4)²
   std::vector<std::array<float, 3>> energy_;
 };
 
 // One object's light for one frame in pixel form, three planes of M² floats
 // (channel c at c·M²): the synthesis of L·ΔΩ as lightInObjectFrame cut it.
+//
+// With a sum tolerance τ > 0 at level ≥ shared::kCellMinLevel the light is
+// also kept by cells (`cells`), and the pass sums by them (shared_cells.h):
+// coarse where the visibility is whole and the slice's detail at most τ.
 struct FusedLight {
   int level = 0;
   std::vector<float> planes;
+  float sumTolerance = 0.0f;
+  CellLight cells;  // level 0: none, every direction is summed
   static FusedLight synthesize(const std::array<SparseHaar, 3>& light);
   // The light whole, from its pixel maps with ΔΩ already folded in
   // (SphereMap::weightedBySolidAngle): no Haar coding, no cut.
-  static FusedLight fromWeightedMaps(const std::array<SphereMap, 3>& weighted);
+  static FusedLight fromWeightedMaps(const std::array<SphereMap, 3>& weighted, float sumTolerance = 0.0f);
+  bool sumsByCells() const { return cells.level == level && level > 0; }
 };
 
 // A bright light taken out of the map (render/light_split.h) and shaded as a
@@ -115,9 +127,12 @@ struct FusedScratch {
   std::vector<float> synthesis;   // one inverse-Haar step
   std::vector<float> blended;     // the θₒ-blended slice, when the blend weight is not 0
   std::size_t blendedRows = 0;    // rows of `blended` that may be non-zero
+  CellScratch cells;               // the adaptive pass's
   // The last fusedShade's pass: the map directions it visited, its rows × M
-  // (shared::passRows); 0 where the lobe path took all.
+  // (shared::passRows), or by cells one per coarse cell and 16 per fine
+  // one; 0 where the lobe path took all.
   std::size_t passDirections = 0;
+  CellCounts cellCounts;  // by cells: the last pass's coarse and fine cells
 };
 
 // One object's lobe path (shared_layout.h, "The lobe path"): its slices'

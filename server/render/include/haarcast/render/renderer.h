@@ -197,6 +197,7 @@ class FusedLightCache {
     glm::dmat3 lightRotation{1.0};
     glm::dmat3 objectRotation{1.0};
     std::optional<glm::dvec3> groundNormal;
+    float sumTolerance = 0.0f;  // RenderOptions::sumTolerance: whether the light is kept by cells
     bool operator==(const Key&) const = default;
   };
   // Copies the kept light of object `index` into `o` when it was resolved

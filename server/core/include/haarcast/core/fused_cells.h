@@ -1,0 +1,70 @@
+// What `fused`'s adaptive sum (shared_cells.h) reads besides the full sum's
+// inputs: the map's directions in cell order with each cell's centre, the
+// light per cell (its sum and centroid), and each slice's detail map.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace haarcast {
+
+// A level's map directions in cell order (direction k of cell q at
+// q·16 + k, shared::cellDirection), and per cell its centre: the
+// ΔΩ-weighted mean of its 16 directions, normalised, and Ω_C = Σ ΔΩ.
+// The per-cell arrays hold kCellPadding zeros past the last cell, so a
+// vector of cells starting at any cell stays inside them.
+inline constexpr std::size_t kCellPadding = 16;
+struct CellDirections {
+  std::vector<float> x, y, z, solidAngle;            // N each, cell order
+  std::vector<float> centreX, centreY, centreZ, cellSolidAngle;  // one per cell, padded
+};
+// Built once per level ≥ shared::kCellMinLevel that `fused` takes
+// (thread-safe static initialisation); throws std::invalid_argument below it.
+const CellDirections& cellDirections(int level);
+
+// One object's light for one frame in cell form (FusedLight::cells):
+// the three planes of L_c·ΔΩ in cell order, and per cell P_c = Σ L_c·ΔΩ
+// and ω̄, the centroid of its directions weighted by L_R + L_G + L_B
+// (normalised; the cell's centre where the cell is black).
+struct CellLight {
+  int level = 0;
+  std::vector<float> planes;                     // 3·N, channel c at c·N, cell order
+  std::size_t stride = 0;                        // K + kCellPadding
+  std::vector<float> power;                      // channel c's K at c·stride, padded
+  std::vector<float> centroidX, centroidY, centroidZ;  // K each, padded
+  // From row-major planes of L·ΔΩ (FusedLight::planes) at `level` ≥ kCellMinLevel.
+  static CellLight fromPlanes(int level, std::span<const float> rowMajorPlanes);
+};
+
+// Per-thread working memory of the adaptive pass (in FusedScratch).
+struct CellScratch {
+  std::vector<float> visibility;     // per cell: V_C, or −1 where mixed
+  std::vector<std::uint32_t> fine;   // the cells summed fine
+  std::vector<std::uint32_t> mixed;  // the mixed cells summed coarse
+  // Per mixed cell: Σ V·L_c·ΔΩ (three planes) and the centroid of its
+  // directions weighted by V·(L_R + L_G + L_B)·ΔΩ.
+  std::vector<float> mixedPower, mixedX, mixedY, mixedZ;
+};
+// What one adaptive pass did.
+struct CellCounts {
+  std::size_t coarse = 0;  // cells summed at one direction (hidden and mixed ones too)
+  std::size_t mixed = 0;   // of them, those whose V varies: their V·L summed first
+  std::size_t fine = 0;    // cells summed direction by direction
+};
+
+// The detail map of one slice (shared_cells.h): per texel of the cell level
+// (M/4 × M/4), how far the mean of ρ over a cell of the map differs from ρ
+// at the cell's centre when the centre falls in or beside that texel,
+// divided by the slice's mean over the hemisphere (max_c E_c/2π). That
+// difference is what a coarse cell gets wrong under a uniform light; the
+// light's own variation inside a cell the centroid takes to first order.
+// Measured with the widest cell (the map's equator) at the texel's centre
+// and corners, turned 0 and 90° about it, on the bilinear lookup the pass
+// uses, the largest channel taken; then the largest of each texel's 3 × 3
+// neighbourhood (a turned cell's footprint reaches into the next texel).
+// `texels`: the slice in pixel form (RGB0 texels, PixelSlices layout).
+std::vector<float> sliceDetail(const float* texels, int level, const float energy[3]);
+
+}  // namespace haarcast
