@@ -94,6 +94,17 @@ int run(RenderArgs& a) {
     if (pointLevels[k] > levels[k]) finer += (finer.empty() ? "" : ", ") + scene.objects[k].name + " " + std::to_string(pointLevels[k]);
   }
   if (!finer.empty()) levelText += ", point lights' slices at " + finer;
+  // What fused's pass summed a sample (render::Frame::passDirections): by
+  // cells where a tolerance is set (core/shared_cells.h), else every direction.
+  if (frame.passSamples > 0) {
+    char sum[96];
+    std::snprintf(sum, sizeof sum, ", %.0f directions a sample", static_cast<double>(frame.passDirections) / frame.passSamples);
+    levelText += sum;
+    if (a.options.sumTolerance > 0.0f) {
+      std::snprintf(sum, sizeof sum, " (by cells, τ %g)", static_cast<double>(a.options.sumTolerance));
+      levelText += sum;
+    }
+  }
   std::fprintf(stderr, "%s on %s: %d×%d, %s, %s, k = %zu, rays %s: precompute %.2f s, frame %.3f s (%s)\n",
                renderer->backend().c_str(), renderer->deviceName().c_str(), a.options.width, a.options.height,
                levelText.c_str(), a.method.c_str(), a.options.lightCoefficients, renderer->rays().c_str(), prepare,
