@@ -50,6 +50,7 @@
 #extension GL_KHR_shader_subgroup_arithmetic : require
 #extension GL_EXT_control_flow_attributes : require
 #include "haarcast/core/shared_layout.h"
+#include "haarcast/core/shared_cells.h"
 #include "common/frame.glsl"
 #include "common/sphere.glsl"
 
@@ -84,16 +85,23 @@ layout(set = 0, binding = kFusedLobeLightTexelsBinding) uniform textureBuffer lo
 // The slices as point values at the texel centres (core PixelSlices::pointSlice), at each object's
 // pointLevel: object o's slice t, direction k at o.pointTexelBase + t·N + k.
 layout(set = 0, binding = kFusedPointSliceTexelsBinding) uniform textureBuffer pointTexels;
-// Per object (kSliceCountsPerObject words from 4·object): its samples shaded
+// Per object (kSliceCountsPerObject words from kSliceCountsPerObject·object): its samples shaded
 // from one slice (the ground's samples, which read none, too) and from two,
-// the pass's rows summed over its samples and the most for one, cleared
+// the pass's rows summed over its samples, the most directions for one, and
+// by cells its coarse and its fine cells summed (shared_passes.h), cleared
 // before the pass; the host counts the coefficient bytes read (core
 // fusedPixelBytes) and the directions summed from them without reading any
 // sample back.
 layout(std430, set = 0, binding = kFusedSliceCountsBinding) buffer SliceCounts { uint sliceCounts[]; };
+// By cells (ObjectInfo::sumTolerance > 0; shared_cells.h): global slice s's
+// detail map at s·kCellDetailStride; the light's cells follow the object's
+// light texels (cellPowerTexel, cellCentroidTexel), the cells' centres its
+// level's directions (cellCentreTexel).
+layout(set = 0, binding = kFusedDetailTexelsBinding) uniform textureBuffer details;
 
 shared vec3 partial[LOCAL];
 shared vec3 partialSum[LOCAL];  // Σ ΔΩ·ρ_c: the lobe's energy as the directions sample it
+shared uint partialCount[LOCAL];  // by cells: the directions summed
 
 void sync() {
   memoryBarrierShared();
@@ -120,6 +128,9 @@ struct PixelSetup {
   uint firstRow, endRow;   // the rows that can reach the slice's non-zero cap
   vec3 axis;               // the lobe's axis before R_y(−γ), and the lobe path's core (fused.cpp setCore)
   float coreCos;
+  float coreCellCos;       // by cells: a cell whose turned centre is nearer the axis is summed fine
+  float tolerance;         // by cells: the detail above which a cell is summed fine
+  uint detail0, detail1;   // the two slices' detail maps
 };
 
 // γ as a column offset of a map of M = m (core fused.cpp columnOffset):
@@ -145,24 +156,28 @@ vec3 texel(const bool blended, PixelSetup p, uint index) {
 // columns; `fraction` its fraction at that M), as the CPU kernel computes
 // them. False where every tap reads zero: cos θ' below the slices' cut, or
 // inside the lobe path's core.
-bool slicePosition(PixelSetup p, vec3 w0, uint m, float fraction, out vec2 pos) {
+// R_x(−β) R_y(−α) w0 (x₁, y₂, z₂).
+vec3 turned(PixelSetup p, vec3 w0) {
   const float x1 = p.cosA * w0.x - p.sinA * w0.z;  // R_y(−α)
   const float z1 = p.sinA * w0.x + p.cosA * w0.z;
-  const float y2 = p.cosB * w0.y + p.sinB * z1;    // R_x(−β)
-  if (y2 < p.skipBelowY) return false;
-  const float z2 = p.cosB * z1 - p.sinB * w0.y;
-  if (x1 * p.axis.x + y2 * p.axis.y + z2 * p.axis.z > p.coreCos) return false;  // the lobe path's core
-  const float theta = atan2Fast(sqrt(x1 * x1 + z2 * z2), y2);
-  const float phi = atan2Fast(x1, z2);
-  pos = vec2(min(max(theta * (float(m) / kPiF) - 0.5, 0.0), float(m - 1u)), phi * (float(m) / kTwoPiF) - fraction);
+  return vec3(x1, p.cosB * w0.y + p.sinB * z1, p.cosB * z1 - p.sinB * w0.y);  // R_x(−β)
+}
+vec2 positionOf(vec3 t, uint m, float fraction) {
+  const float theta = atan2Fast(sqrt(t.x * t.x + t.z * t.z), t.y);
+  const float phi = atan2Fast(t.x, t.z);
+  return vec2(min(max(theta * (float(m) / kPiF) - 0.5, 0.0), float(m - 1u)), phi * (float(m) / kTwoPiF) - fraction);
+}
+bool slicePosition(PixelSetup p, vec3 w0, uint m, float fraction, out vec2 pos) {
+  const vec3 t = turned(p, w0);
+  if (t.y < p.skipBelowY) return false;
+  if (dot(t, p.axis) > p.coreCos) return false;  // the lobe path's core
+  pos = positionOf(t, m, fraction);
   return true;
 }
 
 // ρ_c at the object-frame direction w0, bilinear in the slice texels (core
 // fused_kernel.cpp, the pass's lookup).
-vec3 rhoAt(const bool blended, PixelSetup p, vec3 w0) {
-  vec2 pos;
-  if (!slicePosition(p, w0, p.m, p.fraction, pos)) return vec3(0.0);
+vec3 bilinearAt(const bool blended, PixelSetup p, vec2 pos) {
   const int mask = int(p.m) - 1;
   const float rowFloor = floor(pos.x), colFloor = floor(pos.y);
   const float tRow = pos.x - rowFloor, tCol = pos.y - colFloor;
@@ -177,6 +192,11 @@ vec3 rhoAt(const bool blended, PixelSetup p, vec3 w0) {
   const vec3 top = tCol * (b - a) + a;
   const vec3 bottom = tCol * (e - c) + c;
   return tRow * (bottom - top) + top;
+}
+vec3 rhoAt(const bool blended, PixelSetup p, vec3 w0) {
+  vec2 pos;
+  if (!slicePosition(p, w0, p.m, p.fraction, pos)) return vec3(0.0);
+  return bilinearAt(blended, p, pos);
 }
 
 // ρ_c at the object-frame direction w0 for a point light: slicePosition at
@@ -227,6 +247,74 @@ vec3 sumDirections(const bool blended, PixelSetup p, out vec3 norm) {
     const float vis = p.sh.b[0] * bitOf(p.bits0, i) + p.sh.b[1] * bitOf(p.bits1, i) + p.sh.b[2] * bitOf(p.bits2, i);
     const vec3 w = texelFetch(light, int(p.lightBase + i)).rgb * vis;
     acc += w * rho;
+  }
+  return acc;
+}
+
+// The visibility of cell q for the vertex whose word 0 is `base`: its 16
+// bits (shared_cells.h cellBits).
+uint cellBitsOf(uint base, uint m, uint q) {
+  return cellBits(texelFetch(visibilityBits, int(base + cellWordIndex(m, q, 0u))).r,
+                  texelFetch(visibilityBits, int(base + cellWordIndex(m, q, 1u))).r,
+                  texelFetch(visibilityBits, int(base + cellWordIndex(m, q, 2u))).r,
+                  texelFetch(visibilityBits, int(base + cellWordIndex(m, q, 3u))).r, cellShift(m, q));
+}
+
+// V at a cell's direction k from its vertices' 16 bits, blendVisibility's order.
+float cellV(PixelSetup p, uvec3 bits, uint k) {
+  return p.sh.b[0] * float((bits.x >> k) & 1u) + p.sh.b[1] * float((bits.y >> k) & 1u) + p.sh.b[2] * float((bits.z >> k) & 1u);
+}
+
+// 1, by cells (shared_cells.h; core fused_cells_kernel.cpp): Σ over the
+// cells of this invocation (q ≡ lid mod LOCAL) of the pass's rows. ρ at
+// each cell's turned centre gives Ω_C·ρ and the detail there; a cell with
+// detail above the tolerance, or near the lobe path's core, is summed
+// direction by direction as sumDirections sums; the others at one
+// direction: V_C·P_c·ρ at the light's centroid where each vertex sees all
+// of it or none, Σ(V·L)·ρ at the centroid of V·L where some sees part.
+// `counted`: the coarse cells in its low 16 bits, the fine in its high (a
+// map has at most 1,024 cells, so the workgroup's sum keeps them apart).
+vec3 sumCells(const bool blended, PixelSetup p, out vec3 norm, out uint counted) {
+  vec3 acc = vec3(0.0);
+  norm = vec3(0.0);
+  counted = 0u;
+  const uint across = cellsAcross(p.m);
+  const uint r0 = p.firstRow / kCellSide, r1 = min(across, (p.endRow + kCellSide - 1u) / kCellSide);
+  for (uint q = r0 * across + gl_LocalInvocationID.x; q < r1 * across; q += LOCAL) {
+    const uvec3 bits = uvec3(cellBitsOf(p.bits0, p.m, q), cellBitsOf(p.bits1, p.m, q), cellBitsOf(p.bits2, p.m, q));
+    const float v = cellVisibility(bits.x, bits.y, bits.z, p.sh.b[0], p.sh.b[1], p.sh.b[2]);
+    const vec4 centre = texelFetch(directions, int(p.directionBase + cellCentreTexel(p.m, q)));  // xyz, and w = Ω_C
+    const vec3 t = turned(p, centre.xyz);
+    const vec2 pos = positionOf(t, p.m, p.fraction);
+    const uint texel = detailTexel(p.m, pos.x, pos.y, p.shift);
+    const float detail = max(texelFetch(details, int(p.detail0 + texel)).r, texelFetch(details, int(p.detail1 + texel)).r);
+    if (detail > p.tolerance || dot(t, p.axis) > p.coreCellCos) {
+      for (uint k = 0u; k < kCellDirections; ++k) {
+        const uint i = cellDirection(p.m, q, k);
+        const vec4 dir = texelFetch(directions, int(p.directionBase + i));
+        const vec3 rho = rhoAt(blended, p, dir.xyz);
+        norm += dir.w * rho;
+        acc += texelFetch(light, int(p.lightBase + i)).rgb * cellV(p, bits, k) * rho;
+      }
+      counted += 1u << 16u;
+      continue;
+    }
+    norm += centre.w * bilinearAt(blended, p, pos);
+    counted += 1u;
+    if (v > 0.0) {
+      const vec3 power = texelFetch(light, int(p.lightBase + cellPowerTexel(p.m, q))).rgb;
+      const vec3 toward = texelFetch(light, int(p.lightBase + cellCentroidTexel(p.m, q))).xyz;
+      acc += v * power * bilinearAt(blended, p, positionOf(turned(p, toward), p.m, p.fraction));
+    } else if (v < 0.0) {
+      vec3 power = vec3(0.0), toward = vec3(0.0);
+      for (uint k = 0u; k < kCellDirections; ++k) {
+        const uint i = cellDirection(p.m, q, k);
+        const vec3 l = texelFetch(light, int(p.lightBase + i)).rgb * cellV(p, bits, k);
+        power += l;
+        toward += (l.r + l.g + l.b) * texelFetch(directions, int(p.directionBase + i)).xyz;
+      }
+      acc += power * bilinearAt(blended, p, positionOf(turned(p, toward), p.m, p.fraction));
+    }
   }
   return acc;
 }
@@ -333,6 +421,10 @@ void shadePixel(uint s) {
   p.skipBelowY = o.skipBelowY;
   p.axis = vec3(0.0, 1.0, 0.0);
   p.coreCos = 2.0;
+  p.coreCellCos = 2.0;
+  p.tolerance = o.sumTolerance;
+  p.detail0 = (o.sliceBase + blend.first) * kCellDetailStride;
+  p.detail1 = (o.sliceBase + (blend.weight != 0.0 ? blend.second : blend.first)) * kCellDetailStride;
   vec3 energy;
   if (lobePath) {
     const SliceLobe a = lobes[o.sliceBase + blend.first], b = lobes[o.sliceBase + blend.second];
@@ -340,6 +432,7 @@ void shadePixel(uint s) {
     const vec2 st = sinCosPrecise(theta), sg = sinCosPrecise(rs.gamma);
     p.axis = vec3(-st.x * sg.x, st.y, -st.x * sg.y);
     p.coreCos = o.lobeCore.x;
+    p.coreCellCos = cosPrecise(min(acosPrecise(o.lobeCore.x) + cellReach(p.m), kPiF));  // fused.cpp's cos(core + reach)
     const vec3 e = a.energy.rgb + blend.weight * (b.energy.rgb - a.energy.rgb);
     const vec3 c = a.core.rgb + blend.weight * (b.core.rgb - a.core.rgb);
     energy = max(e - c, vec3(0.0));
@@ -355,32 +448,47 @@ void shadePixel(uint s) {
   const uvec2 rows = passRows(p.m, p.cosB, p.skipBelowY);
   p.firstRow = rows.x;
   p.endRow = rows.y;
-  if (lid == 0u) {
-    atomicAdd(sliceCounts[kSliceCountsPerObject * sh.object + 2u], rows.y - rows.x);
-    atomicMax(sliceCounts[kSliceCountsPerObject * sh.object + 3u], rows.y - rows.x);
-  }
-
   // Two slices: each tap blends its two texels (ρ is linear in the slice),
   // with no pass over the slice first and no scratch.
-  vec3 norm;
-  const vec3 acc = blended ? sumDirections(true, p, norm) : sumDirections(false, p, norm);
+  vec3 norm, acc;
+  uint counted = 0u;
+  const bool cells = o.sumTolerance > 0.0;
+  if (cells) {
+    acc = blended ? sumCells(true, p, norm, counted) : sumCells(false, p, norm, counted);
+  } else {
+    acc = blended ? sumDirections(true, p, norm) : sumDirections(false, p, norm);
+    if (lid == 0u) {
+      atomicAdd(sliceCounts[kSliceCountsPerObject * sh.object + 2u], rows.y - rows.x);
+      atomicMax(sliceCounts[kSliceCountsPerObject * sh.object + 3u], (rows.y - rows.x) * p.m);
+    }
+  }
 
   // 2. Reduce in invocation order, put the lobe's energy back (fused.cpp
   // energyKept: ×∫ρ / Σ ΔΩ·ρ), then the point lights and the lobe path.
   vec3 sum = vec3(0.0), sampled = vec3(0.0);
+  uint directionsSummed = 0u;
   if (SUBGROUP_REDUCE != 0u) {
     sum = subgroupAdd(acc);
     sampled = subgroupAdd(norm);
+    directionsSummed = subgroupAdd(counted);
   } else {
     partial[lid] = acc;
     partialSum[lid] = norm;
+    partialCount[lid] = counted;
     sync();
     if (lid == 0u) {
       for (uint k = 0u; k < LOCAL; ++k) sum += partial[k];
       for (uint k = 0u; k < LOCAL; ++k) sampled += partialSum[k];
+      for (uint k = 0u; k < LOCAL; ++k) directionsSummed += partialCount[k];
     }
   }
   if (lid == 0u) {
+    if (cells) {  // coarse and fine cells (shared_passes.h words 4, 5), directions: one and 16 each
+      const uint coarse = directionsSummed & 0xFFFFu, fine = directionsSummed >> 16u;
+      atomicAdd(sliceCounts[kSliceCountsPerObject * sh.object + 4u], coarse);
+      atomicAdd(sliceCounts[kSliceCountsPerObject * sh.object + 5u], fine);
+      atomicMax(sliceCounts[kSliceCountsPerObject * sh.object + 3u], coarse + kCellDirections * fine);
+    }
     for (int c = 0; c < 3; ++c) {
       if (sampled[c] > 0.0) sum[c] *= energy[c] / sampled[c];
     }

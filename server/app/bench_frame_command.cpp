@@ -22,6 +22,7 @@
 
 #include "haarcast/backends/backends.h"
 #include "haarcast/core/check.h"
+#include "haarcast/core/shared_cells.h"
 #include "list_flags.h"
 #include "progress.h"
 #include "haarcast/render/object_levels.h"
@@ -30,6 +31,12 @@
 
 namespace haarcast::app {
 namespace {
+
+std::string defaultTolerance() {
+  char text[16];
+  std::snprintf(text, sizeof text, "%g", static_cast<double>(shared::kDefaultSumTolerance));
+  return text;
+}
 
 struct BenchArgs {
   std::string backend = "both";
@@ -42,7 +49,8 @@ struct BenchArgs {
   std::string device;
   std::string rays = "auto";
   bool objectSky = true;  // fused: objects hide sky from each other (RenderOptions::objectSky)
-  std::string sumTolerances = "0";  // fused: RenderOptions::sumTolerance, one run each
+  // fused: RenderOptions::sumTolerance, one run each (default: render's and serve's)
+  std::string sumTolerances = defaultTolerance();
   std::string cacheDir;
   int frames = 3;
   int warmup = 1;

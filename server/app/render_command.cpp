@@ -7,6 +7,7 @@
 #include <memory>
 #include <string>
 
+#include "haarcast/core/shared_cells.h"
 #include "haarcast/backends/backends.h"
 #include "haarcast/render/object_levels.h"
 #include "haarcast/render/renderer.h"
@@ -133,6 +134,7 @@ std::function<int()> addRenderCommand(CLI::App& app) {
   c->add_option("--object-sky", args->options.objectSky,
                 "fused: objects hide sky from each other (true|false; false: each meets its own visibility alone)")
       ->capture_default_str();
+  args->options.sumTolerance = shared::kDefaultSumTolerance;  // RenderOptions keeps 0, as for automaticLevel
   c->add_option("--sum-tolerance", args->options.sumTolerance,
                 "fused: sum a cell of 4×4 directions at one where its visibility is whole and the BRDF slice's detail "
                 "is at most this fraction of its mean (0 = every direction)")

@@ -20,6 +20,7 @@
 
 #include "haarcast/backends/backends.h"
 #include "haarcast/core/check.h"
+#include "haarcast/core/shared_cells.h"
 #include "haarcast/net/host_check.h"
 #include "haarcast/net/protocol.h"
 #include "haarcast/net/server.h"
@@ -44,6 +45,7 @@ struct ServeArgs {
   int port = 8080;  // checked, then narrowed into server.port
   int grpcPort = 0;  // 0: no gRPC listener
   std::string antialias = "auto";
+  float sumTolerance = shared::kDefaultSumTolerance;  // fused: RenderOptions::sumTolerance
   std::string backend{render::kCpuBackend}, method = "fused", encoding = "jpeg";
   std::vector<std::string> backends;  // enabled for clients; empty: just --backend
   std::string level = "auto";  // render::parseLevelChoice; auto: its cap at most --max-level
@@ -184,6 +186,7 @@ int run(ServeArgs& a) {
   base.cacheDir = cacheDirFromFlag(a.cacheDir);
   base.sceneLimits = a.sceneLimits;
   base.threads = a.renderThreads;
+  base.sumTolerance = a.sumTolerance;
   const backends::DeviceOptions vulkanOptions{a.vulkanDevice, a.vulkanValidation, a.framesInFlight,
                                               parseRayModeFlag(a.rays)};
   auto sharedScenes = std::make_shared<std::vector<SceneSource>>(std::move(scenes));
@@ -343,6 +346,11 @@ std::function<int()> addServeCommand(CLI::App& app) {
   c->add_option("--token", a->token, "Required token (?token=T or Authorization: Bearer T); default $HAARCAST_TOKEN");
   c->add_option("--backend", a->backend, "Default backend: " + backends::availableText())->capture_default_str();
   c->add_option("--backends", a->backends, "Backends clients may choose (default: only --backend)")->delimiter(',');
+  c->add_option("--sum-tolerance", a->sumTolerance,
+                "fused: sum a cell of 4×4 directions at one where its visibility is whole and the BRDF slice's detail "
+                "is at most this fraction of its mean (0 = every direction)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
   c->add_option("--antialias", a->antialias, "auto|on|off: edge pixels as the mean of 4 sub-samples (auto: on)")
       ->capture_default_str();
   c->add_option("--level", a->level,

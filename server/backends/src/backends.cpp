@@ -53,12 +53,6 @@ std::unique_ptr<render::Renderer> makeRenderer(std::string_view backend, const r
                                                const render::RenderProgress& progress) {
   checkBuilt(backend);
   if (backend == render::kCpuBackend) return render::makeCpuRenderer(scene, options, progress);
-  if (options.sumTolerance > 0.0f) {
-    // fused.comp sums every direction; two backends must show one picture.
-    throw std::invalid_argument("sum tolerance " + std::to_string(options.sumTolerance) + ": the " + std::string(backend) +
-                                " backend sums every direction; the adaptive sum (--sum-tolerance) runs on the " +
-                                std::string(render::kCpuBackend) + " backend");
-  }
 #if HAARCAST_HAS_VULKAN
   gpu::VulkanOptions vulkan;
   vulkan.device = device.device;

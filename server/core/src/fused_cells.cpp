@@ -19,6 +19,9 @@
 namespace haarcast {
 namespace {
 
+static_assert(shared::kCellDetailStride ==
+              (1u << (2u * (shared::kFusedMaxLevel - 2u))));  // (M/4)² at the finest level `fused` takes
+
 void checkCellLevel(int level) {
   if (level < static_cast<int>(shared::kCellMinLevel) || level > static_cast<int>(shared::kFusedMaxLevel)) {
     throw std::invalid_argument("fused cells: level " + std::to_string(level) + " is outside " +
@@ -76,7 +79,7 @@ CellLight CellLight::fromPlanes(int level, std::span<const float> rowMajorPlanes
   CellLight out;
   out.level = level;
   out.stride = cells + kCellPadding;
-  out.planes.resize(3 * n);
+  out.planes.assign(3 * n, 0.0f);
   out.power.assign(3 * out.stride, 0.0f);
   for (auto* v : {&out.centroidX, &out.centroidY, &out.centroidZ}) v->assign(out.stride, 0.0f);
   for (std::size_t q = 0; q < cells; ++q) {

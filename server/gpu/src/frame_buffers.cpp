@@ -209,6 +209,7 @@ void VulkanRenderer::Impl::ensureResolution(int w, int h) {
                      {kFusedLobesBinding, &lobes},
                      {kFusedLobeLightTexelsBinding, &lobeLightTexels},
                      {kFusedPointSliceTexelsBinding, &pointSliceTexels},
+                     {kFusedDetailTexelsBinding, &detailTexels},
                      {kFusedSliceCountsBinding, &sliceCounts},
                      {kFusedHiddenBinding, &hidden}});
     return;

@@ -16,6 +16,7 @@
 #include "haarcast/core/check.h"
 #include "haarcast/core/fused.h"
 #include "haarcast/core/parallel.h"
+#include "haarcast/core/shared_cells.h"
 #include "haarcast/core/splitsum.h"
 #include "haarcast/render/point_lights.h"
 #include "haarcast/render/shading.h"
@@ -136,6 +137,11 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
     if (fused) {
       const std::size_t n = o.fusedLight.planes.size() / 3;  // N at the object's level
       fusedLightTexels(o.fusedLight.planes, std::span<glm::vec4>(lightTexelData).subspan(info.lightBase, n));
+      // By cells: the two agree on which objects (scene_upload.cpp, resolveFusedLight).
+      HC_CHECK_EQ(o.fusedLight.sumsByCells(), info.sumTolerance > 0.0f);
+      if (info.sumTolerance > 0.0f) {
+        fusedCellLightTexels(o.fusedLight.cells, std::span<glm::vec4>(lightTexelData).subspan(info.lightBase + n, 2 * n / shared::kCellDirections));
+      }
     }
     for (int c = 0; c < 3; ++c) info.rotation[c] = glm::vec4(glm::vec3(o.rotation[c]), 0.0f);
     for (int c = 0; c < 3; ++c) info.toLight[c] = glm::vec4(o.toLight[c], 0.0f);
@@ -241,11 +247,12 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
     const std::size_t visibilityBytes = 3 * shared::visibilityWords(static_cast<shared::uint>(objectLevel)) * sizeof(std::uint32_t);
     bytes += c[0] * fusedPixelBytes(objectLevel, false, visibilityBytes) +
              c[1] * fusedPixelBytes(objectLevel, true, visibilityBytes);
-    // The pass's directions: its rows × M (shared_layout.h passRows).
+    // The pass's directions: its rows × M (shared_layout.h passRows), or by
+    // cells one per coarse cell and 16 per fine one (core FusedScratch::passDirections).
     const std::size_t m = static_cast<std::size_t>(mapSize(objectLevel));
     frame.passSamples += std::size_t{c[0]} + c[1];
-    frame.passDirections += std::size_t{c[2]} * m;
-    frame.passDirectionsMax = std::max(frame.passDirectionsMax, std::size_t{c[3]} * m);
+    frame.passDirections += std::size_t{c[2]} * m + c[4] + shared::kCellDirections * std::size_t{c[5]};
+    frame.passDirectionsMax = std::max(frame.passDirectionsMax, std::size_t{c[3]});
   }
   HC_CHECK_EQ(counted, std::size_t{covered});  // the pass shaded every covered sample once
   frame.coefficientBytes = bytes;

@@ -1,6 +1,9 @@
 #include "haarcast/gpu/passes.h"
 
+#include "haarcast/core/check.h"
 #include "haarcast/core/fused.h"
+#include "haarcast/core/fused_cells.h"
+#include "haarcast/core/shared_cells.h"
 #include "haarcast/core/sphere_map.h"
 #include "haarcast/render/shading.h"
 
@@ -46,7 +49,8 @@ std::vector<BindingKind> fusedBindings() {
   std::vector<BindingKind> kinds(shared::kFusedBindings, BindingKind::Storage);
   for (const shared::uint b : {shared::kFusedSliceTexelsBinding, shared::kFusedLightTexelsBinding,
                                shared::kFusedVisibilityTexelsBinding, shared::kFusedDirectionTexelsBinding,
-                               shared::kFusedLobeLightTexelsBinding, shared::kFusedPointSliceTexelsBinding}) {
+                               shared::kFusedLobeLightTexelsBinding, shared::kFusedPointSliceTexelsBinding,
+                               shared::kFusedDetailTexelsBinding}) {
     kinds[b] = BindingKind::Texels;
   }
   return kinds;
@@ -65,6 +69,15 @@ void fusedLightTexels(std::span<const float> planes, std::span<glm::vec4> out) {
                                 std::to_string(n) + " texels");
   }
   for (std::size_t k = 0; k < n; ++k) out[k] = glm::vec4(planes[k], planes[n + k], planes[2 * n + k], 0.0f);
+}
+
+void fusedCellLightTexels(const CellLight& cells, std::span<glm::vec4> out) {
+  const std::size_t k = cells.stride - kCellPadding;
+  HC_CHECK_EQ(out.size(), 2 * k);
+  for (std::size_t q = 0; q < k; ++q) {
+    out[q] = glm::vec4(cells.power[q], cells.power[cells.stride + q], cells.power[2 * cells.stride + q], 0.0f);
+    out[k + q] = glm::vec4(cells.centroidX[q], cells.centroidY[q], cells.centroidZ[q], 0.0f);
+  }
 }
 
 std::vector<glm::vec4> pixelCentreDirections(int level) {
@@ -89,6 +102,12 @@ DirectionTable pixelCentreDirections(std::span<const int> levels) {
     out.base[static_cast<std::size_t>(level)] = static_cast<std::uint32_t>(out.directions.size());
     const std::vector<glm::vec4> one = pixelCentreDirections(level);
     out.directions.insert(out.directions.end(), one.begin(), one.end());
+    if (level < static_cast<int>(shared::kCellMinLevel)) continue;
+    // The sum by cells' centres and Ω_C after them (shared::cellCentreTexel),
+    // the CPU's floats.
+    const CellDirections& cells = cellDirections(level);
+    for (std::size_t q = 0; q + kCellPadding < cells.centreX.size(); ++q)
+      out.directions.emplace_back(cells.centreX[q], cells.centreY[q], cells.centreZ[q], cells.cellSolidAngle[q]);
   }
   return out;
 }

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "haarcast/core/fused.h"
+#include "haarcast/core/shared_cells.h"
 #include "haarcast/gpu/rotation_data.h"
 
 #include "vulkan_renderer_impl.h"
@@ -24,6 +25,7 @@ void VulkanRenderer::Impl::uploadScene() {
   // (the rotation contract's kRotateSlicesBinding).
   std::vector<float> sliceData;
   std::vector<float> pointData;  // fused: the slices as point values, laid out as sliceData
+  std::vector<float> detailData;  // fused: global slice s's detail map at s·kCellDetailStride (shared_cells.h)
   std::vector<std::uint32_t> method;
   std::vector<glm::vec4> pos, nor;
   std::vector<std::uint32_t> tri;
@@ -66,6 +68,18 @@ void VulkanRenderer::Impl::uploadScene() {
       info.lightBase = static_cast<std::uint32_t>(fusedLightTexelCount);
       info.directionBase = directionTable.base[static_cast<std::size_t>(p.level)];
       fusedLightTexelCount += objectN;
+      // By cells (the CPU's rule, renderer.cpp resolveFusedLight): the light's
+      // cells after its texels, the slices' detail maps.
+      const float tolerance = p.ground ? 0.0f : options.sumTolerance;
+      if (shared::sumsByCells(static_cast<shared::uint>(p.level), tolerance)) {
+        info.sumTolerance = tolerance;
+        fusedLightTexelCount += 2 * objectN / shared::kCellDirections;
+      }
+      detailData.resize((static_cast<std::size_t>(info.sliceBase) + T) * shared::kCellDetailStride, 0.0f);
+      for (std::size_t t = 0; t < T && pixelSlices.detail(0); ++t) {
+        const float* d = pixelSlices.detail(static_cast<int>(t));
+        std::copy(d, d + objectN / shared::kCellDirections, detailData.begin() + static_cast<std::ptrdiff_t>((info.sliceBase + t) * shared::kCellDetailStride));
+      }
       sliceData.insert(sliceData.end(), pixelSlices.texels().begin(), pixelSlices.texels().end());
       pointData.insert(pointData.end(), pixelSlices.pointTexels().begin(), pixelSlices.pointTexels().end());
       setFusedSkip(info, p.level, pixelSlices.lastNonZeroRow());
@@ -193,6 +207,8 @@ void VulkanRenderer::Impl::uploadScene() {
     upload(directions, directionTable.directions.data(), directionTable.directions.size() * sizeof(glm::vec4), kTexelUsage);
     upload(sliceEnergy, energies.data(), energies.size() * sizeof(glm::vec4));
     upload(pointSlices, pointData.data(), pointData.size() * sizeof(float), kTexelUsage);
+    if (detailData.empty()) detailData.push_back(0.0f);  // a buffer may not be empty
+    upload(details, detailData.data(), detailData.size() * sizeof(float), kTexelUsage);
     upload(lobes, lobeData.data(), lobeData.size() * sizeof(shared::SliceLobe));
     // No object with a lobe path: one zero texel, never read (a buffer may not be empty).
     const glm::vec4 none(0.0f);
@@ -280,6 +296,7 @@ void VulkanRenderer::Impl::createFusedPipeline(std::uint32_t local) {
   visibilityTexels = TexelView(context, visibility, VK_FORMAT_R32_UINT, sizeof(std::uint32_t));
   lobeLightTexels = TexelView(context, lobeLight, VK_FORMAT_R32G32B32A32_SFLOAT, sizeof(glm::vec4));
   pointSliceTexels = TexelView(context, pointSlices, VK_FORMAT_R32G32B32A32_SFLOAT, sizeof(glm::vec4));
+  detailTexels = TexelView(context, details, VK_FORMAT_R32_SFLOAT, sizeof(float));
   lightTexelData.resize(fusedLightTexelCount);
 
   // No scratch: a workgroup keeps only its reduction's vec3 per invocation,

@@ -94,17 +94,21 @@ struct VulkanRenderer::Impl {
   // `fused` whose objects hide sky from each other (kObjectSkyHidden).
   bool objectSky() const { return fused && options.objectSky && prepared.standingObjects() >= 2; }
   Buffer directions, pointLights, pointSlices;
+  // `fused` by cells (RenderOptions::sumTolerance): every slice's detail map
+  // (shared::kCellDetailStride apart); the light's cells follow each
+  // object's light texels, the cells' centres each level's directions.
+  Buffer details;
   // `fused`: per global slice its ∫ρ (vec4) and its lobe (SliceLobe), and
   // the prefiltered light (core/prefiltered_light.h) the lobe path reads.
   Buffer sliceEnergy, lobes, lobeLight;
   BufferUpload pointLightUpload;
   // fused.comp reads these through texel views (BindingKind::Texels).
-  TexelView sliceTexels, lightTexels, directionTexels, visibilityTexels, lobeLightTexels, pointSliceTexels;
+  TexelView sliceTexels, lightTexels, directionTexels, visibilityTexels, lobeLightTexels, pointSliceTexels, detailTexels;
   std::vector<glm::vec4> lightTexelData;  // this frame's light texels, before upload
   std::vector<PointLight> pointLightData;         // this frame's point lights, before upload
   std::uint32_t fusedGroups = 0;     // the most workgroups of the fused dispatch
   std::uint32_t fusedLocal = 0;      // its local size
-  std::size_t fusedLightTexelCount = 0;  // Σ over objects of N at each one's level
+  std::size_t fusedLightTexelCount = 0;  // Σ over objects of N at each one's level (+ 2K by cells)
   // Where the shadow rays are traced (VulkanRendererLimits::rays, resolved
   // when the renderer is built): on the device (device_rays.cpp) or by Embree
   // on the host (`rays` below). The rotating methods trace none.

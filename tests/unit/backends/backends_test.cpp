@@ -62,19 +62,5 @@ TEST(Backends, TheFactoryMakesTheRendererItsNameSays) {
   EXPECT_EQ(cpu->backend(), render::kCpuBackend);
 }
 
-// The adaptive sum runs on the CPU backend only: the Vulkan backend refuses
-// a tolerance rather than draw another picture, and says where it runs.
-TEST(Backends, OnlyTheCpuBackendTakesASumTolerance) {
-  if (!HAARCAST_TEST_HAS_VULKAN) GTEST_SKIP() << "no Vulkan backend in this build";
-  const render::Scene scene = render::defaultScene();
-  render::RenderOptions options;
-  options.level = 4;
-  options.cacheDir = "";
-  options.sumTolerance = 0.02f;
-  const std::string refused = messageOf([&] { backends::makeRenderer(render::kVulkanBackend, scene, options); });
-  EXPECT_NE(refused.find("runs on the cpu backend"), std::string::npos) << refused;
-  EXPECT_NE(backends::makeRenderer(render::kCpuBackend, scene, options), nullptr);
-}
-
 }  // namespace
 }  // namespace haarcast

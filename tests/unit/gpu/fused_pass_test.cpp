@@ -252,6 +252,10 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
   const TexelView lightView(context, lightBuf, VK_FORMAT_R32G32B32A32_SFLOAT, sizeof(glm::vec4));
   const TexelView bitsView(context, bitsBuf, VK_FORMAT_R32_UINT, sizeof(std::uint32_t));
   const TexelView dirView(context, dirBuf, VK_FORMAT_R32G32B32A32_SFLOAT, sizeof(glm::vec4));
+  // Every object sums every direction (ObjectInfo::sumTolerance 0): no detail map is read.
+  const float noDetail = 0.0f;
+  Buffer detailBuf = upload(&noDetail, sizeof noDetail);
+  const TexelView detailView(context, detailBuf, VK_FORMAT_R32_SFLOAT, sizeof(float));
   ComputePipeline p(context, "fused.comp", fusedBindings(), 0,
                     {{shared::kSpecLocalSize, shared::kLocalSize},
                      {shared::kSpecInterpolate, pc.interpolate ? 1u : 0u},
@@ -260,7 +264,8 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
   std::vector<std::uint32_t> sliceCounts(kWords * objects.size(), 0u);
   Buffer sliceCountBuf = upload(sliceCounts.data(), sliceCounts.size() * sizeof(std::uint32_t));
   p.bind({&sampleBuf, &shadeBuf, &objectBuf, &texelView, &lightView, &bitsView, &dirView, &pointBuf, &radiance,
-          &counterBuf, &maskBuf, &energyBuf, &lobeBuf, &prefilterView, &pointTexelView, &sliceCountBuf, &hiddenBuf});
+          &counterBuf, &maskBuf, &energyBuf, &lobeBuf, &prefilterView, &pointTexelView, &sliceCountBuf, &hiddenBuf,
+          &detailView});
   context.submit([&](VkCommandBuffer cb) { p.dispatch(cb, {kGroups, 1, 1}); });
   std::vector<glm::vec4> got(kPixels);
   radiance.read(got.data(), got.size() * sizeof(glm::vec4));
@@ -300,7 +305,7 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
     expected[i] = fusedShade(slices[o], blend, r, lights[o], vis, pointLights[o], masks[i], work, lobe, sky ? &*sky : nullptr);
     const auto rows = static_cast<std::uint32_t>(work.passDirections / static_cast<std::size_t>(mapSize(levels[o])));
     wantCounts[kWords * o + 2] += rows;
-    wantCounts[kWords * o + 3] = std::max(wantCounts[kWords * o + 3], rows);
+    wantCounts[kWords * o + 3] = std::max(wantCounts[kWords * o + 3], static_cast<std::uint32_t>(work.passDirections));
     if (sky) {
       const std::array<float, 3> open = fusedShade(slices[o], blend, r, lights[o], vis, pointLights[o], masks[i], work, lobe);
       for (std::size_t c = 0; c < 3; ++c)
@@ -344,7 +349,8 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
     EXPECT_EQ(got[0], want[0]) << "object " << o << ": samples of one slice";
     EXPECT_EQ(got[1], want[1]) << "object " << o << ": samples of two";
     EXPECT_NEAR(got[2], want[2], want[0] + want[1]) << "object " << o << ": the pass's rows";
-    EXPECT_NEAR(got[3], want[3], 1.0) << "object " << o << ": the most rows for one sample";
+    EXPECT_NEAR(got[3], want[3], mapSize(levels[o])) << "object " << o << ": the most directions for one sample (a row)";
+    EXPECT_EQ(got[4] + got[5], 0u) << "object " << o << ": no cells";
   }
   EXPECT_GT(wantCounts[kWords * kPlain + 2], 0u) << "the plain object's samples ran the pass";
   std::printf("lobe path: %d samples all on it, %d in part\n", lobeSamples[0], lobeSamples[1]);

@@ -88,6 +88,19 @@ HC_FUNCTION float cellVisibility(uint bits0, uint bits1, uint bits2, float b0, f
 // centre's pull toward the cell's wider rows (SharedCells.CellReach measures it).
 HC_FUNCTION float cellReach(uint m) { return 10.6f / float(m); }
 
+// The Vulkan backend keeps every slice's detail map at a stride of the
+// most cells a map has (M/4 × M/4 at shared::kFusedMaxLevel = 7): global
+// slice s's at s·kCellDetailStride.
+HC_CONST uint kCellDetailStride = 1024u;
+
+// Where the Vulkan backend keeps an object's light by cells, after its N
+// texels of L·ΔΩ at its light base: P_c of cell q (RGB) at N + q, and the
+// centroid of its light at N + K + q (K cells).
+HC_FUNCTION uint cellPowerTexel(uint m, uint q) { return m * m + q; }
+HC_FUNCTION uint cellCentroidTexel(uint m, uint q) { return m * m + cellsAcross(m) * cellsAcross(m) + q; }
+// And its direction table, after its N pixel centres: cell q's centre and Ω_C at N + q.
+HC_FUNCTION uint cellCentreTexel(uint m, uint q) { return m * m + q; }
+
 // The slice's detail map is one value per texel of the cell level (M/4 ×
 // M/4), read at the texel holding the turned cell centre: continuous slice
 // texel position (row, column before γ's whole columns, as the pass's

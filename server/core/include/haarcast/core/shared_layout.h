@@ -274,7 +274,7 @@ struct ObjectInfo {
   uint visibilityBase; // `fused`: word of its vertex 0's bits; global vertex v at visibilityBase + (v − vertexBase)·visibilityWords(level)
   uint pointLevel;     // `fused`: its point slices' level (core PixelSlices::pointLevel), ≥ level
   uint pointTexelBase; // `fused`: texel of its point slice 0 in the point texels; slice t at pointTexelBase + t·N of pointLevel
-  uint levelPad0;
+  float sumTolerance;  // `fused`: sums by cells at this tolerance (shared_cells.h); 0: every direction
 };
 
 // ObjectInfo::flags: the object is the scene's ground, a Lambert plane that

@@ -188,11 +188,13 @@ HC_CONST uint kFusedLobeLightTexelsBinding = 13u;
 HC_CONST uint kFusedPointSliceTexelsBinding = 14u;
 HC_CONST uint kFusedSliceCountsBinding = 15u;
 // kFusedSliceCountsBinding's words per object: its samples of one slice (the
-// ground's too) and of two, the pass's rows summed over its samples and the
-// most for one sample (passRows).
-HC_CONST uint kSliceCountsPerObject = 4u;
+// ground's too) and of two, the pass's rows summed over its samples
+// (passRows), the most directions for one sample, and by cells
+// (shared_cells.h) its coarse cells and its fine cells summed over them.
+HC_CONST uint kSliceCountsPerObject = 6u;
 HC_CONST uint kFusedHiddenBinding = 16u;
-HC_CONST uint kFusedBindings = 17u;
+HC_CONST uint kFusedDetailTexelsBinding = 17u;  // the slices' detail maps (shared_cells.h)
+HC_CONST uint kFusedBindings = 18u;
 
 // splitsum.comp; kSplitsumLobeLightTexelsBinding is a uniform texel
 // buffer, the rest storage buffers (gpu::splitsumBindings).

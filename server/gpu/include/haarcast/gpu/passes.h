@@ -13,6 +13,7 @@
 #include <glm/mat3x3.hpp>
 #include <glm/vec4.hpp>
 
+#include "haarcast/core/fused_cells.h"
 #include "haarcast/core/haar.h"
 #include "haarcast/core/shared_layout.h"
 #include "haarcast/gpu/compute.h"
@@ -66,17 +67,23 @@ std::vector<glm::vec4> pixelCentreDirections(int level);
 
 // The directions of several levels in one table, for objects at their own
 // levels (ObjectInfo::directionBase): each level's pixelCentreDirections
-// once, ascending; level l's direction 0 at base[l] (0 for levels not in it).
+// once, ascending; level l's direction 0 at base[l] (0 for levels not in it),
+// at levels ≥ 5 followed by its cells' centres (shared::cellCentreTexel).
 struct DirectionTable {
   std::vector<glm::vec4> directions;
   std::array<std::uint32_t, shared::kFusedMaxLevel + 1> base{};
 };
 DirectionTable pixelCentreDirections(std::span<const int> levels);
 
+// An object's light by cells as fused.comp reads it after its N light
+// texels (shared::cellPowerTexel, cellCentroidTexel): K texels of P_c
+// (RGB), then K of the centroid (xyz). `out` has 2K texels.
+void fusedCellLightTexels(const CellLight& cells, std::span<glm::vec4> out);
+
 // The kinds of fused.comp's and splitsum.comp's bindings, from their names
 // (core/shared_passes.h): the *TexelsBinding ones uniform texel buffers
 // (fused: RGBA32F slices, light, directions, prefiltered light, point
-// slices; R32UI visibility words), the rest storage buffers.
+// slices; R32UI visibility words; R32F detail maps), the rest storage buffers.
 std::vector<BindingKind> fusedBindings();
 std::vector<BindingKind> splitsumBindings();
 
