@@ -32,6 +32,15 @@
 namespace haarcast::app {
 namespace {
 
+// The bench's "sum" column: how fused sums a pixel (RenderOptions::sumTolerance).
+std::string sumName(RotationMethod method, float tolerance) {
+  if (method != RotationMethod::Fused) return "—";
+  if (!(tolerance > 0.0f)) return "every direction";
+  char text[32];
+  std::snprintf(text, sizeof text, "cells τ %g", static_cast<double>(tolerance));
+  return text;
+}
+
 std::string defaultTolerance() {
   char text[16];
   std::snprintf(text, sizeof text, "%g", static_cast<double>(shared::kDefaultSumTolerance));
@@ -180,10 +189,11 @@ int run(const BenchArgs& a) {
   };
   // "fused / splitsum": the one pass of either, in place of rotation and triple product.
   // "directions": what fused's pass visits per object sample, mean / most.
-  line("| level | method | size | backend | light | gbuffer | rotation-input | shadow-rays | rotation | triple-product | fused / splitsum | tonemap | frame (s) | fps | coeff. bytes/frame | directions / sample (mean, max) | vs cpu |");
-  line("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
-  const std::size_t rows =
-      levels.size() * tolerances.size() * methods.size() * sizes.size() * ((cpu ? 1 : 0) + (vulkan ? 1 : 0));
+  line("| level | method | sum | size | backend | light | gbuffer | rotation-input | shadow-rays | rotation | triple-product | fused / splitsum | tonemap | frame (s) | fps | coeff. bytes/frame | directions / sample (mean, max) | vs cpu |");
+  line("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+  std::size_t runs = 0;  // per level: one per method, fused one per tolerance
+  for (const RotationMethod method : methods) runs += method == RotationMethod::Fused ? tolerances.size() : 1;
+  const std::size_t rows = levels.size() * runs * sizes.size() * ((cpu ? 1 : 0) + (vulkan ? 1 : 0));
   std::size_t rowsDone = 0;
   const auto started = std::chrono::steady_clock::now();
   StderrProgress progress("[bench-frame] ");
@@ -197,12 +207,11 @@ int run(const BenchArgs& a) {
   };
 
   for (const render::LevelChoice& choice : levels) {
-    for (const float tolerance : tolerances) {
-      // The level's name, and the sum's tolerance where one is set (fused only).
-      char tauText[32] = "";
-      if (tolerance > 0.0f) std::snprintf(tauText, sizeof tauText, ", τ %g", static_cast<double>(tolerance));
-      const std::string level = choice.name() + tauText;
-      for (const RotationMethod method : methods) {
+    const std::string level = choice.name();
+    for (const RotationMethod method : methods) {
+      // fused: one run per tolerance; the other methods sum no cells.
+      for (const float tolerance : method == RotationMethod::Fused ? tolerances : std::vector<float>{0.0f}) {
+        const std::string sum = sumName(method, tolerance);
         render::RenderOptions options;
         options.method = method;
         render::applyLevelChoice(options, choice);
@@ -211,7 +220,8 @@ int run(const BenchArgs& a) {
         options.objectSky = a.objectSky;
         options.sumTolerance = tolerance;
         options.cacheDir = a.cacheDir == "none" ? "" : a.cacheDir;
-        progress.message("level " + level + ", " + std::string(methodName(method)) + ": preparing");
+        progress.message("level " + level + ", " + std::string(methodName(method)) + (tolerance > 0.0f ? ", " + sum : "") +
+                         ": preparing");
         std::unique_ptr<render::Renderer> cpuRenderer, gpuRenderer;
         // Slice tables, visibility, rotators: the same progress lines as `render`.
         if (cpu) cpuRenderer = backends::makeRenderer(render::kCpuBackend, scene, options, {}, progress.callback());
@@ -229,8 +239,7 @@ int run(const BenchArgs& a) {
         const render::Renderer& any = *first;
         std::vector<int> objectLevels = any.objectLevels();
         if (objectLevels.empty()) objectLevels.assign(any.objectCount(), options.level);
-        const std::string levelCell =
-            choice.automatic ? choice.name() + " (" + render::describeLevels(objectLevels) + ")" + tauText : level;
+        const std::string levelCell = choice.automatic ? level + " (" + render::describeLevels(objectLevels) + ")" : level;
         for (const auto& [width, height] : sizes) {
           render::FrameRequest request;
           request.width = width;
@@ -283,7 +292,7 @@ int run(const BenchArgs& a) {
             if (method == RotationMethod::Fused || method == RotationMethod::Splitsum) run["slices"] = a.slices;
             run["antialias"] = antialias;
             out["runs"].push_back(run);
-            std::string row = "| " + levelCell + " | " + std::string(methodName(method)) + " | " +
+            std::string row = "| " + levelCell + " | " + std::string(methodName(method)) + " | " + sum + " | " +
                               std::to_string(width) + "×" + std::to_string(height) + " | " + backend +
                               (backend == vulkanName && gpuRenderer ? " (rays " + gpuRenderer->rays() + ")" : "") + " |";
             for (const char* name :

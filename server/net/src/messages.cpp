@@ -49,6 +49,9 @@ std::string frameMessage(const SessionConfig& config, const render::Frame& frame
   f->set_server_ms(facts.serverMs);
   *f->mutable_settings() = settingsToWire(config);
   f->set_exposure_stops(frame.exposureStops);
+  if (frame.passSamples > 0) {
+    f->set_directions_per_sample(static_cast<double>(frame.passDirections) / static_cast<double>(frame.passSamples));
+  }
   return serialize(m);
 }
 

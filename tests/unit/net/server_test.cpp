@@ -207,6 +207,28 @@ TEST(Server, WelcomeDescribesTheSceneAndAMaterialChangeIsAnnounced) {
   ASSERT_TRUE(f);
   EXPECT_TRUE(std::isfinite(f->frame().exposure_stops()));
   EXPECT_NE(f->frame().exposure_stops(), 0.0) << "auto exposure measured nothing";
+  EXPECT_EQ(f->frame().directions_per_sample(), 0.0) << "haar has no fused pass";
+}
+
+// A fused frame says how many map directions its pass summed a sample
+// (render::Frame::passDirections): some, and at level 4 at most the map's 256.
+TEST(Server, AFusedFrameSaysItsDirectionsASample) {
+  TestServer server;
+  Client c(server.port());
+  c.handshake();
+  v1::ClientMessage s;
+  s.mutable_settings()->set_method(v1::ROTATION_METHOD_FUSED);
+  c.send(s);
+  for (int i = 0; i < 5; ++i) {
+    c.send(pose(static_cast<std::uint64_t>(10 + i)));
+    auto f = c.expect(v1::ServerMessage::kFrame);
+    ASSERT_TRUE(f);
+    if (f->frame().settings().method() != v1::ROTATION_METHOD_FUSED) continue;
+    EXPECT_GT(f->frame().directions_per_sample(), 0.0);
+    EXPECT_LE(f->frame().directions_per_sample(), 256.0);
+    return;
+  }
+  FAIL() << "no fused frame";
 }
 
 // ---------------------------------------------------------------- HTTP
