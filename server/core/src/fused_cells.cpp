@@ -162,7 +162,7 @@ std::vector<float> sliceDetail(const float* texels, int level, const float energ
   const double texelTheta = kPi / across, texelPhi = kTwoPi / across;
   for (int row = 0; row < across; ++row) {
     for (int col = 0; col < across; ++col) {
-      float worst = 0.0f;
+      float worst = -1.0f;  // −1: every placement crossed the horizon
       // The texel's centre and its four corners.
       for (int corner = 0; corner < 5; ++corner) {
         const double theta = (row + (corner == 0 ? 0.5 : (corner & 1))) * texelTheta;
@@ -189,22 +189,26 @@ std::vector<float> sliceDetail(const float* texels, int level, const float energ
           // centroid of V·L lies above the kink. Such cells are measured by
           // their neighbours' detail (the 3 × 3 largest below).
           if (acrossHorizon) continue;
+          worst = std::max(worst, 0.0f);
           for (std::size_t c = 0; c < 3; ++c) worst = std::max(worst, std::abs(static_cast<float>(sum[c] / weight) - atCentre[c]));
         }
       }
-      raw[static_cast<std::size_t>(row * across + col)] = worst / mean;
+      raw[static_cast<std::size_t>(row * across + col)] = worst < 0.0f ? -1.0f : worst / mean;
     }
   }
-  // The largest of each texel's 3 × 3 neighbourhood (rows clamped, columns wrapped).
-  std::vector<float> out(raw.size(), 0.0f);
+  // A texel whose every placement crossed the horizon (the band along it)
+  // takes the largest detail measured in its 3 × 3 neighbourhood (rows
+  // clamped, columns wrapped): as smooth as the slice beside it.
+  std::vector<float> out = raw;
   for (int row = 0; row < across; ++row) {
     for (int col = 0; col < across; ++col) {
-      float most = 0.0f;
+      float& d = out[static_cast<std::size_t>(row * across + col)];
+      if (d >= 0.0f) continue;
+      d = 0.0f;
       for (int dr = -1; dr <= 1; ++dr) {
         const int r = std::clamp(row + dr, 0, across - 1);
-        for (int dc = -1; dc <= 1; ++dc) most = std::max(most, raw[static_cast<std::size_t>(r * across + ((col + dc + across) % across))]);
+        for (int dc = -1; dc <= 1; ++dc) d = std::max(d, raw[static_cast<std::size_t>(r * across + ((col + dc + across) % across))]);
       }
-      out[static_cast<std::size_t>(row * across + col)] = most;
     }
   }
   return out;

@@ -34,7 +34,7 @@ HC_CONST uint kCellMinLevel = 5u;
 // RenderOptions::sumTolerance's default: a cell is summed coarse where the
 // slice's detail there (PixelSlices::detail) is at most this fraction of
 // the slice's mean value over the hemisphere (docs/design.md has the bound).
-HC_CONST float kDefaultSumTolerance = 0.02f;
+HC_CONST float kDefaultSumTolerance = 0.1f;
 
 // Whether `fused` sums a map of this level by cells (a tolerance of 0 sums
 // every direction).
