@@ -9,6 +9,7 @@
 #include <sstream>
 #include <utility>
 
+#include "haarcast/core/shared_cells.h"
 #include "haarcast/assets/procedural_mesh.h"
 #include "haarcast/core/metrics.h"
 #include "haarcast/cpu/cpu_renderer.h"
@@ -294,10 +295,12 @@ nlohmann::json runShadowTruth(const TruthRun& run, std::vector<std::string>& not
   const EvalOptions& o = run.options;
   const int frame = o.truthFrame > 0 ? o.truthFrame : (o.quick ? 16 : 64);
   const render::ReferenceOptions ro = truthReferenceOptions(run, frame, o.quick ? 0.05 : 0.01, o.quick ? 256 : 16384, true);
-  // The product's defaults (light k, visibility, slice blend), as `render`
-  // draws; "fused/all-k" keeps every light coefficient, so that the light's
-  // truncation and the rest separate.
+  // The product's defaults (light k, visibility, slice blend, the sum by
+  // cells), as `render` draws; "fused/all-k" keeps every light coefficient
+  // and "fused/every-direction" sums every direction (sumTolerance 0), so
+  // that the light's truncation, the sum by cells and the rest separate.
   render::RenderOptions defaults;
+  defaults.sumTolerance = shared::kDefaultSumTolerance;
   defaults.width = defaults.height = frame;
   defaults.environmentBackground = false;
   defaults.cacheDir = run.base.cacheDir;
@@ -306,9 +309,11 @@ nlohmann::json runShadowTruth(const TruthRun& run, std::vector<std::string>& not
     std::string name;
     RotationMethod method;
     bool allLight;
+    bool everyDirection = false;
   };
   const std::vector<Variant> variants = {{"fused", RotationMethod::Fused, false},
                                          {"fused/all-k", RotationMethod::Fused, true},
+                                         {"fused/every-direction", RotationMethod::Fused, false, true},
                                          {"haar", RotationMethod::Haar, false}};
   const std::vector<int> levels = o.quick ? std::vector<int>{4} : std::vector<int>{5, 6};
 
@@ -321,7 +326,8 @@ nlohmann::json runShadowTruth(const TruthRun& run, std::vector<std::string>& not
                    {"render_defaults", {{"light_coefficients", defaults.lightCoefficients},
                                         {"visibility_supersampling", defaults.visibility.supersampling},
                                         {"visibility_keep", defaults.visibility.keep},
-                                        {"theta_samples", defaults.thetaSamples}}}};
+                                        {"theta_samples", defaults.thetaSamples},
+                                        {"sum_tolerance", defaults.sumTolerance}}}};
   const StageProgress inner = run.progress.callback();
   for (const ShadowScene& sc : shadowScenes(o, notes)) {
     const auto tScene = Clock::now();
@@ -363,6 +369,7 @@ nlohmann::json runShadowTruth(const TruthRun& run, std::vector<std::string>& not
         opt.level = level;
         opt.method = v.method;
         if (v.allLight) opt.lightCoefficients = 1u << 20;
+        if (v.everyDirection) opt.sumTolerance = 0.0f;
         const auto t = Clock::now();
         const render::RenderResult r = render::renderCpu(sc.scene, opt, inner);
         const TruthError e = compareWithTruth(truth.image.rgb, r.image.rgb, truth.objectMask, shadowed);

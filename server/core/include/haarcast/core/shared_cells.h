@@ -5,15 +5,19 @@
 // At level n ≥ kCellMinLevel the M² map directions are grouped in cells of
 // 4 × 4: cell (R, C) holds rows 4R … 4R + 3 and columns 4C … 4C + 3, cell
 // index q = R·(M/4) + C, its direction k (0 … 15) at row 4R + k/4 and column
-// 4C + k%4. Per pixel a cell is summed in one of three ways:
-//   hidden   every direction's V is 0 (each of the three vertices sees none
-//            of it): no light term;
-//   coarse   each vertex sees all of the cell or none, so V is one number
-//            V_C = Σ_v b_v·open_v, and the slice is smooth there (its detail
-//            at the cell's turned centre is at most the tolerance):
-//            V_C·Σ_c P_c·ρ_c(Rᵀω̄), P the cell's L·ΔΩ summed and ω̄ its
-//            light-weighted centroid (exact when ρ is linear over the cell);
-//   fine     otherwise: the 16 directions, as the full sum takes them.
+// 4C + k%4. Per pixel a cell is summed fine or coarse:
+//   fine     where the slice has detail there (its detail map at the cell's
+//            turned centre above the tolerance) or the lobe path's core is
+//            near: the 16 directions, as the full sum takes them;
+//   coarse   otherwise, at one direction, as V allows:
+//            hidden  V is 0 over the cell (each vertex sees none of it):
+//                    no light term;
+//            whole   each vertex sees all of it or none, so V is one number
+//                    V_C = Σ_v b_v·open_v: V_C·Σ_c P_c·ρ_c(Rᵀω̄), P the
+//                    cell's L·ΔΩ summed and ω̄ its light-weighted centroid
+//                    (exact when ρ is linear over the cell);
+//            mixed   Σ_c (Σ V·L_c·ΔΩ)·ρ_c at the centroid of V·L, the 16
+//                    directions' V and L summed first.
 // Every cell that is not fine adds Ω_C·ρ(Rᵀω_C) (its solid angle at its
 // centre) to the lobe's sampled energy, so `fused`'s energy ratio
 // (fused.cpp energyKept) still divides like by like.
