@@ -2,8 +2,11 @@
 // against the row-major bits and the map's directions, and the sum by cells
 // against the sum over every direction.
 #include <gtest/gtest.h>
+#include <hwy/targets.h>
 
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
 #include <random>
 #include <vector>
 
@@ -178,6 +181,38 @@ TEST(FusedCells, ASharpLobeIsSummedFineWhereItIs) {
     EXPECT_GT(got.counts.fine, 0u);
     EXPECT_LT(got.directions * 3, want.directions * 2);
   }
+}
+
+// Both kernels on every SIMD target this machine has (Highway's dispatch,
+// mocked target by target): the vectors are 4, 8 or 16 lanes, a cell's 16
+// directions one to four of them, and the sums agree to float rounding.
+TEST(FusedCells, EveryTargetSumsAlike) {
+  const auto lambert = makeLambert({0.7, 0.6, 0.5});
+  const auto sharp = makeGgx({0.05, 0.05, 0.05}, {0.9, 0.8, 0.6}, 0.1);
+  const PixelSlices slices[2] = {slicesOf(*lambert, 6), slicesOf(*sharp, 6)};
+  const Pixel pixels[2] = {makePixel(6, 0.0f), makePixel(6, shared::kDefaultSumTolerance)};
+  const shared::SliceBlend blend{2u, 3u, 0.25f};
+  const std::vector<std::int64_t> targets = hwy::SupportedAndGeneratedTargets();
+  ASSERT_FALSE(targets.empty());
+  std::vector<Shaded> first;
+  for (const std::int64_t target : targets) {
+    hwy::SetSupportedTargetsForTest(target);
+    std::size_t k = 0;
+    for (const PixelSlices& s : slices) {
+      for (const Pixel& p : pixels) {
+        const Shaded got = shade(s, p, blend);
+        if (first.size() <= k) {
+          first.push_back(got);
+        } else {
+          EXPECT_LT(relativeError(got.rgb, first[k].rgb), 1e-5) << hwy::TargetName(target) << ", case " << k;
+          EXPECT_EQ(got.directions, first[k].directions) << hwy::TargetName(target) << ", case " << k;
+        }
+        ++k;
+      }
+    }
+  }
+  hwy::SetSupportedTargetsForTest(0);
+  std::printf("targets compared: %zu\n", targets.size());
 }
 
 TEST(FusedCells, ANegativeToleranceIsRefused) {

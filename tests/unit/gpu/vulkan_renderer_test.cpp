@@ -122,27 +122,42 @@ render::FrameRequest turnedRequest(const render::Scene& scene, const render::Ren
 // differences; every object pixel must be covered alike.
 class FusedFrame : public testing::GpuTestWithParam<int> {};
 
+// The CPU backend's frame and the Vulkan renderer's of `scene` under `o`
+// (turnedRequest), compared, with the figures printed under `what`.
+struct FusedPair {
+  render::FrameRequest request;
+  render::Frame cpu, vulkan;
+  Comparison c;
+};
+FusedPair renderFusedPair(const char* what, const render::Scene& scene, const render::RenderOptions& o, VulkanRenderer& gpu) {
+  FusedPair p;
+  p.request = turnedRequest(scene, o);
+  p.cpu = render::makeCpuRenderer(scene, o)->render(p.request);
+  p.vulkan = gpu.render(p.request);
+  p.c = compare(p.cpu, p.vulkan);
+  std::printf("%s, level %d: PSNR %.1f dB (MSE %.3g) over %zu pixels; %zu of %zu object pixels mismatched\n", what, o.level,
+              p.c.psnr, p.c.mse, p.c.compared, p.c.mismatched, p.c.objectPixels);
+  std::printf("  directions per sample: cpu %zu / %zu, vulkan %zu / %zu (most %zu, %zu)\n", p.cpu.passDirections,
+              p.cpu.passSamples, p.vulkan.passDirections, p.vulkan.passSamples, p.cpu.passDirectionsMax,
+              p.vulkan.passDirectionsMax);
+  return p;
+}
+
 TEST_P(FusedFrame, VulkanMatchesTheCpuBackend) {
   HAARCAST_REQUIRE_VULKAN();
   const render::Scene scene = render::defaultScene();
   render::RenderOptions o = frameOptions(RotationMethod::Fused, true);
   o.level = GetParam();
-  const auto cpu = render::makeCpuRenderer(scene, o);
   VulkanRenderer gpu(scene, o, testing::testOptions());
-  const render::FrameRequest request = turnedRequest(scene, o);
-  const render::Frame a = cpu->render(request);
-  const render::Frame b = gpu.render(request);
-  const Comparison c = compare(a, b);
-  std::printf("fused, level %d: PSNR %.1f dB (MSE %.3g) over %zu pixels; %zu of %zu object pixels mismatched\n",
-              o.level, c.psnr, c.mse, c.compared, c.mismatched, c.objectPixels);
-  EXPECT_GE(c.psnr, testing::fusedPsnrFloor(gpu.context()));
-  EXPECT_EQ(c.mismatched, 0u);
-  EXPECT_GT(c.objectPixels, 500u);
+  const FusedPair p = renderFusedPair("fused", scene, o, gpu);
+  const render::Frame& a = p.cpu;
+  const render::Frame& b = p.vulkan;
+  EXPECT_GE(p.c.psnr, testing::fusedPsnrFloor(gpu.context()));
+  EXPECT_EQ(p.c.mismatched, 0u);
+  EXPECT_GT(p.c.objectPixels, 500u);
   // The directions the pass visits (shared passRows, rows × M): the same
   // object samples on both; the rows may differ by one where acos rounds
   // differently at a row's edge, a few in a thousand.
-  std::printf("  directions per sample: cpu %zu / %zu, vulkan %zu / %zu (most %zu, %zu)\n", a.passDirections, a.passSamples,
-              b.passDirections, b.passSamples, a.passDirectionsMax, b.passDirectionsMax);
   EXPECT_EQ(a.passSamples, b.passSamples);
   EXPECT_GT(a.passSamples, 500u);
   EXPECT_NEAR(static_cast<double>(b.passDirections), static_cast<double>(a.passDirections), 1e-3 * a.passDirections);
@@ -151,7 +166,7 @@ TEST_P(FusedFrame, VulkanMatchesTheCpuBackend) {
   EXPECT_LT(a.passDirections, a.passSamples * (std::size_t{1} << (2 * o.level))) << "some rows are below every sample's cut";
   // The GPU counts what it reads: with the vertices' pixel forms (levels
   // 4–6 here), three planes of N floats per pixel instead of the lists.
-  expectStagesAndRgba8(b, kFusedStages, request.exposure.stops);
+  expectStagesAndRgba8(b, kFusedStages, p.request.exposure.stops);
   testing::expectNoValidationMessages(gpu.context());
 }
 
@@ -159,8 +174,8 @@ INSTANTIATE_TEST_SUITE_P(Levels, FusedFrame, ::testing::Values(4, 5, 6, 7));
 
 // The sum by cells (RenderOptions::sumTolerance, core/shared_cells.h) on
 // both backends: the same cells coarse and fine, so the same frame and the
-// same directions counted; levels 5 and 6 (cells start at 5), automatic
-// levels with a Lambert sphere (all its cells coarse) beside the torus.
+// same directions counted; levels 5 and 6 (cells start at 5), a Lambert
+// sphere (all its cells coarse) beside the GGX torus.
 class FusedCellsFrame : public testing::GpuTestWithParam<int> {};
 
 TEST_P(FusedCellsFrame, VulkanMatchesTheCpuBackend) {
@@ -170,18 +185,12 @@ TEST_P(FusedCellsFrame, VulkanMatchesTheCpuBackend) {
   render::RenderOptions o = frameOptions(RotationMethod::Fused, true);
   o.level = GetParam();
   o.sumTolerance = shared::kDefaultSumTolerance;
-  const auto cpu = render::makeCpuRenderer(scene, o);
   VulkanRenderer gpu(scene, o, testing::testOptions());
-  const render::FrameRequest request = turnedRequest(scene, o);
-  const render::Frame a = cpu->render(request);
-  const render::Frame b = gpu.render(request);
-  const Comparison c = compare(a, b);
-  std::printf("fused by cells, level %d: PSNR %.1f dB (MSE %.3g) over %zu pixels; %zu of %zu object pixels mismatched\n",
-              o.level, c.psnr, c.mse, c.compared, c.mismatched, c.objectPixels);
-  std::printf("  directions per sample: cpu %zu / %zu, vulkan %zu / %zu (most %zu, %zu)\n", a.passDirections, a.passSamples,
-              b.passDirections, b.passSamples, a.passDirectionsMax, b.passDirectionsMax);
-  EXPECT_GE(c.psnr, testing::fusedPsnrFloor(gpu.context()));
-  EXPECT_EQ(c.mismatched, 0u);
+  const FusedPair p = renderFusedPair("fused by cells", scene, o, gpu);
+  const render::Frame& a = p.cpu;
+  const render::Frame& b = p.vulkan;
+  EXPECT_GE(p.c.psnr, testing::fusedPsnrFloor(gpu.context()));
+  EXPECT_EQ(p.c.mismatched, 0u);
   EXPECT_EQ(a.passSamples, b.passSamples);
   // A cell's detail read at a turned centre on a texel's edge may round
   // the other way: a few cells in ten thousand.
@@ -256,18 +265,20 @@ TEST_P(FusedMirrorFrame, VulkanMatchesTheCpuBackend) {
   scene.objects[1].material = {"hazy mirror", "test-hazy", makeGgx(glm::dvec3(0.3), glm::dvec3(0.9), 0.005), ""};
   render::RenderOptions o = frameOptions(RotationMethod::Fused, true);
   o.level = GetParam();
-  const auto cpu = render::makeCpuRenderer(scene, o);
-  VulkanRenderer gpu(scene, o, testing::testOptions());
-  const render::FrameRequest request = turnedRequest(scene, o);
-  const render::Frame a = cpu->render(request);
-  const render::Frame b = gpu.render(request);
-  const Comparison c = compare(a, b);
-  std::printf("fused with the lobe path, level %d: PSNR %.1f dB (MSE %.3g) over %zu pixels; %zu of %zu object pixels mismatched\n",
-              o.level, c.psnr, c.mse, c.compared, c.mismatched, c.objectPixels);
-  EXPECT_GE(c.psnr, testing::fusedPsnrFloor(gpu.context()));
-  EXPECT_EQ(c.mismatched, 0u);
-  EXPECT_GT(c.objectPixels, 500u);
-  testing::expectNoValidationMessages(gpu.context());
+  // Every direction, then by cells (level 5): the cells near the lobe
+  // path's core are summed fine on both backends.
+  for (const float tolerance : {0.0f, shared::kDefaultSumTolerance}) {
+    o.sumTolerance = tolerance;
+    VulkanRenderer gpu(scene, o, testing::testOptions());
+    const FusedPair p = renderFusedPair(tolerance > 0.0f ? "fused with the lobe path, by cells" : "fused with the lobe path",
+                                        scene, o, gpu);
+    EXPECT_GE(p.c.psnr, testing::fusedPsnrFloor(gpu.context()));
+    EXPECT_EQ(p.c.mismatched, 0u);
+    EXPECT_GT(p.c.objectPixels, 500u);
+    EXPECT_NEAR(static_cast<double>(p.vulkan.passDirections), static_cast<double>(p.cpu.passDirections),
+                2e-3 * p.cpu.passDirections);
+    testing::expectNoValidationMessages(gpu.context());
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Levels, FusedMirrorFrame, ::testing::Values(4, 5));
