@@ -159,6 +159,7 @@ void Context::free(VkDeviceMemory memory) {
 bool Context::validationEnabled() const { return shared_->validationEnabled(); }
 const RayTracingSupport& Context::rayTracing() const { return shared_->rayTracing(); }
 bool Context::subgroupArithmetic() const { return shared_->subgroupArithmetic(); }
+bool Context::subgroupBallotShuffle() const { return shared_->subgroupBallotShuffle(); }
 
 std::vector<std::string> Context::validationMessages() const {
   return shared_->validationLog().since(validationMark_.load());

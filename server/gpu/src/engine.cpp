@@ -304,6 +304,8 @@ SharedDevice::SharedDevice(std::shared_ptr<VulkanInstance> instance, VkPhysicalD
   subgroupSize_ = std::max<std::uint32_t>(subgroup.subgroupSize, 1);
   subgroupArithmetic_ = (subgroup.supportedOperations & VK_SUBGROUP_FEATURE_ARITHMETIC_BIT) != 0 &&
                         (subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) != 0;
+  subgroupBallotShuffle_ = subgroupArithmetic_ && (subgroup.supportedOperations & VK_SUBGROUP_FEATURE_BALLOT_BIT) != 0 &&
+                           (subgroup.supportedOperations & VK_SUBGROUP_FEATURE_SHUFFLE_BIT) != 0;
   vkGetPhysicalDeviceMemoryProperties(physical_, &memory_);
   queueFamily_ = *findQueueFamily(physical_, &timestampValidBits_);  // describe() found one
 

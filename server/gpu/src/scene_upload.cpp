@@ -318,7 +318,8 @@ void VulkanRenderer::Impl::createFusedPipeline(std::uint32_t local) {
       std::vector<SpecConstant>{{shared::kSpecLocalSize, fusedLocal},
                                 {shared::kSpecInterpolate, options.interpolateSlices ? 1u : 0u},
                                 {shared::kSpecPrefilterFinest, static_cast<std::uint32_t>(std::max(prepared.lobeLight.finestLevel(), 0))},
-                                {shared::kSpecSubgroupReduce, subgroupReduce ? 1u : 0u}});
+                                {shared::kSpecSubgroupReduce, subgroupReduce ? 1u : 0u},
+                                {shared::kSpecCellsTogether, limits.cellsTogether && context.subgroupBallotShuffle() ? 1u : 0u}});
 }
 
 }  // namespace haarcast::gpu

@@ -14,6 +14,7 @@
 #include <mutex>
 #include <string>
 #include <thread>
+#include <tuple>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -175,18 +176,24 @@ INSTANTIATE_TEST_SUITE_P(Levels, FusedFrame, ::testing::Values(4, 5, 6, 7));
 // The sum by cells (RenderOptions::sumTolerance, core/shared_cells.h) on
 // both backends: the same cells coarse and fine, so the same frame and the
 // same directions counted; levels 5 and 6 (cells start at 5), a Lambert
-// sphere (all its cells coarse) beside the GGX torus.
-class FusedCellsFrame : public testing::GpuTestWithParam<int> {};
+// sphere (all its cells coarse) beside the GGX torus. The device's cells
+// that need 16 directions summed by their subgroup together, and each by
+// its own invocation (VulkanRendererLimits::cellsTogether, the path of
+// devices without subgroup ballot and shuffle).
+class FusedCellsFrame : public testing::GpuTestWithParam<std::tuple<int, bool>> {};
 
 TEST_P(FusedCellsFrame, VulkanMatchesTheCpuBackend) {
   HAARCAST_REQUIRE_VULKAN();
   render::Scene scene = render::defaultScene();
   scene.objects[0].material = render::materialFromSpec("lambert");
   render::RenderOptions o = frameOptions(RotationMethod::Fused, true);
-  o.level = GetParam();
+  o.level = std::get<0>(GetParam());
   o.sumTolerance = shared::kDefaultSumTolerance;
-  VulkanRenderer gpu(scene, o, testing::testOptions());
-  const FusedPair p = renderFusedPair("fused by cells", scene, o, gpu);
+  VulkanRendererLimits limits;
+  limits.cellsTogether = std::get<1>(GetParam());
+  VulkanRenderer gpu(scene, o, testing::testOptions(), {}, limits);
+  const FusedPair p = renderFusedPair(limits.cellsTogether ? "fused by cells, subgroups together" : "fused by cells, lanes alone",
+                                      scene, o, gpu);
   const render::Frame& a = p.cpu;
   const render::Frame& b = p.vulkan;
   EXPECT_GE(p.c.psnr, testing::fusedPsnrFloor(gpu.context()));
@@ -200,7 +207,7 @@ TEST_P(FusedCellsFrame, VulkanMatchesTheCpuBackend) {
   testing::expectNoValidationMessages(gpu.context());
 }
 
-INSTANTIATE_TEST_SUITE_P(Levels, FusedCellsFrame, ::testing::Values(5, 6));
+INSTANTIATE_TEST_SUITE_P(Levels, FusedCellsFrame, ::testing::Combine(::testing::Values(5, 6), ::testing::Bool()));
 
 // Each object at its own level (RenderOptions::automaticLevel): the default
 // scene with a Lambert sphere (the floor, 5) beside its GGX torus (6) and

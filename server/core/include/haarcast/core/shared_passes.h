@@ -57,6 +57,12 @@ HC_CONST uint kSpecPrefilterFinest = 5u;  // PREFILTER_FINEST: the prefiltered l
 // shader with barriers into LLVM coroutines, which took 126 s for fused.comp
 // (docs/gpu.md, "Shader compilation on lavapipe").
 HC_CONST uint kSpecSubgroupReduce = 6u;
+// CELLS_TOGETHER (fused.comp, the sum by cells): 1 when the device's
+// subgroups have ballot, shuffle and arithmetic in compute shaders: a
+// subgroup takes its cells that need 16 directions one at a time, its lanes
+// across the cell, instead of each lane its own while the others wait;
+// 0: each invocation sums its own cells.
+HC_CONST uint kSpecCellsTogether = 7u;
 
 // ---- Indirect dispatch
 

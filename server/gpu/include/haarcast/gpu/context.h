@@ -142,6 +142,7 @@ class Context {
   std::uint32_t subgroupSize() const;
   // Whether compute shaders may use subgroup arithmetic (subgroupAdd).
   bool subgroupArithmetic() const;
+  bool subgroupBallotShuffle() const;  // Engine::subgroupBallotShuffle
 
   const RayTracingSupport& rayTracing() const;
 

@@ -92,6 +92,8 @@ class SharedDevice {
   std::uint32_t timestampValidBits() const { return timestampValidBits_; }
   std::uint32_t subgroupSize() const { return subgroupSize_; }
   bool subgroupArithmetic() const { return subgroupArithmetic_; }
+  // Arithmetic, ballot and shuffle subgroup operations in compute shaders.
+  bool subgroupBallotShuffle() const { return subgroupBallotShuffle_; }
   const DeviceInfo& info() const { return info_; }
   const VkPhysicalDeviceProperties& properties() const { return properties_; }
   const VkPhysicalDeviceMemoryProperties& memoryProperties() const { return memory_; }
@@ -116,6 +118,7 @@ class SharedDevice {
   std::uint32_t timestampValidBits_ = 0;
   std::uint32_t subgroupSize_ = 1;
   bool subgroupArithmetic_ = false;
+  bool subgroupBallotShuffle_ = false;
   VkPhysicalDeviceProperties properties_{};
   VkPhysicalDeviceMemoryProperties memory_{};
   RayTracingSupport rayTracing_;

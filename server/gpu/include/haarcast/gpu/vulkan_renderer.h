@@ -63,6 +63,10 @@ struct VulkanRendererLimits {
   // GPUs, at most the device's limit).
   std::uint32_t fusedLocalSize = 0;
   std::uint32_t fusedGroups = 0;
+  // `fused` by cells: a subgroup sums its fine and mixed cells together
+  // (shared_passes.h kSpecCellsTogether) where the device can; false: each
+  // invocation its own (the path of devices that cannot).
+  bool cellsTogether = true;
   // Frames that may render at once, each with its own device buffers,
   // command buffers and host scratch (the prepared scene is shared; its
   // device copy is uploaded once per frame in flight): 0 = 1 on a CPU device (lavapipe's frames share
