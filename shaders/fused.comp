@@ -19,7 +19,10 @@
 //      a + w·(b − a), as fusedShade blends texels (rhoAt); V(ω) is the hit
 //      triangle's three vertices' visibility bits blended by the
 //      barycentrics, V = b0·bit0 + b1·bit1 + b2·bit2 (core blendVisibility);
-//      accumulated with W_c = L_c·V;
+//      accumulated with W_c = L_c·V. An object with ObjectInfo::sumTolerance
+//      > 0 is summed by cells of 4 × 4 directions instead (sumCells,
+//      core/shared_cells.h): one lookup where its slice is smooth, the 16
+//      directions where not;
 //   2. the partial sums are reduced (subgroupAdd where the workgroup is one
 //      subgroup, SUBGROUP_REDUCE; else in invocation order through shared
 //      memory, with barriers); invocation 0 puts
@@ -347,7 +350,7 @@ vec3 sumCells(const bool blended, PixelSetup p, out vec3 norm, out uint counted)
     if (CELLS_TOGETHER == 0u) {
       if (kind == kCellDone) continue;
       vec3 power = vec3(0.0), toward = vec3(0.0);
-      for (uint k = 0u; k < kCellDirections; ++k) cellDirectionTerm(blended, p, q, bits, kind, k, acc, norm, power, toward);
+      [[dont_unroll]] for (uint k = 0u; k < kCellDirections; ++k) cellDirectionTerm(blended, p, q, bits, kind, k, acc, norm, power, toward);
       if (kind == kCellMixed) acc += mixedTerm(blended, p, power, toward);
       continue;
     }
