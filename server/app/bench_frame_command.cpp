@@ -144,19 +144,7 @@ int run(const BenchArgs& a) {
     levels.push_back(*choice);
   }
   const std::vector<RotationMethod> methods = parseMethodList(a.methods, "--method", true);
-  std::vector<float> tolerances;
-  for (const std::string& item : splitList(a.sumTolerances, "--sum-tolerance")) {
-    std::size_t used = 0;
-    float t = -1.0f;
-    try {
-      t = std::stof(item, &used);
-    } catch (const std::exception&) {
-    }
-    if (used != item.size() || !(t >= 0.0f && t <= 1.0f)) {
-      throw std::invalid_argument("--sum-tolerance: \"" + item + "\" is not a number in 0..1");
-    }
-    tolerances.push_back(t);
-  }
+  const std::vector<float> tolerances = parseToleranceList(a.sumTolerances, "--sum-tolerance");
   const std::string cpuName(render::kCpuBackend), vulkanName(render::kVulkanBackend);
   const bool cpu = a.backend != vulkanName, vulkan = a.backend != cpuName;
   if (a.antialias != "on" && a.antialias != "off") {
@@ -349,7 +337,7 @@ std::function<int()> addBenchFrameCommand(CLI::App& app) {
   c->add_option("--device", args->device, "Vulkan device: an index or a name substring");
   c->add_option("--rays", args->rays, rayModeHelp())->capture_default_str();
   c->add_option("--sum-tolerance", args->sumTolerances,
-                "fused: the adaptive sum's tolerances, comma-separated (0 = every direction); e.g. 0,0.02 times both in one run")
+                sumToleranceHelp() + "; comma-separated, one run each: e.g. 0,0.1 times both")
       ->capture_default_str();
   c->add_option("--object-sky", args->objectSky, "fused: objects hide sky from each other (true|false: its cost, side by side)")
       ->capture_default_str();

@@ -9,9 +9,9 @@
 #include <sstream>
 #include <utility>
 
-#include "haarcast/core/shared_cells.h"
 #include "haarcast/assets/procedural_mesh.h"
 #include "haarcast/core/metrics.h"
+#include "haarcast/core/shared_cells.h"
 #include "haarcast/cpu/cpu_renderer.h"
 #include "haarcast/io/mesh_io.h"
 #include "haarcast/cpu/reference.h"

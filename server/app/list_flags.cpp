@@ -4,6 +4,7 @@
 #include <optional>
 #include <sstream>
 #include <stdexcept>
+#include <string>
 
 #include "haarcast/render/renderer.h"
 
@@ -72,6 +73,28 @@ std::vector<RotationMethod> parseMethodList(const std::string& text, const char*
 render::RayMode parseRayModeFlag(const std::string& text) {
   if (const std::optional<render::RayMode> mode = render::parseRayMode(text)) return *mode;
   throw std::invalid_argument("--rays must be auto, device or host (got \"" + text + "\")");
+}
+
+std::string sumToleranceHelp() {
+  return "fused: sum a cell of 4×4 directions at one direction where the BRDF slice's detail there is at most "
+         "this fraction of its mean, the rest direction by direction (0 = every direction; docs/design.md)";
+}
+
+std::vector<float> parseToleranceList(const std::string& text, const char* flag) {
+  std::vector<float> out;
+  for (const std::string& item : splitList(text, flag)) {
+    std::size_t used = 0;
+    float t = -1.0f;
+    try {
+      t = std::stof(item, &used);
+    } catch (const std::exception&) {
+    }
+    if (used != item.size() || !(t >= 0.0f && t <= 1.0f)) {
+      throw std::invalid_argument(std::string(flag) + ": \"" + item + "\" is not a number in 0..1");
+    }
+    out.push_back(t);
+  }
+  return out;
 }
 
 std::string rayModeHelp() {

@@ -1,6 +1,6 @@
-// Comma-separated flag values that `bench-frame` and `loadtest` both take
-// (--sizes, --levels, --clients, --methods): one parser, one wording of
-// every error, which names the flag, the item and what is allowed.
+// Flag values that several commands take (--sizes, --levels, --clients,
+// --methods, --sum-tolerance, --rays): one parser, one wording of every
+// error, which names the flag, the item and what is allowed.
 #pragma once
 
 #include <string>
@@ -27,6 +27,11 @@ std::vector<std::pair<int, int>> parseSizeList(const std::string& text, const ch
 // Per-pixel method names (DESIGN.md), comma-separated; "all" (when allowed)
 // stands for every method.
 std::vector<RotationMethod> parseMethodList(const std::string& text, const char* flag, bool allowAll);
+
+// --sum-tolerance (RenderOptions::sumTolerance): its --help text, and a
+// comma-separated list of them, each in 0..1 (bench-frame times each).
+std::string sumToleranceHelp();
+std::vector<float> parseToleranceList(const std::string& text, const char* flag);
 
 // --rays: auto, device or host (render::RayMode).
 render::RayMode parseRayModeFlag(const std::string& text);

@@ -35,8 +35,9 @@ std::size_t methodStoredBytes(RotationMethod method, const std::vector<BrdfSlice
     }
     if (method == RotationMethod::Fused) {
       // fused reads the unrotated slices in pixel form (cpu_backend.cpp keeps
-      // exactly this per object), every channel.
-      bytes += PixelSlices::synthesize(table).storedBytes();
+      // exactly this per object), every channel, and the slices' detail
+      // maps, which `serve` keeps at its default (the sum by cells).
+      bytes += PixelSlices::synthesize(table, nullptr, true).storedBytes();
       continue;
     }
     // The CPU backend builds one rotator per channel (cpu_backend.cpp), so do

@@ -7,8 +7,8 @@
 #include <memory>
 #include <string>
 
-#include "haarcast/core/shared_cells.h"
 #include "haarcast/backends/backends.h"
+#include "haarcast/core/shared_cells.h"
 #include "haarcast/render/object_levels.h"
 #include "haarcast/render/renderer.h"
 #include "haarcast/render/scene.h"
@@ -136,8 +136,7 @@ std::function<int()> addRenderCommand(CLI::App& app) {
       ->capture_default_str();
   args->options.sumTolerance = shared::kDefaultSumTolerance;  // RenderOptions keeps 0, as for automaticLevel
   c->add_option("--sum-tolerance", args->options.sumTolerance,
-                "fused: sum a cell of 4×4 directions at one where its visibility is whole and the BRDF slice's detail "
-                "is at most this fraction of its mean (0 = every direction)")
+                sumToleranceHelp())
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));
   c->add_option("--backend", args->backend, "The backend: " + backends::availableText())->capture_default_str();

@@ -347,8 +347,7 @@ std::function<int()> addServeCommand(CLI::App& app) {
   c->add_option("--backend", a->backend, "Default backend: " + backends::availableText())->capture_default_str();
   c->add_option("--backends", a->backends, "Backends clients may choose (default: only --backend)")->delimiter(',');
   c->add_option("--sum-tolerance", a->sumTolerance,
-                "fused: sum a cell of 4×4 directions at one where its visibility is whole and the BRDF slice's detail "
-                "is at most this fraction of its mean (0 = every direction)")
+                sumToleranceHelp())
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));
   c->add_option("--antialias", a->antialias, "auto|on|off: edge pixels as the mean of 4 sub-samples (auto: on)")

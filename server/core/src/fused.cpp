@@ -129,7 +129,7 @@ std::vector<float> pointValues(const std::vector<float>& means, int level, int t
 
 }  // namespace
 
-PixelSlices PixelSlices::synthesize(const BrdfSliceTable& table, const BrdfSliceTable* pointTable) {
+PixelSlices PixelSlices::synthesize(const BrdfSliceTable& table, const BrdfSliceTable* pointTable, bool detailMaps) {
   checkFusedLevel(table.level());
   if (pointTable) {
     checkFusedLevel(pointTable->level());
@@ -163,7 +163,7 @@ PixelSlices PixelSlices::synthesize(const BrdfSliceTable& table, const BrdfSlice
   // The point lights' lookup reads a finer table where one is given: one
   // Catmull-Rom read a light, so its texels cost memory only.
   out.pointTexels_ = pointValues(pointTable ? sliceTexels(*pointTable) : out.texels_, out.pointLevel_, out.thetaSamples_);
-  if (out.level_ >= static_cast<int>(shared::kCellMinLevel)) {
+  if (detailMaps && out.level_ >= static_cast<int>(shared::kCellMinLevel)) {
     for (int t = 0; t < out.thetaSamples_; ++t) {
       const std::vector<float> d = sliceDetail(out.slice(t), out.level_, out.energy_[static_cast<std::size_t>(t)].data());
       out.detail_.insert(out.detail_.end(), d.begin(), d.end());
@@ -421,8 +421,8 @@ std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBl
   }
   std::array<float, 3> out{};
   if (inPass && light.sumsByCells() && slices.detail(0)) {
-    // By cells (shared_cells.h): coarse where the visibility is whole and
-    // the slice smooth, the rest direction by direction.
+    // By cells (shared_cells.h): at one direction where the slice is
+    // smooth, the rest direction by direction.
     detail::FusedCellPass cells;
     cells.pass = pass;
     cells.cells = &cellDirections(level);

@@ -58,7 +58,7 @@ void VulkanRenderer::Impl::uploadScene() {
       // The slices in pixel form, RGB0 texels (core PixelSlices), the
       // object's slice t at texelBase + t·N of its level; its energies and
       // lobes at global slice sliceBase + t; its light at lightBase.
-      const PixelSlices pixelSlices = PixelSlices::synthesize(p.table, p.finerPointTable());
+      const PixelSlices pixelSlices = PixelSlices::synthesize(p.table, p.finerPointTable(), options.sumTolerance > 0.0f);
       const std::size_t objectN = static_cast<std::size_t>(mapSize(p.level)) * static_cast<std::size_t>(mapSize(p.level));
       info.level = static_cast<std::uint32_t>(p.level);
       info.sliceBase = static_cast<std::uint32_t>(energies.size());

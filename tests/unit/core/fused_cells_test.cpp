@@ -138,7 +138,7 @@ PixelSlices slicesOf(const Brdf& brdf, int level) {
   SliceTableOptions options;
   options.level = level;
   options.thetaSamples = 4;
-  return PixelSlices::synthesize(BrdfSliceTable::build(brdf, options));
+  return PixelSlices::synthesize(BrdfSliceTable::build(brdf, options), nullptr, true);
 }
 
 // With a tolerance below every detail, every cell that can add anything

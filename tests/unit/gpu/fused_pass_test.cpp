@@ -344,13 +344,13 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
   // summed and the most for one sample to a row a sample (passRows' acos
   // may round differently on a device where a row's edge falls).
   for (std::size_t o = 0; o < objects.size(); ++o) {
-    const std::uint32_t* got = sliceCounts.data() + kWords * o;
+    const std::uint32_t* counted = sliceCounts.data() + kWords * o;
     const std::uint32_t* want = wantCounts.data() + kWords * o;
-    EXPECT_EQ(got[0], want[0]) << "object " << o << ": samples of one slice";
-    EXPECT_EQ(got[1], want[1]) << "object " << o << ": samples of two";
-    EXPECT_NEAR(got[2], want[2], want[0] + want[1]) << "object " << o << ": the pass's rows";
-    EXPECT_NEAR(got[3], want[3], mapSize(levels[o])) << "object " << o << ": the most directions for one sample (a row)";
-    EXPECT_EQ(got[4] + got[5], 0u) << "object " << o << ": no cells";
+    EXPECT_EQ(counted[0], want[0]) << "object " << o << ": samples of one slice";
+    EXPECT_EQ(counted[1], want[1]) << "object " << o << ": samples of two";
+    EXPECT_NEAR(counted[2], want[2], want[0] + want[1]) << "object " << o << ": the pass's rows";
+    EXPECT_NEAR(counted[3], want[3], mapSize(levels[o])) << "object " << o << ": the most directions for one sample (a row)";
+    EXPECT_EQ(counted[4] + counted[5], 0u) << "object " << o << ": no cells";
   }
   EXPECT_GT(wantCounts[kWords * kPlain + 2], 0u) << "the plain object's samples ran the pass";
   std::printf("lobe path: %d samples all on it, %d in part\n", lobeSamples[0], lobeSamples[1]);

@@ -51,7 +51,10 @@ class PixelSlices {
   // Synthesises every slice of the table (inverse Haar per channel). The
   // point slices come from `pointTable` when given (the same BRDF and θₒ
   // at a level as fine or finer: render::pointLightLevel), else from `table`.
-  static PixelSlices synthesize(const BrdfSliceTable& table, const BrdfSliceTable* pointTable = nullptr);
+  // `detailMaps`: each slice's detail map too (detail()), for the sum by
+  // cells (RenderOptions::sumTolerance > 0; level ≥ shared::kCellMinLevel).
+  static PixelSlices synthesize(const BrdfSliceTable& table, const BrdfSliceTable* pointTable = nullptr,
+                                bool detailMaps = false);
 
   int level() const { return level_; }
   // The point slices' level: level() or finer.
@@ -69,7 +72,8 @@ class PixelSlices {
   // equator), which lets the pass skip directions that cannot contribute.
   int lastNonZeroRow() const { return lastNonZeroRow_; }
   // Slice t's detail map at the cell level (fused_cells.h sliceDetail):
-  // what the adaptive sum reads; empty (nullptr) below shared::kCellMinLevel.
+  // what the sum by cells reads; nullptr where synthesize made none (not
+  // asked for, or below shared::kCellMinLevel).
   const float* detail(int t) const;
   std::size_t storedBytes() const { return (texels_.size() + pointTexels_.size() + detail_.size()) * sizeof(float); }
   // ∫ ρ_c dω of slice t (the directional albedo, cos θᵢ included), R, G, B.
@@ -91,7 +95,7 @@ class PixelSlices {
 //
 // With a sum tolerance τ > 0 at level ≥ shared::kCellMinLevel the light is
 // also kept by cells (`cells`), and the pass sums by them (shared_cells.h):
-// coarse where the visibility is whole and the slice's detail at most τ.
+// at one direction a cell where the slice's detail is at most τ.
 struct FusedLight {
   int level = 0;
   std::vector<float> planes;

@@ -62,10 +62,10 @@ struct RenderOptions {
   // others (point_lights.h objectSkyHidden); false: each object's map part
   // meets its own visibility alone.
   bool objectSky = true;
-  // fused: the adaptive sum's tolerance τ (core/shared_cells.h): at level
-  // ≥ 5 a cell of 4 × 4 directions whose visibility is whole and where the
-  // slice's detail is at most τ is summed at one direction; 0 sums every
-  // direction.
+  // fused: the sum by cells' tolerance τ (core/shared_cells.h): at level
+  // ≥ 5 a cell of 4 × 4 directions where the slice's detail is at most τ
+  // is summed at one direction; 0 sums every direction. `render`, `serve`
+  // and `bench-frame` take shared::kDefaultSumTolerance.
   float sumTolerance = 0.0f;
   SceneLimits sceneLimits;                // objects, triangles, visibility memory (prepareScene)
   bool environmentBackground = true;      // false: black where no object is
