@@ -87,7 +87,7 @@ class CpuRenderer final : public Renderer {
       }
     }
     // The meshes' ray structures are built once; frames only move them.
-    idleRays_.push_back(makeRays());
+    idleWork_.push_back(makeWork());
   }
 
   std::string backend() const override { return std::string(kCpuBackend); }
@@ -114,32 +114,43 @@ class CpuRenderer final : public Renderer {
     return std::make_unique<RayScene>(std::move(instances));
   }
   // A frame poses its objects in a ray scene (setTransform), which no other
-  // frame may query meanwhile: each concurrent render borrows its own from
-  // the pool, built on first need (the concurrency the server runs, at most),
-  // and returns it when done. Everything else a frame reads is immutable.
-  class RaysLease {
+  // frame may query meanwhile, and fills a G-buffer: each concurrent render
+  // borrows both from the pool, built on first need (the concurrency the
+  // server runs, at most), and returns them when done. The G-buffer keeps its
+  // storage between frames: at 1280×720 it is ~140 MB, which a frame that
+  // allocated it afresh paid for in page faults (~6 % of its time).
+  // Everything else a frame reads is immutable.
+  struct GBuffer;
+  struct FusedSlots;
+  struct FrameWork;
+  class FrameLease {
    public:
-    explicit RaysLease(const CpuRenderer& r) : owner_(r) {
+    explicit FrameLease(const CpuRenderer& r) : owner_(r) {
       {
-        const std::lock_guard lock(owner_.raysMutex_);
-        if (!owner_.idleRays_.empty()) {
-          rays_ = std::move(owner_.idleRays_.back());
-          owner_.idleRays_.pop_back();
+        const std::lock_guard lock(owner_.workMutex_);
+        if (!owner_.idleWork_.empty()) {
+          work_ = std::move(owner_.idleWork_.back());
+          owner_.idleWork_.pop_back();
         }
       }
-      if (!rays_) rays_ = owner_.makeRays();
+      if (!work_) work_ = owner_.makeWork();
     }
-    ~RaysLease() {
-      const std::lock_guard lock(owner_.raysMutex_);
-      owner_.idleRays_.push_back(std::move(rays_));
+    ~FrameLease() {
+      const std::lock_guard lock(owner_.workMutex_);
+      owner_.idleWork_.push_back(std::move(work_));
     }
-    RaysLease(const RaysLease&) = delete;
-    RaysLease& operator=(const RaysLease&) = delete;
-    RayScene& operator*() const { return *rays_; }
+    FrameLease(const FrameLease&) = delete;
+    FrameLease& operator=(const FrameLease&) = delete;
+    RayScene& rays() const;
+    GBuffer& gbuffer() const;
+    FusedSlots& fusedSlots() const;
+    // Lets go of storage kept from a frame over twice this one's size, so a
+    // single large frame does not hold its memory for the renderer's life.
+    void fitTo(std::size_t pixels) const;
 
    private:
     const CpuRenderer& owner_;
-    std::unique_ptr<RayScene> rays_;
+    std::unique_ptr<FrameWork> work_;
   };
   Frame renderFrame(const FrameRequest& request, const CancelPoint& cancelPoint) const;
   // Bytes one rotation of one channel reads: the slice, plus for `matrix`
@@ -169,6 +180,22 @@ class CpuRenderer final : public Renderer {
     std::vector<std::array<std::optional<Sample>, shared::kSubsamples>> sub;
     std::size_t width = 0, height = 0;
   };
+  // fused's per-sample records, by slot (shadeFused).
+  struct FusedSlots {
+    std::vector<ShadingPoint> points;
+    std::vector<std::uint32_t> lightsSeen;     // the point lights each sees
+    std::vector<shared::HiddenLight> hidden;   // the sky other objects hide from it
+  };
+  struct FrameWork {
+    std::unique_ptr<RayScene> rays;
+    GBuffer gbuffer;
+    FusedSlots fusedSlots;
+  };
+  std::unique_ptr<FrameWork> makeWork() const {
+    auto w = std::make_unique<FrameWork>();
+    w->rays = makeRays();
+    return w;
+  }
   // gbuffer: traces the centres, finds the edge pixels, traces their
   // sub-samples. rotation-input: each sample's slice and Euler angles.
   void traceGBuffer(const RayScene& rays, const CameraRays& camera, int w, int h, GBuffer& g,
@@ -197,7 +224,7 @@ class CpuRenderer final : public Renderer {
   // (point_lights.h), for the shadow rays `fused` and `splitsum` cast.
   ShadingPoint samplePoint(const ObjectFrames& frames, const ResolvedFrame& resolved, std::size_t object,
                            const PixelInput& in) const;
-  std::size_t shadeFused(const ResolvedFrame& resolved, const RayScene& rays, const GBuffer& g,
+  std::size_t shadeFused(const ResolvedFrame& resolved, const RayScene& rays, const GBuffer& g, FusedSlots& slotRecords,
                          const FrameRequest& request, const CameraRays& camera, Frame& frame,
                          const CancelPoint& cancelPoint) const;
   std::size_t shadeSplitsum(const ResolvedFrame& resolved, const RayScene& rays, const GBuffer& g,
@@ -209,11 +236,20 @@ class CpuRenderer final : public Renderer {
   std::vector<std::array<std::unique_ptr<SliceRotator>, 3>> rotators_;  // rotating methods
   std::vector<std::unique_ptr<RgbHaarRotator>> rgbHaar_;                 // haar refined, else null
   std::vector<PixelSlices> pixelSlices_;                                 // fused
-  // Ray scenes not in use by a frame (RaysLease); posed per frame with
-  // setTransform (top level only).
-  mutable std::mutex raysMutex_;
-  mutable std::vector<std::unique_ptr<RayScene>> idleRays_;
+  // Ray scenes and G-buffers not in use by a frame (FrameLease); the ray
+  // scenes posed per frame with setTransform (top level only).
+  mutable std::mutex workMutex_;
+  mutable std::vector<std::unique_ptr<FrameWork>> idleWork_;
 };
+
+RayScene& CpuRenderer::FrameLease::rays() const { return *work_->rays; }
+CpuRenderer::GBuffer& CpuRenderer::FrameLease::gbuffer() const { return work_->gbuffer; }
+CpuRenderer::FusedSlots& CpuRenderer::FrameLease::fusedSlots() const { return work_->fusedSlots; }
+void CpuRenderer::FrameLease::fitTo(std::size_t pixels) const {
+  if (work_->gbuffer.centre.capacity() <= 2 * pixels) return;
+  work_->gbuffer = GBuffer{};
+  work_->fusedSlots = FusedSlots{};
+}
 
 std::size_t CpuRenderer::rotationBytes(std::size_t object) const {
   const std::size_t slice = static_cast<std::size_t>(mapSize(options_.level)) * static_cast<std::size_t>(mapSize(options_.level)) * sizeof(float);
@@ -402,20 +438,22 @@ Frame CpuRenderer::renderFrame(const FrameRequest& request, const CancelPoint& c
 
   // ---- gbuffer, rotation-input: Embree primary rays, per-sample inputs ----
   cancelPoint();
-  const RaysLease rays(*this);
-  for (std::size_t i = 0; i < resolved.objects.size(); ++i) (*rays).setTransform(i, glm::mat4(resolved.objects[i].objectToWorld));
+  const FrameLease lease(*this);
+  RayScene& rays = lease.rays();
+  for (std::size_t i = 0; i < resolved.objects.size(); ++i) rays.setTransform(i, glm::mat4(resolved.objects[i].objectToWorld));
   const int w = request.width, h = request.height;
   frame.width = w;
   frame.height = h;
   const CameraRays camera(request.camera, w, h);
   const std::size_t pixels = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
-  GBuffer g;
+  GBuffer& g = lease.gbuffer();
+  lease.fitTo(pixels);
   t0 = Clock::now();
   // Its tiles: the 4-row bands of centres, then with antialiasing the edge
   // search's rows, one check, and the edge samples' rows (traceGBuffer).
   const std::size_t rows = static_cast<std::size_t>(h);
   enterFrameStage(request, "gbuffer", (rows + 3) / 4 + (options_.antialias ? 2 * rows + 1 : 0));
-  traceGBuffer(*rays, camera, w, h, g, cancelPoint);
+  traceGBuffer(rays, camera, w, h, g, cancelPoint);
   frame.stages.push_back({"gbuffer", since(t0)});
   t0 = Clock::now();
   enterFrameStage(request, "rotation-input", rows + (g.sub.size() + 63) / 64);
@@ -434,8 +472,8 @@ Frame CpuRenderer::renderFrame(const FrameRequest& request, const CancelPoint& c
                                                                 : "rotation",
                   options_.method == RotationMethod::Fused ? 2 * rows : rows);
   switch (options_.method) {
-    case RotationMethod::Fused: bytes += shadeFused(resolved, *rays, g, request, camera, frame, cancelPoint); break;
-    case RotationMethod::Splitsum: bytes += shadeSplitsum(resolved, *rays, g, request, camera, frame, cancelPoint); break;
+    case RotationMethod::Fused: bytes += shadeFused(resolved, rays, g, lease.fusedSlots(), request, camera, frame, cancelPoint); break;
+    case RotationMethod::Splitsum: bytes += shadeSplitsum(resolved, rays, g, request, camera, frame, cancelPoint); break;
     default: bytes += shadeRotating(resolved, g, request, camera, frame, cancelPoint); break;
   }
 
@@ -532,7 +570,7 @@ ShadingPoint CpuRenderer::samplePoint(const ObjectFrames& frames, const Resolved
 }
 
 std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const RayScene& rays, const GBuffer& g,
-                                    const FrameRequest& request, const CameraRays& camera, Frame& frame,
+                                    FusedSlots& slotRecords, const FrameRequest& request, const CameraRays& camera, Frame& frame,
                                     const CancelPoint& cancelPoint) const {
   const auto t0 = Clock::now();
   const ObjectFrames frames(resolved);
@@ -554,12 +592,15 @@ std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const RayScen
   // ray each (point_lights.h), a pixel row's samples at a time so that each
   // light's rays go in packets. By slot (Shade), for the pass below.
   const std::size_t slotCount = g.centre.size() + g.sub.size() * shared::kSubsamples;
-  std::vector<ShadingPoint> points(slotCount);
-  std::vector<std::uint32_t> lightsSeen(slotCount, 0u);
+  std::vector<ShadingPoint>& points = slotRecords.points;
+  std::vector<std::uint32_t>& lightsSeen = slotRecords.lightsSeen;
+  points.resize(slotCount);  // each slot a sample takes is written below
+  lightsSeen.assign(slotCount, 0u);
   // The sky other objects hide from each object sample (point_lights.h),
   // packed as the Vulkan backend reads it.
   const SkyOccluders& occluders = resolved.skyOccluders;
-  std::vector<shared::HiddenLight> hidden(occluders.objectSky ? slotCount : 0, shared::HiddenLight{});
+  std::vector<shared::HiddenLight>& hidden = slotRecords.hidden;
+  hidden.assign(occluders.objectSky ? slotCount : 0, shared::HiddenLight{});
   parallelFor(g.height, [&](std::size_t y) {
     cancelPoint();
     thread_local std::vector<ShadingPoint> row;

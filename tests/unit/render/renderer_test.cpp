@@ -163,6 +163,39 @@ TEST(CpuBackend, FramesAreRepeatableAndEqualTheOneShotRender) {
   for (std::size_t i = 0; i < rotatingNames.size(); ++i) EXPECT_EQ(rotating.stages[i].name, rotatingNames[i]);
 }
 
+// A renderer keeps each frame's G-buffer and per-sample records for the
+// next (FrameLease): frames of other sizes and poses before, antialiased
+// edges, a ground and two objects (every per-sample record fused keeps),
+// must leave nothing behind.
+TEST(CpuBackend, AFrameAfterOthersOfOtherSizesEqualsAFreshRenderersFrame) {
+  Scene scene = torusScene();
+  scene.objects.push_back({"sphere", std::make_shared<Mesh>(assets::makeSphere(16)), materialFromSpec("lambert"), {}});
+  scene.objects.back().pose.translate = {0.9, 0.0, 0.0};
+  scene.objects.back().pose.scale = 0.4;
+  addGround(scene);
+  RenderOptions o = tinyOptions();
+  o.antialias = true;
+  FrameRequest small;
+  small.width = 20;
+  small.height = 14;
+  small.camera = scene.camera;
+  FrameRequest large = small;
+  large.width = 48;
+  large.height = 36;
+  large.poses = {scene.objects[0].pose, scene.objects[1].pose, scene.objects[2].pose};
+  large.poses[0].rotateDegrees.y += 30.0;
+  const auto renderer = makeCpuRenderer(scene, o);
+  renderer->render(large);
+  const Frame afterLarge = renderer->render(small);
+  renderer->render(small);
+  const Frame largeAgain = renderer->render(large);
+  const Frame freshSmall = makeCpuRenderer(scene, o)->render(small);
+  const Frame freshLarge = makeCpuRenderer(scene, o)->render(large);
+  EXPECT_EQ(afterLarge.image.rgb, freshSmall.image.rgb);
+  EXPECT_EQ(afterLarge.objectMask, freshSmall.objectMask);
+  EXPECT_EQ(largeAgain.image.rgb, freshLarge.image.rgb);
+}
+
 TEST(CpuBackend, PosesAndLightChangeTheFrame) {
   const Scene scene = torusScene();
   RenderOptions o = tinyOptions();
