@@ -63,7 +63,7 @@ class CpuRenderer final : public Renderer {
       if (options.method == RotationMethod::Splitsum) continue;  // its lobes are all it keeps (prepareScene)
       if (options.method == RotationMethod::Fused) {
         // The only per-object data fused keeps: the unrotated slices in pixel form.
-        pixelSlices_.push_back(PixelSlices::synthesize(p.table, p.finerPointTable(), options_.sumTolerance > 0.0f));
+        pixelSlices_.push_back(PixelSlices::synthesize(p.table, p.finerPointTable(), p.sumTolerance > 0.0f));
         continue;
       }
       // matrix and table precompute per channel for seconds at level 6

@@ -58,7 +58,7 @@ void VulkanRenderer::Impl::uploadScene() {
       // The slices in pixel form, RGB0 texels (core PixelSlices), the
       // object's slice t at texelBase + t·N of its level; its energies and
       // lobes at global slice sliceBase + t; its light at lightBase.
-      const PixelSlices pixelSlices = PixelSlices::synthesize(p.table, p.finerPointTable(), options.sumTolerance > 0.0f);
+      const PixelSlices pixelSlices = PixelSlices::synthesize(p.table, p.finerPointTable(), p.sumTolerance > 0.0f);
       const std::size_t objectN = static_cast<std::size_t>(mapSize(p.level)) * static_cast<std::size_t>(mapSize(p.level));
       info.level = static_cast<std::uint32_t>(p.level);
       info.sliceBase = static_cast<std::uint32_t>(energies.size());
@@ -68,11 +68,10 @@ void VulkanRenderer::Impl::uploadScene() {
       info.lightBase = static_cast<std::uint32_t>(fusedLightTexelCount);
       info.directionBase = directionTable.base[static_cast<std::size_t>(p.level)];
       fusedLightTexelCount += objectN;
-      // By cells (the CPU's rule, renderer.cpp resolveFusedLight): the light's
+      // By cells (PreparedObject::sumTolerance, as the CPU): the light's
       // cells after its texels, the slices' detail maps.
-      const float tolerance = p.ground ? 0.0f : options.sumTolerance;
-      if (shared::sumsByCells(static_cast<shared::uint>(p.level), tolerance)) {
-        info.sumTolerance = tolerance;
+      if (p.sumTolerance > 0.0f) {
+        info.sumTolerance = p.sumTolerance;
         fusedLightTexelCount += 2 * objectN / shared::kCellDirections;
       }
       detailData.resize((static_cast<std::size_t>(info.sliceBase) + T) * shared::kCellDetailStride, 0.0f);

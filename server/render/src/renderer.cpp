@@ -10,6 +10,7 @@
 #include <glm/geometric.hpp>
 
 #include "haarcast/core/lobe.h"
+#include "haarcast/core/shared_cells.h"
 #include "haarcast/core/splitsum.h"
 #include "haarcast/io/slice_cache.h"
 #include "haarcast/render/build_plan.h"
@@ -106,6 +107,7 @@ PreparedScene prepareScene(const Scene& scene, const RenderOptions& options, con
     if (!splitsum) p.table = objectSliceTable(object, options, p.level, progress);
     p.ground = object.ground;
     p.groundAlbedo = object.groundAlbedo;
+    if (!p.ground && shared::sumsByCells(static_cast<shared::uint>(p.level), options.sumTolerance)) p.sumTolerance = options.sumTolerance;
     p.sphereCentre = p.mesh->bounds().centre();
     for (const glm::vec3& v : p.mesh->positions) p.sphereRadius = std::max(p.sphereRadius, glm::length(glm::dvec3(v) - p.sphereCentre));
     if (p.ground) {
@@ -292,7 +294,7 @@ namespace {
 // lights in the object's frame; and for the ground itself its closed form.
 void resolveFusedLight(const PreparedScene& prepared, const PreparedObject& object, const glm::dmat3& lightRotation,
                        const std::optional<glm::dvec3>& groundNormal, const std::vector<glm::vec3>& worldDirections,
-                       float sumTolerance, ResolvedObject& o) {
+                       ResolvedObject& o) {
   // L_obj(ω) = L(Mω), M = lightRotationᵀ·objectRotation (lightInObjectFrame).
   const EulerYXY toObject = eulerFromMatrix(glm::transpose(glm::transpose(lightRotation) * o.rotation));
   std::array<SphereMap, 3> weighted =
@@ -309,7 +311,7 @@ void resolveFusedLight(const PreparedScene& prepared, const PreparedObject& obje
         if (glm::dot(sphericalToDirection(rowTheta(level, r), colPhi(level, col)), down) < 0.0)
           for (std::size_t c = 0; c < 3; ++c) weighted[c].at(r, col) = 0.0f;
   }
-  o.fusedLight = FusedLight::fromWeightedMaps(weighted, object.ground ? 0.0f : sumTolerance);
+  o.fusedLight = FusedLight::fromWeightedMaps(weighted, object.sumTolerance);
   o.pointLights.resize(worldDirections.size());
   for (std::size_t k = 0; k < worldDirections.size(); ++k) {
     const glm::dvec3 d = glm::transpose(o.rotation) * glm::dvec3(worldDirections[k]);
@@ -438,9 +440,9 @@ ResolvedFrame resolveFrame(const PreparedScene& prepared, const RenderOptions& o
     ResolvedObject& o = out.objects[i];
     if (fused) {
       // Everything resolveFusedLight reads that a request changes.
-      const FusedLightCache::Key key{light, o.rotation, groundNormal, options.sumTolerance};
+      const FusedLightCache::Key key{light, o.rotation, groundNormal};
       if (!prepared.fusedLightCache->find(i, key, o)) {
-        resolveFusedLight(prepared, prepared.objects[i], light, groundNormal, out.pointLightDirections, options.sumTolerance, o);
+        resolveFusedLight(prepared, prepared.objects[i], light, groundNormal, out.pointLightDirections, o);
         prepared.fusedLightCache->store(i, key, o);
       }
       out.lightBytes += o.fusedLight.planes.size() * sizeof(float);

@@ -127,6 +127,27 @@ TEST(SharedSteps, FrameRequestsAreCheckedWithClearErrors) {
   }
 }
 
+// Which objects fused sums by cells is decided once, in prepareScene, for
+// both backends: not the ground (shaded in closed form), not a level below
+// shared::kCellMinLevel, and not at all without a tolerance.
+TEST(SharedSteps, TheSumByCellsIsEachObjectsTolerance) {
+  Scene scene = torusScene();
+  addGround(scene);
+  RenderOptions o = tinyOptions();
+  o.level = 5;
+  o.sumTolerance = 0.1f;
+  const PreparedScene atFive = prepareScene(scene, o);
+  ASSERT_EQ(atFive.objects.size(), 2u);
+  EXPECT_EQ(atFive.objects[0].sumTolerance, 0.1f);
+  EXPECT_TRUE(atFive.objects[1].ground);
+  EXPECT_EQ(atFive.objects[1].sumTolerance, 0.0f);
+  o.level = 4;
+  EXPECT_EQ(prepareScene(scene, o).objects[0].sumTolerance, 0.0f);
+  o.level = 5;
+  o.sumTolerance = 0.0f;
+  EXPECT_EQ(prepareScene(scene, o).objects[0].sumTolerance, 0.0f);
+}
+
 TEST(CpuBackend, FramesAreRepeatableAndEqualTheOneShotRender) {
   const Scene scene = torusScene();
   RenderOptions o = tinyOptions();

@@ -167,6 +167,11 @@ struct PreparedObject {
   VisibilityBits visibilityBits;
   Pose pose;                           // the scene's pose
   bool ground = false;                 // the scene's ground (SceneObject::ground)
+  // `fused`: RenderOptions::sumTolerance where the object is summed by cells
+  // (shared_cells.h), else 0: the ground, shaded in closed form, and levels
+  // below shared::kCellMinLevel. Both backends read it here, for the
+  // slices' detail maps and the light's cells alike.
+  float sumTolerance = 0.0f;
   glm::dvec3 groundAlbedo{0.0};        // its Lambert albedo
   float shadowShift = 0.0f;            // point-light rays' origin shift, object units (× pose scale)
   // A sphere around the mesh, object frame: its bounds' centre and the
@@ -197,7 +202,6 @@ class FusedLightCache {
     glm::dmat3 lightRotation{1.0};
     glm::dmat3 objectRotation{1.0};
     std::optional<glm::dvec3> groundNormal;
-    float sumTolerance = 0.0f;  // RenderOptions::sumTolerance: whether the light is kept by cells
     bool operator==(const Key&) const = default;
   };
   // Copies the kept light of object `index` into `o` when it was resolved
