@@ -197,7 +197,12 @@ TEST(GrpcServer, AnEvictedSilentStreamIsEnded) {
   o.admission.pendingPerAddress = 2;
   TestServer server(o);
   const auto grpcPort = server.server().grpcPort();
-  GrpcClient first(grpcPort), second(grpcPort);  // silent: no Hello
+  // Silent streams, no Hello. Each client has its own channel, so two opened
+  // back to back may reach the server in either order: the second is opened
+  // only once the first is counted, which makes `first` the oldest.
+  GrpcClient first(grpcPort);
+  ASSERT_TRUE(eventually([&] { return metric(server.port(), "haarcast_pending_connections") == 1; }));
+  GrpcClient second(grpcPort);
   ASSERT_TRUE(eventually([&] { return metric(server.port(), "haarcast_pending_connections") == 2; }));
   Client newcomer(server.port(), std::string("/ws?token=") + kToken, 0, "127.0.0.7");
   ASSERT_TRUE(newcomer.connected());
