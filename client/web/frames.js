@@ -44,7 +44,8 @@ export async function onFrame(f, gen) {
     // serverMs, latencyMs: what the HUD counted of this frame (NaN: not counted).
     state.lastFrame = { sequence: f.sequence, poseSequence: f.poseSequence, width: f.width, height: f.height,
                         encoding: f.encoding, method, bytes, exposureStops: f.exposureStops, exposureMode,
-                        tone, serverMs, latencyMs, directions: f.directionsPerSample };
+                        tone, serverMs, latencyMs, directions: f.directionsPerSample,
+                        smoothShare: f.smoothShare };
     showFrameExposure(f.exposureStops, exposureMode);
     // The first frame of a change ends its build on the page, and the first
     // of a new scene lists its objects.

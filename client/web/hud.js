@@ -65,8 +65,10 @@ export function updateHud() {
   $('hud-size').textContent = f ? `${f.width}×${f.height} ${resolutionLabel()}` : '—';
   $('hud-method').textContent = (f && f.method) || '—';
   $('hud-exposure').textContent = f ? `${formatStops(f.exposureStops)} stops ${f.exposureMode}` : '—';
-  // fused: what a pixel cost, in map directions summed (by cells, fewer where the picture allows).
-  $('hud-directions').textContent = f && f.directions > 0 ? `${formatNumber(f.directions)} directions/px` : '';
+  // fused: what a pixel cost, in map directions summed (by cells, fewer where the picture allows),
+  // and the share of pixels whose sum came from their neighbours.
+  const smooth = f && f.smoothShare > 0 ? ` · ${Math.round(100 * f.smoothShare)} % from neighbours` : '';
+  $('hud-directions').textContent = f && f.directions > 0 ? `${formatNumber(f.directions)} directions/px${smooth}` : '';
   $('hud-stages').textContent = s.stages.length
     ? s.stages.map((x) => `${x.name} ${formatNumber(x.ms)}`).join(' · ') + ' ms' : '—';
   $('hud').classList.toggle('idle', s.idle);

@@ -28,22 +28,34 @@
 #include "haarcast/render/object_levels.h"
 #include "haarcast/render/renderer.h"
 #include "haarcast/render/scene.h"
+#include "haarcast/render/smooth_sum.h"
 
 namespace haarcast::app {
 namespace {
 
-// The bench's "sum" column: how fused sums a pixel (RenderOptions::sumTolerance).
-std::string sumName(RotationMethod method, float tolerance) {
+// How fused sums a pixel: RenderOptions::sumTolerance and smoothSumTolerance.
+struct SumChoice {
+  float cells = 0.0f;
+  float smooth = 0.0f;
+};
+
+// The bench's "sum" column.
+std::string sumName(RotationMethod method, const SumChoice& sum) {
   if (method != RotationMethod::Fused) return "—";
-  if (!(tolerance > 0.0f)) return "every direction";
-  char text[32];
-  std::snprintf(text, sizeof text, "cells τ %g", static_cast<double>(tolerance));
-  return text;
+  char text[64];
+  if (sum.cells > 0.0f) std::snprintf(text, sizeof text, "cells τ %g", static_cast<double>(sum.cells));
+  else std::snprintf(text, sizeof text, "every direction");
+  std::string out = text;
+  if (sum.smooth > 0.0f) {
+    std::snprintf(text, sizeof text, ", smooth ε %g", static_cast<double>(sum.smooth));
+    out += text;
+  }
+  return out;
 }
 
-std::string defaultTolerance() {
+std::string defaultTolerance(float value) {
   char text[16];
-  std::snprintf(text, sizeof text, "%g", static_cast<double>(shared::kDefaultSumTolerance));
+  std::snprintf(text, sizeof text, "%g", static_cast<double>(value));
   return text;
 }
 
@@ -59,7 +71,9 @@ struct BenchArgs {
   std::string rays = "auto";
   bool objectSky = true;  // fused: objects hide sky from each other (RenderOptions::objectSky)
   // fused: RenderOptions::sumTolerance, one run each (default: render's and serve's)
-  std::string sumTolerances = defaultTolerance();
+  std::string sumTolerances = defaultTolerance(shared::kDefaultSumTolerance);
+  // fused: RenderOptions::smoothSumTolerance, one run each with each of the above
+  std::string smoothSums = defaultTolerance(render::kDefaultSmoothSumTolerance);
   std::string cacheDir;
   int frames = 3;
   int warmup = 1;
@@ -144,7 +158,9 @@ int run(const BenchArgs& a) {
     levels.push_back(*choice);
   }
   const std::vector<RotationMethod> methods = parseMethodList(a.methods, "--method", true);
-  const std::vector<float> tolerances = parseToleranceList(a.sumTolerances, "--sum-tolerance");
+  std::vector<SumChoice> sums;
+  for (const float cells : parseToleranceList(a.sumTolerances, "--sum-tolerance"))
+    for (const float smooth : parseToleranceList(a.smoothSums, "--smooth-sum")) sums.push_back({cells, smooth});
   const std::string cpuName(render::kCpuBackend), vulkanName(render::kVulkanBackend);
   const bool cpu = a.backend != vulkanName, vulkan = a.backend != cpuName;
   if (a.antialias != "on" && a.antialias != "off") {
@@ -179,8 +195,8 @@ int run(const BenchArgs& a) {
   // "directions": what fused's pass visits per object sample, mean / most.
   line("| level | method | sum | size | backend | light | gbuffer | rotation-input | shadow-rays | rotation | triple-product | fused / splitsum | tonemap | frame (s) | fps | coeff. bytes/frame | directions / sample (mean, max) | vs cpu |");
   line("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
-  std::size_t runs = 0;  // per level: one per method, fused one per tolerance
-  for (const RotationMethod method : methods) runs += method == RotationMethod::Fused ? tolerances.size() : 1;
+  std::size_t runs = 0;  // per level: one per method, fused one per pair of tolerances
+  for (const RotationMethod method : methods) runs += method == RotationMethod::Fused ? sums.size() : 1;
   const std::size_t rows = levels.size() * runs * sizes.size() * ((cpu ? 1 : 0) + (vulkan ? 1 : 0));
   std::size_t rowsDone = 0;
   const auto started = std::chrono::steady_clock::now();
@@ -197,18 +213,19 @@ int run(const BenchArgs& a) {
   for (const render::LevelChoice& choice : levels) {
     const std::string level = choice.name();
     for (const RotationMethod method : methods) {
-      // fused: one run per tolerance; the other methods sum no cells.
-      for (const float tolerance : method == RotationMethod::Fused ? tolerances : std::vector<float>{0.0f}) {
-        const std::string sum = sumName(method, tolerance);
+      // fused: one run per pair of tolerances; the other methods sum no cells.
+      for (const SumChoice& choiceOfSum : method == RotationMethod::Fused ? sums : std::vector<SumChoice>{SumChoice{}}) {
+        const std::string sum = sumName(method, choiceOfSum);
         render::RenderOptions options;
         options.method = method;
         render::applyLevelChoice(options, choice);
         options.interpolateSlices = a.slices == "blend";
         options.antialias = antialias;
         options.objectSky = a.objectSky;
-        options.sumTolerance = tolerance;
+        options.sumTolerance = choiceOfSum.cells;
+        options.smoothSumTolerance = choiceOfSum.smooth;
         options.cacheDir = a.cacheDir == "none" ? "" : a.cacheDir;
-        progress.message("level " + level + ", " + std::string(methodName(method)) + (tolerance > 0.0f ? ", " + sum : "") +
+        progress.message("level " + level + ", " + std::string(methodName(method)) + (method == RotationMethod::Fused ? ", " + sum : "") +
                          ": preparing");
         std::unique_ptr<render::Renderer> cpuRenderer, gpuRenderer;
         // Slice tables, visibility, rotators: the same progress lines as `render`.
@@ -250,7 +267,8 @@ int run(const BenchArgs& a) {
                                {"fps", m.frameSeconds > 0.0 ? 1.0 / m.frameSeconds : 0.0},
                                {"coefficient_bytes", m.coefficientBytes}, {"covered_pixels", m.covered}};
             if (method == RotationMethod::Fused) {
-              run["sum_tolerance"] = tolerance;
+              run["sum_tolerance"] = choiceOfSum.cells;
+              run["smooth_sum_tolerance"] = choiceOfSum.smooth;
               run["directions_per_sample_mean"] = m.directionsMean;
               run["directions_per_sample_max"] = m.directionsMax;
             }
@@ -338,6 +356,9 @@ std::function<int()> addBenchFrameCommand(CLI::App& app) {
   c->add_option("--rays", args->rays, rayModeHelp())->capture_default_str();
   c->add_option("--sum-tolerance", args->sumTolerances,
                 sumToleranceHelp() + "; comma-separated, one run each: e.g. 0,0.1 times both")
+      ->capture_default_str();
+  c->add_option("--smooth-sum", args->smoothSums,
+                smoothSumHelp() + "; comma-separated, one run each with each --sum-tolerance: e.g. 0,0.01 times both")
       ->capture_default_str();
   c->add_option("--object-sky", args->objectSky, "fused: objects hide sky from each other (true|false: its cost, side by side)")
       ->capture_default_str();

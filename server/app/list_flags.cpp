@@ -80,6 +80,12 @@ std::string sumToleranceHelp() {
          "this fraction of its mean, the rest direction by direction (0 = every direction; docs/design.md)";
 }
 
+std::string smoothSumHelp() {
+  return "fused, CPU backend: take a pixel's sum (the light's rest × visibility × BRDF) from its neighbours where "
+         "theirs agree within this fraction of what it shows, coarse to fine from every 4th pixel; point lights, "
+         "shadows between objects and mirror cores stay each pixel's own (0 = sum every pixel; docs/design.md)";
+}
+
 std::vector<float> parseToleranceList(const std::string& text, const char* flag) {
   std::vector<float> out;
   for (const std::string& item : splitList(text, flag)) {

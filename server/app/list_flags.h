@@ -31,6 +31,8 @@ std::vector<RotationMethod> parseMethodList(const std::string& text, const char*
 // --sum-tolerance (RenderOptions::sumTolerance): its --help text, and a
 // comma-separated list of them, each in 0..1 (bench-frame times each).
 std::string sumToleranceHelp();
+// --smooth-sum (RenderOptions::smoothSumTolerance): its --help text.
+std::string smoothSumHelp();
 std::vector<float> parseToleranceList(const std::string& text, const char* flag);
 
 // --rays: auto, device or host (render::RayMode).

@@ -12,6 +12,7 @@
 #include "haarcast/render/object_levels.h"
 #include "haarcast/render/renderer.h"
 #include "haarcast/render/scene.h"
+#include "haarcast/render/smooth_sum.h"
 #include "progress.h"
 #include "app_paths.h"
 #include "scene_flags.h"
@@ -105,6 +106,12 @@ int run(RenderArgs& a) {
       std::snprintf(sum, sizeof sum, " (by cells, τ %g)", static_cast<double>(a.options.sumTolerance));
       levelText += sum;
     }
+    if (frame.smoothSamples > 0) {
+      std::snprintf(sum, sizeof sum, ", %.0f %% of them from their neighbours (ε %g)",
+                    100.0 * static_cast<double>(frame.smoothSamples) / static_cast<double>(frame.passSamples),
+                    static_cast<double>(a.options.smoothSumTolerance));
+      levelText += sum;
+    }
   }
   std::fprintf(stderr, "%s on %s: %d×%d, %s, %s, k = %zu, rays %s: precompute %.2f s, frame %.3f s (%s)\n",
                renderer->backend().c_str(), renderer->deviceName().c_str(), a.options.width, a.options.height,
@@ -137,6 +144,10 @@ std::function<int()> addRenderCommand(CLI::App& app) {
   args->options.sumTolerance = shared::kDefaultSumTolerance;  // RenderOptions keeps 0, as for automaticLevel
   c->add_option("--sum-tolerance", args->options.sumTolerance,
                 sumToleranceHelp())
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
+  args->options.smoothSumTolerance = render::kDefaultSmoothSumTolerance;
+  c->add_option("--smooth-sum", args->options.smoothSumTolerance, smoothSumHelp())
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));
   c->add_option("--backend", args->backend, "The backend: " + backends::availableText())->capture_default_str();

@@ -28,6 +28,7 @@
 #include "haarcast/render/object_levels.h"
 #include "haarcast/render/renderer.h"
 #include "haarcast/render/scene.h"
+#include "haarcast/render/smooth_sum.h"
 #include "haarcast/wire/encoding_name.h"
 #include "app_paths.h"
 #include "progress.h"
@@ -46,6 +47,7 @@ struct ServeArgs {
   int grpcPort = 0;  // 0: no gRPC listener
   std::string antialias = "auto";
   float sumTolerance = shared::kDefaultSumTolerance;  // fused: RenderOptions::sumTolerance
+  float smoothSum = render::kDefaultSmoothSumTolerance;  // fused: RenderOptions::smoothSumTolerance
   std::string backend{render::kCpuBackend}, method = "fused", encoding = "jpeg";
   std::vector<std::string> backends;  // enabled for clients; empty: just --backend
   std::string level = "auto";  // render::parseLevelChoice; auto: its cap at most --max-level
@@ -187,6 +189,7 @@ int run(ServeArgs& a) {
   base.sceneLimits = a.sceneLimits;
   base.threads = a.renderThreads;
   base.sumTolerance = a.sumTolerance;
+  base.smoothSumTolerance = a.smoothSum;
   const backends::DeviceOptions vulkanOptions{a.vulkanDevice, a.vulkanValidation, a.framesInFlight,
                                               parseRayModeFlag(a.rays)};
   auto sharedScenes = std::make_shared<std::vector<SceneSource>>(std::move(scenes));
@@ -348,6 +351,9 @@ std::function<int()> addServeCommand(CLI::App& app) {
   c->add_option("--backends", a->backends, "Backends clients may choose (default: only --backend)")->delimiter(',');
   c->add_option("--sum-tolerance", a->sumTolerance,
                 sumToleranceHelp())
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
+  c->add_option("--smooth-sum", a->smoothSum, smoothSumHelp())
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));
   c->add_option("--antialias", a->antialias, "auto|on|off: edge pixels as the mean of 4 sub-samples (auto: on)")

@@ -20,7 +20,7 @@ fail() { echo "FAIL $1"; failures=$((failures + 1)); }
 [[ "$rc" == 0 ]] || fail "bench-frame exited $rc"
 
 line_of() { grep -n -m1 -F -- "$1" "$out" | cut -d: -f1; }
-first_row=$(line_of "| 3 | fused | cells τ 0.1 | 16×16 | cpu |")
+first_row=$(line_of "| 3 | fused | cells τ 0.1, smooth ε 0.01 | 16×16 | cpu |")
 haar_prepared=$(line_of "level 3, haar: preparing")
 last_row=$(line_of "| 3 | haar | — | 24×24 | cpu |")
 if [[ -z "$first_row" || -z "$haar_prepared" || -z "$last_row" ]]; then

@@ -384,7 +384,8 @@ void setCore(detail::FusedPass& pass, const EulerYXY& r, float axisTheta, float 
 std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBlend& blend, const EulerYXY& r,
                                 const FusedLight& light, std::span<const WeightedBits> visibility,
                                 std::span<const FusedPointLight> lights, std::uint32_t visibleLights,
-                                FusedScratch& scratch, const LobePath* lobe, const std::array<float, 3>* hidden) {
+                                FusedScratch& scratch, const LobePath* lobe, const std::array<float, 3>* hidden,
+                                FusedSum* sum) {
   const int level = slices.level();
   scratch.passDirections = 0;
   if (lobe && lobe->coreAngle >= static_cast<float>(kPi)) return lobeShade(*lobe, blend, r, visibleLights);
@@ -394,13 +395,15 @@ std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBl
   // or vectors wider than a word) here, into V.
   static const bool bitsInPass = detail::fusedLanes() <= 32;
   const bool inPass = bitsInPass && visibility.size() == 3;
-  if (!inPass) {
+  const bool given = sum && sum->given;
+  if (!inPass && !given) {
     scratch.visibility.resize(n);
     blendVisibility(visibility, level, scratch.visibility);
   }
 
-  detail::FusedPass pass = makePass(slices, blendedSlice(slices, blend, scratch), r);
-  scratch.passDirections = static_cast<std::size_t>(pass.endRow - pass.firstRow) * static_cast<std::size_t>(mapSize(level));
+  // Given the sum, the pass is only its turn (pointRhoAt, the core's cone).
+  detail::FusedPass pass = makePass(slices, given ? nullptr : blendedSlice(slices, blend, scratch), r);
+  scratch.passDirections = given ? 0 : static_cast<std::size_t>(pass.endRow - pass.firstRow) * static_cast<std::size_t>(mapSize(level));
   pass.light = light.planes.data();
   if (inPass) {
     pass.visibility = nullptr;
@@ -420,7 +423,10 @@ std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBl
     for (std::size_t c = 0; c < 3; ++c) energy[c] = std::max(0.0f, core.energy[static_cast<int>(c)] - core.core[static_cast<int>(c)]);
   }
   std::array<float, 3> out{};
-  if (inPass && light.sumsByCells() && slices.detail(0)) {
+  if (given) {
+    out = sum->value;
+    scratch.cellCounts = {};
+  } else if (inPass && light.sumsByCells() && slices.detail(0)) {
     // By cells (shared_cells.h): at one direction where the slice is
     // smooth, the rest direction by direction.
     detail::FusedCellPass cells;
@@ -442,6 +448,7 @@ std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBl
   } else {
     out = energyKept(pass, energy);
   }
+  if (sum && !given) sum->value = out;
   const ColumnOffset pointColumn = columnOffset(r.gamma, slices.pointLevel());
   for (std::size_t k = 0; k < lights.size(); ++k) {
     if (((visibleLights >> k) & 1u) == 0) continue;

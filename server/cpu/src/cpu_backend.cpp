@@ -26,6 +26,7 @@
 #include "haarcast/render/exposure_meter.h"
 #include "haarcast/render/point_lights.h"
 #include "haarcast/render/shading.h"
+#include "haarcast/render/smooth_sum.h"
 
 namespace haarcast::render {
 namespace {
@@ -185,6 +186,10 @@ class CpuRenderer final : public Renderer {
     std::vector<ShadingPoint> points;
     std::vector<std::uint32_t> lightsSeen;     // the point lights each sees
     std::vector<shared::HiddenLight> hidden;   // the sky other objects hide from it
+    // By pixel, with a smooth-sum tolerance (smooth_sum.h): the centre
+    // sample's sum and radiance, and whether it was summed or taken.
+    std::vector<std::array<float, 3>> sums, shaded;
+    std::vector<std::uint8_t> centreState;
   };
   struct FrameWork {
     std::unique_ptr<RayScene> rays;
@@ -227,6 +232,21 @@ class CpuRenderer final : public Renderer {
   std::size_t shadeFused(const ResolvedFrame& resolved, const RayScene& rays, const GBuffer& g, FusedSlots& slotRecords,
                          const FrameRequest& request, const CameraRays& camera, Frame& frame,
                          const CancelPoint& cancelPoint) const;
+  // One fused sample: the bytes read, the directions summed (0 for the
+  // ground, the lobe path alone, or a given sum).
+  struct Shaded {
+    std::size_t bytes = 0, directions = 0;
+    bool pass = false;  // an object sample of the pass (not the ground)
+  };
+  using ShadeFusedSample = std::function<Shaded(const Sample&, std::size_t slot, std::array<float, 3>& rgb, FusedSum* sum)>;
+  // With a smooth-sum tolerance: the interior pixels' centre samples on the
+  // pass's objects, coarse to fine (smooth_sum.h), into `slots`' sums,
+  // shaded and centreState; `count` takes each one's directions. Returns
+  // the bytes read.
+  static constexpr std::uint8_t kNotVisited = 0, kSummed = 1, kTaken = 2;
+  std::size_t shadeSmoothSums(const GBuffer& g, FusedSlots& slots, const ShadeFusedSample& shade,
+                              const std::function<void(std::size_t)>& count, std::size_t& smoothSamples,
+                              const CancelPoint& cancelPoint) const;
   std::size_t shadeSplitsum(const ResolvedFrame& resolved, const RayScene& rays, const GBuffer& g,
                             const FrameRequest& request, const CameraRays& camera, Frame& frame,
                             const CancelPoint& cancelPoint) const;
@@ -631,7 +651,14 @@ std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const RayScen
   }, {}, options_.threads);
   // What the pass visited (Frame::passDirections), over the object samples.
   std::atomic<std::size_t> passSamples{0}, passDirections{0}, passDirectionsMax{0};
-  const std::size_t bytes = shadePixels(g, request, camera, frame, [&](const Sample& sample, std::size_t slot, std::array<float, 3>& rgb) {
+  auto count = [&](std::size_t directions) {
+    passSamples.fetch_add(1, std::memory_order_relaxed);
+    passDirections.fetch_add(directions, std::memory_order_relaxed);
+    for (std::size_t most = passDirectionsMax.load(std::memory_order_relaxed);
+         directions > most && !passDirectionsMax.compare_exchange_weak(most, directions);) {
+    }
+  };
+  auto shadeSample = [&](const Sample& sample, std::size_t slot, std::array<float, 3>& rgb, FusedSum* sum) -> Shaded {
     // Per worker thread, kept across pixels: no allocation per pixel.
     thread_local FusedScratch scratch;
     const std::size_t object = sample.hit.object;
@@ -649,7 +676,7 @@ std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const RayScen
       for (std::size_t k = 0; k < o.pointLights.size(); ++k)
         if ((seen >> k) & 1u)
           for (std::size_t c = 0; c < 3; ++c) rgb[c] += o.pointLights[k].power[c];
-      return std::size_t{0};
+      return Shaded{};
     }
     std::array<WeightedBits, 3> vis;
     for (std::size_t v = 0; v < 3; ++v) vis[v] = {p.visibilityBits.point(in.vertex[v]).data(), static_cast<float>(in.b[v])};
@@ -660,19 +687,116 @@ std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const RayScen
     const LobePath lobe{&prepared_.lobeLight, p.lobes, o.toLight, p.lobeCore};
     const std::optional<std::array<float, 3>> hiddenSky = hidden.empty() ? std::nullopt : hiddenIrradiance(hidden[slot]);
     rgb = fusedShade(slices, blend, in.rotation.euler, o.fusedLight, vis, o.pointLights, seen, scratch,
-                     p.lobePath ? &lobe : nullptr, hiddenSky ? &*hiddenSky : nullptr);
-    passSamples.fetch_add(1, std::memory_order_relaxed);
-    passDirections.fetch_add(scratch.passDirections, std::memory_order_relaxed);
-    for (std::size_t most = passDirectionsMax.load(std::memory_order_relaxed);
-         scratch.passDirections > most && !passDirectionsMax.compare_exchange_weak(most, scratch.passDirections);) {
+                     p.lobePath ? &lobe : nullptr, hiddenSky ? &*hiddenSky : nullptr, sum);
+    const bool summed = !(sum && sum->given);
+    return Shaded{summed ? fusedPixelBytes(slices.level(), blend.weight != 0.0f, 3 * p.visibilityBits.wordsPerPoint() * sizeof(std::uint32_t))
+                         : 0,
+                  scratch.passDirections, true};
+  };
+  std::size_t bytes = 0;
+  const std::vector<std::uint8_t>& centreState = slotRecords.centreState;
+  if (options_.smoothSumTolerance > 0.0f) bytes += shadeSmoothSums(g, slotRecords, shadeSample, count, frame.smoothSamples, cancelPoint);
+  else slotRecords.centreState.clear();
+  bytes += shadePixels(g, request, camera, frame, [&](const Sample& sample, std::size_t slot, std::array<float, 3>& rgb) {
+    if (slot < centreState.size() && centreState[slot] != kNotVisited) {
+      rgb = slotRecords.shaded[slot];  // shaded in shadeSmoothSums, and counted there
+      return std::size_t{0};
     }
-    return fusedPixelBytes(slices.level(), blend.weight != 0.0f, 3 * p.visibilityBits.wordsPerPoint() * sizeof(std::uint32_t));
+    const Shaded s = shadeSample(sample, slot, rgb, nullptr);
+    if (s.pass) count(s.directions);
+    return s.bytes;
   }, cancelPoint);
   frame.stages.push_back({"fused", since(t0)});
   frame.passSamples = passSamples.load();
   frame.passDirections = passDirections.load();
   frame.passDirectionsMax = passDirectionsMax.load();
   return bytes;
+}
+
+std::size_t CpuRenderer::shadeSmoothSums(const GBuffer& g, FusedSlots& slots, const ShadeFusedSample& shade,
+                                         const std::function<void(std::size_t)>& count, std::size_t& smoothSamples,
+                                         const CancelPoint& cancelPoint) const {
+  const int w = static_cast<int>(g.width), h = static_cast<int>(g.height);
+  const std::size_t pixels = g.centre.size();
+  slots.sums.resize(pixels);
+  slots.shaded.resize(pixels);
+  std::vector<std::uint8_t>& state = slots.centreState;
+  state.assign(pixels, kNotVisited);
+  // A pixel whose sum the pass computes: an interior pixel's centre on an
+  // object the pass sums (not the ground, not the lobe path alone).
+  auto objectOf = [&](std::size_t i) -> std::optional<std::size_t> {
+    if (g.edge[i] != kInterior || !g.centre[i]) return std::nullopt;
+    const std::size_t object = g.centre[i]->hit.object;
+    const PreparedObject& p = prepared_.objects[object];
+    if (p.ground || (p.lobePath && p.lobeCore >= static_cast<float>(kPi))) return std::nullopt;
+    return object;
+  };
+  // A centre sample's mirror direction: its camera ray reflected about its normal.
+  auto mirrorOf = [&](std::size_t i) {
+    return glm::reflect(glm::vec3(g.centre[i]->direction), slots.points[i].normal);
+  };
+  std::atomic<std::size_t> bytes{0}, taken{0};
+  for (const SmoothSumStage& stage : smoothSumStages(kSmoothSumSpacing)) {
+    parallelFor(static_cast<std::size_t>(h), [&](std::size_t row) {
+      cancelPoint();
+      const int y = static_cast<int>(row);
+      std::array<std::array<float, 3>, 4> parentSums{};
+      std::size_t rowBytes = 0, rowTaken = 0;
+      for (int x = 0; x < w; ++x) {
+        const SmoothSumParents parents = smoothSumParents(stage, x, y, w, h);
+        if (parents.count == -2) continue;  // not this stage's
+        const std::size_t i = static_cast<std::size_t>(y) * g.width + static_cast<std::size_t>(x);
+        const std::optional<std::size_t> object = objectOf(i);
+        if (!object) continue;
+        // Its parents' sums, where each is on this object and summed or taken.
+        auto usable = [&](std::uint32_t q) { return state[q] != kNotVisited && g.centre[q]->hit.object == *object; };
+        const std::size_t n = parents.count > 0 ? (parents.count == 2 && parents.outer ? 4 : static_cast<std::size_t>(parents.count)) : 0;
+        bool fromParents = n > 0;
+        SmoothSumParents used = parents;
+        for (std::size_t k = 0; k < n && fromParents; ++k) {
+          const bool ok = usable(parents.at[k]);
+          if (!ok && parents.count == 2 && k >= 2) {
+            used.outer = false;  // A' or B' elsewhere: the two near ones alone
+            break;
+          }
+          fromParents = ok;
+          if (ok) parentSums[k] = slots.sums[parents.at[k]];
+        }
+        if (fromParents) {
+          // The mirror directions first: is the sum smooth here at all?
+          std::array<glm::vec3, 4> mirrors{};
+          for (std::size_t k = 0; k < n; ++k) mirrors[k] = mirrorOf(parents.at[k]);
+          fromParents = mirrorsWithinLobe(mirrorOf(i), std::span<const glm::vec3>(mirrors.data(), n),
+                                          prepared_.objects[*object].sharpestLobe);
+        }
+        FusedSum sum;
+        if (fromParents) {
+          const std::span<const std::array<float, 3>> from(parentSums.data(), n);
+          std::array<std::array<float, 3>, 4> shown{};
+          for (std::size_t k = 0; k < n; ++k) shown[k] = slots.shaded[parents.at[k]];
+          const float brightness = parentsBrightness(used, std::span<const std::array<float, 3>>(shown.data(), n));
+          if (sumsAgree(used, from, brightness, options_.smoothSumTolerance)) {
+            sum = {parentsSum(used, from), true};
+            shade(*g.centre[i], i, slots.shaded[i], &sum);
+            slots.sums[i] = sum.value;
+            state[i] = kTaken;
+            count(0);
+            ++rowTaken;
+            continue;
+          }
+        }
+        const Shaded s = shade(*g.centre[i], i, slots.shaded[i], &sum);
+        slots.sums[i] = sum.value;
+        state[i] = kSummed;
+        count(s.directions);
+        rowBytes += s.bytes;
+      }
+      bytes.fetch_add(rowBytes, std::memory_order_relaxed);
+      taken.fetch_add(rowTaken, std::memory_order_relaxed);
+    }, {}, options_.threads);
+  }
+  smoothSamples = taken.load();
+  return bytes.load();
 }
 
 std::size_t CpuRenderer::shadeSplitsum(const ResolvedFrame& resolved, const RayScene& rays, const GBuffer& g,

@@ -51,6 +51,7 @@ std::string frameMessage(const SessionConfig& config, const render::Frame& frame
   f->set_exposure_stops(frame.exposureStops);
   if (frame.passSamples > 0) {
     f->set_directions_per_sample(static_cast<double>(frame.passDirections) / static_cast<double>(frame.passSamples));
+    f->set_smooth_share(static_cast<double>(frame.smoothSamples) / static_cast<double>(frame.passSamples));
   }
   return serialize(m);
 }

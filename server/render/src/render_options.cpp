@@ -19,6 +19,8 @@ void checkRenderOptions(const RenderOptions& o) {
   if (o.thetaSamples < 1 || o.thetaSamples > 256) bad("theta samples must be in 1..256");
   checkRefineOptions(o.refine);
   if (!(o.sumTolerance >= 0.0f && o.sumTolerance <= 1.0f)) bad("sum tolerance " + std::to_string(o.sumTolerance) + " is outside 0..1");
+  if (!(o.smoothSumTolerance >= 0.0f && o.smoothSumTolerance <= 1.0f))
+    bad("smooth-sum tolerance " + std::to_string(o.smoothSumTolerance) + " is outside 0..1");
   if (o.pointLights.maxLights > shared::kMaxPointLights) {
     bad("point lights " + std::to_string(o.pointLights.maxLights) + " is over " + std::to_string(shared::kMaxPointLights));
   }

@@ -168,6 +168,7 @@ PreparedScene prepareScene(const Scene& scene, const RenderOptions& options, con
           p.pointTable = objectSliceTable(scene.objects[k], options, p.pointLevel, progress, kPointSlicesStage);
         }
       }
+      p.sharpestLobe = static_cast<float>(sharpestMedian(levels[k].lobes));
       LobeCore core = chooseLobeCore(*scene.objects[k].material.brdf, thetaOut, p.level, std::move(levels[k].lobes));
       p.lobes = std::move(core.lobes);
       p.lobeCore = core.angle;

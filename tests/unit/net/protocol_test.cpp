@@ -1,4 +1,5 @@
 #include "haarcast/net/protocol.h"
+#include "haarcast/net/messages.h"
 
 #include <gtest/gtest.h>
 
@@ -454,6 +455,25 @@ TEST(Protocol, LatestPoseWinsAndBadPosesChangeNothing) {
   EXPECT_EQ(request.width, 64);
   EXPECT_EQ(request.poses.size(), 2u);
   EXPECT_EQ(request.camera.eye.z, 7);
+}
+
+// A fused frame carries what its pixels cost: the directions summed a
+// sample, and the share of samples whose sum came from their neighbours.
+TEST(Protocol, AFrameSaysItsDirectionsAndItsSmoothShare) {
+  render::Frame frame;
+  frame.width = frame.height = 4;
+  frame.passSamples = 8;
+  frame.passDirections = 2000;
+  frame.smoothSamples = 2;
+  v1::ServerMessage m;
+  ASSERT_TRUE(m.ParseFromString(frameMessage(SessionConfig{}, frame, "jpeg bytes", FrameFacts{})));
+  ASSERT_TRUE(m.has_frame());
+  EXPECT_EQ(m.frame().directions_per_sample(), 250.0);
+  EXPECT_EQ(m.frame().smooth_share(), 0.25);
+  frame.passSamples = 0;  // no fused pass: neither
+  ASSERT_TRUE(m.ParseFromString(frameMessage(SessionConfig{}, frame, "jpeg bytes", FrameFacts{})));
+  EXPECT_EQ(m.frame().directions_per_sample(), 0.0);
+  EXPECT_EQ(m.frame().smooth_share(), 0.0);
 }
 
 }  // namespace

@@ -158,6 +158,17 @@ struct LobePath {
 std::array<float, 3> lobeShade(const LobePath& path, const shared::SliceBlend& blend, const EulerYXY& r,
                                std::uint32_t word);
 
+// The pass's sum of a pixel, the part of fusedShade that is smooth across a
+// surface (the light's rest × V × ρ, the energy put back): given, fusedShade
+// takes it instead of summing (no slice blend, no pass), and everything
+// else (point lights, hidden sky, lobe path) is the pixel's own; not given,
+// fusedShade sums it and writes it here. render/smooth_sum.h takes it from a
+// pixel's neighbours where they agree.
+struct FusedSum {
+  std::array<float, 3> value{};
+  bool given = false;
+};
+
 // One pixel of `fused` with exact visibility: V(ω) = Σ_v b_v·bit_v(ω) blended
 // from the hit triangle's vertices (visibility_bits.h), then the pass below;
 // plus Σ_k power_k·ρ(Rᵀd_k) over the point lights whose bit k is set in
@@ -172,7 +183,7 @@ std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBl
                                 const FusedLight& light, std::span<const WeightedBits> visibility,
                                 std::span<const FusedPointLight> lights, std::uint32_t visibleLights,
                                 FusedScratch& scratch, const LobePath* lobe = nullptr,
-                                const std::array<float, 3>* hidden = nullptr);
+                                const std::array<float, 3>* hidden = nullptr, FusedSum* sum = nullptr);
 
 // One pixel of `fused` from Haar visibility lists: Σ_ω W_c(ω)·ρ_c(Rᵀω) for c = R, G, B, with
 // ρ = (1 − w)·slice[first] + w·slice[second] (shared::sliceBlendAt) looked up

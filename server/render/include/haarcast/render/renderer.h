@@ -103,6 +103,9 @@ struct Frame {
   std::size_t passSamples = 0;
   std::size_t passDirections = 0;
   std::size_t passDirectionsMax = 0;
+  // Of passSamples, those whose sum came from their neighbours
+  // (RenderOptions::smoothSumTolerance), with no directions.
+  std::size_t smoothSamples = 0;
   double exposureStops = 0.0;         // the exposure rgba8 was made with
   double logAverageLuminance = 0.0;   // auto exposure's weighted log-average (exposure_meter.h); 0: none lit
   // The request's `cancelled` turned true mid-frame: the render stopped at
@@ -187,6 +190,10 @@ struct PreparedObject {
   std::vector<shared::SliceLobe> lobes;
   bool lobePath = false;
   float lobeCore = 0.0f;  // the lobe path's core angle (fused.h LobePath::coreAngle); π: the path takes all
+  // `fused`: its sharpest slice's median lobe angle (core/lobe.h
+  // sharpestMedian; π for the ground): how far a pixel's mirror direction
+  // may be from its neighbours' for it to take their sum (smooth_sum.h).
+  float sharpestLobe = 3.14159265f;
 };
 
 struct ResolvedObject;
