@@ -11,7 +11,11 @@
 //
 // One workgroup per covered sample at a time; workgroups loop over the
 // compacted samples (s = group, group + groups, …), so the dispatch is sized
-// by the rotation-input pass's indirect arguments. Per sample:
+// by the rotation-input pass's indirect arguments. With a smooth-sum
+// tolerance (push.stage ≠ kSmoothSumOff; core/shared_smooth.h) the pass is
+// dispatched once per stage, coarse to fine: each visits its stage's pixels
+// (and stage 0 every sample the smooth sum does not visit), and a pixel
+// whose parents allow takes their mean sum instead of steps 1–2. Per sample:
 //   1. the invocations stride over the directions: Rᵀω with R = Ry(α)Rx(β)Ry(γ)
 //      (γ only offsets the source column), θ', φ' with the CPU kernel's
 //      atan2, ρ bilinear in the slice texels exactly as bilinearTaps (θ
@@ -56,6 +60,7 @@
 #extension GL_EXT_control_flow_attributes : require
 #include "haarcast/core/shared_layout.h"
 #include "haarcast/core/shared_cells.h"
+#include "haarcast/core/shared_smooth.h"
 #include "common/frame.glsl"
 #include "common/sphere.glsl"
 
@@ -104,6 +109,11 @@ layout(std430, set = 0, binding = kFusedSliceCountsBinding) buffer SliceCounts {
 // light texels (cellPowerTexel, cellCentroidTexel), the cells' centres its
 // level's directions (cellCentreTexel).
 layout(set = 0, binding = kFusedDetailTexelsBinding) uniform textureBuffer details;
+// The smooth sum (shared_smooth.h): pixel q's sum and 1 + its object at
+// 2q, its mirror direction at 2q + 1, written where it is visited; the
+// stage this dispatch visits, the frame's size and the tolerance.
+layout(std430, set = 0, binding = kFusedSmoothBinding) buffer Smooth { vec4 smoothData[]; };
+layout(push_constant) uniform Push { FusedPush push; };
 
 shared vec3 partial[LOCAL];
 shared vec3 partialSum[LOCAL];  // Σ ΔΩ·ρ_c: the lobe's energy as the directions sample it
@@ -286,6 +296,55 @@ vec3 lobeShade(ObjectInfo o, RotationSample rs, SliceBlend blend, uint seen) {
   return core * sum;
 }
 
+// Whether sample s is the smooth sum's to visit (cpu_backend.cpp
+// shadeSmoothSums): an interior pixel's centre sample on an object the pass
+// sums (not the ground, not the lobe path alone).
+bool smoothVisited(ShadeSample sh, ObjectInfo o) {
+  return sh.pixel < push.width * push.height && (o.flags & kObjectGround) == 0u &&
+         !((o.flags & kObjectLobePath) != 0u && o.lobeCore.x <= -1.0);
+}
+// Whether this dispatch shades sample s: every sample without a smooth
+// sum; with one, each visited sample in its stage and every other sample
+// in stage 0.
+bool shadesNow(uint s) {
+  if (push.stage == kSmoothSumOff) return true;
+  const ShadeSample sh = shade[s];
+  if (!smoothVisited(sh, objects[sh.object])) return push.stage == 0u;
+  const int x = int(sh.pixel % push.width), y = int(sh.pixel / push.width);
+  return smoothParents(push.stage, x, y, int(push.width), int(push.height)).count != -2;
+}
+// A parent's sum and mirror, where it is on `object` and visited.
+bool smoothParent(uint q, uint object, vec3 mirror, float cosLimit, out vec3 sum) {
+  const vec4 a = smoothData[2u * q];
+  sum = a.rgb;
+  return floatBitsToUint(a.w) == object + 1u && smoothMirrorNear(mirror, smoothData[2u * q + 1u].xyz, cosLimit);
+}
+// The sum pixel `pixel` takes from its parents (cpu_backend.cpp
+// shadeSmoothSums, in the same order), or false where it sums its own.
+bool smoothTaken(ShadeSample sh, ObjectInfo o, vec3 mirror, out vec3 sum) {
+  sum = vec3(0.0);
+  if (push.stage == kSmoothSumOff || push.stage == 0u) return false;
+  const int x = int(sh.pixel % push.width), y = int(sh.pixel / push.width);
+  SmoothParents p = smoothParents(push.stage, x, y, int(push.width), int(push.height));
+  if (p.count <= 0) return false;
+  const float cosLimit = o.lobeCore.y;
+  vec3 s0, s1, s2 = vec3(0.0), s3 = vec3(0.0);
+  if (!smoothParent(p.at0, sh.object, mirror, cosLimit, s0) || !smoothParent(p.at1, sh.object, mirror, cosLimit, s1))
+    return false;
+  if (p.count == 4) {
+    if (!smoothParent(p.at2, sh.object, mirror, cosLimit, s2) || !smoothParent(p.at3, sh.object, mirror, cosLimit, s3))
+      return false;
+  } else if (p.outer != 0u) {
+    if (!smoothParent(p.at2, sh.object, mirror, cosLimit, s2) || !smoothParent(p.at3, sh.object, mirror, cosLimit, s3))
+      p.outer = 0u;
+  }
+  const float brightness = smoothBrightness(p, radiance[p.at0].rgb, radiance[p.at1].rgb, radiance[p.at2].rgb,
+                                            radiance[p.at3].rgb);
+  if (!smoothSumsAgree(p, s0, s1, s2, s3, brightness, push.tolerance)) return false;
+  sum = smoothParentsSum(p, s0, s1, s2, s3);
+  return true;
+}
+
 // sum + Σ_k bit_k·power_k·ρ(Rᵀd_k) over the lights the sample sees, added
 // one by one in light order (fusedShade's order).
 vec3 addPointLights(PixelSetup p, uint object, uint count, uint seen, vec3 sum) {
@@ -294,6 +353,25 @@ vec3 addPointLights(PixelSetup p, uint object, uint count, uint seen, vec3 sum) 
     const PointLight l = pointLights[object * kMaxPointLights + k];
     sum += l.power.rgb * pointRhoAt(p, l.direction.xyz);
   }
+  return sum;
+}
+
+// The radiance from the pixel's sum (the pass's with the lobe's energy put
+// back, or its parents': FusedSum): the point lights, the hidden sky and the
+// lobe path added as fusedShade adds them.
+vec3 finishSum(PixelSetup p, ObjectInfo o, RotationSample rs, SliceBlend blend, uint s, uint seen, vec3 energy,
+               vec3 sum, bool lobePath) {
+  if ((seen & 0xFFFFu) != 0u) {
+    sum = addPointLights(p, p.sh.object, o.pointLights, seen, sum);
+  }
+  // The sky other objects hide from it, taken off as a light (fusedShade's `hidden`).
+  if ((o.flags & kObjectSkyHidden) != 0u) {
+    const HiddenLight h = hidden[s];
+    if (h.power.r > 0.0 || h.power.g > 0.0 || h.power.b > 0.0) {
+      sum = max(sum - h.power * energy / kPiF, vec3(0.0));
+    }
+  }
+  if (lobePath) sum += lobeShade(o, rs, blend, seen);
   return sum;
 }
 
@@ -380,6 +458,22 @@ void shadePixel(uint s) {
     energy = e0 + blend.weight * (e1 - e0);
   }
 
+  // The smooth sum: this pixel's from its parents where they allow
+  // (shared_smooth.h), uniform over the workgroup (every invocation reads
+  // the same records); its own sum and mirror kept for its children.
+  const bool visited = push.stage != kSmoothSumOff && smoothVisited(sh, o);
+  const vec3 mirror = visited ? smoothMirror(rs.alpha, rs.beta, rs.gamma, rs.thetaOut) : vec3(0.0);
+  vec3 given;
+  if (visited && smoothTaken(sh, o, mirror, given)) {
+    if (lid == 0u) {
+      atomicAdd(sliceCounts[kSliceCountsPerObject * sh.object + 6u], 1u);
+      radiance[sh.pixel] = vec4(finishSum(p, o, rs, blend, s, seen, energy, given, lobePath), 1.0);
+      smoothData[2u * sh.pixel] = vec4(given, uintBitsToFloat(sh.object + 1u));
+      smoothData[2u * sh.pixel + 1u] = vec4(mirror, 0.0);
+    }
+    return;  // uniform over the workgroup
+  }
+
   // Only rows that can reach the slice's non-zero cap (shared_layout.h
   // passRows). The range is uniform over the workgroup, so every device
   // skips the rows outside it for real (the test in rhoAt only masks lanes
@@ -431,23 +525,18 @@ void shadePixel(uint s) {
     for (int c = 0; c < 3; ++c) {
       if (sampled[c] > 0.0) sum[c] *= energy[c] / sampled[c];
     }
-    if ((seen & 0xFFFFu) != 0u) {
-      sum = addPointLights(p, sh.object, o.pointLights, seen, sum);
+    if (visited) {
+      smoothData[2u * sh.pixel] = vec4(sum, uintBitsToFloat(sh.object + 1u));
+      smoothData[2u * sh.pixel + 1u] = vec4(mirror, 0.0);
     }
-    // The sky other objects hide from it, taken off as a light (fusedShade's `hidden`).
-    if ((o.flags & kObjectSkyHidden) != 0u) {
-      const HiddenLight h = hidden[s];
-      if (h.power.r > 0.0 || h.power.g > 0.0 || h.power.b > 0.0) {
-        sum = max(sum - h.power * energy / kPiF, vec3(0.0));
-      }
-    }
-    if (lobePath) sum += lobeShade(o, rs, blend, seen);
-    radiance[sh.pixel] = vec4(sum, 1.0);
+    radiance[sh.pixel] = vec4(finishSum(p, o, rs, blend, s, seen, energy, sum, lobePath), 1.0);
   }
   if (SUBGROUP_REDUCE == 0u) sync();  // `partial` is reused by the next sample
 }
 
 void main() {
   const uint count = counter.covered;
-  for (uint s = gl_WorkGroupID.x; s < count; s += gl_NumWorkGroups.x) shadePixel(s);
+  for (uint s = gl_WorkGroupID.x; s < count; s += gl_NumWorkGroups.x) {
+    if (shadesNow(s)) shadePixel(s);
+  }
 }

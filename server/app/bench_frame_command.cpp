@@ -23,12 +23,12 @@
 #include "haarcast/backends/backends.h"
 #include "haarcast/core/check.h"
 #include "haarcast/core/shared_cells.h"
+#include "haarcast/core/shared_smooth.h"
 #include "list_flags.h"
 #include "progress.h"
 #include "haarcast/render/object_levels.h"
 #include "haarcast/render/renderer.h"
 #include "haarcast/render/scene.h"
-#include "haarcast/render/smooth_sum.h"
 
 namespace haarcast::app {
 namespace {
@@ -73,7 +73,7 @@ struct BenchArgs {
   // fused: RenderOptions::sumTolerance, one run each (default: render's and serve's)
   std::string sumTolerances = defaultTolerance(shared::kDefaultSumTolerance);
   // fused: RenderOptions::smoothSumTolerance, one run each with each of the above
-  std::string smoothSums = defaultTolerance(render::kDefaultSmoothSumTolerance);
+  std::string smoothSums = defaultTolerance(shared::kDefaultSmoothSumTolerance);
   std::string cacheDir;
   int frames = 3;
   int warmup = 1;

@@ -81,9 +81,10 @@ std::string sumToleranceHelp() {
 }
 
 std::string smoothSumHelp() {
-  return "fused, CPU backend: take a pixel's sum (the light's rest × visibility × BRDF) from its neighbours where "
-         "theirs agree within this fraction of what it shows, coarse to fine from every 4th pixel; point lights, "
-         "shadows between objects and mirror cores stay each pixel's own (0 = sum every pixel; docs/design.md)";
+  return "fused: take a pixel's sum (the light's rest × visibility × BRDF) from its neighbours where their mirror "
+         "directions are within half the lobe and their sums agree within this fraction of what they show, coarse to "
+         "fine from every 4th pixel; point lights, shadows between objects and mirror cores stay each pixel's own "
+         "(0 = sum every pixel; docs/design.md)";
 }
 
 std::vector<float> parseToleranceList(const std::string& text, const char* flag) {

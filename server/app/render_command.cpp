@@ -9,10 +9,10 @@
 
 #include "haarcast/backends/backends.h"
 #include "haarcast/core/shared_cells.h"
+#include "haarcast/core/shared_smooth.h"
 #include "haarcast/render/object_levels.h"
 #include "haarcast/render/renderer.h"
 #include "haarcast/render/scene.h"
-#include "haarcast/render/smooth_sum.h"
 #include "progress.h"
 #include "app_paths.h"
 #include "scene_flags.h"
@@ -146,7 +146,7 @@ std::function<int()> addRenderCommand(CLI::App& app) {
                 sumToleranceHelp())
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));
-  args->options.smoothSumTolerance = render::kDefaultSmoothSumTolerance;
+  args->options.smoothSumTolerance = shared::kDefaultSmoothSumTolerance;
   c->add_option("--smooth-sum", args->options.smoothSumTolerance, smoothSumHelp())
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));

@@ -21,6 +21,7 @@
 #include "haarcast/backends/backends.h"
 #include "haarcast/core/check.h"
 #include "haarcast/core/shared_cells.h"
+#include "haarcast/core/shared_smooth.h"
 #include "haarcast/net/host_check.h"
 #include "haarcast/net/protocol.h"
 #include "haarcast/net/server.h"
@@ -28,7 +29,6 @@
 #include "haarcast/render/object_levels.h"
 #include "haarcast/render/renderer.h"
 #include "haarcast/render/scene.h"
-#include "haarcast/render/smooth_sum.h"
 #include "haarcast/wire/encoding_name.h"
 #include "app_paths.h"
 #include "progress.h"
@@ -47,7 +47,7 @@ struct ServeArgs {
   int grpcPort = 0;  // 0: no gRPC listener
   std::string antialias = "auto";
   float sumTolerance = shared::kDefaultSumTolerance;  // fused: RenderOptions::sumTolerance
-  float smoothSum = render::kDefaultSmoothSumTolerance;  // fused: RenderOptions::smoothSumTolerance
+  float smoothSum = shared::kDefaultSmoothSumTolerance;  // fused: RenderOptions::smoothSumTolerance
   std::string backend{render::kCpuBackend}, method = "fused", encoding = "jpeg";
   std::vector<std::string> backends;  // enabled for clients; empty: just --backend
   std::string level = "auto";  // render::parseLevelChoice; auto: its cap at most --max-level

@@ -17,6 +17,7 @@
 #include <glm/geometric.hpp>
 
 #include "haarcast/core/parallel.h"
+#include "haarcast/core/shared_smooth.h"
 #include "haarcast/core/rotate_haar.h"
 #include "haarcast/core/splitsum.h"
 #include "haarcast/core/triple_product.h"
@@ -26,7 +27,6 @@
 #include "haarcast/render/exposure_meter.h"
 #include "haarcast/render/point_lights.h"
 #include "haarcast/render/shading.h"
-#include "haarcast/render/smooth_sum.h"
 
 namespace haarcast::render {
 namespace {
@@ -186,9 +186,10 @@ class CpuRenderer final : public Renderer {
     std::vector<ShadingPoint> points;
     std::vector<std::uint32_t> lightsSeen;     // the point lights each sees
     std::vector<shared::HiddenLight> hidden;   // the sky other objects hide from it
-    // By pixel, with a smooth-sum tolerance (smooth_sum.h): the centre
+    // By pixel, with a smooth-sum tolerance (core/shared_smooth.h): the centre
     // sample's sum and radiance, and whether it was summed or taken.
     std::vector<std::array<float, 3>> sums, shaded;
+    std::vector<glm::vec3> mirrors;  // shared::smoothMirror
     std::vector<std::uint8_t> centreState;
   };
   struct FrameWork {
@@ -240,7 +241,7 @@ class CpuRenderer final : public Renderer {
   };
   using ShadeFusedSample = std::function<Shaded(const Sample&, std::size_t slot, std::array<float, 3>& rgb, FusedSum* sum)>;
   // With a smooth-sum tolerance: the interior pixels' centre samples on the
-  // pass's objects, coarse to fine (smooth_sum.h), into `slots`' sums,
+  // pass's objects, coarse to fine (core/shared_smooth.h), into `slots`' sums,
   // shaded and centreState; `count` takes each one's directions. Returns
   // the bytes read.
   static constexpr std::uint8_t kNotVisited = 0, kSummed = 1, kTaken = 2;
@@ -720,10 +721,12 @@ std::size_t CpuRenderer::shadeSmoothSums(const GBuffer& g, FusedSlots& slots, co
   const std::size_t pixels = g.centre.size();
   slots.sums.resize(pixels);
   slots.shaded.resize(pixels);
+  slots.mirrors.resize(pixels);
   std::vector<std::uint8_t>& state = slots.centreState;
   state.assign(pixels, kNotVisited);
   // A pixel whose sum the pass computes: an interior pixel's centre on an
-  // object the pass sums (not the ground, not the lobe path alone).
+  // object the pass sums (not the ground, not the lobe path alone), as
+  // fused.comp's smoothVisited.
   auto objectOf = [&](std::size_t i) -> std::optional<std::size_t> {
     if (g.edge[i] != kInterior || !g.centre[i]) return std::nullopt;
     const std::size_t object = g.centre[i]->hit.object;
@@ -731,52 +734,45 @@ std::size_t CpuRenderer::shadeSmoothSums(const GBuffer& g, FusedSlots& slots, co
     if (p.ground || (p.lobePath && p.lobeCore >= static_cast<float>(kPi))) return std::nullopt;
     return object;
   };
-  // A centre sample's mirror direction: its camera ray reflected about its normal.
-  auto mirrorOf = [&](std::size_t i) {
-    return glm::reflect(glm::vec3(g.centre[i]->direction), slots.points[i].normal);
-  };
+  const float tolerance = options_.smoothSumTolerance;
   std::atomic<std::size_t> bytes{0}, taken{0};
-  for (const SmoothSumStage& stage : smoothSumStages(kSmoothSumSpacing)) {
+  for (shared::uint stage = 0; stage < shared::kSmoothSumStages; ++stage) {
     parallelFor(static_cast<std::size_t>(h), [&](std::size_t row) {
       cancelPoint();
       const int y = static_cast<int>(row);
-      std::array<std::array<float, 3>, 4> parentSums{};
       std::size_t rowBytes = 0, rowTaken = 0;
       for (int x = 0; x < w; ++x) {
-        const SmoothSumParents parents = smoothSumParents(stage, x, y, w, h);
+        shared::SmoothParents parents = shared::smoothParents(stage, x, y, w, h);
         if (parents.count == -2) continue;  // not this stage's
         const std::size_t i = static_cast<std::size_t>(y) * g.width + static_cast<std::size_t>(x);
         const std::optional<std::size_t> object = objectOf(i);
         if (!object) continue;
-        // Its parents' sums, where each is on this object and summed or taken.
-        auto usable = [&](std::uint32_t q) { return state[q] != kNotVisited && g.centre[q]->hit.object == *object; };
-        const std::size_t n = parents.count > 0 ? (parents.count == 2 && parents.outer ? 4 : static_cast<std::size_t>(parents.count)) : 0;
-        bool fromParents = n > 0;
-        SmoothSumParents used = parents;
-        for (std::size_t k = 0; k < n && fromParents; ++k) {
-          const bool ok = usable(parents.at[k]);
-          if (!ok && parents.count == 2 && k >= 2) {
-            used.outer = false;  // A' or B' elsewhere: the two near ones alone
-            break;
-          }
-          fromParents = ok;
-          if (ok) parentSums[k] = slots.sums[parents.at[k]];
-        }
-        if (fromParents) {
-          // The mirror directions first: is the sum smooth here at all?
-          std::array<glm::vec3, 4> mirrors{};
-          for (std::size_t k = 0; k < n; ++k) mirrors[k] = mirrorOf(parents.at[k]);
-          fromParents = mirrorsWithinLobe(mirrorOf(i), std::span<const glm::vec3>(mirrors.data(), n),
-                                          prepared_.objects[*object].sharpestLobe);
-        }
+        const RotationInput& r = g.centre[i]->input.rotation;
+        slots.mirrors[i] = shared::smoothMirror(static_cast<float>(r.euler.alpha), static_cast<float>(r.euler.beta),
+                                                static_cast<float>(r.euler.gamma), static_cast<float>(r.thetaOut));
+        // Its parents, where each is on this object, visited, and its
+        // mirror direction near the pixel's (A' and B' are only left out).
+        const std::array<shared::uint, 4> at{parents.at0, parents.at1, parents.at2, parents.at3};
+        const float cosLimit = shared::smoothMirrorCos(prepared_.objects[*object].sharpestLobe);
+        auto usable = [&](shared::uint q) {
+          return state[q] != kNotVisited && g.centre[q]->hit.object == *object &&
+                 shared::smoothMirrorNear(slots.mirrors[i], slots.mirrors[q], cosLimit);
+        };
+        bool fromParents = parents.count > 0;
+        const std::size_t near = parents.count == 4 ? 4 : 2;
+        for (std::size_t k = 0; k < near && fromParents; ++k) fromParents = usable(at[k]);
+        if (fromParents && parents.outer != 0u && !(usable(at[2]) && usable(at[3]))) parents.outer = 0u;
         FusedSum sum;
         if (fromParents) {
-          const std::span<const std::array<float, 3>> from(parentSums.data(), n);
-          std::array<std::array<float, 3>, 4> shown{};
-          for (std::size_t k = 0; k < n; ++k) shown[k] = slots.shaded[parents.at[k]];
-          const float brightness = parentsBrightness(used, std::span<const std::array<float, 3>>(shown.data(), n));
-          if (sumsAgree(used, from, brightness, options_.smoothSumTolerance)) {
-            sum = {parentsSum(used, from), true};
+          std::array<glm::vec3, 4> sums{}, shown{};
+          for (std::size_t k = 0; k < (parents.count == 4 || parents.outer != 0u ? 4u : 2u); ++k) {
+            sums[k] = glm::vec3(slots.sums[at[k]][0], slots.sums[at[k]][1], slots.sums[at[k]][2]);
+            shown[k] = glm::vec3(slots.shaded[at[k]][0], slots.shaded[at[k]][1], slots.shaded[at[k]][2]);
+          }
+          const float brightness = shared::smoothBrightness(parents, shown[0], shown[1], shown[2], shown[3]);
+          if (shared::smoothSumsAgree(parents, sums[0], sums[1], sums[2], sums[3], brightness, tolerance)) {
+            const glm::vec3 mean = shared::smoothParentsSum(parents, sums[0], sums[1], sums[2], sums[3]);
+            sum = {{mean.x, mean.y, mean.z}, true};
             shade(*g.centre[i], i, slots.shaded[i], &sum);
             slots.sums[i] = sum.value;
             state[i] = kTaken;

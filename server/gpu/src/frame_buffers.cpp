@@ -89,7 +89,8 @@ void VulkanRenderer::Impl::releaseResolution() {
   maskUpload = BufferUpload();
   hiddenUpload = BufferUpload();
   for (Buffer* b : {&gbufIds, &gbufNormals, &gbufPositions, &samples, &shade, &counter, &counterOut, &shadeOut, &radiance,
-                    &rgba8, &rotated, &radianceOut, &idsOut, &batchArgs, &subIds, &subNormals, &edges, &masks, &hidden, &pixelSample, &skyGrid}) {
+                    &rgba8, &rotated, &radianceOut, &idsOut, &batchArgs, &subIds, &subNormals, &edges, &masks, &hidden, &pixelSample, &skyGrid,
+                    &smoothSums}) {
     *b = Buffer();
   }
   width = height = 0;
@@ -133,6 +134,8 @@ void VulkanRenderer::Impl::ensureResolution(int w, int h) {
   // Per pixel, then (antialiasing) per sub-sample slot (shared_layout.h subsampleSlot).
   radiance = Buffer(context, (options.antialias ? 1 + shared::kSubsamples : 1) * pixels * sizeof(glm::vec4),
                     kStorageUsage, MemoryUse::DeviceOnly);
+  // fused's smooth sum: pixel q's sum and object, then its mirror direction.
+  smoothSums = Buffer(context, (fused ? 2 * pixels : 1) * sizeof(glm::vec4), kStorageUsage, MemoryUse::DeviceOnly);
   // The one image every frame reads back, written once by the tonemap pass.
   rgba8 = Buffer(context, pixels * sizeof(std::uint32_t), kStorageUsage, MemoryUse::Readback);
   radianceOut = Buffer(context, pixels * sizeof(glm::vec4), kStorageUsage, MemoryUse::Readback);
@@ -211,7 +214,8 @@ void VulkanRenderer::Impl::ensureResolution(int w, int h) {
                      {kFusedPointSliceTexelsBinding, &pointSliceTexels},
                      {kFusedDetailTexelsBinding, &detailTexels},
                      {kFusedSliceCountsBinding, &sliceCounts},
-                     {kFusedHiddenBinding, &hidden}});
+                     {kFusedHiddenBinding, &hidden},
+                     {kFusedSmoothBinding, &smoothSums}});
     return;
   }
 

@@ -17,6 +17,7 @@
 #include "haarcast/core/fused.h"
 #include "haarcast/core/parallel.h"
 #include "haarcast/core/shared_cells.h"
+#include "haarcast/core/shared_smooth.h"
 #include "haarcast/core/splitsum.h"
 #include "haarcast/render/point_lights.h"
 #include "haarcast/render/shading.h"
@@ -183,7 +184,22 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
                                if (!deviceRays) maskUpload.record(cb);
                                if (!deviceRays && objectSky()) hiddenUpload.record(cb);
                                computeBarrier(cb);
-                               fusedPass->dispatchIndirect(cb, counter, offsetof(CoverageCounter, groups));
+                               if (!fused) {
+                                 fusedPass->dispatchIndirect(cb, counter, offsetof(CoverageCounter, groups));
+                               } else if (!(options.smoothSumTolerance > 0.0f)) {
+                                 const shared::FusedPush push{shared::kSmoothSumOff, static_cast<shared::uint>(width), static_cast<shared::uint>(height), 0.0f};
+                                 fusedPass->dispatchIndirect(cb, counter, offsetof(CoverageCounter, groups), &push, sizeof push);
+                               } else {
+                                 // The smooth sum's stages, coarse to fine, each reading the ones before.
+                                 vkCmdFillBuffer(cb, smoothSums.handle(), 0, VK_WHOLE_SIZE, 0u);
+                                 computeBarrier(cb);
+                                 for (shared::uint stage = 0; stage < shared::kSmoothSumStages; ++stage) {
+                                   if (stage > 0) computeBarrier(cb);
+                                   const shared::FusedPush push{stage, static_cast<shared::uint>(width), static_cast<shared::uint>(height),
+                                                                options.smoothSumTolerance};
+                                   fusedPass->dispatchIndirect(cb, counter, offsetof(CoverageCounter, groups), &push, sizeof push);
+                                 }
+                               }
                                if (fused) {
                                  computeBarrier(cb);
                                  const VkBufferCopy counts{0, 0, sliceCounts.size()};
@@ -253,6 +269,7 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
     frame.passSamples += std::size_t{c[0]} + c[1];
     frame.passDirections += std::size_t{c[2]} * m + c[4] + shared::kCellDirections * std::size_t{c[5]};
     frame.passDirectionsMax = std::max(frame.passDirectionsMax, std::size_t{c[3]});
+    frame.smoothSamples += c[6];
   }
   HC_CHECK_EQ(counted, std::size_t{covered});  // the pass shaded every covered sample once
   frame.coefficientBytes = bytes;

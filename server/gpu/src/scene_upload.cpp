@@ -10,6 +10,7 @@
 
 #include "haarcast/core/fused.h"
 #include "haarcast/core/shared_cells.h"
+#include "haarcast/core/shared_smooth.h"
 #include "haarcast/gpu/rotation_data.h"
 
 #include "vulkan_renderer_impl.h"
@@ -89,8 +90,9 @@ void VulkanRenderer::Impl::uploadScene() {
       }
       if (p.lobePath) {
         info.flags |= shared::kObjectLobePath;
-        info.lobeCore = glm::vec4(std::cos(p.lobeCore), 0.0f, 0.0f, 0.0f);  // fused.cpp setCore's cos, in float
+        info.lobeCore.x = std::cos(p.lobeCore);  // fused.cpp setCore's cos, in float
       }
+      info.lobeCore.y = shared::smoothMirrorCos(p.sharpestLobe);  // as cpu_backend.cpp's shadeSmoothSums
     } else {
       info.sliceBase = static_cast<std::uint32_t>(sliceData.size() / (3 * n));
       for (std::size_t t = 0; t < T; ++t) {
@@ -313,7 +315,7 @@ void VulkanRenderer::Impl::createFusedPipeline(std::uint32_t local) {
   fusedGroups = static_cast<std::uint32_t>(std::min<std::size_t>(maxGroups, groups));
   if (limits.fusedGroups) fusedGroups = std::min(fusedGroups, limits.fusedGroups);
   fusedPass = std::make_unique<ComputePipeline>(
-      context, "fused.comp", fusedBindings(), 0,
+      context, "fused.comp", fusedBindings(), sizeof(shared::FusedPush),
       std::vector<SpecConstant>{{shared::kSpecLocalSize, fusedLocal},
                                 {shared::kSpecInterpolate, options.interpolateSlices ? 1u : 0u},
                                 {shared::kSpecPrefilterFinest, static_cast<std::uint32_t>(std::max(prepared.lobeLight.finestLevel(), 0))},

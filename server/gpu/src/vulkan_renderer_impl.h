@@ -181,6 +181,9 @@ struct VulkanRenderer::Impl {
   // per covered sample its HiddenLight (shared_rays.h), else one record.
   Buffer hidden;
   BufferUpload hiddenUpload;
+  // `fused`'s smooth sum (shared_smooth.h): two vec4 per pixel, cleared
+  // each frame that takes sums from neighbours (RenderOptions::smoothSumTolerance).
+  Buffer smoothSums;
   std::vector<HiddenLight> hiddenData;
   // Antialiasing: the sub-samples' ids and normals (else 4-byte stand-ins),
   // and each pixel's edge word (shared_layout.h kEdgeFlag).

@@ -24,6 +24,7 @@
 #include "gpu_test_util.h"
 #include "haarcast/core/brdf_slices.h"
 #include "haarcast/core/fused.h"
+#include "haarcast/core/shared_smooth.h"
 #include "haarcast/core/visibility_bits.h"
 #include "haarcast/gpu/compute.h"
 #include "haarcast/gpu/passes.h"
@@ -256,7 +257,8 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
   const float noDetail = 0.0f;
   Buffer detailBuf = upload(&noDetail, sizeof noDetail);
   const TexelView detailView(context, detailBuf, VK_FORMAT_R32_SFLOAT, sizeof(float));
-  ComputePipeline p(context, "fused.comp", fusedBindings(), 0,
+  Buffer smoothBuf(context, sizeof(glm::vec4));
+  ComputePipeline p(context, "fused.comp", fusedBindings(), sizeof(shared::FusedPush),
                     {{shared::kSpecLocalSize, shared::kLocalSize},
                      {shared::kSpecInterpolate, pc.interpolate ? 1u : 0u},
                      {shared::kSpecPrefilterFinest, static_cast<std::uint32_t>(kPrefilterFinest)}});
@@ -265,8 +267,10 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
   Buffer sliceCountBuf = upload(sliceCounts.data(), sliceCounts.size() * sizeof(std::uint32_t));
   p.bind({&sampleBuf, &shadeBuf, &objectBuf, &texelView, &lightView, &bitsView, &dirView, &pointBuf, &radiance,
           &counterBuf, &maskBuf, &energyBuf, &lobeBuf, &prefilterView, &pointTexelView, &sliceCountBuf, &hiddenBuf,
-          &detailView});
-  context.submit([&](VkCommandBuffer cb) { p.dispatch(cb, {kGroups, 1, 1}); });
+          &detailView, &smoothBuf});
+  // Every sample shaded in one dispatch: no sum from neighbours (its own test: FusedFrame).
+  const shared::FusedPush push{shared::kSmoothSumOff, static_cast<std::uint32_t>(kPixels), 1u, 0.0f};
+  context.submit([&](VkCommandBuffer cb) { p.dispatch(cb, {kGroups, 1, 1}, &push, sizeof push); });
   std::vector<glm::vec4> got(kPixels);
   radiance.read(got.data(), got.size() * sizeof(glm::vec4));
   sliceCountBuf.read(sliceCounts.data(), sliceCounts.size() * sizeof(std::uint32_t));

@@ -22,6 +22,7 @@
 #include "frame_compare.h"
 #include "gpu_test_util.h"
 #include "haarcast/core/shared_cells.h"
+#include "haarcast/core/shared_smooth.h"
 #include "haarcast/core/fused.h"
 #include "haarcast/core/shared_layout.h"
 #include "haarcast/cpu/cpu_renderer.h"
@@ -208,6 +209,34 @@ TEST_P(FusedCellsFrame, VulkanMatchesTheCpuBackend) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Levels, FusedCellsFrame, ::testing::Combine(::testing::Values(5, 6), ::testing::Bool()));
+
+// The sum from a pixel's neighbours (RenderOptions::smoothSumTolerance,
+// core/shared_smooth.h) on both backends: the device's five dispatches,
+// coarse to fine, take the same pixels' sums as the CPU's pass and make the
+// same frame; a Lambert sphere (whose sum is smooth) beside the GGX torus.
+TEST(FusedSmoothFrame, VulkanTakesTheSameSumsAsTheCpuBackend) {
+  HAARCAST_REQUIRE_VULKAN();
+  render::Scene scene = render::defaultScene();
+  scene.objects[0].material = render::materialFromSpec("lambert");
+  render::RenderOptions o = frameOptions(RotationMethod::Fused, true);
+  o.width = o.height = 128;  // the sphere wide enough for its sum to be smooth over 4 pixels
+  o.level = 5;
+  o.sumTolerance = shared::kDefaultSumTolerance;
+  o.smoothSumTolerance = shared::kDefaultSmoothSumTolerance;
+  VulkanRenderer gpu(scene, o, testing::testOptions());
+  const FusedPair p = renderFusedPair("fused, sums from neighbours", scene, o, gpu);
+  const render::Frame& a = p.cpu;
+  const render::Frame& b = p.vulkan;
+  std::printf("  sums from neighbours: cpu %zu, vulkan %zu of %zu\n", a.smoothSamples, b.smoothSamples, a.passSamples);
+  EXPECT_GE(p.c.psnr, testing::fusedPsnrFloor(gpu.context()));
+  EXPECT_EQ(p.c.mismatched, 0u);
+  EXPECT_EQ(a.passSamples, b.passSamples);
+  EXPECT_GT(a.smoothSamples, a.passSamples / 10) << "the test must see sums taken";
+  // A decision on a threshold may round the other way: a few in a thousand.
+  EXPECT_NEAR(static_cast<double>(b.smoothSamples), static_cast<double>(a.smoothSamples), 3e-3 * a.passSamples + 1.0);
+  EXPECT_NEAR(static_cast<double>(b.passDirections), static_cast<double>(a.passDirections), 5e-3 * a.passDirections);
+  testing::expectNoValidationMessages(gpu.context());
+}
 
 // Each object at its own level (RenderOptions::automaticLevel): the default
 // scene with a Lambert sphere (the floor, 5) beside its GGX torus (6) and

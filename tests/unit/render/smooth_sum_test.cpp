@@ -1,12 +1,14 @@
-// fused's sum taken from a pixel's neighbours (smooth_sum.h): the order the
+// fused's sum taken from a pixel's neighbours (core/shared_smooth.h): the order the
 // pixels are visited in, the agreement rule, and the CPU backend's frames.
-#include "haarcast/render/smooth_sum.h"
+#include "haarcast/core/shared_frame.h"
+#include "haarcast/core/shared_smooth.h"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <vector>
 
+#include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 #include <gtest/gtest.h>
 
@@ -17,24 +19,25 @@
 namespace haarcast::render {
 namespace {
 
-using Sums = std::vector<std::array<float, 3>>;
+using shared::SmoothParents;
 
 // Every pixel is visited once, and every parent before its child.
 TEST(SmoothSum, EveryPixelIsVisitedOnceAfterItsParents) {
   for (const auto [w, h] : {std::pair{13, 9}, {16, 16}, {1, 1}, {5, 1}, {1, 7}, {33, 20}}) {
     std::vector<int> visited(static_cast<std::size_t>(w * h), -1);
-    const std::vector<SmoothSumStage> stages = smoothSumStages(kSmoothSumSpacing);
-    for (std::size_t k = 0; k < stages.size(); ++k) {
+    for (shared::uint k = 0; k < shared::kSmoothSumStages; ++k) {
       for (int y = 0; y < h; ++y) {
         for (int x = 0; x < w; ++x) {
-          const SmoothSumParents p = smoothSumParents(stages[k], x, y, w, h);
+          const SmoothParents p = shared::smoothParents(k, x, y, w, h);
           if (p.count == -2) continue;
           const std::size_t i = static_cast<std::size_t>(y * w + x);
           EXPECT_EQ(visited[i], -1) << w << "×" << h << " (" << x << ", " << y << ") twice";
           visited[i] = static_cast<int>(k);
-          const int n = p.count == 2 && p.outer ? 4 : std::max(p.count, 0);
+          const std::array<shared::uint, 4> at{p.at0, p.at1, p.at2, p.at3};
+          const int n = p.count == 2 && p.outer != 0u ? 4 : std::max(p.count, 0);
           for (int j = 0; j < n; ++j) {
-            const int parent = visited[p.at[static_cast<std::size_t>(j)]];
+            ASSERT_LT(at[static_cast<std::size_t>(j)], static_cast<shared::uint>(w * h));
+            const int parent = visited[at[static_cast<std::size_t>(j)]];
             EXPECT_TRUE(parent >= 0 && parent < static_cast<int>(k)) << "(" << x << ", " << y << ") before a parent";
           }
         }
@@ -42,82 +45,97 @@ TEST(SmoothSum, EveryPixelIsVisitedOnceAfterItsParents) {
     }
     EXPECT_EQ(std::count(visited.begin(), visited.end(), -1), 0) << w << "×" << h << ": a pixel never visited";
   }
-  EXPECT_THROW(smoothSumStages(3), std::invalid_argument);
 }
 
 TEST(SmoothSum, ParentsAreTheGridNeighboursAtTheStagesStep) {
-  const std::vector<SmoothSumStage> stages = smoothSumStages(4);
-  ASSERT_EQ(stages.size(), 5u);  // grid 4, edges 2, centres 2, edges 1, centres 1
+  ASSERT_EQ(shared::kSmoothSumSpacing, 4u);
+  // grid 4, edges 2, centres 2, edges 1, centres 1
+  EXPECT_EQ(shared::smoothStageStep(0), 4u);
+  EXPECT_EQ(shared::smoothStageStep(1), 2u);
+  EXPECT_EQ(shared::smoothStageKind(2), shared::kSmoothCentres);
+  EXPECT_EQ(shared::smoothStageStep(3), 1u);
+  EXPECT_EQ(shared::smoothStageKind(4), shared::kSmoothCentres);
   const int w = 20, h = 20;
-  auto at = [&](int x, int y) { return static_cast<std::uint32_t>(y * w + x); };
-  SmoothSumParents p = smoothSumParents(stages[1], 10, 8, w, h);  // across, step 2
+  auto at = [&](int x, int y) { return static_cast<shared::uint>(y * w + x); };
+  SmoothParents p = shared::smoothParents(1, 10, 8, w, h);  // across, step 2
   ASSERT_EQ(p.count, 2);
-  EXPECT_EQ(p.at[0], at(8, 8));
-  EXPECT_EQ(p.at[1], at(12, 8));
-  ASSERT_TRUE(p.outer);
-  EXPECT_EQ(p.at[2], at(4, 8));
-  EXPECT_EQ(p.at[3], at(16, 8));
-  p = smoothSumParents(stages[1], 4, 2, w, h);  // down, step 2: no row -4
+  EXPECT_EQ(p.at0, at(8, 8));
+  EXPECT_EQ(p.at1, at(12, 8));
+  ASSERT_EQ(p.outer, 1u);
+  EXPECT_EQ(p.at2, at(4, 8));
+  EXPECT_EQ(p.at3, at(16, 8));
+  p = shared::smoothParents(1, 4, 2, w, h);  // down, step 2: no row -4
   ASSERT_EQ(p.count, 2);
-  EXPECT_EQ(p.at[0], at(4, 0));
-  EXPECT_EQ(p.at[1], at(4, 4));
-  EXPECT_FALSE(p.outer);
-  p = smoothSumParents(stages[4], 5, 7, w, h);  // a square's centre, step 1
+  EXPECT_EQ(p.at0, at(4, 0));
+  EXPECT_EQ(p.at1, at(4, 4));
+  EXPECT_EQ(p.outer, 0u);
+  p = shared::smoothParents(4, 5, 7, w, h);  // a square's centre, step 1
   ASSERT_EQ(p.count, 4);
-  EXPECT_EQ(p.at[0], at(4, 7));
-  EXPECT_EQ(p.at[3], at(5, 8));
-  EXPECT_EQ(smoothSumParents(stages[1], 18, 0, w, h).count, -1);  // x + 2 = 20 is outside
+  EXPECT_EQ(p.at0, at(4, 7));
+  EXPECT_EQ(p.at3, at(5, 8));
+  EXPECT_EQ(shared::smoothParents(1, 18, 0, w, h).count, -1);  // x + 2 = 20 is outside
 }
+
+glm::vec3 grey(float v) { return glm::vec3(v); }
 
 // ε = 0.01 of parents that show 100: 1.
 TEST(SmoothSum, ALineIsTakenAndABumpOrAStepIsNot) {
   const float shown = 100.0f;  // the parents' dimmest brightest channel
   const float tolerance = 0.01f;
-  auto edges = [](float a, float b, float outerA, float outerB) {
-    return Sums{{a, a, a}, {b, b, b}, {outerA, outerA, outerA}, {outerB, outerB, outerB}};
+  SmoothParents across{2, 1u, 0u, 0u, 0u, 0u};
+  auto agree = [&](const SmoothParents& p, float a, float b, float outerA, float outerB, float brightness = 100.0f) {
+    return shared::smoothSumsAgree(p, grey(a), grey(b), grey(outerA), grey(outerB), brightness, tolerance);
   };
-  SmoothSumParents across;
-  across.count = 2;
-  across.outer = true;
   // A line, whatever its slope within the step limit 4ε.
-  EXPECT_TRUE(sumsAgree(across, edges(10, 13, 7, 16), shown, tolerance));
-  EXPECT_EQ(parentsSum(across, edges(10, 13, 7, 16))[0], 11.5f);
+  EXPECT_TRUE(agree(across, 10, 13, 7, 16));
+  EXPECT_EQ(shared::smoothParentsSum(across, grey(10), grey(13), grey(7), grey(16)).x, 11.5f);
   // A bump: |A' − A − B + B'|/16 = 20/16 > 1.
-  EXPECT_FALSE(sumsAgree(across, edges(10, 10, 0, 0), shown, tolerance));
-  EXPECT_TRUE(sumsAgree(across, edges(10, 10, 2, 2), shown, tolerance));  // 16/16
+  EXPECT_FALSE(agree(across, 10, 10, 0, 0));
+  EXPECT_TRUE(agree(across, 10, 10, 2, 2));  // 16/16
   // A step the outer pair cannot see: its size alone, at most 4ε.
-  EXPECT_FALSE(sumsAgree(across, edges(10, 15, 10, 15), shown, tolerance));
+  EXPECT_FALSE(agree(across, 10, 15, 10, 15));
   // Without the outer pair, the spread at most ε.
-  SmoothSumParents near = across;
-  near.outer = false;
-  EXPECT_FALSE(sumsAgree(near, edges(10, 12, 0, 0), shown, tolerance));
-  EXPECT_TRUE(sumsAgree(near, edges(10, 11, 0, 0), shown, tolerance));
+  SmoothParents near = across;
+  near.outer = 0u;
+  EXPECT_FALSE(agree(near, 10, 12, 0, 0));
+  EXPECT_TRUE(agree(near, 10, 11, 0, 0));
   // One channel is enough to refuse.
-  Sums red = edges(10, 11, 0, 0);
-  red[1][2] = 13.0f;
-  EXPECT_FALSE(sumsAgree(near, red, shown, tolerance));
+  EXPECT_FALSE(shared::smoothSumsAgree(near, grey(10), glm::vec3(11, 11, 13), grey(0), grey(0), shown, tolerance));
   // The square's centre: the across and the down means agree within 2ε.
-  SmoothSumParents centre;
-  centre.count = 4;
-  EXPECT_TRUE(sumsAgree(centre, Sums{{10, 10, 10}, {10, 10, 10}, {12, 12, 12}, {12, 12, 12}}, shown, tolerance));
-  EXPECT_FALSE(sumsAgree(centre, Sums{{10, 10, 10}, {10, 10, 10}, {13, 13, 13}, {13, 13, 13}}, shown, tolerance));
-  EXPECT_EQ(parentsSum(centre, Sums{{10, 0, 0}, {11, 0, 0}, {12, 0, 0}, {13, 0, 0}})[0], 11.5f);
-  // Brighter point lights shown allow more: the tolerance is of what the parents show.
-  EXPECT_TRUE(sumsAgree(near, edges(10, 12, 0, 0), 200.0f, tolerance));
+  const SmoothParents centre{4, 0u, 0u, 0u, 0u, 0u};
+  EXPECT_TRUE(shared::smoothSumsAgree(centre, grey(10), grey(10), grey(12), grey(12), shown, tolerance));
+  EXPECT_FALSE(shared::smoothSumsAgree(centre, grey(10), grey(10), grey(13), grey(13), shown, tolerance));
+  EXPECT_EQ(shared::smoothParentsSum(centre, grey(10), grey(11), grey(12), grey(13)).x, 11.5f);
+  // Brighter point lights shown allow more: the tolerance is of what the parents show…
+  EXPECT_TRUE(agree(near, 10, 12, 0, 0, 200.0f));
   // …and the dimmest parent sets it: next to a shadow's edge, less.
-  EXPECT_EQ(parentsBrightness(near, Sums{{200, 50, 0}, {0, 90, 80}}), 90.0f);
-  EXPECT_EQ(parentsBrightness(centre, Sums{{200, 0, 0}, {150, 0, 0}, {300, 0, 0}, {0, 0, 40}}), 40.0f);
+  EXPECT_EQ(shared::smoothBrightness(near, glm::vec3(200, 50, 0), glm::vec3(0, 90, 80), grey(0), grey(0)), 90.0f);
+  EXPECT_EQ(shared::smoothBrightness(centre, glm::vec3(200, 0, 0), glm::vec3(150, 0, 0), glm::vec3(300, 0, 0),
+                                     glm::vec3(0, 0, 40)), 40.0f);
 }
 
 TEST(SmoothSum, AParentsMirrorDirectionMustBeWithinHalfTheLobe) {
-  const float lobe = 0.2f;  // radians: parents within 0.1 of the pixel's direction
+  const float cosLimit = shared::smoothMirrorCos(0.2f);  // radians: parents within 0.1 of the pixel's direction
+  EXPECT_NEAR(cosLimit, std::cos(0.1f), 1e-6f);
   const glm::vec3 pixel(0.0f, 0.0f, 1.0f);
   auto turned = [](float angle) { return glm::vec3(std::sin(angle), 0.0f, std::cos(angle)); };
-  const std::vector<glm::vec3> near{turned(0.09f), turned(-0.05f)};
-  const std::vector<glm::vec3> far{turned(0.09f), turned(-0.11f)};
-  EXPECT_TRUE(mirrorsWithinLobe(pixel, near, lobe));
-  EXPECT_FALSE(mirrorsWithinLobe(pixel, far, lobe));
-  EXPECT_TRUE(mirrorsWithinLobe(pixel, far, 0.25f));
+  EXPECT_TRUE(shared::smoothMirrorNear(pixel, turned(0.09f), cosLimit));
+  EXPECT_TRUE(shared::smoothMirrorNear(pixel, turned(-0.05f), cosLimit));
+  EXPECT_FALSE(shared::smoothMirrorNear(pixel, turned(-0.11f), cosLimit));
+}
+
+// The mirror direction from the Euler angles and θₒ is the view reflected
+// about the normal: with the frame of shadingFrame, R·(0, cos θₒ, −sin θₒ)
+// = 2(n·wo)n − wo.
+TEST(SmoothSum, TheMirrorIsTheViewReflectedAboutTheNormal) {
+  const glm::vec3 n = glm::normalize(glm::vec3(0.3f, 0.8f, -0.2f));
+  const glm::vec3 wo = glm::normalize(glm::vec3(-0.5f, 0.4f, 0.7f));
+  float thetaOut = 0.0f;
+  const glm::mat3 frame = shared::shadingFrame(n, wo, thetaOut);
+  const glm::vec3 e = shared::eulerYXYOf(frame);
+  const glm::vec3 mirror = shared::smoothMirror(e.x, e.y, e.z, thetaOut);
+  const glm::vec3 expected = 2.0f * glm::dot(n, wo) * n - wo;
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(mirror[c], expected[c], 1e-5f);
 }
 
 RenderOptions smallFused() {

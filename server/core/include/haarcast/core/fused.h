@@ -162,7 +162,7 @@ std::array<float, 3> lobeShade(const LobePath& path, const shared::SliceBlend& b
 // surface (the light's rest × V × ρ, the energy put back): given, fusedShade
 // takes it instead of summing (no slice blend, no pass), and everything
 // else (point lights, hidden sky, lobe path) is the pixel's own; not given,
-// fusedShade sums it and writes it here. render/smooth_sum.h takes it from a
+// fusedShade sums it and writes it here. core/shared_smooth.h takes it from a
 // pixel's neighbours where they agree.
 struct FusedSum {
   std::array<float, 3> value{};

@@ -266,7 +266,11 @@ struct ObjectInfo {
   uint flags;          // kObjectGround, …
   vec4 groundRadiance; // a ground object: the radiance of its unshadowed map light (rgb)
   vec4 toLight[3];     // `fused`'s lobe path: object frame → the environment's, this frame (columns)
-  vec4 lobeCore;       // x: cos of the lobe path's core angle (core fused.h LobePath::coreAngle), −1: the path takes all; yzw: 0
+  // x: cos of the lobe path's core angle (core fused.h LobePath::coreAngle),
+  // −1: the path takes all; y: the smooth sum's cos limit between mirror
+  // directions (shared_smooth.h smoothMirrorCos of its sharpest median lobe
+  // angle, core PreparedObject::sharpestLobe); zw: 0
+  vec4 lobeCore;
   uint level;          // `fused`: its map level n (M = 2^n, N = M² directions)
   uint texelBase;      // `fused`: texel of its slice 0 in the slice texels; slice t at texelBase + t·N
   uint lightBase;      // `fused`: texel of its light's direction 0 this frame

@@ -195,12 +195,27 @@ HC_CONST uint kFusedPointSliceTexelsBinding = 14u;
 HC_CONST uint kFusedSliceCountsBinding = 15u;
 // kFusedSliceCountsBinding's words per object: its samples of one slice (the
 // ground's too) and of two, the pass's rows summed over its samples
-// (passRows), the most directions for one sample, and by cells
-// (shared_cells.h) its coarse cells and its fine cells summed over them.
-HC_CONST uint kSliceCountsPerObject = 6u;
+// (passRows), the most directions for one sample, by cells
+// (shared_cells.h) its coarse cells and its fine cells summed over them,
+// and its samples whose sum came from their neighbours (shared_smooth.h).
+HC_CONST uint kSliceCountsPerObject = 7u;
 HC_CONST uint kFusedHiddenBinding = 16u;
 HC_CONST uint kFusedDetailTexelsBinding = 17u;  // the slices' detail maps (shared_cells.h)
-HC_CONST uint kFusedBindings = 18u;
+// The smooth sum's records, two vec4 per pixel (shared_smooth.h): the
+// pixel's sum (rgb) and 1 + its object as the bits of w, 0 until it is
+// visited; its mirror direction (xyz).
+HC_CONST uint kFusedSmoothBinding = 18u;
+HC_CONST uint kFusedBindings = 19u;
+
+// fused.comp's push block: the smooth sum's stage this dispatch
+// (shared_smooth.h; kSmoothSumOff: one dispatch shades every sample), the
+// frame's size and the tolerance.
+struct FusedPush {
+  uint stage;
+  uint width;
+  uint height;
+  float tolerance;
+};
 
 // splitsum.comp; kSplitsumLobeLightTexelsBinding is a uniform texel
 // buffer, the rest storage buffers (gpu::splitsumBindings).

@@ -67,10 +67,10 @@ struct RenderOptions {
   // is summed at one direction; 0 sums every direction. `render`, `serve`
   // and `bench-frame` take shared::kDefaultSumTolerance.
   float sumTolerance = 0.0f;
-  // `fused`, CPU backend: ε > 0 takes a pixel's sum (the light's rest × V ×
-  // ρ) from its neighbours where theirs agree within ε of what it shows
-  // (smooth_sum.h); 0 sums every pixel. `render`, `serve` and `bench-frame`
-  // take shared::kDefaultSmoothSumTolerance.
+  // `fused`: ε > 0 takes a pixel's sum (the light's rest × V × ρ) from its
+  // neighbours where theirs agree within ε of what they show
+  // (core/shared_smooth.h); 0 sums every pixel. `render`, `serve` and
+  // `bench-frame` take shared::kDefaultSmoothSumTolerance.
   float smoothSumTolerance = 0.0f;
   SceneLimits sceneLimits;                // objects, triangles, visibility memory (prepareScene)
   bool environmentBackground = true;      // false: black where no object is

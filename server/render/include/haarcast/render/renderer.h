@@ -192,7 +192,7 @@ struct PreparedObject {
   float lobeCore = 0.0f;  // the lobe path's core angle (fused.h LobePath::coreAngle); π: the path takes all
   // `fused`: its sharpest slice's median lobe angle (core/lobe.h
   // sharpestMedian; π for the ground): how far a pixel's mirror direction
-  // may be from its neighbours' for it to take their sum (smooth_sum.h).
+  // may be from its neighbours' for it to take their sum (core/shared_smooth.h).
   float sharpestLobe = 3.14159265f;
 };
 

@@ -1,0 +1,182 @@
+// `fused`'s sum taken from a pixel's neighbours where the image shows it is
+// smooth (docs/design.md, "Where the sum is smooth across the image"),
+// written once for the CPU backend (cpu_backend.cpp) and fused.comp (C++
+// and GLSL, shared_language.h).
+//
+// The pass's sum (the light's rest × V × ρ, the lobe's energy put back:
+// core/fused.h FusedSum) changes slowly across a surface wherever the lobe
+// is wider than a pixel's turn and V has no edge; what a pixel shows
+// sharply — the point lights and their shadows, the sky other objects hide,
+// the lobe path's mirror core — is not in it and stays each pixel's own.
+// So the frame's pixels are visited coarse to fine, in the order of
+// adaptive image subdivision, in kSmoothSumStages stages: stage 0 sums every
+// pixel of a grid kSmoothSumSpacing apart; then, halving the step, each
+// midpoint of the grid's edges (Edges: two parents, across or down) and each
+// centre of its squares (Centres: four parents, the midpoints just done)
+// takes its parents' mean sum where
+//   - each parent's mirror direction is within kSmoothSumLobeShare of the
+//     object's sharpest median lobe angle of the pixel's (the sum is the
+//     light blurred by the lobe: smooth only where the mirror directions
+//     move by less than the lobe is wide; a near-mirror's sum, sampled by
+//     the map's directions, changes from pixel to pixel more than its
+//     neighbours' agreement can show), and
+//   - their sums agree (smoothSumsAgree) within the tolerance of what they
+//     show,
+// and is summed where not. A parent outside the frame, on another object or
+// not summed (the ground, an edge pixel's sub-samples) makes the pixel sum.
+// What slips through is a feature of the sum narrower than the spacing whose
+// parents agree on both sides of it.
+#ifndef HAARCAST_CORE_SHARED_SMOOTH_H
+#define HAARCAST_CORE_SHARED_SMOOTH_H
+
+#include "haarcast/core/shared_language.h"
+
+#ifdef __cplusplus
+namespace haarcast::shared {
+#endif
+
+// The coarsest grid: every 4th pixel of every 4th row is summed.
+HC_CONST uint kSmoothSumSpacing = 4u;
+// Grid, then Edges and Centres at steps 2 and 1.
+HC_CONST uint kSmoothSumStages = 5u;
+// RenderOptions::smoothSumTolerance's default (`render`, `serve`,
+// `bench-frame`; RenderOptions keeps 0).
+HC_CONST float kDefaultSmoothSumTolerance = 0.01f;
+// A parent's mirror direction within this share of the lobe's median angle.
+HC_CONST float kSmoothSumLobeShare = 0.5f;
+// fused.comp's push constant `stage` where nothing is taken: one dispatch
+// shades every sample.
+HC_CONST uint kSmoothSumOff = 0xFFFFFFFFu;
+
+HC_CONST uint kSmoothGrid = 0u;
+HC_CONST uint kSmoothEdges = 1u;
+HC_CONST uint kSmoothCentres = 2u;
+// Stage s's kind and step: 0 the grid at the spacing; then Edges, Centres
+// at spacing/2, …, 1.
+HC_FUNCTION uint smoothStageKind(uint stage) { return stage == 0u ? kSmoothGrid : ((stage & 1u) != 0u ? kSmoothEdges : kSmoothCentres); }
+HC_FUNCTION uint smoothStageStep(uint stage) { return stage == 0u ? kSmoothSumSpacing : (kSmoothSumSpacing >> ((stage + 1u) / 2u)); }
+
+// A pixel's parents in a stage, as y·width + x.
+struct SmoothParents {
+  // 0: a Grid pixel (summed); 2: Edges, A and B at ±h across or down, then
+  // A' and B' at ±3h beyond them where `outer` is 1; 4: Centres, the
+  // midpoints left, right, above and below; −1: a parent outside the
+  // frame; −2: the pixel is not in this stage.
+  int count;
+  uint outer;
+  uint at0, at1, at2, at3;
+};
+
+HC_FUNCTION SmoothParents smoothParents(uint stage, int x, int y, int width, int height) {
+  SmoothParents p;
+  p.count = -2;
+  p.outer = 0u;
+  p.at0 = 0u;
+  p.at1 = 0u;
+  p.at2 = 0u;
+  p.at3 = 0u;
+  const int h = int(smoothStageStep(stage));
+  const uint kind = smoothStageKind(stage);
+  if (kind == kSmoothGrid) {
+    if (x % h == 0 && y % h == 0) p.count = 0;
+    return p;
+  }
+  const int rx = x % (2 * h), ry = y % (2 * h);
+  int dx = 0;
+  int dy = 0;
+  if (kind == kSmoothEdges) {
+    if (rx == h && ry == 0) dx = 1;       // across
+    else if (rx == 0 && ry == h) dy = 1;  // down
+    else return p;
+  } else {
+    if (rx != h || ry != h) return p;
+    if (x + h >= width || y + h >= height) {
+      p.count = -1;
+      return p;
+    }
+    p.count = 4;
+    p.at0 = uint(y * width + x - h);
+    p.at1 = uint(y * width + x + h);
+    p.at2 = uint((y - h) * width + x);
+    p.at3 = uint((y + h) * width + x);
+    return p;
+  }
+  // x − h·dx and y − h·dy are ≥ 0: x or y is ≥ h where its remainder is h.
+  if (x + h * dx >= width || y + h * dy >= height) {
+    p.count = -1;
+    return p;
+  }
+  p.count = 2;
+  p.at0 = uint((y - h * dy) * width + x - h * dx);
+  p.at1 = uint((y + h * dy) * width + x + h * dx);
+  if (x - 3 * h * dx >= 0 && y - 3 * h * dy >= 0 && x + 3 * h * dx < width && y + 3 * h * dy < height) {
+    p.outer = 1u;
+    p.at2 = uint((y - 3 * h * dy) * width + x - 3 * h * dx);
+    p.at3 = uint((y + 3 * h * dy) * width + x + 3 * h * dx);
+  }
+  return p;
+}
+
+// The mirror direction of the view in the object's frame: the slice frame's
+// (0, cos θₒ, −sin θₒ) (the view is at φ = 0, shared_frame.h shadingFrame)
+// turned by R = R_y(α) R_x(β) R_y(γ).
+HC_FUNCTION vec3 smoothMirror(float alpha, float beta, float gamma, float thetaOut) {
+  const float s = HC_SIN(thetaOut);
+  const float c = HC_SIN(thetaOut + 1.57079632679f);
+  return rotY(alpha) * (rotX(beta) * (rotY(gamma) * vec3(0.0f, c, -s)));
+}
+
+// Whether a parent's mirror direction is near enough the pixel's (both unit)
+// for an object whose sharpest median lobe angle is `lobe`.
+HC_FUNCTION bool smoothMirrorNear(vec3 pixel, vec3 parent, float cosLimit) { return dot(pixel, parent) >= cosLimit; }
+HC_FUNCTION float smoothMirrorCos(float lobe) { return HC_SIN(1.57079632679f - min(kSmoothSumLobeShare * lobe, 3.14159265f)); }
+
+// The brightness the tolerance is of: the dimmest of the near parents'
+// brightest channels as shown (their radiance, point lights included), so
+// that where the point lights are bright the sum may vary more, and next to
+// a shadow's edge it may not.
+HC_FUNCTION float smoothBrightness(SmoothParents p, vec3 shown0, vec3 shown1, vec3 shown2, vec3 shown3) {
+  float dimmest = min(max(max(shown0.x, shown0.y), shown0.z), max(max(shown1.x, shown1.y), shown1.z));
+  if (p.count == 4) {
+    dimmest = min(dimmest, max(max(shown2.x, shown2.y), shown2.z));
+    dimmest = min(dimmest, max(max(shown3.x, shown3.y), shown3.z));
+  }
+  return dimmest;
+}
+
+// Whether the parents' sums may stand for the pixel's, measured against
+// ε = tolerance × brightness in each channel:
+// - how far their mean is from a curve through them: Edges with outer,
+//   |A' − A − B + B'|/16 (the cubic through the four at the middle less the
+//   line: exact for a quadratic); Centres, the across and the down means'
+//   difference, halved; each at most ε;
+// - and the near parents' spread, max − min, at most 4ε (ε for Edges
+//   without outer): a step between two parents the curve cannot see errs
+//   by half of it at most.
+HC_FUNCTION bool smoothSumsAgree(SmoothParents p, vec3 s0, vec3 s1, vec3 s2, vec3 s3, float brightness, float tolerance) {
+  const float epsilon = tolerance * brightness;
+  const bool curve = p.count == 4 || p.outer != 0u;
+  const float stepLimit = curve ? 4.0f * epsilon : epsilon;
+  vec3 lo = min(s0, s1);
+  vec3 hi = max(s0, s1);
+  if (p.count == 4) {
+    lo = min(lo, min(s2, s3));
+    hi = max(hi, max(s2, s3));
+  }
+  const vec3 spread = hi - lo;
+  if (!(max(max(spread.x, spread.y), spread.z) <= stepLimit)) return false;
+  if (!curve) return true;
+  const vec3 bend = p.count == 4 ? 0.25f * abs(s0 + s1 - s2 - s3) : abs(s2 - s0 - s1 + s3) / 16.0f;
+  return max(max(bend.x, bend.y), bend.z) <= epsilon;
+}
+
+// The sum the pixel takes: the mean of A and B, or of the four midpoints.
+HC_FUNCTION vec3 smoothParentsSum(SmoothParents p, vec3 s0, vec3 s1, vec3 s2, vec3 s3) {
+  return p.count == 4 ? (s0 + s1 + s2 + s3) / 4.0f : (s0 + s1) / 2.0f;
+}
+
+#ifdef __cplusplus
+}  // namespace haarcast::shared
+#endif
+
+#endif  // HAARCAST_CORE_SHARED_SMOOTH_H
