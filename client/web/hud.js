@@ -65,10 +65,14 @@ export function updateHud() {
   $('hud-size').textContent = f ? `${f.width}×${f.height} ${resolutionLabel()}` : '—';
   $('hud-method').textContent = (f && f.method) || '—';
   $('hud-exposure').textContent = f ? `${formatStops(f.exposureStops)} stops ${f.exposureMode}` : '—';
-  // fused: what a pixel cost, in map directions summed (by cells, fewer where the picture allows),
-  // and the share of pixels whose sum came from their neighbours.
+  // fused: the level each object is drawn at (SceneInfo.Object.level) and
+  // what a pixel cost there, one plan per object: map directions summed (by
+  // cells, fewer where the picture allows) and the share of pixels whose
+  // sum came from their neighbours.
+  const levels = ((state.sceneInfo && state.sceneInfo.objects) || []).map((o) => o.level).filter((l) => l > 0);
+  const levelText = levels.length ? `level${levels.length > 1 ? 's' : ''} ${levels.join('/')} · ` : '';
   const smooth = f && f.smoothShare > 0 ? ` · ${Math.round(100 * f.smoothShare)} % from neighbours` : '';
-  $('hud-directions').textContent = f && f.directions > 0 ? `${formatNumber(f.directions)} directions/px${smooth}` : '';
+  $('hud-directions').textContent = f && f.directions > 0 ? `${levelText}${formatNumber(f.directions)} directions/px${smooth}` : '';
   $('hud-stages').textContent = s.stages.length
     ? s.stages.map((x) => `${x.name} ${formatNumber(x.ms)}`).join(' · ') + ' ms' : '—';
   $('hud').classList.toggle('idle', s.idle);

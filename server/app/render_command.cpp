@@ -113,6 +113,15 @@ int run(RenderArgs& a) {
       levelText += sum;
     }
   }
+  // How each object's pixels were drawn: its level and what a pixel may
+  // spend there, one decision (object_levels.h planObjects).
+  const std::vector<std::string> plans = renderer->objectPlans();
+  if (!plans.empty()) {
+    std::string planText;
+    for (std::size_t k = 0; k < plans.size() && k < scene.objects.size(); ++k)
+      planText += (k ? "; " : "") + scene.objects[k].name + ": " + plans[k];
+    std::fprintf(stderr, "plan: %s\n", planText.c_str());
+  }
   std::fprintf(stderr, "%s on %s: %d×%d, %s, %s, k = %zu, rays %s: precompute %.2f s, frame %.3f s (%s)\n",
                renderer->backend().c_str(), renderer->deviceName().c_str(), a.options.width, a.options.height,
                levelText.c_str(), a.method.c_str(), a.options.lightCoefficients, renderer->rays().c_str(), prepare,

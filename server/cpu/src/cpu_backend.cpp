@@ -103,6 +103,7 @@ class CpuRenderer final : public Renderer {
   std::size_t objectCount() const override { return prepared_.objects.size(); }
   std::vector<int> objectLevels() const override { return prepared_.objectLevels(); }
   std::vector<int> pointLightLevels() const override { return prepared_.pointLightLevels(); }
+  std::vector<std::string> objectPlans() const override { return prepared_.objectPlans(); }
   bool concurrentRenders() const override { return true; }
 
   Frame render(const FrameRequest& request) override;

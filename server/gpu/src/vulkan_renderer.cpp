@@ -147,6 +147,7 @@ const render::RenderOptions& VulkanRenderer::options() const { return slots_.fro
 std::size_t VulkanRenderer::objectCount() const { return slots_.front()->prepared.objects.size(); }
 std::vector<int> VulkanRenderer::objectLevels() const { return slots_.front()->prepared.objectLevels(); }
 std::vector<int> VulkanRenderer::pointLightLevels() const { return slots_.front()->prepared.pointLightLevels(); }
+std::vector<std::string> VulkanRenderer::objectPlans() const { return slots_.front()->prepared.objectPlans(); }
 Context& VulkanRenderer::context() { return last().context; }
 const render::PreparedScene& VulkanRenderer::prepared() const { return *slots_.front()->preparedScene; }
 std::size_t VulkanRenderer::batchSamples() const { return last().batch; }

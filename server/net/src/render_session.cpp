@@ -243,6 +243,13 @@ void RenderSession::onPrepared(const std::string& key, std::shared_ptr<PreparedR
     requested_ = std::max(requested_, now);  // the build was no frame's time
   }
   const std::vector<int> levels = renderer_->renderer->objectLevels();
+  // How each object's pixels are drawn (object_levels.h planObjects), once per renderer.
+  const std::vector<std::string> plans = renderer_->renderer->objectPlans();
+  if (!plans.empty()) {
+    std::string text;
+    for (std::size_t k = 0; k < plans.size(); ++k) text += (k ? "; " : "") + std::to_string(k) + ": " + plans[k];
+    log("plan: " + text);
+  }
   if (!welcomed_) {
     welcomed_ = true;
     lastStats_ = now;

@@ -57,7 +57,7 @@ BuildPlan planBuild(const Scene& scene, const RenderOptions& options, std::strin
   BuildPlan plan;
   const bool fused = options.method == RotationMethod::Fused;
   const bool splitsum = options.method == RotationMethod::Splitsum;
-  const std::vector<ObjectLevel> levels = chooseObjectLevels(scene, options);
+  const std::vector<ObjectPlan> levels = planObjects(scene, options);
   const double supersamples = static_cast<double>(options.sliceSupersampling) * options.sliceSupersampling;
   const double rays = static_cast<double>(options.visibility.supersampling) * options.visibility.supersampling;
   std::vector<double> sliceWork(scene.objects.size(), 0.0);

@@ -2,20 +2,23 @@
 #include "haarcast/render/object_levels.h"
 
 #include <algorithm>
+#include <cstdio>
 
 #include "haarcast/core/lobe.h"
+#include "haarcast/core/shared_cells.h"
+#include "haarcast/core/shared_smooth.h"
 #include "haarcast/render/renderer.h"
 #include "haarcast/core/splitsum.h"
 
 namespace haarcast::render {
 
-std::vector<ObjectLevel> chooseObjectLevels(const Scene& scene, const RenderOptions& options) {
-  std::vector<ObjectLevel> out(scene.objects.size());
+std::vector<ObjectPlan> planObjects(const Scene& scene, const RenderOptions& options) {
+  std::vector<ObjectPlan> out(scene.objects.size());
   const bool fused = options.method == RotationMethod::Fused;
   const std::vector<double> thetaOut = lobeThetaOut(options.thetaSamples);  // the slice table's θₒ (BrdfSliceTable::build)
   for (std::size_t k = 0; k < out.size(); ++k) {
     const SceneObject& object = scene.objects[k];
-    ObjectLevel& o = out[k];
+    ObjectPlan& o = out[k];
     o.level = options.level;
     if (!fused) continue;
     if (object.ground) {
@@ -23,9 +26,26 @@ std::vector<ObjectLevel> chooseObjectLevels(const Scene& scene, const RenderOpti
       continue;
     }
     o.lobes = measureLobes(*object.material.brdf, thetaOut);
+    o.sharpestLobe = static_cast<float>(sharpestMedian(o.lobes));
     if (options.automaticLevel) o.level = chooseLevel(*object.material.brdf, thetaOut, o.lobes, options.level);
+    if (shared::sumsByCells(static_cast<shared::uint>(o.level), options.sumTolerance)) o.sumTolerance = options.sumTolerance;
+    o.smoothSumTolerance = options.smoothSumTolerance;
   }
   return out;
+}
+
+std::string describePlan(const ObjectPlan& plan, bool ground, RotationMethod method) {
+  if (method != RotationMethod::Fused) return "level " + std::to_string(plan.level);
+  if (ground) return "closed form";
+  char text[160];
+  int n = std::snprintf(text, sizeof text, "level %d, ", plan.level);
+  if (plan.sumTolerance > 0.0f) n += std::snprintf(text + n, sizeof text - static_cast<std::size_t>(n), "cells τ %g", static_cast<double>(plan.sumTolerance));
+  else n += std::snprintf(text + n, sizeof text - static_cast<std::size_t>(n), "every direction");
+  if (plan.smoothSumTolerance > 0.0f) {
+    std::snprintf(text + n, sizeof text - static_cast<std::size_t>(n), ", a neighbour's sum within %.1f°",
+                  static_cast<double>(shared::kSmoothSumLobeShare * plan.sharpestLobe) * 180.0 / kPi);
+  }
+  return text;
 }
 
 int pointLightLevel(std::span<const shared::SliceLobe> lobes, int level) {

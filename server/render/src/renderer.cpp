@@ -59,7 +59,7 @@ PreparedScene prepareScene(const Scene& scene, const RenderOptions& options, con
   }
   // Each object's level (its lobes measured, for `fused`): the visibility
   // is counted at each object's own.
-  std::vector<ObjectLevel> levels = chooseObjectLevels(scene, options);
+  std::vector<ObjectPlan> levels = planObjects(scene, options);
   auto perVertex = [&](int level) -> std::size_t {
     return splitsum ? 0
            : fused  ? 4 * visibilityWordsPerPoint(level)
@@ -107,7 +107,9 @@ PreparedScene prepareScene(const Scene& scene, const RenderOptions& options, con
     if (!splitsum) p.table = objectSliceTable(object, options, p.level, progress);
     p.ground = object.ground;
     p.groundAlbedo = object.groundAlbedo;
-    if (!p.ground && shared::sumsByCells(static_cast<shared::uint>(p.level), options.sumTolerance)) p.sumTolerance = options.sumTolerance;
+    p.sumTolerance = levels[k].sumTolerance;
+    p.sharpestLobe = levels[k].sharpestLobe;
+    p.plan = describePlan(levels[k], p.ground, options.method);
     p.sphereCentre = p.mesh->bounds().centre();
     for (const glm::vec3& v : p.mesh->positions) p.sphereRadius = std::max(p.sphereRadius, glm::length(glm::dvec3(v) - p.sphereCentre));
     if (p.ground) {
@@ -168,7 +170,6 @@ PreparedScene prepareScene(const Scene& scene, const RenderOptions& options, con
           p.pointTable = objectSliceTable(scene.objects[k], options, p.pointLevel, progress, kPointSlicesStage);
         }
       }
-      p.sharpestLobe = static_cast<float>(sharpestMedian(levels[k].lobes));
       LobeCore core = chooseLobeCore(*scene.objects[k].material.brdf, thetaOut, p.level, std::move(levels[k].lobes));
       p.lobes = std::move(core.lobes);
       p.lobeCore = core.angle;
@@ -191,6 +192,12 @@ const std::array<SphereMap, 3>& PreparedScene::restLightAt(int level) const {
     throw std::out_of_range("render: no rest light at level " + std::to_string(level) + " (no object uses it)");
   }
   return restLight[static_cast<std::size_t>(level)];
+}
+
+std::vector<std::string> PreparedScene::objectPlans() const {
+  std::vector<std::string> out;
+  for (const PreparedObject& p : objects) out.push_back(p.plan);
+  return out;
 }
 
 std::vector<int> PreparedScene::pointLightLevels() const {

@@ -8,6 +8,8 @@
 #include <gtest/gtest.h>
 
 #include <cstddef>
+#include <cstdio>
+#include <string>
 #include <stdexcept>
 #include <vector>
 
@@ -39,25 +41,63 @@ RenderOptions options(int level, bool automatic) {
   return o;
 }
 
-std::vector<int> levelsOf(const std::vector<ObjectLevel>& levels) {
+std::vector<int> levelsOf(const std::vector<ObjectPlan>& levels) {
   std::vector<int> out;
-  for (const ObjectLevel& l : levels) out.push_back(l.level);
+  for (const ObjectPlan& l : levels) out.push_back(l.level);
   return out;
+}
+
+// The level and what a pixel may spend there are one plan per object, from
+// one measure of its material: the ground is closed form, an object below
+// the cells' level sums every direction, and the neighbours' mirror
+// directions may turn by half the lobe chooseLevel spans.
+TEST(ObjectLevels, ThePlanIsTheLevelTheCellsAndTheNeighboursFromOneMeasure) {
+  Scene scene = defaultScene();  // phong:64 sphere, ggx:0.3 torus, ground
+  RenderOptions o = options(6, true);
+  o.sumTolerance = 0.1f;
+  o.smoothSumTolerance = 0.01f;
+  const std::vector<ObjectPlan> plans = planObjects(scene, o);
+  ASSERT_EQ(plans.size(), 3u);
+  const ObjectPlan& sphere = plans[0];
+  EXPECT_EQ(sphere.level, 6);
+  EXPECT_EQ(sphere.sumTolerance, 0.1f);
+  EXPECT_EQ(sphere.smoothSumTolerance, 0.01f);
+  EXPECT_EQ(sphere.sharpestLobe, static_cast<float>(sharpestMedian(sphere.lobes)));
+  EXPECT_LT(sphere.sharpestLobe, plans[1].sharpestLobe) << "phong:64 is sharper than ggx:0.3";
+  const ObjectPlan& ground = plans[2];
+  EXPECT_EQ(ground.sumTolerance, 0.0f);
+  EXPECT_EQ(ground.smoothSumTolerance, 0.0f);
+  EXPECT_EQ(describePlan(ground, true, RotationMethod::Fused), "closed form");
+  char within[32];
+  std::snprintf(within, sizeof within, "%.1f°", static_cast<double>(sphere.sharpestLobe) * 90.0 / kPi);
+  EXPECT_EQ(describePlan(sphere, false, RotationMethod::Fused),
+            std::string("level 6, cells τ 0.1, a neighbour's sum within ") + within);
+  // Below the cells' level every direction is summed.
+  const std::vector<ObjectPlan> coarse = planObjects(scene, options(4, false));
+  EXPECT_EQ(coarse[0].sumTolerance, 0.0f);
+  EXPECT_EQ(describePlan(coarse[0], false, RotationMethod::Fused), "level 4, every direction");
+  // The prepared objects carry the plan, as the log and the renderers say it.
+  const PreparedScene prepared = prepareScene(scene, o);
+  for (std::size_t k = 0; k < plans.size(); ++k) {
+    EXPECT_EQ(prepared.objects[k].sumTolerance, plans[k].sumTolerance);
+    EXPECT_EQ(prepared.objects[k].sharpestLobe, plans[k].sharpestLobe);
+    EXPECT_EQ(prepared.objects[k].plan, describePlan(plans[k], k == 2, RotationMethod::Fused));
+  }
 }
 
 TEST(ObjectLevels, EachObjectByItsMaterialWithinTheCapTheGroundAtTheFloor) {
   Scene scene = defaultScene();  // phong:64 sphere, ggx:0.3 torus, ground
-  EXPECT_EQ(levelsOf(chooseObjectLevels(scene, options(7, true))), (std::vector<int>{7, 6, kAutoLevelFloor}));
-  EXPECT_EQ(levelsOf(chooseObjectLevels(scene, options(6, true))), (std::vector<int>{6, 6, kAutoLevelFloor}));
-  EXPECT_EQ(levelsOf(chooseObjectLevels(scene, options(3, true))), (std::vector<int>{3, 3, 3})) << "a cap under the floor";
+  EXPECT_EQ(levelsOf(planObjects(scene, options(7, true))), (std::vector<int>{7, 6, kAutoLevelFloor}));
+  EXPECT_EQ(levelsOf(planObjects(scene, options(6, true))), (std::vector<int>{6, 6, kAutoLevelFloor}));
+  EXPECT_EQ(levelsOf(planObjects(scene, options(3, true))), (std::vector<int>{3, 3, 3})) << "a cap under the floor";
   scene.objects[0].material = materialFromSpec("lambert");
-  EXPECT_EQ(levelsOf(chooseObjectLevels(scene, options(6, true))), (std::vector<int>{kAutoLevelFloor, 6, kAutoLevelFloor}));
-  EXPECT_EQ(levelsOf(chooseObjectLevels(scene, options(6, false))), (std::vector<int>{6, 6, 6})) << "fixed";
+  EXPECT_EQ(levelsOf(planObjects(scene, options(6, true))), (std::vector<int>{kAutoLevelFloor, 6, kAutoLevelFloor}));
+  EXPECT_EQ(levelsOf(planObjects(scene, options(6, false))), (std::vector<int>{6, 6, 6})) << "fixed";
   RenderOptions haar = options(6, true);
   haar.method = RotationMethod::Haar;
-  EXPECT_EQ(levelsOf(chooseObjectLevels(scene, haar)), (std::vector<int>{6, 6, 6})) << "one level for the other methods";
+  EXPECT_EQ(levelsOf(planObjects(scene, haar)), (std::vector<int>{6, 6, 6})) << "one level for the other methods";
   // fused measures its objects' lobes (the lobe path's choice reuses them); not the ground's.
-  const std::vector<ObjectLevel> fused = chooseObjectLevels(scene, options(5, false));
+  const std::vector<ObjectPlan> fused = planObjects(scene, options(5, false));
   EXPECT_EQ(fused[0].lobes.size(), 8u);
   EXPECT_TRUE(fused[2].lobes.empty());
 }
@@ -132,7 +172,7 @@ TEST(ObjectLevels, PointLightsReadAFinerTableWhereTheLobeIsNarrow) {
   EXPECT_EQ(p.objects[1].pointTable.storedBytes(), 0u) << "no second table where the first serves";
   EXPECT_EQ(p.objects[2].pointLevel, p.objects[2].level);
   EXPECT_EQ(pointLightLevel({}, 5), 5) << "no lobes measured";
-  const std::vector<ObjectLevel> levels = chooseObjectLevels(scene, options(7, false));
+  const std::vector<ObjectPlan> levels = planObjects(scene, options(7, false));
   EXPECT_EQ(pointLightLevel(levels[0].lobes, 7), 7) << "never past the finest level";
   EXPECT_EQ(pointLightLevel(levels[1].lobes, 4), 6) << "a coarse object's lights read the level its lobe needs";
 }

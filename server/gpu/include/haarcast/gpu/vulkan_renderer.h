@@ -99,6 +99,7 @@ class VulkanRenderer final : public render::Renderer {
   std::size_t objectCount() const override;
   std::vector<int> objectLevels() const override;
   std::vector<int> pointLightLevels() const override;
+  std::vector<std::string> objectPlans() const override;
   bool concurrentRenders() const override { return slots_.size() > 1; }
   std::size_t framesInFlight() const override { return slots_.size(); }
   // Waits for a free frame slot (one of framesInFlight()), renders in it.

@@ -18,19 +18,42 @@
 
 namespace haarcast::render {
 
-struct ObjectLevel {
+// How an object's pixels are drawn, decided once, from one measure of its
+// material (its lobes), before anything is prepared: the map level and
+// what a pixel spends there. The light's rest and the visibility then
+// decide per pixel within it: which cells are summed fine (their detail and
+// V; shared_cells.h) and whether the pixel's sum comes from its neighbours
+// (their sums, and the point lights they show; shared_smooth.h).
+struct ObjectPlan {
   int level = 0;
   // `fused`: its lobes measured whole at the slice table's θₒ (core
   // measureLobes), from which the level and the lobe path are chosen; empty
   // for the ground (shaded in closed form) and for the other methods.
   std::vector<shared::SliceLobe> lobes;
+  // `fused`: its sharpest slice's median lobe angle (core sharpestMedian;
+  // π without lobes): the level spans it with K texels (chooseLevel), and
+  // a pixel may take its neighbours' sum where their mirror directions are
+  // within half of it (shared_smooth.h).
+  float sharpestLobe = 3.14159265f;
+  // `fused`: the cells' tolerance (RenderOptions::sumTolerance where the
+  // object is summed by cells, else 0: the ground, shaded in closed form,
+  // and levels below shared::kCellMinLevel).
+  float sumTolerance = 0.0f;
+  // `fused`: RenderOptions::smoothSumTolerance where its pixels may take
+  // their neighbours' sum, else 0 (the ground).
+  float smoothSumTolerance = 0.0f;
 };
 
 // Per scene object, in order. Fixed (automaticLevel false) or a method
 // other than `fused`: options.level for every object. Automatic:
 // chooseLevel within [kAutoLevelFloor, options.level], the ground at the
 // floor (its map light is one closed form, its pixels read no map).
-std::vector<ObjectLevel> chooseObjectLevels(const Scene& scene, const RenderOptions& options);
+std::vector<ObjectPlan> planObjects(const Scene& scene, const RenderOptions& options);
+
+// A plan as the log says it: "level 6, cells τ 0.1, a neighbour's sum
+// within 4.3°" (`fused`), "closed form" for the ground, "level 5" for the
+// other methods.
+std::string describePlan(const ObjectPlan& plan, bool ground, RotationMethod method);
 
 // The level of an object's point-light slices (PreparedObject::pointLevel):
 // a point light reads its slice at one direction, by Catmull-Rom over the

@@ -130,6 +130,9 @@ class Renderer {
   // Each object's point-light slices' level (PreparedObject::pointLevel),
   // in scene order; empty where a renderer does not say.
   virtual std::vector<int> pointLightLevels() const { return {}; }
+  // How each object's pixels are drawn (PreparedObject::plan, object_levels.h
+  // describePlan), in scene order; empty where a renderer does not say.
+  virtual std::vector<std::string> objectPlans() const { return {}; }
   // Whether render() may run on several threads at once. The CPU backend's
   // prepared data is immutable and each call keeps its own scratch, so it
   // may; a Vulkan renderer owns one set of device buffers per frame in
@@ -194,6 +197,8 @@ struct PreparedObject {
   // sharpestMedian; π for the ground): how far a pixel's mirror direction
   // may be from its neighbours' for it to take their sum (core/shared_smooth.h).
   float sharpestLobe = 3.14159265f;
+  // The object's plan as the log says it (object_levels.h describePlan).
+  std::string plan;
 };
 
 struct ResolvedObject;
@@ -245,6 +250,7 @@ struct PreparedScene {
   // Each object's level, in scene order (PreparedObject::level).
   std::vector<int> objectLevels() const;
   std::vector<int> pointLightLevels() const;  // PreparedObject::pointLevel, in scene order
+  std::vector<std::string> objectPlans() const;  // PreparedObject::plan, in scene order
   PrefilteredLight lobeLight;           // `fused`, `splitsum`: the backdrop's maps at every level, for the lobe path (empty when no object has one)
   std::optional<std::size_t> ground;    // index of the ground object, if any
   std::shared_ptr<FusedLightCache> fusedLightCache = std::make_shared<FusedLightCache>();
