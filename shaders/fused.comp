@@ -399,13 +399,18 @@ void shadePixel(uint s) {
   const RotationSample rs = samples[s];
   const SliceBlend blend = sliceBlendAt(rs.thetaOut, o.thetaSamples, INTERPOLATE);
   const bool blended = blend.weight != 0.0 && blend.second != blend.first;
-  if (lid == 0u) atomicAdd(sliceCounts[kSliceCountsPerObject * sh.object + (blended ? 1u : 0u)], 1u);
+  // Counted as shaded from one slice or two below, or as taken from its
+  // neighbours (word 6), where it reads no slice of the pass.
+  const uint sliceWord = kSliceCountsPerObject * sh.object + (blended ? 1u : 0u);
 
   // The lobe path (fused.h LobePath): all of the lobe, with no pass, or
   // its core, with the pass over the rest.
   const bool lobePath = (o.flags & kObjectLobePath) != 0u;
   if (lobePath && o.lobeCore.x <= -1.0) {
-    if (lid == 0u) radiance[sh.pixel] = vec4(lobeShade(o, rs, blend, seen), 1.0);
+    if (lid == 0u) {
+      atomicAdd(sliceCounts[sliceWord], 1u);
+      radiance[sh.pixel] = vec4(lobeShade(o, rs, blend, seen), 1.0);
+    }
     return;  // uniform over the workgroup
   }
   PixelSetup p;
@@ -473,6 +478,7 @@ void shadePixel(uint s) {
     }
     return;  // uniform over the workgroup
   }
+  if (lid == 0u) atomicAdd(sliceCounts[sliceWord], 1u);
 
   // Only rows that can reach the slice's non-zero cap (shared_layout.h
   // passRows). The range is uniform over the workgroup, so every device

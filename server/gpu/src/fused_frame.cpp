@@ -257,7 +257,7 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
   std::size_t counted = 0;
   for (std::size_t i = 0; i < objectCount; ++i) {
     const std::uint32_t* c = counts.data() + kWords * i;
-    counted += std::size_t{c[0]} + c[1];
+    counted += std::size_t{c[0]} + c[1] + c[6];
     if (prepared.objects[i].ground) continue;
     const int objectLevel = prepared.objects[i].level;
     const std::size_t visibilityBytes = 3 * shared::visibilityWords(static_cast<shared::uint>(objectLevel)) * sizeof(std::uint32_t);
@@ -266,7 +266,7 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
     // The pass's directions: its rows × M (shared_layout.h passRows), or by
     // cells one per coarse cell and 16 per fine one (core FusedScratch::passDirections).
     const std::size_t m = static_cast<std::size_t>(mapSize(objectLevel));
-    frame.passSamples += std::size_t{c[0]} + c[1];
+    frame.passSamples += std::size_t{c[0]} + c[1] + c[6];  // those taken from their neighbours read no slice
     frame.passDirections += std::size_t{c[2]} * m + c[4] + shared::kCellDirections * std::size_t{c[5]};
     frame.passDirectionsMax = std::max(frame.passDirectionsMax, std::size_t{c[3]});
     frame.smoothSamples += c[6];

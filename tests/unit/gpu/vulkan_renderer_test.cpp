@@ -235,6 +235,8 @@ TEST(FusedSmoothFrame, VulkanTakesTheSameSumsAsTheCpuBackend) {
   // A decision on a threshold may round the other way: a few in a thousand.
   EXPECT_NEAR(static_cast<double>(b.smoothSamples), static_cast<double>(a.smoothSamples), 3e-3 * a.passSamples + 1.0);
   EXPECT_NEAR(static_cast<double>(b.passDirections), static_cast<double>(a.passDirections), 5e-3 * a.passDirections);
+  // A sample that takes its sum reads no slice of the pass: counted alike.
+  EXPECT_EQ(b.coefficientBytes, a.coefficientBytes);
   testing::expectNoValidationMessages(gpu.context());
 }
 
