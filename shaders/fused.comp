@@ -268,6 +268,7 @@ vec3 sumDirections(const bool blended, PixelSetup p, out vec3 norm) {
 }
 
 #include "common/fused_cells.glsl"
+#include "common/fused_smooth.glsl"
 #include "common/prefiltered.glsl"
 
 // The lobe path (shared_layout.h, core fused.cpp lobeShade): E_c of the
@@ -294,55 +295,6 @@ vec3 lobeShade(ObjectInfo o, RotationSample rs, SliceBlend blend, uint seen) {
   }
   const vec3 core = lobes[a].core.rgb + t * (lobes[b].core.rgb - lobes[a].core.rgb);
   return core * sum;
-}
-
-// Whether sample s is the smooth sum's to visit (cpu_backend.cpp
-// shadeSmoothSums): an interior pixel's centre sample on an object the pass
-// sums (not the ground, not the lobe path alone).
-bool smoothVisited(ShadeSample sh, ObjectInfo o) {
-  return sh.pixel < push.width * push.height && (o.flags & kObjectGround) == 0u &&
-         !((o.flags & kObjectLobePath) != 0u && o.lobeCore.x <= -1.0);
-}
-// Whether this dispatch shades sample s: every sample without a smooth
-// sum; with one, each visited sample in its stage and every other sample
-// in stage 0.
-bool shadesNow(uint s) {
-  if (push.stage == kSmoothSumOff) return true;
-  const ShadeSample sh = shade[s];
-  if (!smoothVisited(sh, objects[sh.object])) return push.stage == 0u;
-  const int x = int(sh.pixel % push.width), y = int(sh.pixel / push.width);
-  return smoothParents(push.stage, x, y, int(push.width), int(push.height)).count != -2;
-}
-// A parent's sum and mirror, where it is on `object` and visited.
-bool smoothParent(uint q, uint object, vec3 mirror, float cosLimit, out vec3 sum) {
-  const vec4 a = smoothData[2u * q];
-  sum = a.rgb;
-  return floatBitsToUint(a.w) == object + 1u && smoothMirrorNear(mirror, smoothData[2u * q + 1u].xyz, cosLimit);
-}
-// The sum pixel `pixel` takes from its parents (cpu_backend.cpp
-// shadeSmoothSums, in the same order), or false where it sums its own.
-bool smoothTaken(ShadeSample sh, ObjectInfo o, vec3 mirror, out vec3 sum) {
-  sum = vec3(0.0);
-  if (push.stage == kSmoothSumOff || push.stage == 0u) return false;
-  const int x = int(sh.pixel % push.width), y = int(sh.pixel / push.width);
-  SmoothParents p = smoothParents(push.stage, x, y, int(push.width), int(push.height));
-  if (p.count <= 0) return false;
-  const float cosLimit = o.lobeCore.y;
-  vec3 s0, s1, s2 = vec3(0.0), s3 = vec3(0.0);
-  if (!smoothParent(p.at0, sh.object, mirror, cosLimit, s0) || !smoothParent(p.at1, sh.object, mirror, cosLimit, s1))
-    return false;
-  if (p.count == 4) {
-    if (!smoothParent(p.at2, sh.object, mirror, cosLimit, s2) || !smoothParent(p.at3, sh.object, mirror, cosLimit, s3))
-      return false;
-  } else if (p.outer != 0u) {
-    if (!smoothParent(p.at2, sh.object, mirror, cosLimit, s2) || !smoothParent(p.at3, sh.object, mirror, cosLimit, s3))
-      p.outer = 0u;
-  }
-  const float brightness = smoothBrightness(p, radiance[p.at0].rgb, radiance[p.at1].rgb, radiance[p.at2].rgb,
-                                            radiance[p.at3].rgb);
-  if (!smoothSumsAgree(p, s0, s1, s2, s3, brightness, push.tolerance)) return false;
-  sum = smoothParentsSum(p, s0, s1, s2, s3);
-  return true;
 }
 
 // sum + Σ_k bit_k·power_k·ρ(Rᵀd_k) over the lights the sample sees, added
