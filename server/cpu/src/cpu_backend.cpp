@@ -16,6 +16,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "haarcast/core/check.h"
 #include "haarcast/core/parallel.h"
 #include "haarcast/core/shared_smooth.h"
 #include "haarcast/core/rotate_haar.h"
@@ -737,14 +738,23 @@ std::size_t CpuRenderer::shadeSmoothSums(const GBuffer& g, FusedSlots& slots, co
   };
   const float tolerance = options_.smoothSumTolerance;
   std::atomic<std::size_t> bytes{0}, taken{0};
+  std::vector<int> rows;
   for (shared::uint stage = 0; stage < shared::kSmoothSumStages; ++stage) {
-    parallelFor(static_cast<std::size_t>(h), [&](std::size_t row) {
+    // The rows with pixels of this stage, in parallel; in each only its pixels.
+    rows.clear();
+    for (int y = 0; y < h; ++y) {
+      int stride = 0;
+      if (shared::smoothRowFirst(stage, y, stride) >= 0) rows.push_back(y);
+    }
+    parallelFor(rows.size(), [&](std::size_t r) {
       cancelPoint();
-      const int y = static_cast<int>(row);
+      const int y = rows[r];
+      int stride = 0;
+      const int first = shared::smoothRowFirst(stage, y, stride);
       std::size_t rowBytes = 0, rowTaken = 0;
-      for (int x = 0; x < w; ++x) {
+      for (int x = first; x < w; x += stride) {
         shared::SmoothParents parents = shared::smoothParents(stage, x, y, w, h);
-        if (parents.count == -2) continue;  // not this stage's
+        HC_CHECK_NE(parents.count, -2);  // smoothRowFirst visits the stage's pixels only
         const std::size_t i = static_cast<std::size_t>(y) * g.width + static_cast<std::size_t>(x);
         const std::optional<std::size_t> object = objectOf(i);
         if (!object) continue;

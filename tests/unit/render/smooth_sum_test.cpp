@@ -44,6 +44,18 @@ TEST(SmoothSum, EveryPixelIsVisitedOnceAfterItsParents) {
       }
     }
     EXPECT_EQ(std::count(visited.begin(), visited.end(), -1), 0) << w << "×" << h << ": a pixel never visited";
+    // smoothRowFirst lists each row's pixels of a stage, no more, no fewer.
+    for (shared::uint k = 0; k < shared::kSmoothSumStages; ++k) {
+      for (int y = 0; y < h; ++y) {
+        int stride = 0;
+        const int first = shared::smoothRowFirst(k, y, stride);
+        std::vector<int> listed, inStage;
+        for (int x = first; first >= 0 && x < w; x += stride) listed.push_back(x);
+        for (int x = 0; x < w; ++x)
+          if (shared::smoothParents(k, x, y, w, h).count != -2) inStage.push_back(x);
+        EXPECT_EQ(listed, inStage) << "stage " << k << ", row " << y << " of " << w << "×" << h;
+      }
+    }
   }
 }
 

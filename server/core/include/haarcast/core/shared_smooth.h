@@ -117,6 +117,21 @@ HC_FUNCTION SmoothParents smoothParents(uint stage, int x, int y, int width, int
   return p;
 }
 
+// The pixels of row y a stage visits: x = first, first + stride, … (what
+// smoothParents says is the stage's, count ≠ −2); first −1 where none.
+HC_FUNCTION int smoothRowFirst(uint stage, int y, HC_OUT(int) stride) {
+  const int h = int(smoothStageStep(stage));
+  const uint kind = smoothStageKind(stage);
+  if (kind == kSmoothGrid) {
+    stride = h;
+    return y % h == 0 ? 0 : -1;
+  }
+  stride = 2 * h;
+  const int ry = y % (2 * h);
+  if (kind == kSmoothEdges) return ry == 0 ? h : (ry == h ? 0 : -1);
+  return ry == h ? h : -1;
+}
+
 // The mirror direction of the view in the object's frame: the slice frame's
 // (0, cos θₒ, −sin θₒ) (the view is at φ = 0, shared_frame.h shadingFrame)
 // turned by R = R_y(α) R_x(β) R_y(γ).
