@@ -112,14 +112,25 @@ log "server at $URL"
 
 # /healthz answers "ok" once the server is ready for sessions.
 healthy=0
+answer=""
 for ((i = 0; i < TIMEOUT * 2; i++)); do
-  if http_get "$host" "$port" /healthz 2>/dev/null | tail -1 | grep -qx 'ok'; then
+  answer="$(http_get "$host" "$port" /healthz 2>&1 | tail -1)" || true
+  if [[ "$answer" == "ok" ]]; then
     healthy=1
     break
   fi
+  # A server started here that is gone will not answer: say so now, with its log.
+  if [[ -n "$server_pid" ]] && ! kill -0 "$server_pid" 2>/dev/null; then
+    wait "$server_pid" 2>/dev/null && status=0 || status=$?
+    tail -20 "$work/server.err" >&2 2>/dev/null || true
+    fail "the server exited (status $status) before /healthz answered ok"
+  fi
   sleep 0.5
 done
-((healthy)) || fail "/healthz did not answer ok within ${TIMEOUT} s"
+if ((!healthy)); then
+  [[ -n "$server_pid" ]] && tail -20 "$work/server.err" >&2 2>/dev/null
+  fail "/healthz did not answer ok within ${TIMEOUT} s (its last answer: \"${answer:-none}\")"
+fi
 log "/healthz ok"
 
 client_args=("$URL" --frames "$FRAMES" --size "$SIZE" --encoding "$ENCODING" --orbit 90 --light 45
