@@ -44,6 +44,7 @@ expect "render level neither a number nor auto" 'or auto:CAP (at most CAP, 2..7)
   "$bin" render --level fine --out "$work/x.exr"
 expect "bench-frame level cap outside the range" '--levels: "auto:9" is not N (2..7' -- "$bin" bench-frame --levels 5,auto:9
 expect "bench-frame sum tolerance outside 0..1" '--sum-tolerance: "2" is not a number in 0..1' -- "$bin" bench-frame --backend cpu --sum-tolerance 0,2
+expect "bench-frame smooth-sum tolerance outside 0..1" '--smooth-sum: "2" is not a number in 0..1' -- "$bin" bench-frame --backend cpu --smooth-sum 0,2
 expect "serve level cap over --max-level" "--level auto:7 is outside 2..6 (see --max-level)" -- "$bin" serve --level auto:7
 expect "unknown method" "--method must be one of fused" -- "$bin" render --method fast --out "$work/x.exr"
 expect "material without a mesh" "--material applies to --mesh" -- "$bin" render --material velvet --out "$work/x.exr"
