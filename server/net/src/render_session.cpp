@@ -247,7 +247,11 @@ void RenderSession::onPrepared(const std::string& key, std::shared_ptr<PreparedR
   const std::vector<std::string> plans = renderer_->renderer->objectPlans();
   if (!plans.empty()) {
     std::string text;
-    for (std::size_t k = 0; k < plans.size(); ++k) text += (k ? "; " : "") + std::to_string(k) + ": " + plans[k];
+    const Catalog::SceneEntry* scene = catalog_.findScene(config_.scene);
+    for (std::size_t k = 0; k < plans.size(); ++k) {
+      const bool named = scene && k < scene->objectNames.size() && !scene->objectNames[k].empty();
+      text += (k ? "; " : "") + (named ? sanitizeForLog(scene->objectNames[k], 64) : "object " + std::to_string(k)) + ": " + plans[k];
+    }
     log("plan: " + text);
   }
   if (!welcomed_) {
