@@ -477,14 +477,19 @@ GPU_TEST(VulkanRenderer, TwoFramesInFlightRenderAtOnceAndAsOne) {
   testing::expectNoValidationMessages(one.context());
 }
 
-// A fused frame polls the request's cancel before each submission and
-// before the host's shadow rays: cancelled at any of those points it stops
-// with no images, and the next frame is whole.
+// A fused frame with the host's shadow rays polls the request's cancel
+// before each of its two submissions and before the rays: cancelled at any
+// of those points it stops with no images, and the next frame is whole.
+// (With the device's rays a frame is one submission and polls once:
+// DeviceRays.AFrameIsOneSubmission. The host's are pinned here, so a GPU
+// that traces rays runs this path too.)
 GPU_TEST(VulkanRenderer, FusedFrameCancelsBetweenItsSubmissions) {
   HAARCAST_REQUIRE_VULKAN();
   const render::Scene scene = render::defaultScene();
   const render::RenderOptions o = frameOptions(RotationMethod::Fused, true);
-  VulkanRenderer gpu(scene, o, testing::testOptions());
+  VulkanRendererLimits hostRays;
+  hostRays.rays = render::RayMode::Host;
+  VulkanRenderer gpu(scene, o, testing::testOptions(), {}, hostRays);
   render::FrameRequest request = requestFor(scene, 32, 32);
   int polls = 0;
   request.cancelled = [&] { return ++polls < 0; };
