@@ -737,6 +737,9 @@ std::size_t CpuRenderer::shadeSmoothSums(const GBuffer& g, FusedSlots& slots, co
     return object;
   };
   const float tolerance = options_.smoothSumTolerance;
+  // Each object's limit between mirror directions, once (as scene_upload.cpp puts it in ObjectInfo).
+  std::vector<float> cosLimits;
+  for (const PreparedObject& p : prepared_.objects) cosLimits.push_back(shared::smoothMirrorCos(p.sharpestLobe));
   std::atomic<std::size_t> bytes{0}, taken{0};
   std::vector<int> rows;
   for (shared::uint stage = 0; stage < shared::kSmoothSumStages; ++stage) {
@@ -764,7 +767,7 @@ std::size_t CpuRenderer::shadeSmoothSums(const GBuffer& g, FusedSlots& slots, co
         // Its parents, where each is on this object, visited, and its
         // mirror direction near the pixel's (A' and B' are only left out).
         const std::array<shared::uint, 4> at{parents.at0, parents.at1, parents.at2, parents.at3};
-        const float cosLimit = shared::smoothMirrorCos(prepared_.objects[*object].sharpestLobe);
+        const float cosLimit = cosLimits[*object];
         auto usable = [&](shared::uint q) {
           return state[q] != kNotVisited && g.centre[q]->hit.object == *object &&
                  shared::smoothMirrorNear(slots.mirrors[i], slots.mirrors[q], cosLimit);

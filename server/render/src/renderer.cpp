@@ -10,7 +10,6 @@
 #include <glm/geometric.hpp>
 
 #include "haarcast/core/lobe.h"
-#include "haarcast/core/shared_cells.h"
 #include "haarcast/core/splitsum.h"
 #include "haarcast/io/slice_cache.h"
 #include "haarcast/render/build_plan.h"
