@@ -8,7 +8,10 @@
 #   every GPU test, validation on, in one process (one engine per process);
 #   bench-frame, Vulkan, fused at 1280×720 and 1920×1080, levels auto and 6
 #   (rays on the device where it traces them), and 1080p level 6 with the host's rays;
-#   serve --backend vulkan with 1, 4 and 16 load-test clients at 1280×720;
+#   frames in flight on one renderer (bench-frame --in-flight), each slot
+#   on a queue of its own, then all on one queue;
+#   serve --backend vulkan with 1, 4 and 16 load-test clients at 1280×720,
+#   then with one queue (four and two frames in flight);
 #   H.264 at 1920×1080 (libx264 on the CPU: the H100/H200 have no NVENC),
 #   its encode time per frame read from the server's /metrics;
 #   bench-frame with both backends (Vulkan = CPU in dB, and the ratio).
@@ -94,6 +97,12 @@ bench fused_vulkan 120 --backend vulkan --method fused --sizes 1280x720,1920x108
 # `auto` takes the device's rays on a GPU that traces them: the host's
 # (Embree, the frame in two parts) beside it, the same run.
 bench fused_vulkan_host_rays 60 --backend vulkan --rays host --method fused --sizes 1920x1080 --levels 6 --frames "$frames"
+# Frames in flight on one renderer, the service's frame (1280×720, level 4,
+# antialiased): its slots on queues of their own, then every slot on one queue.
+bench in_flight 90 --backend vulkan --method fused --sizes 1280x720 --levels 4 --antialias on --in-flight 1,2,4,8 \
+  --frames "$frames"
+bench in_flight_one_queue 60 --backend vulkan --vulkan-queues 1 --method fused --sizes 1280x720 --levels 4 \
+  --antialias on --in-flight 1,4 --frames "$frames"
 old="$hc/bin/haarcast.old"
 [[ -x "$old" ]] && BIN="$old" bench fused_vulkan_old 60 --backend vulkan --method fused --sizes 1280x720,1920x1080 \
   --levels auto,6 --frames "$frames"
@@ -138,9 +147,13 @@ loadtest loadtest_1080_h264 45 --clients 1 --sizes 1920x1080 --encodings h264
 metrics >"$out/metrics.txt"
 grep stage_seconds "$out/metrics.txt"
 stop_server
-# One frame in flight against the default (two on a GPU): what the second slot gives.
-serve "$hc/bin/haarcast" _k1 "--frames-in-flight 1"
-loadtest loadtest_720_k1 60 --clients 4,16 --sizes 1280x720 --encodings jpeg
+# Four frames in flight (the default on a GPU) on one queue: what the queues
+# give; then two on one queue, the service before frames had queues of their own.
+serve "$hc/bin/haarcast" _one_queue "--vulkan-queues 1"
+loadtest loadtest_720_one_queue 60 --clients 4,16 --sizes 1280x720 --encodings jpeg
+stop_server
+serve "$hc/bin/haarcast" _k2_one_queue "--vulkan-queues 1 --frames-in-flight 2"
+loadtest loadtest_720_k2_one_queue 60 --clients 1,4,16 --sizes 1280x720 --encodings jpeg
 stop_server
 if [[ -x "$old" ]]; then
   serve "$old" _old

@@ -5,6 +5,8 @@
 #include "bench_frame_command.h"
 
 #include <algorithm>
+#include <atomic>
+#include <barrier>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -16,6 +18,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -75,6 +78,10 @@ struct BenchArgs {
   // fused: RenderOptions::smoothSumTolerance, one run each with each of the above
   std::string smoothSums = defaultTolerance(shared::kDefaultSmoothSumTolerance);
   std::string cacheDir;
+  // Vulkan: frames in flight to measure, comma-separated (empty: none), each
+  // as that many threads rendering at once on one renderer of as many slots.
+  std::string inFlight;
+  std::uint32_t queues = 0;  // Vulkan: the most device queues (0: all its family offers)
   int frames = 3;
   int warmup = 1;
   bool json = false;
@@ -120,6 +127,39 @@ Measured measure(render::Renderer& r, const render::FrameRequest& request, int f
   return m;
 }
 
+// Frames per second in all with `k` frames in flight: k threads, each
+// rendering one warm-up frame (its slot's first) and then `frames` timed
+// frames, all started together; the wall time of the timed frames.
+double measureInFlight(render::Renderer& r, const render::FrameRequest& request, int frames, std::size_t k) {
+  render::FrameRequest timed = request;
+  timed.linearImage = false;
+  std::barrier ready(static_cast<std::ptrdiff_t>(k) + 1), done(static_cast<std::ptrdiff_t>(k) + 1);
+  std::vector<std::jthread> threads;
+  std::atomic<bool> failed{false};
+  for (std::size_t t = 0; t < k; ++t) {
+    threads.emplace_back([&] {
+      try {
+        r.render(timed);
+      } catch (...) {
+        failed = true;
+      }
+      ready.arrive_and_wait();
+      try {
+        for (int i = 0; i < frames && !failed; ++i) r.render(timed);
+      } catch (...) {
+        failed = true;
+      }
+      done.arrive_and_wait();
+    });
+  }
+  ready.arrive_and_wait();
+  const auto t0 = std::chrono::steady_clock::now();
+  done.arrive_and_wait();
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (failed) throw std::runtime_error("--in-flight " + std::to_string(k) + ": a frame failed");
+  return wall > 0.0 ? static_cast<double>(k) * frames / wall : 0.0;
+}
+
 // PSNR over identically covered pixels (peak = the reference's object
 // maximum), and the coverage mismatches, as the GPU tests compute them.
 std::pair<double, std::size_t> agreement(const render::Frame& reference, const render::Frame& test) {
@@ -147,6 +187,20 @@ int run(const BenchArgs& a) {
   if (a.frames < 1 || a.frames > 1000) throw std::invalid_argument("--frames must be in 1..1000");
   if (a.warmup < 0 || a.warmup > 100) throw std::invalid_argument("--warmup must be in 0..100");
   const std::vector<std::pair<int, int>> sizes = parseSizeList(a.sizes, "--sizes");
+  std::vector<std::size_t> inFlight;
+  if (!a.inFlight.empty()) {
+    for (const std::string& item : splitList(a.inFlight, "--in-flight")) {
+      const int k = std::atoi(item.c_str());
+      if (k < 1 || k > 16 || std::to_string(k) != item) {
+        throw std::invalid_argument("--in-flight: \"" + item + "\" is not a count of frames in 1..16");
+      }
+      inFlight.push_back(static_cast<std::size_t>(k));
+    }
+    if (a.backend == std::string(render::kCpuBackend)) {
+      throw std::invalid_argument("--in-flight measures the Vulkan backend's frames in flight: give --backend vulkan or both");
+    }
+  }
+  const std::size_t slots = inFlight.empty() ? 0 : *std::max_element(inFlight.begin(), inFlight.end());
   const render::RayMode rays = parseRayModeFlag(a.rays);
   if (a.slices != "blend" && a.slices != "nearest") {
     throw std::invalid_argument("--slices must be blend or nearest (got \"" + a.slices + "\")");
@@ -233,7 +287,7 @@ int run(const BenchArgs& a) {
         if (vulkan) {
           // Timing: validation layers would dominate.
           gpuRenderer = backends::makeRenderer(render::kVulkanBackend, scene, options,
-                                               {a.device, false, 0, rays}, progress.callback());
+                                               {a.device, false, slots, rays, a.queues}, progress.callback());
           out["vulkan_device"] = gpuRenderer->deviceName();
           out["vulkan_rays"] = gpuRenderer->rays();
         }
@@ -321,6 +375,31 @@ int run(const BenchArgs& a) {
                         std::to_string(width) + "×" + std::to_string(height) + ", " + backend,
                     m.frameSeconds > 0.0 ? 1.0 / m.frameSeconds : 0.0);
           }
+          if (gpuRenderer && !inFlight.empty()) {
+            // The same renderer, its slots on their own queues where the device has them.
+            std::string text = "frames in flight, " + std::to_string(width) + "×" + std::to_string(height) + ":";
+            nlohmann::json measured = nlohmann::json::array();
+            double one = 0.0;
+            for (const std::size_t k : inFlight) {
+              progress.message("frames in flight: " + std::to_string(k) + " at once, " + std::to_string(a.frames) + " frames each");
+              const double fps = measureInFlight(*gpuRenderer, request, a.frames, k);
+              if (k == 1) one = fps;
+              measured.push_back({{"frames_in_flight", k}, {"fps_in_all", fps}});
+              char buf[96];
+              std::snprintf(buf, sizeof buf, "%s %zu: %.2f fps in all", k == inFlight.front() ? "" : ";", k, fps);
+              text += buf;
+              if (k != 1 && one > 0.0) {
+                std::snprintf(buf, sizeof buf, " (%.2f× one)", fps / one);
+                text += buf;
+              }
+            }
+            out["runs"].back()["in_flight"] = measured;
+            out["runs"].back()["frame_slots"] = gpuRenderer->framesInFlight();
+            line("");
+            line(text);
+            line("");
+            progress.message(text);
+          }
         }
       }
     }
@@ -354,6 +433,15 @@ std::function<int()> addBenchFrameCommand(CLI::App& app) {
   c->add_option("--scene", args->scene, "Scene file (default: the built-in scene)");
   c->add_option("--device", args->device, "Vulkan device: an index or a name substring");
   c->add_option("--rays", args->rays, rayModeHelp())->capture_default_str();
+  c->add_option("--in-flight", args->inFlight,
+                "Vulkan: frames rendered at once, comma-separated (e.g. 1,4): each as that many threads on one renderer "
+                "with as many frame slots, each slot on a queue of its own where the device has them; frames per second "
+                "in all, after each size's rows");
+  c->add_option("--vulkan-queues", args->queues,
+                "Vulkan: the most queues the device is opened with (0: every queue its family offers, at most 16; 1: "
+                "every frame on one queue)")
+      ->check(CLI::Range(0, 16))
+      ->capture_default_str();
   c->add_option("--sum-tolerance", args->sumTolerances,
                 sumToleranceHelp() + "; comma-separated, one run each: e.g. 0,0.1 times both")
       ->capture_default_str();

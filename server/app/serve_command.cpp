@@ -58,6 +58,7 @@ struct ServeArgs {
   render::SceneLimits sceneLimits;
   bool vulkanValidation = false, quiet = false;
   std::size_t framesInFlight = 0;
+  std::uint32_t vulkanQueues = 0;
   unsigned renderThreads = 0;
   long long serverPixelBudget = -1;  // -1: 2 × --max-session-pixels
 };
@@ -191,7 +192,7 @@ int run(ServeArgs& a) {
   base.sumTolerance = a.sumTolerance;
   base.smoothSumTolerance = a.smoothSum;
   const backends::DeviceOptions vulkanOptions{a.vulkanDevice, a.vulkanValidation, a.framesInFlight,
-                                              parseRayModeFlag(a.rays)};
+                                              parseRayModeFlag(a.rays), a.vulkanQueues};
   auto sharedScenes = std::make_shared<std::vector<SceneSource>>(std::move(scenes));
   const bool quiet = a.quiet;
   const std::string antialias = a.antialias;
@@ -288,8 +289,12 @@ int run(ServeArgs& a) {
       stages("warm-up", 1, 1);
     }
     if (!quiet) {
-      std::fprintf(stderr, "[serve] renderer ready: %s on %s, rays %s\n", prepared->renderer->backend().c_str(),
-                   prepared->renderer->deviceName().c_str(), prepared->renderer->rays().c_str());
+      // framesInFlight() 0: any number (the CPU backend, bounded by the workers).
+      const std::size_t k = prepared->renderer->framesInFlight();
+      const std::string inFlight = k == 0 ? "frames in flight up to the workers"
+                                          : std::to_string(k) + (k == 1 ? " frame" : " frames") + " in flight";
+      std::fprintf(stderr, "[serve] renderer ready: %s on %s, rays %s, %s\n", prepared->renderer->backend().c_str(),
+                   prepared->renderer->deviceName().c_str(), prepared->renderer->rays().c_str(), inFlight.c_str());
     }
     return prepared;
   };
@@ -423,10 +428,16 @@ std::function<int()> addServeCommand(CLI::App& app) {
   c->add_option("--vulkan-device", a->vulkanDevice, "Vulkan device name substring");
   c->add_flag("--vulkan-validation", a->vulkanValidation, "Enable the Vulkan validation layers");
   c->add_option("--rays", a->rays, rayModeHelp())->capture_default_str();
+  c->add_option("--vulkan-queues", a->vulkanQueues,
+                "The most queues the Vulkan device is opened with, each frame slot lent the least-lent: frames on "
+                "different queues run side by side (0: every queue its family offers, at most 16; 1: every frame on one "
+                "queue, each barrier waiting for the frames submitted before it)")
+      ->check(CLI::Range(0, 16))
+      ->capture_default_str();
   c->add_option("--frames-in-flight", a->framesInFlight,
                 "Frames a Vulkan renderer may render at once, each with its own device buffers (the scene uploaded once "
                 "per frame in flight): while one frame's host stages run, another's passes run on the device. "
-                "0 = 1 on a CPU device (lavapipe), 2 on a GPU")
+                "0 = 1 on a CPU device (lavapipe), 4 on a GPU (at most its queues)")
       ->check(CLI::Range(0, 16))
       ->capture_default_str();
   c->add_flag("--quiet", a->quiet, "No per-session log lines on stderr");

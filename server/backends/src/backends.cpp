@@ -57,6 +57,7 @@ std::unique_ptr<render::Renderer> makeRenderer(std::string_view backend, const r
   gpu::VulkanOptions vulkan;
   vulkan.device = device.device;
   vulkan.validation = device.validation;
+  vulkan.queues = device.queues;
   gpu::VulkanRendererLimits limits;
   limits.framesInFlight = device.framesInFlight;
   limits.rays = device.rays;

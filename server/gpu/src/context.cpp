@@ -45,8 +45,9 @@ void throwVkError(VkResult result, const char* call) {
 }
 
 Context::Context(const VulkanOptions& options)
-    : shared_(Engine::get(EngineOptions{options.validation}).device(options.device)),
+    : shared_(Engine::get(EngineOptions{options.validation}).device(options.device, options.queues)),
       device_(shared_->device()),
+      queueIndex_(shared_->lendQueue()),
       directInputs_(!options.stageInputs),
       validationMark_(shared_->validationLog().count()) {
   try {
@@ -72,6 +73,8 @@ void Context::destroy() {
   if (pool_) vkDestroyCommandPool(device_, pool_, nullptr);
   fence_ = VK_NULL_HANDLE;
   pool_ = VK_NULL_HANDLE;
+  if (queueIndex_) shared_->returnQueue(*queueIndex_);
+  queueIndex_.reset();
 }
 
 void Context::waitIdle() {
@@ -81,7 +84,8 @@ void Context::waitIdle() {
 
 VkInstance Context::instance() const { return shared_->instance(); }
 VkPhysicalDevice Context::physicalDevice() const { return shared_->physicalDevice(); }
-VkQueue Context::queue() const { return shared_->queue(); }
+VkQueue Context::queue() const { return shared_->queue(*queueIndex_); }
+std::uint32_t Context::queueIndex() const { return *queueIndex_; }
 std::uint32_t Context::queueFamily() const { return shared_->queueFamily(); }
 const DeviceInfo& Context::info() const { return shared_->info(); }
 const VkPhysicalDeviceProperties& Context::properties() const { return shared_->properties(); }
@@ -118,7 +122,7 @@ void Context::submit(const std::function<void(VkCommandBuffer)>& record) {
   waitIdle();  // a previous submission whose wait threw: its fence cannot be reset while in use
   if (inFlight_) throw std::runtime_error("Context::submit: the previous submission never finished (vkWaitForFences failed)");
   vkCheck(vkResetFences(device_, 1, &fence_), "vkResetFences");
-  shared_->submit(s, fence_);  // under the shared queue's lock; the wait below is outside it
+  shared_->submit(*queueIndex_, s, fence_);  // under its queue's lock; the wait below is outside it
   ++submissions_;
   inFlight_ = true;
   vkCheck(vkWaitForFences(device_, 1, &fence_, VK_TRUE, UINT64_MAX), "vkWaitForFences");

@@ -84,8 +84,9 @@ bool validationFromEnvironment() {
 }
 
 // A queue family with graphics and compute (the G-buffer and the passes
-// share one queue), or nothing.
-std::optional<std::uint32_t> findQueueFamily(VkPhysicalDevice device, std::uint32_t* timestampBits = nullptr) {
+// share each queue), or nothing; `queueCount`: how many queues it has.
+std::optional<std::uint32_t> findQueueFamily(VkPhysicalDevice device, std::uint32_t* timestampBits = nullptr,
+                                             std::uint32_t* queueCount = nullptr) {
   std::uint32_t count = 0;
   vkGetPhysicalDeviceQueueFamilyProperties(device, &count, nullptr);
   std::vector<VkQueueFamilyProperties> families(count);
@@ -94,10 +95,19 @@ std::optional<std::uint32_t> findQueueFamily(VkPhysicalDevice device, std::uint3
     const VkQueueFlags need = VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT;
     if ((families[i].queueFlags & need) == need) {
       if (timestampBits) *timestampBits = families[i].timestampValidBits;
+      if (queueCount) *queueCount = families[i].queueCount;
       return i;
     }
   }
   return std::nullopt;
+}
+
+// The queues a device is opened with: its family's, at most `limit`
+// (0 = kMaxDeviceQueues), at least one.
+std::uint32_t queuesToOpen(VkPhysicalDevice device, std::uint32_t limit) {
+  std::uint32_t offered = 1;
+  findQueueFamily(device, nullptr, &offered);
+  return std::clamp(offered, 1u, limit == 0 ? kMaxDeviceQueues : limit);
 }
 
 std::vector<VkPhysicalDevice> physicalDevices(VkInstance instance) {
@@ -291,8 +301,14 @@ class VulkanInstance {
 
 // ------------------------------------------------------------------ SharedDevice
 
-SharedDevice::SharedDevice(std::shared_ptr<VulkanInstance> instance, VkPhysicalDevice physical, DeviceInfo info)
-    : instance_(std::move(instance)), physical_(physical), info_(std::move(info)) {
+SharedDevice::SharedDevice(std::shared_ptr<VulkanInstance> instance, VkPhysicalDevice physical, DeviceInfo info,
+                           std::uint32_t queues)
+    : instance_(std::move(instance)),
+      physical_(physical),
+      info_(std::move(info)),
+      queues_(queuesToOpen(physical, queues), VK_NULL_HANDLE),
+      queueMutexes_(std::make_unique<std::mutex[]>(queues_.size())),
+      lender_(queues_.size()) {
   HC_CHECK_EQ(info_.rejected, "");  // Engine::device opens usable devices only
   vkGetPhysicalDeviceProperties(physical_, &properties_);
   VkPhysicalDeviceSubgroupProperties subgroup{};
@@ -326,12 +342,13 @@ SharedDevice::SharedDevice(std::shared_ptr<VulkanInstance> instance, VkPhysicalD
     asFeatures.pNext = &rtFeatures;
   }
 
-  const float priority = 1.0f;
+  // Every queue the same priority: the sessions' frames are equals.
+  const std::vector<float> priorities(queues_.size(), 1.0f);
   VkDeviceQueueCreateInfo q{};
   q.sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO;
   q.queueFamilyIndex = queueFamily_;
-  q.queueCount = 1;
-  q.pQueuePriorities = &priority;
+  q.queueCount = static_cast<std::uint32_t>(queues_.size());
+  q.pQueuePriorities = priorities.data();
   VkDeviceCreateInfo d{};
   d.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO;
   d.queueCreateInfoCount = 1;
@@ -343,7 +360,7 @@ SharedDevice::SharedDevice(std::shared_ptr<VulkanInstance> instance, VkPhysicalD
   }
   vkCheck(vkCreateDevice(physical_, &d, nullptr, &device_), "vkCreateDevice");
   ++gDevicesCreated;
-  vkGetDeviceQueue(device_, queueFamily_, 0, &queue_);
+  for (std::uint32_t i = 0; i < queues_.size(); ++i) vkGetDeviceQueue(device_, queueFamily_, i, &queues_[i]);
 }
 
 SharedDevice::~SharedDevice() {
@@ -356,9 +373,10 @@ VkInstance SharedDevice::instance() const { return instance_->handle(); }
 bool SharedDevice::validationEnabled() const { return instance_->validationEnabled(); }
 ValidationLog& SharedDevice::validationLog() const { return instance_->log(); }
 
-void SharedDevice::submit(const VkSubmitInfo& submit, VkFence fence) {
-  std::lock_guard lock(queueMutex_);
-  vkCheck(vkQueueSubmit(queue_, 1, &submit, fence), "vkQueueSubmit");
+void SharedDevice::submit(std::uint32_t index, const VkSubmitInfo& submit, VkFence fence) {
+  HC_CHECK_LT(index, queues_.size());
+  std::lock_guard lock(queueMutexes_[index]);
+  vkCheck(vkQueueSubmit(queues_[index], 1, &submit, fence), "vkQueueSubmit");
 }
 
 // ------------------------------------------------------------------ Engine
@@ -386,7 +404,7 @@ ValidationLog& Engine::validationLog() const { return instance_->log(); }
 std::uint64_t Engine::instancesCreated() { return gInstancesCreated.load(); }
 std::uint64_t Engine::devicesCreated() { return gDevicesCreated.load(); }
 
-std::shared_ptr<SharedDevice> Engine::device(const std::string& selector) {
+std::shared_ptr<SharedDevice> Engine::device(const std::string& selector, std::uint32_t queues) {
   if (physical_.empty()) {
     throw std::runtime_error("no Vulkan device: the loader found no physical devices "
                              "(install mesa-vulkan-drivers for the lavapipe CPU device)");
@@ -424,7 +442,7 @@ std::shared_ptr<SharedDevice> Engine::device(const std::string& selector) {
   }
   const auto at = static_cast<std::size_t>(chosen);
   std::lock_guard lock(devicesMutex_);
-  if (!opened_[at]) opened_[at] = std::make_shared<SharedDevice>(instance_, physical_[at], infos_[at]);
+  if (!opened_[at]) opened_[at] = std::make_shared<SharedDevice>(instance_, physical_[at], infos_[at], queues);
   return opened_[at];
 }
 

@@ -83,10 +83,13 @@ VulkanRenderer::VulkanRenderer(const render::Scene& scene, const render::RenderO
   Impl::checkOptions(options);
   // The device first (it throws when there is none), then the scene,
   // prepared once for every slot.
-  const std::shared_ptr<SharedDevice> device = Engine::get(EngineOptions{vulkan.validation}).device(vulkan.device);
+  const std::shared_ptr<SharedDevice> device =
+      Engine::get(EngineOptions{vulkan.validation}).device(vulkan.device, vulkan.queues);
   const auto prepared = std::make_shared<const render::PreparedScene>(render::prepareScene(scene, options, progress));
   std::size_t slots = limits.framesInFlight;
-  if (slots == 0) slots = device->info().type == "cpu" ? 1 : 2;
+  // A CPU device's frames share its cores; a GPU's run side by side, one
+  // per queue (each slot's Context is lent the least-lent queue).
+  if (slots == 0) slots = device->info().type == "cpu" ? 1 : std::min<std::size_t>(kDefaultGpuFramesInFlight, device->queueCount());
   // Each slot uploads its own copy of the scene's data and compiles the
   // same pipelines (the driver's cache makes the second compile a lookup).
   // The further slots' progress is one stage of its own, so that the
@@ -135,6 +138,12 @@ render::Frame VulkanRenderer::render(const render::FrameRequest& request) {
 std::size_t VulkanRenderer::peakFramesInFlight() const {
   std::lock_guard lock(mutex_);
   return peak_;
+}
+
+std::vector<std::uint32_t> VulkanRenderer::slotQueues() const {
+  std::vector<std::uint32_t> queues;
+  for (const auto& slot : slots_) queues.push_back(slot->context.queueIndex());
+  return queues;
 }
 
 std::string VulkanRenderer::deviceName() const { return slots_.front()->context.info().name; }

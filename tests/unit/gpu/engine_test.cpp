@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <map>
 #include <memory>
+#include <set>
 #include <span>
 #include <string>
 #include <thread>
@@ -108,6 +109,62 @@ GPU_TEST(Engine, ContextsSubmitFromManyThreadsAtOnce) {
   for (int t = 0; t < kThreads; ++t) EXPECT_EQ(failures[static_cast<std::size_t>(t)], "") << "thread " << t;
   EXPECT_EQ(Engine::instancesCreated(), 1u);
   EXPECT_EQ(Engine::devicesCreated(), 1u);
+}
+
+// Each Context is lent the least-lent of the device's queues, and gives it
+// back when it goes (queue_lender.h): one more Context than the device has
+// queues puts one Context on every queue, then shares the least-lent. On a
+// device of one queue (lavapipe) every Context is lent queue 0.
+GPU_TEST(Engine, EachContextIsLentTheLeastLentQueueAndGivesItBack) {
+  HAARCAST_REQUIRE_VULKAN();
+  const std::shared_ptr<SharedDevice> device = Engine::get().device(testing::testOptions().device);
+  ASSERT_GE(device->queueCount(), 1u);
+  ASSERT_LE(device->queueCount(), kMaxDeviceQueues);
+  const std::vector<std::size_t> before = device->queuesLent();
+  ASSERT_EQ(before.size(), device->queueCount());
+  {
+    std::vector<std::unique_ptr<Context>> contexts;
+    for (std::uint32_t i = 0; i <= device->queueCount(); ++i) {
+      const std::vector<std::size_t> lent = device->queuesLent();
+      const std::size_t least = *std::min_element(lent.begin(), lent.end());
+      contexts.push_back(std::make_unique<Context>(testing::testOptions()));
+      const std::uint32_t q = contexts.back()->queueIndex();
+      ASSERT_LT(q, device->queueCount());
+      EXPECT_EQ(lent[q], least) << "Context " << i << " was lent queue " << q;
+      EXPECT_EQ(device->queuesLent()[q], lent[q] + 1);
+      EXPECT_EQ(contexts.back()->queue(), device->queue(q));
+      // It submits and waits on the queue it was lent.
+      contexts.back()->submit([](VkCommandBuffer) {});
+    }
+  }
+  EXPECT_EQ(device->queuesLent(), before);  // every one given back
+}
+
+// A renderer's frame slots are lent queues as Contexts are, one after
+// another: K slots on K queues where the device has them (what lets its
+// frames run side by side), all on queue 0 on lavapipe.
+GPU_TEST(Engine, ARenderersFrameSlotsAreSpreadOverTheQueues) {
+  HAARCAST_REQUIRE_VULKAN();
+  const std::shared_ptr<SharedDevice> device = Engine::get().device(testing::testOptions().device);
+  render::RenderOptions options;
+  options.method = RotationMethod::Spatial;
+  options.level = 2;
+  VulkanRendererLimits limits;
+  limits.framesInFlight = 3;
+  // The rule, from the queues' counts now: the least lent, lowest first.
+  std::vector<std::size_t> counts = device->queuesLent();
+  std::vector<std::uint32_t> want;
+  for (int k = 0; k < 3; ++k) {
+    const auto least = std::min_element(counts.begin(), counts.end());
+    ++*least;
+    want.push_back(static_cast<std::uint32_t>(least - counts.begin()));
+  }
+  VulkanRenderer renderer(render::defaultScene(), options, testing::testOptions(), {}, limits);
+  EXPECT_EQ(renderer.slotQueues(), want);
+  EXPECT_EQ(renderer.framesInFlight(), 3u);
+  if (device->queueCount() >= 3) {
+    EXPECT_EQ(std::set<std::uint32_t>(want.begin(), want.end()).size(), 3u);
+  }
 }
 
 // The default scene with its environment's maps made once per level: the

@@ -1,14 +1,15 @@
 // A renderer's handle on the Vulkan device every GPU pass runs on: device
-// selection, the device's one queue, memory and one-shot command submission
-// (buffers: buffer.h).
+// selection, the queue it submits to, memory and one-shot command
+// submission (buffers: buffer.h).
 //
 // The instance and the VkDevice are the process's (engine.h): made once,
 // the device on the first Context that selects it, and lent to every
-// Context. What a Context owns is its own: a command pool, a fence, the
-// count of its allocations and its stageInputs choice. Contexts on one
-// device may submit from different threads at once (the shared queue's
-// submissions are serialised in the engine; each Context waits on its own
-// fence).
+// Context, as is one of the device's queues (the least-lent:
+// queue_lender.h). What a Context owns is its own: a command pool, a fence,
+// the count of its allocations and its stageInputs choice. Contexts on one
+// device may submit from different threads at once (submissions to one
+// queue are serialised in the engine; each Context waits on its own fence),
+// and those on different queues run side by side.
 //
 // Selection (no --device): the first usable device in the order discrete GPU,
 // integrated GPU, virtual GPU, CPU device (Mesa's lavapipe), other. A device
@@ -43,6 +44,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -68,6 +70,10 @@ struct VulkanOptions {
   // where their memory could be mapped (buffer.h): the path of a discrete
   // GPU, run on any device (tests).
   bool stageInputs = false;
+  // The most queues the device is opened with (0 = every queue of its
+  // graphics-and-compute family, at most kMaxDeviceQueues: engine.h). Counts
+  // only for the Context that opens the device, the first to select it.
+  std::uint32_t queues = 0;
 };
 
 // "VK_ERROR_OUT_OF_DEVICE_MEMORY" etc., or the number for unknown codes.
@@ -131,9 +137,11 @@ class Context {
   VkInstance instance() const;
   VkPhysicalDevice physicalDevice() const;
   VkDevice device() const { return device_; }
-  // The device's one queue, shared with every other Context on it: submit
-  // through submit() only (the engine serialises submissions).
+  // The queue lent to this Context (maybe shared with other Contexts on the
+  // device): submit through submit() only (the engine serialises
+  // submissions to one queue), and its index among the device's queues.
   VkQueue queue() const;
+  std::uint32_t queueIndex() const;
   std::uint32_t queueFamily() const;
   const DeviceInfo& info() const;
   const VkPhysicalDeviceProperties& properties() const;
@@ -188,6 +196,7 @@ class Context {
   void destroy();
   std::shared_ptr<SharedDevice> shared_;  // the process's device: outlives this Context
   VkDevice device_ = VK_NULL_HANDLE;
+  std::optional<std::uint32_t> queueIndex_;  // lent by the device until destroy()
   VkCommandPool pool_ = VK_NULL_HANDLE;
   VkFence fence_ = VK_NULL_HANDLE;
   bool inFlight_ = false;  // submitted, not yet waited for

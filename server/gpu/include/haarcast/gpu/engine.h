@@ -12,14 +12,21 @@
 //   - The instance, created on the first Engine::get() (a Context,
 //     vulkanAvailable(), listDevices()); its physical devices are listed once.
 //   - One SharedDevice per physical device, opened the first time a Context
-//     selects it and kept until the process ends: VkDevice, its one queue,
+//     selects it and kept until the process ends: VkDevice, its queues,
 //     properties and memory properties. Vulkan calls on a VkDevice are
 //     thread-safe except where an object needs external synchronisation; of
-//     the shared objects only the queue does, so every vkQueueSubmit goes
-//     through SharedDevice::submit, which holds the queue's mutex around that
-//     call alone. Each Context waits on its own fence, outside the lock, and
-//     never calls vkDeviceWaitIdle or vkQueueWaitIdle (either would wait for
-//     the other renderers' work and need the queue's lock).
+//     the shared objects only the queues do, so every vkQueueSubmit goes
+//     through SharedDevice::submit, which holds that queue's mutex around
+//     that call alone. Each Context waits on its own fence, outside the lock,
+//     and never calls vkDeviceWaitIdle or vkQueueWaitIdle (either would wait
+//     for the other renderers' work and need a queue's lock).
+//   - Queues: the device is opened with every queue of its graphics-and-
+//     compute family (at most kMaxDeviceQueues, or VulkanOptions::queues of
+//     the Context that opens it), and each Context is lent one for its
+//     lifetime, the least-lent (queue_lender.h): frames of different
+//     Contexts on different queues run side by side, where on one queue
+//     every barrier would wait for the frames submitted before it. lavapipe
+//     offers one queue; NVIDIA's family has 16.
 //   - Lifetime: a Context holds its SharedDevice, and a SharedDevice holds
 //     the instance (shared_ptr). The engine is a function-local static: it is
 //     destroyed at exit before the Vulkan loader's own destructors run (the
@@ -48,6 +55,7 @@
 #include <vulkan/vulkan.h>
 
 #include "haarcast/gpu/context.h"
+#include "haarcast/gpu/queue_lender.h"
 
 namespace haarcast::gpu {
 
@@ -74,11 +82,18 @@ class ValidationLog {
 // SharedDevice made from it).
 class VulkanInstance;
 
+// The most queues a device is opened with: more than the frames a server
+// has in flight on it.
+inline constexpr std::uint32_t kMaxDeviceQueues = 16;
+
 // One physical device, opened once per process and shared by every Context
 // that selects it.
 class SharedDevice {
  public:
-  SharedDevice(std::shared_ptr<VulkanInstance> instance, VkPhysicalDevice physical, DeviceInfo info);
+  // `queues`: the most queues to open (0 = kMaxDeviceQueues); the family's
+  // count bounds it.
+  SharedDevice(std::shared_ptr<VulkanInstance> instance, VkPhysicalDevice physical, DeviceInfo info,
+               std::uint32_t queues = 0);
   ~SharedDevice();  // vkDestroyDevice: no Context holds it any more
   SharedDevice(const SharedDevice&) = delete;
   SharedDevice& operator=(const SharedDevice&) = delete;
@@ -86,9 +101,15 @@ class SharedDevice {
   VkInstance instance() const;
   VkPhysicalDevice physicalDevice() const { return physical_; }
   VkDevice device() const { return device_; }
-  // The queue, for queries only: submissions go through submit().
-  VkQueue queue() const { return queue_; }
+  // Queue `index`, for queries only: submissions go through submit().
+  VkQueue queue(std::uint32_t index) const { return queues_.at(index); }
+  std::uint32_t queueCount() const { return static_cast<std::uint32_t>(queues_.size()); }
   std::uint32_t queueFamily() const { return queueFamily_; }
+  // The queue a new Context submits to, lent until returnQueue (queue_lender.h).
+  std::uint32_t lendQueue() { return static_cast<std::uint32_t>(lender_.lend()); }
+  void returnQueue(std::uint32_t index) { lender_.giveBack(index); }
+  // Contexts each queue is lent to now.
+  std::vector<std::size_t> queuesLent() const { return lender_.lent(); }
   std::uint32_t timestampValidBits() const { return timestampValidBits_; }
   std::uint32_t subgroupSize() const { return subgroupSize_; }
   bool subgroupArithmetic() const { return subgroupArithmetic_; }
@@ -103,17 +124,18 @@ class SharedDevice {
   // it offers it, else why not.
   const RayTracingSupport& rayTracing() const { return rayTracing_; }
 
-  // vkQueueSubmit on the shared queue, under its mutex (the queue needs
+  // vkQueueSubmit on queue `index`, under its mutex (a queue needs
   // external synchronisation); the caller waits on its own `fence` after.
-  void submit(const VkSubmitInfo& submit, VkFence fence);
+  void submit(std::uint32_t index, const VkSubmitInfo& submit, VkFence fence);
 
  private:
   std::shared_ptr<VulkanInstance> instance_;
   VkPhysicalDevice physical_ = VK_NULL_HANDLE;
   DeviceInfo info_;
   VkDevice device_ = VK_NULL_HANDLE;
-  VkQueue queue_ = VK_NULL_HANDLE;
-  std::mutex queueMutex_;
+  std::vector<VkQueue> queues_;
+  std::unique_ptr<std::mutex[]> queueMutexes_;  // one per queue
+  QueueLender lender_;
   std::uint32_t queueFamily_ = 0;
   std::uint32_t timestampValidBits_ = 0;
   std::uint32_t subgroupSize_ = 1;
@@ -144,9 +166,10 @@ class Engine {
   const std::vector<DeviceInfo>& devices() const { return infos_; }
   // The device `selector` picks (VulkanOptions::device: an index, a name
   // substring, or empty for the automatic order of context.h), opened on the
-  // first request for it. Throws std::runtime_error listing every device and
-  // why it was rejected when none fits. Thread-safe.
-  std::shared_ptr<SharedDevice> device(const std::string& selector);
+  // first request for it, with at most `queues` queues (0 = kMaxDeviceQueues;
+  // only the request that opens it counts). Throws std::runtime_error listing
+  // every device and why it was rejected when none fits. Thread-safe.
+  std::shared_ptr<SharedDevice> device(const std::string& selector, std::uint32_t queues = 0);
 
   // Successful vkCreateInstance and vkCreateDevice calls in this process:
   // what tests check to see that the handles are made once.

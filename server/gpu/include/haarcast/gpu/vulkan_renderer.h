@@ -50,6 +50,11 @@
 
 namespace haarcast::gpu {
 
+// Frames in flight on a GPU by default: four sessions' frames at once, each
+// slot's buffers sized for its frames (about 0.7 KiB a pixel antialiased:
+// docs/gpu.md, Buffers).
+inline constexpr std::size_t kDefaultGpuFramesInFlight = 4;
+
 // Options of the Vulkan backend beyond the device (context.h VulkanOptions).
 struct VulkanRendererLimits {
   // Covered pixels rotated per batch (the rotated buffer holds batch·3·N
@@ -68,10 +73,13 @@ struct VulkanRendererLimits {
   // invocation its own (the path of devices that cannot).
   bool cellsTogether = true;
   // Frames that may render at once, each with its own device buffers,
-  // command buffers and host scratch (the prepared scene is shared; its
-  // device copy is uploaded once per frame in flight): 0 = 1 on a CPU device (lavapipe's frames share
-  // its cores), 2 on a GPU. While one frame's host stages run (the light,
-  // the shadow rays, the encoding after it), another's passes run on the device.
+  // command buffers, host scratch and queue where the device has enough
+  // (queue_lender.h; the prepared scene is shared, its device copy uploaded
+  // once per frame in flight): 0 = 1 on a CPU device (lavapipe's frames
+  // share its cores and its one queue), kDefaultGpuFramesInFlight on a GPU
+  // (at most its queues). Frames on different queues run side by side on
+  // the device, and while one frame's host stages run (the light, the
+  // readback, the encoding after it), another's passes run.
   std::size_t framesInFlight = 0;
   // Where the shadow rays of `fused` and `splitsum` are traced
   // (render/backend_names.h): `device` needs a device with ray tracing
@@ -106,6 +114,8 @@ class VulkanRenderer final : public render::Renderer {
   render::Frame render(const render::FrameRequest& request) override;
   // The most frames that have rendered at once so far.
   std::size_t peakFramesInFlight() const;
+  // The queue each frame slot submits to (Context::queueIndex), in slot order.
+  std::vector<std::uint32_t> slotQueues() const;
 
   // ---- For tests and diagnostics: the last frame's intermediate data -----
   // (of the slot that finished a frame last; call between frames)
