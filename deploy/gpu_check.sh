@@ -19,7 +19,13 @@
 # bench-frame and load test too, in the same run: ratios against a baseline
 # measured on the same machine.
 #
-#   deploy/gpu_check.sh BUNDLE.tar.xz OUT_DIR [quick]
+#   deploy/gpu_check.sh BUNDLE.tar.xz OUT_DIR [quick|profile]
+#
+# profile: the device, the GPU tests of HAARCAST_GPU_TEST_FILTER (default
+# all), then bench-frame's JSON with each stage's parts (render::Frame::parts:
+# device timestamps within the stages) for the service's frame (1280×720,
+# level 4, antialiased) and 1920×1080 at levels auto and 6, and frames in
+# flight on one queue and on every queue at 256² and 1280×720.
 #
 # OUT_DIR receives device.txt, vulkaninfo.txt, gpu_tests.log, one JSON file
 # per bench-frame run with bench.log, loadtest logs and reports, metrics.txt:
@@ -28,8 +34,8 @@
 # HAARCAST_GPU_SECONDS (default 400) is the whole run's budget: a step whose
 # own limit no longer fits in what is left is skipped and says so.
 set -uo pipefail
-bundle="${1:?usage: deploy/gpu_check.sh BUNDLE.tar.xz OUT_DIR [quick]}"
-out="${2:?usage: deploy/gpu_check.sh BUNDLE.tar.xz OUT_DIR [quick]}"
+bundle="${1:?usage: deploy/gpu_check.sh BUNDLE.tar.xz OUT_DIR [quick|profile]}"
+out="${2:?usage: deploy/gpu_check.sh BUNDLE.tar.xz OUT_DIR [quick|profile]}"
 mode="${3:-full}"
 mkdir -p "$out" /tmp/hcgpu
 tar -C /tmp/hcgpu -xJf "$bundle" || exit 1
@@ -79,7 +85,8 @@ fi
 # One process, as CI runs them: step 14 made one VkInstance per process, so
 # every test starts (on the H200 the 41st instance used to fail).
 step "GPU unit tests, validation on, one process"
-timeout "${HAARCAST_GPU_TEST_SECONDS:-150}" "$hc/bin/haarcast_gpu_tests" --gtest_brief=1 >"$out/gpu_tests.log" 2>&1
+timeout "${HAARCAST_GPU_TEST_SECONDS:-240}" "$hc/bin/haarcast_gpu_tests" --gtest_brief=1 \
+  --gtest_filter="${HAARCAST_GPU_TEST_FILTER:-*}" >"$out/gpu_tests.log" 2>&1
 echo "rc=$?"
 grep -E '^\[  (PASSED|FAILED|SKIPPED)|^\[==========\]|validation:|Failure|PSNR|dB' "$out/gpu_tests.log" | head -60
 
@@ -93,6 +100,24 @@ bench() {
   cat /tmp/hcgpu/bench.err >>"$out/bench.log"
 }
 frames="${HAARCAST_GPU_FRAMES:-20}"
+if [[ "$mode" == profile ]]; then
+  bench profile_720_service 60 --backend vulkan --method fused --sizes 1280x720 --levels 4 --antialias on --frames "$frames"
+  bench profile_1080 60 --backend vulkan --method fused --sizes 1920x1080 --levels auto,6 --frames "$frames"
+  for q in 1 0; do
+    bench "in_flight_queues$q" 90 --backend vulkan --vulkan-queues "$q" --method fused --sizes 256,1280x720 --levels 4 \
+      --antialias on --in-flight 1,2,4 --frames "$frames"
+  done
+  # Each run's stages and their parts, in ms.
+  for f in "$out"/profile_*.json; do
+    python3 -c 'import json,sys
+for r in json.load(open(sys.argv[1]))["runs"]:
+  print(r["width"], r["height"], r["level"], "fps %.2f" % r["fps"])
+  for k, v in r["stages"].items(): print("  %-16s %8.3f ms" % (k, 1e3 * v))
+  for k, v in r.get("parts", {}).items(): print("    %-34s %8.3f ms" % (k, 1e3 * v))' "$f" | tee -a "$out/profile.txt"
+  done
+  ls -la "$out"
+  exit 0
+fi
 bench fused_vulkan 120 --backend vulkan --method fused --sizes 1280x720,1920x1080 --levels auto,6 --frames "$frames"
 # `auto` takes the device's rays on a GPU that traces them: the host's
 # (Embree, the frame in two parts) beside it, the same run.

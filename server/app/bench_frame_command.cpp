@@ -81,7 +81,7 @@ struct BenchArgs {
   // Vulkan: frames in flight to measure, comma-separated (empty: none), each
   // as that many threads rendering at once on one renderer of as many slots.
   std::string inFlight;
-  std::uint32_t queues = 0;  // Vulkan: the most device queues (0: all its family offers)
+  std::uint32_t queues = 1;  // Vulkan: the most device queues (0: all its family offers)
   int frames = 3;
   int warmup = 1;
   bool json = false;
@@ -90,6 +90,7 @@ struct BenchArgs {
 // Mean of each stage and of the frame over the timed frames.
 struct Measured {
   std::vector<std::pair<std::string, double>> stages;
+  std::map<std::string, double> parts;  // render::Frame::parts, the mean of each
   double frameSeconds = 0.0;
   std::size_t coefficientBytes = 0;
   std::size_t covered = 0;
@@ -118,6 +119,7 @@ Measured measure(render::Renderer& r, const render::FrameRequest& request, int f
       for (const auto& s : f.stages) m.stages.emplace_back(s.name, 0.0);
     }
     for (std::size_t k = 0; k < f.stages.size() && k < m.stages.size(); ++k) m.stages[k].second += f.stages[k].seconds / frames;
+    for (const auto& part : f.parts) m.parts[part.name] += part.seconds / frames;
     m.frameSeconds += f.seconds / frames;
     m.coefficientBytes = f.coefficientBytes;
     m.directionsMean = f.passSamples ? static_cast<double>(f.passDirections) / static_cast<double>(f.passSamples) : 0.0;
@@ -329,6 +331,7 @@ int run(const BenchArgs& a) {
             nlohmann::json stages = nlohmann::json::object();
             for (const auto& [name, seconds] : m.stages) stages[name] = seconds;
             run["stages"] = stages;
+            if (!m.parts.empty()) run["parts"] = m.parts;  // what the device's stages went to
             std::string ratio = "";
             if (backend == vulkanName && results.count(cpuName)) {
               const double r = results[cpuName].frameSeconds / m.frameSeconds;
@@ -376,7 +379,7 @@ int run(const BenchArgs& a) {
                     m.frameSeconds > 0.0 ? 1.0 / m.frameSeconds : 0.0);
           }
           if (gpuRenderer && !inFlight.empty()) {
-            // The same renderer, its slots on their own queues where the device has them.
+            // The same renderer, its slots on their own queues where --vulkan-queues opened enough.
             std::string text = "frames in flight, " + std::to_string(width) + "×" + std::to_string(height) + ":";
             nlohmann::json measured = nlohmann::json::array();
             double one = 0.0;
@@ -435,11 +438,11 @@ std::function<int()> addBenchFrameCommand(CLI::App& app) {
   c->add_option("--rays", args->rays, rayModeHelp())->capture_default_str();
   c->add_option("--in-flight", args->inFlight,
                 "Vulkan: frames rendered at once, comma-separated (e.g. 1,4): each as that many threads on one renderer "
-                "with as many frame slots, each slot on a queue of its own where the device has them; frames per second "
-                "in all, after each size's rows");
+                "with as many frame slots (each on a queue of its own where --vulkan-queues opens enough); frames per "
+                "second in all, after each size's rows");
   c->add_option("--vulkan-queues", args->queues,
                 "Vulkan: the most queues the device is opened with (0: every queue its family offers, at most 16; 1: "
-                "every frame on one queue)")
+                "every frame on one queue, the default)")
       ->check(CLI::Range(0, 16))
       ->capture_default_str();
   c->add_option("--sum-tolerance", args->sumTolerances,

@@ -58,7 +58,7 @@ struct ServeArgs {
   render::SceneLimits sceneLimits;
   bool vulkanValidation = false, quiet = false;
   std::size_t framesInFlight = 0;
-  std::uint32_t vulkanQueues = 0;
+  std::uint32_t vulkanQueues = 1;
   unsigned renderThreads = 0;
   long long serverPixelBudget = -1;  // -1: 2 × --max-session-pixels
 };
@@ -430,14 +430,15 @@ std::function<int()> addServeCommand(CLI::App& app) {
   c->add_option("--rays", a->rays, rayModeHelp())->capture_default_str();
   c->add_option("--vulkan-queues", a->vulkanQueues,
                 "The most queues the Vulkan device is opened with, each frame slot lent the least-lent: frames on "
-                "different queues run side by side (0: every queue its family offers, at most 16; 1: every frame on one "
-                "queue, each barrier waiting for the frames submitted before it)")
+                "different queues run side by side, where on one queue each barrier waits for the frames submitted "
+                "before it (0: every queue its family offers, at most 16). One by default: on the H200 a 1280x720 frame "
+                "fills the device and frames side by side made fewer frames in all (docs/gpu.md)")
       ->check(CLI::Range(0, 16))
       ->capture_default_str();
   c->add_option("--frames-in-flight", a->framesInFlight,
                 "Frames a Vulkan renderer may render at once, each with its own device buffers (the scene uploaded once "
                 "per frame in flight): while one frame's host stages run, another's passes run on the device. "
-                "0 = 1 on a CPU device (lavapipe), 4 on a GPU (at most its queues)")
+                "0 = 1 on a CPU device (lavapipe), 2 on a GPU")
       ->check(CLI::Range(0, 16))
       ->capture_default_str();
   c->add_flag("--quiet", a->quiet, "No per-session log lines on stderr");

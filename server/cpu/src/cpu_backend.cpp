@@ -761,9 +761,9 @@ std::size_t CpuRenderer::shadeSmoothSums(const GBuffer& g, FusedSlots& slots, co
         const std::size_t i = static_cast<std::size_t>(y) * g.width + static_cast<std::size_t>(x);
         const std::optional<std::size_t> object = objectOf(i);
         if (!object) continue;
-        const RotationInput& r = g.centre[i]->input.rotation;
-        slots.mirrors[i] = shared::smoothMirror(static_cast<float>(r.euler.alpha), static_cast<float>(r.euler.beta),
-                                                static_cast<float>(r.euler.gamma), static_cast<float>(r.thetaOut));
+        const RotationInput& in = g.centre[i]->input.rotation;
+        slots.mirrors[i] = shared::smoothMirror(static_cast<float>(in.euler.alpha), static_cast<float>(in.euler.beta),
+                                                static_cast<float>(in.euler.gamma), static_cast<float>(in.thetaOut));
         // Its parents, where each is on this object, visited, and its
         // mirror direction near the pixel's (A' and B' are only left out).
         const std::array<shared::uint, 4> at{parents.at0, parents.at1, parents.at2, parents.at3};

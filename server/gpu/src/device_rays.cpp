@@ -164,7 +164,9 @@ void VulkanRenderer::Impl::recordDeviceRays(VkCommandBuffer cb) {
   rayObjectsUpload.record(cb);
   rayFrameUpload.record(cb);
   rayTracingBarrier(cb);  // rotation-input's samples and the uploads, for the launches
+  markPart(cb, "uploads");
   accelerationStructures->recordTopLevel(cb, posesData);  // ends with a barrier for the launches
+  markPart(cb, "top level");
   // The samples' launches: kRaysLaunchWidth wide, as many rows as the
   // capacity needs; invocations past the covered count return at once.
   const std::uint32_t rows = groupsOf(sampleCapacity, kRaysLaunchWidth);
@@ -174,16 +176,20 @@ void VulkanRenderer::Impl::recordDeviceRays(VkCommandBuffer cb) {
     RaysPush push{shared::kRaysPhaseCentres};
     shadowRays->trace(cb, kRaysLaunchWidth, rows, &push, sizeof push);
     rayTracingBarrier(cb);
+    markPart(cb, "ground centres");
     push.phase = shared::kRaysPhaseGrid;
     shadowRays->trace(cb, rayFrameData.gridColumns, rayFrameData.gridRows, &push, sizeof push);
     rayTracingBarrier(cb);
+    markPart(cb, "ground grid");
     push.phase = shared::kRaysPhaseFineGrid;  // reads the coarse grid: after it
     shadowRays->trace(cb, rayFrameData.fineColumns, rayFrameData.fineRows, &push, sizeof push);
     rayTracingBarrier(cb);
+    markPart(cb, "ground fine grid");
   }
   const RaysPush push{shared::kRaysPhaseMasks};
   shadowRays->trace(cb, kRaysLaunchWidth, rows, &push, sizeof push);
   rayTracingBarrier(cb);
+  markPart(cb, "masks");
 }
 
 }  // namespace haarcast::gpu

@@ -73,27 +73,54 @@ void VulkanRenderer::Impl::runStages(const std::vector<FrameStage>& stages, cons
   if (frame.cancelled || stages.empty()) return;
   render::enterFrameStage(request, stages.front().first);
   const auto count = static_cast<std::uint32_t>(stages.size());
-  ensureQueries(count + 1);
+  // The stages' boundaries, then the parts' marks (markPart), up to kMaxPartMarks.
+  ensureQueries(count + 1 + kMaxPartMarks);
+  partMarks.clear();
+  nextPartQuery = count + 1;
+  struct Recording {  // markPart records only inside this submission
+    Impl& impl;
+    ~Recording() { impl.markStage = -1; }
+  } recording{*this};
   context.submit([&](VkCommandBuffer cb) {
-    vkCmdResetQueryPool(cb, queries, 0, count + 1);
+    vkCmdResetQueryPool(cb, queries, 0, count + 1 + kMaxPartMarks);
     vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, queries, 0);
     for (std::uint32_t i = 0; i < count; ++i) {
+      markStage = static_cast<int>(i);
       stages[i].second(cb);
       computeBarrier(cb);
       vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, queries, i + 1);
     }
+    markStage = -1;
   });
-  std::vector<std::uint64_t> ticks(count + 1);
-  vkCheck(vkGetQueryPoolResults(context.device(), queries, 0, count + 1, (count + 1) * sizeof(std::uint64_t), ticks.data(),
+  const std::uint32_t written = nextPartQuery;
+  std::vector<std::uint64_t> ticks(written);
+  vkCheck(vkGetQueryPoolResults(context.device(), queries, 0, written, written * sizeof(std::uint64_t), ticks.data(),
                                 sizeof(std::uint64_t), VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
           "vkGetQueryPoolResults");
   // Only timestampValidBits of a tick count; differences are taken modulo that.
   const std::uint64_t mask = context.timestampValidBits() >= 64 ? ~std::uint64_t{0}
                                                                  : (std::uint64_t{1} << context.timestampValidBits()) - 1;
+  const auto seconds = [&](std::uint32_t from, std::uint32_t to) {
+    return static_cast<double>((ticks[to] - ticks[from]) & mask) * context.timestampPeriodNs() * 1e-9;
+  };
   for (std::uint32_t i = 0; i < count; ++i) {
-    const std::uint64_t delta = (ticks[i + 1] - ticks[i]) & mask;
-    add(stages[i].first, static_cast<double>(delta) * context.timestampPeriodNs() * 1e-9);
+    add(stages[i].first, seconds(i, i + 1));
+    // Its parts: each from the mark before it (the stage's start first), the rest to its end.
+    std::uint32_t from = i;
+    for (const PartMark& m : partMarks) {
+      if (m.stage != i) continue;
+      frame.parts.push_back({std::string(stages[i].first) + ": " + m.name, seconds(from, m.query)});
+      from = m.query;
+    }
+    if (from != i) frame.parts.push_back({std::string(stages[i].first) + ": rest", seconds(from, i + 1)});
   }
+}
+
+void VulkanRenderer::Impl::markPart(VkCommandBuffer cb, const char* part) {
+  if (markStage < 0 || nextPartQuery >= queryCapacity) return;
+  vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, queries, nextPartQuery);
+  partMarks.push_back({part, static_cast<std::uint32_t>(markStage), nextPartQuery});
+  ++nextPartQuery;
 }
 
 void VulkanRenderer::Impl::uploadFrameUniforms(const render::FrameRequest& request, const render::ResolvedFrame& resolved) {
@@ -113,6 +140,7 @@ void VulkanRenderer::Impl::recordTonemap(VkCommandBuffer cb, const render::Frame
   const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
   resolve->dispatch(cb, {groupsOf(pixels, shared::kLocalSize), 1, 1});
   computeBarrier(cb);
+  markPart(cb, "resolve");
   // The meter: histograms over many workgroups, then one invocation's read-out.
   vkCmdFillBuffer(cb, exposureHistograms.handle(), 0, VK_WHOLE_SIZE, 0u);
   computeBarrier(cb);
@@ -121,8 +149,10 @@ void VulkanRenderer::Impl::recordTonemap(VkCommandBuffer cb, const render::Frame
   const ExposurePush push = render::exposurePush(request.exposure, request.tone);
   exposureReadout->dispatch(cb, {1, 1, 1}, &push, sizeof push);
   computeBarrier(cb);
+  markPart(cb, "exposure");
   tonemap->dispatch(cb, {groupsOf(pixels, shared::kLocalSize), 1, 1});
   computeBarrier(cb);
+  markPart(cb, "tonemap");
   // What the host reads: the exposure's outcome, and on request the
   // pixels' radiance (the first `pixels` entries) and ids (the object mask).
   const VkBufferCopy result{0, 0, sizeof(ExposureResult)};

@@ -7,6 +7,7 @@
 // backend's rays for the same hit: render/point_lights.h) it is two, around
 // the covered samples read back and their shadow words uploaded.
 
+#include <array>
 #include <algorithm>
 #include <cstddef>
 #include <span>
@@ -117,6 +118,10 @@ std::uint32_t VulkanRenderer::Impl::computeShadowMasks(const render::ResolvedFra
   return covered;
 }
 
+// The smooth sum's stages as bench-frame's profile names them (Frame::parts).
+constexpr std::array<const char*, shared::kSmoothSumStages> kSmoothStageParts{
+    "grid sums", "step 2 edges", "step 2 centres", "step 1 edges", "step 1 centres"};
+
 render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& request) {
   const auto start = RendererClock::now();
   render::Frame frame;
@@ -184,6 +189,7 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
                                if (!deviceRays) maskUpload.record(cb);
                                if (!deviceRays && objectSky()) hiddenUpload.record(cb);
                                computeBarrier(cb);
+                               markPart(cb, "uploads");
                                if (!fused) {
                                  fusedPass->dispatchIndirect(cb, counter, offsetof(CoverageCounter, groups));
                                } else if (!(options.smoothSumTolerance > 0.0f)) {
@@ -198,6 +204,7 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
                                    const shared::FusedPush push{stage, static_cast<shared::uint>(width), static_cast<shared::uint>(height),
                                                                 options.smoothSumTolerance};
                                    fusedPass->dispatchIndirect(cb, counter, offsetof(CoverageCounter, groups), &push, sizeof push);
+                                   markPart(cb, kSmoothStageParts[stage]);
                                  }
                                }
                                if (fused) {

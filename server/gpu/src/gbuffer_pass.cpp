@@ -202,6 +202,7 @@ void VulkanRenderer::Impl::rasterise(VkCommandBuffer cb, const render::ResolvedF
     vkCmdDraw(cb, 3 * triangleCount[i], 1, 0, 0);
   }
   vkCmdEndRenderPass(cb);
+  markPart(cb, positionsOut ? "raster" : "sub-sample raster");
   VkBufferImageCopy region{};
   region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
   region.imageExtent = {t.width, t.height, 1};
@@ -215,7 +216,11 @@ void VulkanRenderer::Impl::rasterise(VkCommandBuffer cb, const render::ResolvedF
 
 void VulkanRenderer::Impl::recordGBuffer(VkCommandBuffer cb, const render::ResolvedFrame& resolved) {
   rasterise(cb, resolved, target, gbufIds, gbufNormals, &gbufPositions);
-  if (options.antialias) rasterise(cb, resolved, subTarget, subIds, subNormals, nullptr);
+  markPart(cb, "copies");
+  if (options.antialias) {
+    rasterise(cb, resolved, subTarget, subIds, subNormals, nullptr);
+    markPart(cb, "sub-sample copies");
+  }
 }
 
 }  // namespace haarcast::gpu

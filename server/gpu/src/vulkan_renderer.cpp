@@ -87,9 +87,10 @@ VulkanRenderer::VulkanRenderer(const render::Scene& scene, const render::RenderO
       Engine::get(EngineOptions{vulkan.validation}).device(vulkan.device, vulkan.queues);
   const auto prepared = std::make_shared<const render::PreparedScene>(render::prepareScene(scene, options, progress));
   std::size_t slots = limits.framesInFlight;
-  // A CPU device's frames share its cores; a GPU's run side by side, one
-  // per queue (each slot's Context is lent the least-lent queue).
-  if (slots == 0) slots = device->info().type == "cpu" ? 1 : std::min<std::size_t>(kDefaultGpuFramesInFlight, device->queueCount());
+  // A CPU device's frames share its cores; a GPU's overlap one frame's
+  // host work with another's passes (each slot's Context is lent the
+  // least-lent queue).
+  if (slots == 0) slots = device->info().type == "cpu" ? 1 : kDefaultGpuFramesInFlight;
   // Each slot uploads its own copy of the scene's data and compiles the
   // same pipelines (the driver's cache makes the second compile a lookup).
   // The further slots' progress is one stage of its own, so that the

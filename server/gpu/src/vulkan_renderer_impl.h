@@ -52,6 +52,8 @@ struct DeviceImage {
 
 // A stage of a frame: its name (renderer.h) and what it records.
 using FrameStage = std::pair<const char*, std::function<void(VkCommandBuffer)>>;
+// Timestamps a submission may write within its stages (Impl::markPart).
+inline constexpr std::uint32_t kMaxPartMarks = 32;
 
 struct VulkanRenderer::Impl {
   render::RenderOptions options;
@@ -198,6 +200,15 @@ struct VulkanRenderer::Impl {
   bool useTimestamps = false;
   VkQueryPool queries = VK_NULL_HANDLE;
   std::uint32_t queryCapacity = 0;  // timestamps the pool holds
+  // markPart's marks in the submission being recorded: name, the stage it
+  // is in, its query; markStage: that stage (-1: not recording timestamps).
+  struct PartMark {
+    const char* name;
+    std::uint32_t stage, query;
+  };
+  std::vector<PartMark> partMarks;
+  int markStage = -1;
+  std::uint32_t nextPartQuery = 0;
   // The request's `cancelled` while render() runs (null otherwise): polled
   // by runStages before each submission, the batch boundary of a frame.
   const std::function<bool()>* cancelled = nullptr;
@@ -257,6 +268,10 @@ struct VulkanRenderer::Impl {
   // stage is entered (render::enterFrameStage) as it is submitted; one
   // submission of every stage is the first stage's, for a watcher.
   void runStages(const std::vector<FrameStage>& stages, const render::FrameRequest& request, render::Frame& frame);
+  // A timestamp after everything recorded so far in the stage being
+  // recorded, named `part` (render::Frame::parts): only inside runStages's
+  // timestamped submission; elsewhere (CPU devices) nothing.
+  void markPart(VkCommandBuffer cb, const char* part);
   void ensureQueries(std::uint32_t count);
 
   // fused_frame.cpp

@@ -117,7 +117,8 @@ GPU_TEST(Engine, ContextsSubmitFromManyThreadsAtOnce) {
 // device of one queue (lavapipe) every Context is lent queue 0.
 GPU_TEST(Engine, EachContextIsLentTheLeastLentQueueAndGivesItBack) {
   HAARCAST_REQUIRE_VULKAN();
-  const std::shared_ptr<SharedDevice> device = Engine::get().device(testing::testOptions().device);
+  const std::shared_ptr<SharedDevice> device =
+      Engine::get().device(testing::testOptions().device, testing::testOptions().queues);
   ASSERT_GE(device->queueCount(), 1u);
   ASSERT_LE(device->queueCount(), kMaxDeviceQueues);
   const std::vector<std::size_t> before = device->queuesLent();
@@ -145,7 +146,8 @@ GPU_TEST(Engine, EachContextIsLentTheLeastLentQueueAndGivesItBack) {
 // frames run side by side), all on queue 0 on lavapipe.
 GPU_TEST(Engine, ARenderersFrameSlotsAreSpreadOverTheQueues) {
   HAARCAST_REQUIRE_VULKAN();
-  const std::shared_ptr<SharedDevice> device = Engine::get().device(testing::testOptions().device);
+  const std::shared_ptr<SharedDevice> device =
+      Engine::get().device(testing::testOptions().device, testing::testOptions().queues);
   render::RenderOptions options;
   options.method = RotationMethod::Spatial;
   options.level = 2;

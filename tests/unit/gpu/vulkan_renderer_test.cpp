@@ -512,6 +512,46 @@ GPU_TEST(VulkanRenderer, FusedFrameCancelsBetweenItsSubmissions) {
   testing::expectNoValidationMessages(gpu.context());
 }
 
+// What a stage's device time went to (render::Frame::parts): on a device
+// that times its stages with timestamps, each marked stage's parts, from
+// mark to mark and the rest to its end, add up to the stage's time, in the
+// order they were recorded; on a CPU device (host-timed stages) there are none.
+GPU_TEST(VulkanRenderer, AFramesPartsAddUpToTheStagesTheyAreIn) {
+  HAARCAST_REQUIRE_VULKAN();
+  const render::Scene scene = render::defaultScene();
+  render::RenderOptions o = frameOptions(RotationMethod::Fused, true);
+  o.antialias = true;
+  o.smoothSumTolerance = 0.01f;
+  VulkanRenderer gpu(scene, o, testing::testOptions());
+  const render::Frame f = gpu.render(requestFor(scene, 48, 32));
+  if (gpu.context().info().type == "cpu") {
+    EXPECT_TRUE(f.parts.empty());
+    return;
+  }
+  std::vector<std::string> names;
+  for (const render::StageTime& p : f.parts) names.push_back(p.name);
+  const std::vector<std::string> want{"gbuffer: raster", "gbuffer: copies", "gbuffer: sub-sample raster",
+                                      "gbuffer: sub-sample copies", "gbuffer: rest"};
+  ASSERT_GE(names.size(), want.size());
+  EXPECT_EQ(std::vector<std::string>(names.begin(), names.begin() + 5), want);
+  for (const char* part : {"fused: uploads", "fused: grid sums", "fused: step 1 centres", "fused: rest", "tonemap: resolve",
+                           "tonemap: exposure", "tonemap: tonemap", "tonemap: rest"}) {
+    EXPECT_NE(std::find(names.begin(), names.end(), part), names.end()) << part;
+  }
+  for (const render::StageTime& stage : f.stages) {
+    double sum = 0.0;
+    bool any = false;
+    for (const render::StageTime& p : f.parts) {
+      if (p.name.rfind(stage.name + ": ", 0) != 0) continue;
+      any = true;
+      EXPECT_GE(p.seconds, 0.0) << p.name;
+      sum += p.seconds;
+    }
+    if (any) EXPECT_NEAR(sum, stage.seconds, 1e-9 + 1e-6 * stage.seconds) << stage.name;
+  }
+  testing::expectNoValidationMessages(gpu.context());
+}
+
 // Scene data and the light in device-local memory reached only through
 // staging copies (the discrete-GPU path, forced here): the same frames, bit
 // for bit, as with mapped memory, over frames whose light and poses change

@@ -23,7 +23,7 @@ using shared::SmoothParents;
 
 // Every pixel is visited once, and every parent before its child.
 TEST(SmoothSum, EveryPixelIsVisitedOnceAfterItsParents) {
-  for (const auto [w, h] : {std::pair{13, 9}, {16, 16}, {1, 1}, {5, 1}, {1, 7}, {33, 20}}) {
+  for (const auto& [w, h] : {std::pair{13, 9}, {16, 16}, {1, 1}, {5, 1}, {1, 7}, {33, 20}}) {
     std::vector<int> visited(static_cast<std::size_t>(w * h), -1);
     for (shared::uint k = 0; k < shared::kSmoothSumStages; ++k) {
       for (int y = 0; y < h; ++y) {

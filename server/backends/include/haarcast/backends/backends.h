@@ -32,15 +32,14 @@ struct DeviceOptions {
   // The Vulkan validation layer, when installed.
   bool validation = kValidationByDefault;
   // Vulkan: frames one renderer may have in flight at once
-  // (gpu::VulkanRendererLimits::framesInFlight; 0 = 1 on a CPU device, up to
-  // 4 on a GPU, one per queue).
+  // (gpu::VulkanRendererLimits::framesInFlight; 0 = 1 on a CPU device, 2 on a GPU).
   std::size_t framesInFlight = 0;
   // Vulkan: where the shadow rays are traced (render/backend_names.h,
   // gpu::VulkanRendererLimits::rays).
   render::RayMode rays = render::RayMode::Auto;
   // Vulkan: the most queues the device is opened with (gpu::VulkanOptions::queues;
   // 0 = all its family offers, at most 16); the first renderer on it decides.
-  std::uint32_t queues = 0;
+  std::uint32_t queues = 1;
 };
 
 // True when this build has `name` (one of render::kBackendNames).

@@ -70,10 +70,13 @@ struct VulkanOptions {
   // where their memory could be mapped (buffer.h): the path of a discrete
   // GPU, run on any device (tests).
   bool stageInputs = false;
-  // The most queues the device is opened with (0 = every queue of its
-  // graphics-and-compute family, at most kMaxDeviceQueues: engine.h). Counts
+  // The most queues the device is opened with (engine.h; 0 = every queue
+  // of its graphics-and-compute family, at most kMaxDeviceQueues). Counts
   // only for the Context that opens the device, the first to select it.
-  std::uint32_t queues = 0;
+  // One by default: on the H200 one frame fills the device, and frames on
+  // queues of their own ran 0.8× as many frames a second in all as one
+  // frame at a time (docs/gpu.md); more may pay where frames are small.
+  std::uint32_t queues = 1;
 };
 
 // "VK_ERROR_OUT_OF_DEVICE_MEMORY" etc., or the number for unknown codes.

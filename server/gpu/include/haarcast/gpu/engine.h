@@ -20,13 +20,16 @@
 //     that call alone. Each Context waits on its own fence, outside the lock,
 //     and never calls vkDeviceWaitIdle or vkQueueWaitIdle (either would wait
 //     for the other renderers' work and need a queue's lock).
-//   - Queues: the device is opened with every queue of its graphics-and-
-//     compute family (at most kMaxDeviceQueues, or VulkanOptions::queues of
-//     the Context that opens it), and each Context is lent one for its
-//     lifetime, the least-lent (queue_lender.h): frames of different
-//     Contexts on different queues run side by side, where on one queue
-//     every barrier would wait for the frames submitted before it. lavapipe
-//     offers one queue; NVIDIA's family has 16.
+//   - Queues: the device is opened with VulkanOptions::queues of the
+//     Context that opens it (one by default; 0 = every queue of its
+//     graphics-and-compute family, at most kMaxDeviceQueues), and each
+//     Context is lent one for its lifetime, the least-lent
+//     (queue_lender.h): frames of different Contexts on different queues
+//     run side by side, where on one queue every barrier waits for the
+//     frames submitted before it. lavapipe offers one queue; NVIDIA's
+//     family has 16. Whether side by side pays is the device's and the
+//     frame's: on the H200 a 1280×720 frame fills the device, and four on
+//     four queues made 0.8× the frames of one at a time (docs/gpu.md).
 //   - Lifetime: a Context holds its SharedDevice, and a SharedDevice holds
 //     the instance (shared_ptr). The engine is a function-local static: it is
 //     destroyed at exit before the Vulkan loader's own destructors run (the
@@ -93,7 +96,7 @@ class SharedDevice {
   // `queues`: the most queues to open (0 = kMaxDeviceQueues); the family's
   // count bounds it.
   SharedDevice(std::shared_ptr<VulkanInstance> instance, VkPhysicalDevice physical, DeviceInfo info,
-               std::uint32_t queues = 0);
+               std::uint32_t queues);
   ~SharedDevice();  // vkDestroyDevice: no Context holds it any more
   SharedDevice(const SharedDevice&) = delete;
   SharedDevice& operator=(const SharedDevice&) = delete;
@@ -169,7 +172,7 @@ class Engine {
   // first request for it, with at most `queues` queues (0 = kMaxDeviceQueues;
   // only the request that opens it counts). Throws std::runtime_error listing
   // every device and why it was rejected when none fits. Thread-safe.
-  std::shared_ptr<SharedDevice> device(const std::string& selector, std::uint32_t queues = 0);
+  std::shared_ptr<SharedDevice> device(const std::string& selector, std::uint32_t queues = 1);
 
   // Successful vkCreateInstance and vkCreateDevice calls in this process:
   // what tests check to see that the handles are made once.

@@ -50,10 +50,13 @@
 
 namespace haarcast::gpu {
 
-// Frames in flight on a GPU by default: four sessions' frames at once, each
-// slot's buffers sized for its frames (about 0.7 KiB a pixel antialiased:
-// docs/gpu.md, Buffers).
-inline constexpr std::size_t kDefaultGpuFramesInFlight = 4;
+// Frames in flight on a GPU by default. Measured on the H200 (docs/gpu.md,
+// service at 1280×720, four clients, one queue): two gave 6.23 frames a
+// second each, one 5.91, four 5.79; a frame fills the device, so a second
+// slot pays only by overlapping one frame's host work (the light, the
+// readback) with another's passes. Each slot's buffers are its own (about
+// 0.7 KiB a pixel antialiased: docs/gpu.md, Buffers).
+inline constexpr std::size_t kDefaultGpuFramesInFlight = 2;
 
 // Options of the Vulkan backend beyond the device (context.h VulkanOptions).
 struct VulkanRendererLimits {
@@ -73,13 +76,13 @@ struct VulkanRendererLimits {
   // invocation its own (the path of devices that cannot).
   bool cellsTogether = true;
   // Frames that may render at once, each with its own device buffers,
-  // command buffers, host scratch and queue where the device has enough
-  // (queue_lender.h; the prepared scene is shared, its device copy uploaded
-  // once per frame in flight): 0 = 1 on a CPU device (lavapipe's frames
-  // share its cores and its one queue), kDefaultGpuFramesInFlight on a GPU
-  // (at most its queues). Frames on different queues run side by side on
-  // the device, and while one frame's host stages run (the light, the
-  // readback, the encoding after it), another's passes run.
+  // command buffers, host scratch and queue where the device was opened
+  // with enough (VulkanOptions::queues, queue_lender.h; the prepared scene
+  // is shared, its device copy uploaded once per frame in flight): 0 = 1 on
+  // a CPU device (lavapipe's frames share its cores and its one queue),
+  // kDefaultGpuFramesInFlight on a GPU. While one frame's host stages run
+  // (the light, the readback, the encoding after it), another's passes run;
+  // frames on different queues also run side by side on the device.
   std::size_t framesInFlight = 0;
   // Where the shadow rays of `fused` and `splitsum` are traced
   // (render/backend_names.h): `device` needs a device with ray tracing
