@@ -514,11 +514,12 @@ Frame CpuRenderer::renderFrame(const FrameRequest& request, const CancelPoint& c
       }
     }, {}, options_.threads);
   }
-  const shared::ExposureResult exposure = meterExposure(frame.image, frame.objectMask, request.exposure, request.tone);
+  const shared::ExposureResult exposure =
+      meterExposure(frame.image, frame.objectMask, request.exposure, request.tone, options_.threads);
   frame.logAverageLuminance = exposure.logAverage;
   // A fixed exposure is reported as asked, as the Vulkan backend does.
   frame.exposureStops = request.exposure.automatic ? static_cast<double>(exposure.stops) : request.exposure.stops;
-  frame.rgba8 = tonemapRgba8(frame.image, frame.exposureStops, request.tone);
+  frame.rgba8 = tonemapRgba8(frame.image, frame.exposureStops, request.tone, options_.threads);
   frame.stages.push_back({"tonemap", since(t0)});
   frame.coefficientBytes = bytes;
   frame.seconds = since(start);

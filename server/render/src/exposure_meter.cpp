@@ -1,19 +1,37 @@
 #include "haarcast/render/exposure_meter.h"
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
+
+#include "haarcast/core/parallel.h"
 
 namespace haarcast::render {
 
-ExposureHistograms meterHistograms(const io::RgbImage& image, const std::vector<std::uint8_t>& objectMask) {
-  ExposureHistograms h;
+ExposureHistograms meterHistograms(const io::RgbImage& image, const std::vector<std::uint8_t>& objectMask,
+                                   unsigned threads) {
   const std::size_t pixels = image.rgb.size() / 3;
-  for (std::size_t p = 0; p < pixels; ++p) {
-    const glm::vec3 c(image.rgb[3 * p], image.rgb[3 * p + 1], image.rgb[3 * p + 2]);
-    const float y = shared::meterLuminance(c);
-    const std::uint32_t w = shared::meterWeight(y, p < objectMask.size() && objectMask[p] != 0);
-    if (w == 0) continue;
-    h.luminance[shared::meterBin(y)] += w;
-    h.peak[shared::meterBin(shared::meterPeak(c))] += w;
+  // Bands of 64K pixels, each counted into its own histograms, added after.
+  constexpr std::size_t kBand = std::size_t{1} << 16;
+  const std::size_t bands = (pixels + kBand - 1) / kBand;
+  std::vector<ExposureHistograms> counted(bands);
+  parallelFor(bands, [&](std::size_t b) {
+    ExposureHistograms& h = counted[b];
+    for (std::size_t p = b * kBand; p < std::min(pixels, (b + 1) * kBand); ++p) {
+      const glm::vec3 c(image.rgb[3 * p], image.rgb[3 * p + 1], image.rgb[3 * p + 2]);
+      const float y = shared::meterLuminance(c);
+      const std::uint32_t w = shared::meterWeight(y, p < objectMask.size() && objectMask[p] != 0);
+      if (w == 0) continue;
+      h.luminance[shared::meterBin(y)] += w;
+      h.peak[shared::meterBin(shared::meterPeak(c))] += w;
+    }
+  }, {}, threads);
+  ExposureHistograms h;
+  for (const ExposureHistograms& band : counted) {
+    for (std::size_t k = 0; k < h.luminance.size(); ++k) {
+      h.luminance[k] += band.luminance[k];
+      h.peak[k] += band.peak[k];
+    }
   }
   return h;
 }
@@ -36,8 +54,8 @@ shared::ExposureResult meterExposure(const ExposureHistograms& h, const shared::
 }
 
 shared::ExposureResult meterExposure(const io::RgbImage& image, const std::vector<std::uint8_t>& objectMask,
-                                     const ExposureControl& control, ToneCurve curve) {
-  return meterExposure(meterHistograms(image, objectMask), exposurePush(control, curve));
+                                     const ExposureControl& control, ToneCurve curve, unsigned threads) {
+  return meterExposure(meterHistograms(image, objectMask, threads), exposurePush(control, curve));
 }
 
 }  // namespace haarcast::render

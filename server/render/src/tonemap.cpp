@@ -4,6 +4,9 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <vector>
+
+#include "haarcast/core/parallel.h"
 
 namespace haarcast::render {
 
@@ -111,14 +114,18 @@ std::uint8_t tonemapByte(float value, const ToneThresholds& threshold) {
   return static_cast<std::uint8_t>(shared::tonemapCode(value, threshold));
 }
 
-std::vector<std::uint8_t> tonemapRgba8(const io::RgbImage& image, double exposureStops, ToneCurve curve) {
+std::vector<std::uint8_t> tonemapRgba8(const io::RgbImage& image, double exposureStops, ToneCurve curve,
+                                       unsigned threads) {
   const ToneThresholds thresholds = tonemapThresholds(exposureStops, curve);
   const std::size_t pixels = static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height);
   std::vector<std::uint8_t> out(pixels * 4);
-  for (std::size_t p = 0; p < pixels; ++p) {
-    for (std::size_t c = 0; c < 3; ++c) out[4 * p + c] = tonemapByte(image.rgb[3 * p + c], thresholds);
-    out[4 * p + 3] = 255;
-  }
+  constexpr std::size_t kBand = std::size_t{1} << 16;  // pixels a task
+  parallelFor((pixels + kBand - 1) / kBand, [&](std::size_t b) {
+    for (std::size_t p = b * kBand; p < std::min(pixels, (b + 1) * kBand); ++p) {
+      for (std::size_t c = 0; c < 3; ++c) out[4 * p + c] = tonemapByte(image.rgb[3 * p + c], thresholds);
+      out[4 * p + 3] = 255;
+    }
+  }, {}, threads);
   return out;
 }
 

@@ -547,7 +547,9 @@ GPU_TEST(VulkanRenderer, AFramesPartsAddUpToTheStagesTheyAreIn) {
       EXPECT_GE(p.seconds, 0.0) << p.name;
       sum += p.seconds;
     }
-    if (any) EXPECT_NEAR(sum, stage.seconds, 1e-9 + 1e-6 * stage.seconds) << stage.name;
+    if (any) {
+      EXPECT_NEAR(sum, stage.seconds, 1e-9 + 1e-6 * stage.seconds) << stage.name;
+    }
   }
   testing::expectNoValidationMessages(gpu.context());
 }

@@ -3,8 +3,11 @@
 // the highlight guard and its cap, the easing. The device's copy of the
 // same steps is checked against this one in tests/unit/gpu/exposure_pass_test.cpp.
 #include "haarcast/render/exposure_meter.h"
+#include "haarcast/render/tonemap.h"
 
 #include <cmath>
+#include <cstdint>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -64,6 +67,35 @@ TEST(ExposureMeter, HistogramsWeighObjectsFourTimesAndSkipWhatCarriesNoLight) {
 // brightest 1% of the weight is the backdrop pixel.
 shared::ExposureResult twoPixels(int e, ToneCurve curve = ToneCurve::Reinhard) {
   return meterExposure(greys({grey(-4), grey(e)}), {1, 0}, ExposureControl{}, curve);
+}
+
+// Counted on several threads, band by band, the histograms are the one
+// thread's exactly (integer counts); so are the RGBA8 bytes. An image of
+// 300 × 500 pixels: three bands of 64K and a part, every bin class (zero,
+// negative, NaN, a spread of greys), objects on a pattern.
+TEST(ExposureMeter, ThreadsCountAndEncodeWhatOneThreadDoes) {
+  io::RgbImage image = io::makeImage(300, 500);
+  std::vector<std::uint8_t> mask(300 * 500);
+  for (int y = 0; y < 500; ++y) {
+    for (int x = 0; x < 300; ++x) {
+      const int i = y * 300 + x;
+      for (int c = 0; c < 3; ++c) image.at(y, x, c) = static_cast<float>(std::ldexp(1.0 + (i * 7 + c) % 97 / 97.0, (i % 41) - 20));
+      if (i % 13 == 0) image.at(y, x, 0) = 0.0f;
+      if (i % 17 == 0) image.at(y, x, 1) = -1.0f;
+      if (i % 19 == 0) image.at(y, x, 2) = std::nanf("");
+      mask[static_cast<std::size_t>(i)] = (x / 7 + y / 5) % 3 == 0;
+    }
+  }
+  const ExposureHistograms one = meterHistograms(image, mask, 1);
+  for (const unsigned threads : {2u, 3u, 0u}) {
+    const ExposureHistograms many = meterHistograms(image, mask, threads);
+    EXPECT_EQ(many.luminance, one.luminance) << threads << " threads";
+    EXPECT_EQ(many.peak, one.peak) << threads << " threads";
+    EXPECT_EQ(tonemapRgba8(image, 1.5, ToneCurve::Reinhard, threads), tonemapRgba8(image, 1.5, ToneCurve::Reinhard, 1));
+  }
+  std::uint64_t weight = 0;
+  for (const std::uint32_t w : one.luminance) weight += w;
+  EXPECT_GT(weight, 100000u);  // most pixels carry light and are counted
 }
 
 TEST(ExposureMeter, KeyExposureOfTheWeightedLogAverage) {

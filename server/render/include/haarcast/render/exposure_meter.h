@@ -22,8 +22,11 @@ struct ExposureHistograms {
 };
 
 // objectMask[p] ≠ 0 marks an object pixel (weight shared::kMeterObjectWeight);
-// the rest, and every pixel when the mask is empty, are backdrop.
-ExposureHistograms meterHistograms(const io::RgbImage& image, const std::vector<std::uint8_t>& objectMask);
+// the rest, and every pixel when the mask is empty, are backdrop. On up to
+// `threads` threads (0 = the hardware's), each counting its own rows: the
+// counts are integers, so the sum does not depend on the split.
+ExposureHistograms meterHistograms(const io::RgbImage& image, const std::vector<std::uint8_t>& objectMask,
+                                   unsigned threads = 1);
 
 // The push block exposure.comp gets for a request: the control, log2 of the
 // key and of the curve's highlight (toneHighlight), the stops bound.
@@ -34,6 +37,6 @@ shared::ExposureResult meterExposure(const ExposureHistograms& histograms, const
 
 // Both steps for a frame: the exposure its RGBA8 is made with is `stops`.
 shared::ExposureResult meterExposure(const io::RgbImage& image, const std::vector<std::uint8_t>& objectMask,
-                                     const ExposureControl& control, ToneCurve curve);
+                                     const ExposureControl& control, ToneCurve curve, unsigned threads = 1);
 
 }  // namespace haarcast::render

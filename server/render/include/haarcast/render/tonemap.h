@@ -76,9 +76,10 @@ std::uint8_t tonemapByte(float linear, const ToneThresholds& thresholds);
 // treats each channel alone and never decreases: all three do.
 ToneThresholds tonemapThresholds(double exposureStops, ToneCurve curve = ToneCurve::Reinhard);
 
-// RGBA8 (alpha 255), row 0 at the top, 4 bytes per pixel.
+// RGBA8 (alpha 255), row 0 at the top, 4 bytes per pixel; on up to
+// `threads` threads (0 = the hardware's), each pixel alone.
 std::vector<std::uint8_t> tonemapRgba8(const io::RgbImage& image, double exposureStops,
-                                       ToneCurve curve = ToneCurve::Reinhard);
+                                       ToneCurve curve = ToneCurve::Reinhard, unsigned threads = 1);
 
 // The exposed value the curve shows as kHighlightCode at most: the boundary
 // to kHighlightCode + 1 (thresholds[kHighlightCode + 1] at 0 stops).
