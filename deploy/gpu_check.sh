@@ -11,7 +11,7 @@
 #   frames in flight on one renderer (bench-frame --in-flight), each slot
 #   on a queue of its own, then all on one queue;
 #   serve --backend vulkan with 1, 4 and 16 load-test clients at 1280×720,
-#   then with one queue (four and two frames in flight);
+#   then with four frames in flight on four queues and on one;
 #   H.264 at 1920×1080 (libx264 on the CPU: the H100/H200 have no NVENC),
 #   its encode time per frame read from the server's /metrics;
 #   bench-frame with both backends (Vulkan = CPU in dB, and the ratio).
@@ -124,8 +124,8 @@ bench fused_vulkan 120 --backend vulkan --method fused --sizes 1280x720,1920x108
 bench fused_vulkan_host_rays 60 --backend vulkan --rays host --method fused --sizes 1920x1080 --levels 6 --frames "$frames"
 # Frames in flight on one renderer, the service's frame (1280×720, level 4,
 # antialiased): its slots on queues of their own, then every slot on one queue.
-bench in_flight 90 --backend vulkan --method fused --sizes 1280x720 --levels 4 --antialias on --in-flight 1,2,4,8 \
-  --frames "$frames"
+bench in_flight 90 --backend vulkan --vulkan-queues 0 --method fused --sizes 1280x720 --levels 4 --antialias on \
+  --in-flight 1,2,4,8 --frames "$frames"
 bench in_flight_one_queue 60 --backend vulkan --vulkan-queues 1 --method fused --sizes 1280x720 --levels 4 \
   --antialias on --in-flight 1,4 --frames "$frames"
 old="$hc/bin/haarcast.old"
@@ -172,13 +172,13 @@ loadtest loadtest_1080_h264 45 --clients 1 --sizes 1920x1080 --encodings h264
 metrics >"$out/metrics.txt"
 grep stage_seconds "$out/metrics.txt"
 stop_server
-# Four frames in flight (the default on a GPU) on one queue: what the queues
-# give; then two on one queue, the service before frames had queues of their own.
-serve "$hc/bin/haarcast" _one_queue "--vulkan-queues 1"
-loadtest loadtest_720_one_queue 60 --clients 4,16 --sizes 1280x720 --encodings jpeg
+# Against the default (two frames in flight on one queue): four frames on
+# four queues of their own, and four on one queue.
+serve "$hc/bin/haarcast" _k4_queues "--vulkan-queues 0 --frames-in-flight 4"
+loadtest loadtest_720_k4_queues 60 --clients 4,16 --sizes 1280x720 --encodings jpeg
 stop_server
-serve "$hc/bin/haarcast" _k2_one_queue "--vulkan-queues 1 --frames-in-flight 2"
-loadtest loadtest_720_k2_one_queue 60 --clients 1,4,16 --sizes 1280x720 --encodings jpeg
+serve "$hc/bin/haarcast" _k4_one_queue "--frames-in-flight 4"
+loadtest loadtest_720_k4_one_queue 60 --clients 4,16 --sizes 1280x720 --encodings jpeg
 stop_server
 if [[ -x "$old" ]]; then
   serve "$old" _old
