@@ -24,6 +24,7 @@
 #include "haarcast/core/shared_smooth.h"
 #include "haarcast/net/host_check.h"
 #include "haarcast/net/protocol.h"
+#include "haarcast/net/left_behind.h"
 #include "haarcast/net/server.h"
 #include "haarcast/render/build_plan.h"
 #include "haarcast/render/object_levels.h"
@@ -311,15 +312,12 @@ int run(ServeArgs& a) {
                  a.server.webRoot.empty() ? "not found" : a.server.webRoot.c_str());
   }
   server.run();  // until SIGINT/SIGTERM, then drains
-  if (server.renderThreadsLeft() > 0) {
-    // A render thread stuck inside a library call (logged above, with its
-    // stage) is not waited for, and neither are destructors that could wait
-    // on it (the renderer's, the driver's at exit): leave now, the log
-    // flushed, with the status of a clean stop.
-    std::fflush(stdout);
-    std::fflush(stderr);
-    std::_Exit(0);
-  }
+  // A render or build thread stuck inside a library call (logged above,
+  // with its stage) is not waited for, and neither are destructors that
+  // could wait on it or pull the library from under it (the renderer's,
+  // Embree's and the driver's at exit): leave now, the log flushed, with
+  // the status of a clean stop (net/left_behind.h).
+  net::exitNowIfThreadsLeftBehind(0);
   return 0;
 }
 

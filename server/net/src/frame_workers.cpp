@@ -5,6 +5,7 @@
 
 #include "haarcast/core/check.h"
 #include "haarcast/net/encode.h"
+#include "haarcast/net/left_behind.h"
 
 namespace haarcast::net {
 namespace {
@@ -263,7 +264,7 @@ bool FrameWorkers::release(Worker& w) {
   }
   w.counted = false;
   w.rendering = false;
-  left_.remove_if([&w](const std::shared_ptr<Worker>& p) { return p.get() == &w; });
+  if (left_.remove_if([&w](const std::shared_ptr<Worker>& p) { return p.get() == &w; }) > 0) noteLeftThreadReturned();
   w.exited = true;
   return false;
 }
@@ -318,6 +319,7 @@ FrameWorkers::Done FrameWorkers::abandonLocked(const std::shared_ptr<Worker>& w,
   w->job = nullptr;
   workers_.remove(w);
   left_.push_back(w);
+  noteThreadLeftBehind();
   w->thread.detach();
   metrics_.framesAbandoned.fetch_add(1);
   spawnLocked();
@@ -400,6 +402,7 @@ void FrameWorkers::stop(Clock::time_point graceUntil) {
       }
       w->thread.detach();
       left_.push_back(w);
+      noteThreadLeftBehind();
     }
     workers_.clear();
   }

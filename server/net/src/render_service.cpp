@@ -16,6 +16,7 @@
 #include <utility>
 
 #include "frame_workers.h"
+#include "haarcast/net/left_behind.h"
 
 namespace haarcast::net {
 namespace {
@@ -341,6 +342,10 @@ RenderService::RenderService(AbandonableRendererBuilder builder, Options options
   impl_->builderThread = std::thread([impl = impl_] {
     impl->builderLoop();
     impl->builderExitedPromise.set_value();
+    // Left behind by stop() and back after all: no longer counted (a return
+    // just before stop() set the flag stays counted, which only makes the
+    // process's exit skip its destructors).
+    if (impl->builderLeft.exchange(false)) noteLeftThreadReturned();
   });
   impl_->frames->start();
 }
@@ -422,6 +427,7 @@ void RenderService::stop(Clock::time_point graceUntil) {
       s.builderThread.join();
     } else {
       s.builderThread.detach();
+      noteThreadLeftBehind();
       s.builderLeft = true;
       if (s.options.log) s.options.log("a renderer build was still running after the stop grace: left behind");
     }

@@ -17,6 +17,7 @@
 #include <gtest/gtest.h>
 
 #include "haarcast/net/render_service.h"
+#include "haarcast/net/left_behind.h"
 #include "haarcast/render/frame_stage.h"
 
 namespace haarcast::net {
@@ -307,11 +308,16 @@ TEST(FrameDeadline, AnAbandonedFrameThatReturnsIsDroppedAndItsDeviceRecovers) {
   Outcomes outcomes;
   const auto gate = std::make_shared<Gate>();
   const auto renderer = stuckOn("gpu0", "tonemap", gate);
+  // The process's count of threads left behind (net/left_behind.h): one
+  // more while the abandoned render is out, back once it has returned.
+  const std::size_t leftBefore = threadsLeftBehind();
   service.submit(job(renderer, outcomes, "stuck"));
   ASSERT_TRUE(waitUntil([&] { return !outcomes.of("stuck").empty(); }));
   ASSERT_FALSE(service.devices().at(0).healthy);
+  EXPECT_EQ(threadsLeftBehind(), leftBefore + 1);
   gate->release();
   ASSERT_TRUE(waitUntil([&] { return service.devices().at(0).healthy && service.stuckRenders().empty(); }));
+  EXPECT_EQ(threadsLeftBehind(), leftBefore);
   std::this_thread::sleep_for(50ms);
   EXPECT_EQ(outcomes.of("stuck").size(), 1u);  // the late frame answered nobody: the error stays the only outcome
   {

@@ -1,4 +1,5 @@
 #include "haarcast/net/render_service.h"
+#include "haarcast/net/left_behind.h"
 
 #include <algorithm>
 #include <atomic>
@@ -174,6 +175,36 @@ TEST(RenderService, BuildFailureNamesTheError) {
     error.set_value(e);
   });
   EXPECT_EQ(error.get_future().get(), "no such probe: sky.exr");
+}
+
+// A build deaf to its abandonment (a library call) outlives stop()'s grace:
+// it is left behind, named among the stuck, and counted in the process's
+// threads left behind (net/left_behind.h) until it returns.
+TEST(RenderService, ABuildPastTheStopGraceIsLeftBehindAndCountedUntilItReturns) {
+  Metrics metrics;
+  auto gate = std::make_shared<std::promise<void>>();
+  std::shared_future<void> open = gate->get_future().share();
+  std::atomic<bool> building{false};
+  RenderService::Options options;
+  options.stopGraceSeconds = 0.1;
+  RenderService service([open, &building](const SessionConfig&) {
+    building = true;
+    open.wait();
+    return std::make_shared<PreparedRenderer>();
+  }, options, metrics);
+  const std::size_t before = threadsLeftBehind();
+  service.prepare(config(4), [](std::shared_ptr<PreparedRenderer>, std::string) {});
+  for (int i = 0; i < 2000 && !building; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  ASSERT_TRUE(building.load());
+  service.stop();
+  EXPECT_EQ(threadsLeftBehind(), before + 1);
+  const auto stuck = service.stuckRenders();
+  ASSERT_EQ(stuck.size(), 1u);
+  EXPECT_EQ(stuck[0].stage, "a renderer build");
+  gate->set_value();
+  for (int i = 0; i < 2000 && threadsLeftBehind() != before; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  EXPECT_EQ(threadsLeftBehind(), before);
+  EXPECT_TRUE(service.stuckRenders().empty());
 }
 
 TEST(RenderService, RoundRobinIsFairAndRendersNeverOverlap) {
