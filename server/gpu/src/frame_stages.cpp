@@ -77,6 +77,7 @@ void VulkanRenderer::Impl::runStages(const std::vector<FrameStage>& stages, cons
   ensureQueries(count + 1 + kMaxPartMarks);
   partMarks.clear();
   nextPartQuery = count + 1;
+  partQueryEnd = count + 1 + kMaxPartMarks;  // the queries reset below: the pool may hold more
   struct Recording {  // markPart records only inside this submission
     Impl& impl;
     ~Recording() { impl.markStage = -1; }
@@ -117,7 +118,7 @@ void VulkanRenderer::Impl::runStages(const std::vector<FrameStage>& stages, cons
 }
 
 void VulkanRenderer::Impl::markPart(VkCommandBuffer cb, const char* part) {
-  if (markStage < 0 || nextPartQuery >= queryCapacity) return;
+  if (markStage < 0 || nextPartQuery >= partQueryEnd) return;
   vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, queries, nextPartQuery);
   partMarks.push_back({part, static_cast<std::uint32_t>(markStage), nextPartQuery});
   ++nextPartQuery;

@@ -208,7 +208,7 @@ struct VulkanRenderer::Impl {
   };
   std::vector<PartMark> partMarks;
   int markStage = -1;
-  std::uint32_t nextPartQuery = 0;
+  std::uint32_t nextPartQuery = 0, partQueryEnd = 0;
   // The request's `cancelled` while render() runs (null otherwise): polled
   // by runStages before each submission, the batch boundary of a frame.
   const std::function<bool()>* cancelled = nullptr;
