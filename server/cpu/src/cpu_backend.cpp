@@ -504,12 +504,13 @@ Frame CpuRenderer::renderFrame(const FrameRequest& request, const CancelPoint& c
   t0 = Clock::now();
   enterFrameStage(request, "tonemap", options_.environmentBackground ? rows : 0);
   if (options_.environmentBackground) {
+    const glm::dmat3 lightRotation = lightRotationOf(prepared_, request);  // once, not per pixel
     parallelFor(static_cast<std::size_t>(h), [&](std::size_t y) {
       cancelPoint();
       for (int x = 0; x < w; ++x) {
         const std::size_t i = y * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
         if (frame.objectMask[i] || g.edge[i] != kInterior) continue;  // drawn by the shading
-        const glm::dvec3 L = backgroundRadiance(prepared_.background, lightRotationOf(prepared_, request), camera.direction(x, static_cast<int>(y)));
+        const glm::dvec3 L = backgroundRadiance(prepared_.background, lightRotation, camera.direction(x, static_cast<int>(y)));
         for (int c = 0; c < 3; ++c) frame.image.at(static_cast<int>(y), x, c) = static_cast<float>(L[c]);
       }
     }, {}, options_.threads);
