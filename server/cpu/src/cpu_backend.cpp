@@ -767,7 +767,8 @@ std::size_t CpuRenderer::shadeSmoothSums(const GBuffer& g, FusedSlots& slots, co
         slots.mirrors[i] = shared::smoothMirror(static_cast<float>(in.euler.alpha), static_cast<float>(in.euler.beta),
                                                 static_cast<float>(in.euler.gamma), static_cast<float>(in.thetaOut));
         // Its parents, where each is on this object, visited, and its
-        // mirror direction near the pixel's (A' and B' are only left out).
+        // mirror direction near the pixel's; where A' or B' is not, the
+        // outer pair is dropped and A and B decide alone.
         const std::array<shared::uint, 4> at{parents.at0, parents.at1, parents.at2, parents.at3};
         const float cosLimit = cosLimits[*object];
         auto usable = [&](shared::uint q) {

@@ -4,6 +4,7 @@
 #include "haarcast/core/parallel.h"
 
 #include <atomic>
+#include <chrono>
 #include <mutex>
 #include <set>
 #include <stdexcept>
@@ -53,9 +54,10 @@ TEST(ParallelFor, WithoutProgressTheCallingThreadWorks) {
   // Two threads, items that wait until both have started one: the caller is one of them.
   seen.clear();
   std::atomic<int> started{0};
+  const auto giveUp = std::chrono::steady_clock::now() + std::chrono::seconds(10);  // bounded: never hangs a CI
   parallelFor(2, [&](std::size_t) {
     ++started;
-    while (started.load() < 2) std::this_thread::yield();
+    while (started.load() < 2 && std::chrono::steady_clock::now() < giveUp) std::this_thread::yield();
     const std::lock_guard lock(mutex);
     seen.insert(std::this_thread::get_id());
   }, {}, 2);
