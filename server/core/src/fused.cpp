@@ -283,49 +283,6 @@ void setRotation(detail::FusedPass& pass, const EulerYXY& r) {
   pass.columnFraction = column.fraction;
 }
 
-// ρ_c at one object-frame direction for a point light: Rᵀω, θ', φ' as the
-// kernel computes them (fused_kernel.cpp), then Catmull-Rom over 4 × 4 taps
-// of the point slices at their level, γ's offset `column` at that level
-// (shared::catmullRomWeights; rows clamped, columns wrapped), the two slices
-// of the blend taken tap by tap. Zero below the slices' cut and inside the
-// lobe path's core, as the pass reads them.
-std::array<float, 3> pointRhoAt(const detail::FusedPass& p, const PixelSlices& slices, const shared::SliceBlend& blend,
-                                const ColumnOffset& column, const glm::vec3& w) {
-  const int level = slices.pointLevel();
-  const int m = 1 << level;
-  const float x1 = p.cosAlpha * w.x - p.sinAlpha * w.z;  // R_y(−α)
-  const float z1 = p.sinAlpha * w.x + p.cosAlpha * w.z;
-  const float y2 = p.cosBeta * w.y + p.sinBeta * z1;     // R_x(−β)
-  const float z2 = p.cosBeta * z1 - p.sinBeta * w.y;
-  if (y2 < p.skipBelowY) return {0.0f, 0.0f, 0.0f};
-  if (x1 * p.axisX + y2 * p.axisY + z2 * p.axisZ > p.coreCos) return {0.0f, 0.0f, 0.0f};  // the lobe path's core
-  const float theta = std::atan2(std::sqrt(x1 * x1 + z2 * z2), y2);
-  const float phi = std::atan2(x1, z2);
-  const float rowPos = std::min(std::max(theta * (static_cast<float>(m) / shared::kPiF) - 0.5f, 0.0f), static_cast<float>(m - 1));
-  const float colPos = phi * (static_cast<float>(m) / (2.0f * shared::kPiF)) - column.fraction;
-  const float rowFloor = std::floor(rowPos), colFloor = std::floor(colPos);
-  const glm::vec4 wr = shared::catmullRomWeights(rowPos - rowFloor);
-  const glm::vec4 wc = shared::catmullRomWeights(colPos - colFloor);
-  const int r0 = static_cast<int>(rowFloor);
-  const int c0 = (static_cast<int>(colFloor) - column.shift) & (m - 1);
-  const float* first = slices.pointSlice(static_cast<int>(blend.first));
-  const float* second = blend.weight != 0.0f ? slices.pointSlice(static_cast<int>(blend.second)) : first;
-  glm::vec3 sum(0.0f);
-  for (int i = 0; i < 4; ++i) {
-    const int row = std::min(std::max(r0 - 1 + i, 0), m - 1);
-    glm::vec3 across(0.0f);
-    for (int j = 0; j < 4; ++j) {
-      const std::size_t k = static_cast<std::size_t>((row << level) | ((c0 - 1 + j) & (m - 1))) * shared::kTexelFloats;
-      const glm::vec3 a(first[k], first[k + 1], first[k + 2]);
-      const glm::vec3 b(second[k], second[k + 1], second[k + 2]);
-      across += wc[j] * (a + blend.weight * (b - a));
-    }
-    sum += wr[i] * across;
-  }
-  // The cubic overshoots below zero beside a steep lobe; ρ never is.
-  return {std::max(sum.x, 0.0f), std::max(sum.y, 0.0f), std::max(sum.z, 0.0f)};
-}
-
 detail::FusedPass makePass(const PixelSlices& slices, const float* slice, const EulerYXY& r) {
   detail::FusedPass pass;
   pass.level = slices.level();
@@ -401,7 +358,7 @@ std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBl
     blendVisibility(visibility, level, scratch.visibility);
   }
 
-  // Given the sum, the pass is only its turn (pointRhoAt, the core's cone).
+  // Given the sum, the pass is only its turn (pointRho, the core's cone).
   detail::FusedPass pass = makePass(slices, given ? nullptr : blendedSlice(slices, blend, scratch), r);
   scratch.passDirections = given ? 0 : static_cast<std::size_t>(pass.endRow - pass.firstRow) * static_cast<std::size_t>(mapSize(level));
   pass.light = light.planes.data();
@@ -449,11 +406,32 @@ std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBl
     out = energyKept(pass, energy);
   }
   if (sum && !given) sum->value = out;
-  const ColumnOffset pointColumn = columnOffset(r.gamma, slices.pointLevel());
+  // The point lights it sees: ρ at each one's direction, a vector of them at
+  // a time (point_rho_kernel.cpp), at the point slices' level.
+  static_assert(std::tuple_size_v<decltype(scratch.lightX)> == detail::kPointRhoStride);
+  static_assert(std::tuple_size_v<decltype(scratch.lightRho)> == 3 * detail::kPointRhoStride);
+  HC_CHECK_LE(lights.size(), detail::kPointRhoLights);  // one bit of visibleLights each
+  std::size_t seen = 0;
   for (std::size_t k = 0; k < lights.size(); ++k) {
     if (((visibleLights >> k) & 1u) == 0) continue;
-    const std::array<float, 3> rho = pointRhoAt(pass, slices, blend, pointColumn, lights[k].direction);
-    for (std::size_t c = 0; c < 3; ++c) out[c] += lights[k].power[c] * rho[c];
+    scratch.lightX[seen] = lights[k].direction.x;
+    scratch.lightY[seen] = lights[k].direction.y;
+    scratch.lightZ[seen] = lights[k].direction.z;
+    scratch.lightIndex[seen++] = static_cast<std::uint32_t>(k);
+  }
+  if (seen > 0) {
+    const ColumnOffset pointColumn = columnOffset(r.gamma, slices.pointLevel());
+    detail::PointRhoPass points;
+    points.pass = &pass;
+    points.level = slices.pointLevel();
+    points.columnShift = pointColumn.shift;
+    points.columnFraction = pointColumn.fraction;
+    points.first = slices.pointSlice(static_cast<int>(blend.first));
+    points.second = blend.weight != 0.0f ? slices.pointSlice(static_cast<int>(blend.second)) : points.first;
+    points.weight = blend.weight;
+    detail::pointRho(points, scratch.lightX.data(), scratch.lightY.data(), scratch.lightZ.data(), seen, scratch.lightRho.data());
+    for (std::size_t j = 0; j < seen; ++j)
+      for (std::size_t c = 0; c < 3; ++c) out[c] += lights[scratch.lightIndex[j]].power[c] * scratch.lightRho[c * detail::kPointRhoStride + j];
   }
   if (hidden) {
     for (std::size_t c = 0; c < 3; ++c)

@@ -71,6 +71,24 @@ struct FusedCellPass {
 };
 // out as fusedSample's, over the cells of rows firstRow … endRow − 1.
 void fusedSampleCells(const FusedCellPass& pass, CellScratch& scratch, float out[6], CellCounts& counts);
+// ρ_c at point lights' directions (object frame), fused.cpp's pointRhoAt
+// for a vector of lights at a time (point_rho_kernel.cpp): the pass's turn,
+// cut and core, then Catmull-Rom over 4 × 4 taps of the point slices.
+struct PointRhoPass {
+  const FusedPass* pass = nullptr;  // the turn (α, β), skipBelowY and the core
+  int level = 0;                    // the point slices'
+  int columnShift = 0;              // γ at that level (as FusedPass's)
+  float columnFraction = 0.0f;
+  const float* first = nullptr;     // the blend's two point slices (shared::kTexelFloats texels)
+  const float* second = nullptr;
+  float weight = 0.0f;
+};
+// At most kPointRhoLights; x, y, z hold kPointRhoStride floats each (whole
+// vectors are read; what lies past n is ignored), rho three planes of
+// kPointRhoStride (R, then G, then B; light j at j).
+inline constexpr std::size_t kPointRhoLights = 32;  // one bit of a visibility word each
+inline constexpr std::size_t kPointRhoStride = kPointRhoLights + 16;  // and a vector of the widest target
+void pointRho(const PointRhoPass& pass, const float* x, const float* y, const float* z, std::size_t n, float* rho);
 const char* fusedTarget();
 // The target's float lanes: the pass forms V from the bits only where a
 // vector's lanes lie in one word (≤ 32).

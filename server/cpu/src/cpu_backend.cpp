@@ -341,20 +341,24 @@ void CpuRenderer::traceGBuffer(const RayScene& rays, const CameraRays& camera, i
     const auto& c = g.centre[static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)];
     return c ? c->hit.object + 1 : 0;
   };
-  for (int y = 0; y < h; ++y) {
+  // Rows in parallel mark their edge pixels (0); one pass numbers them in
+  // pixel order.
+  parallelFor(static_cast<std::size_t>(h), [&](std::size_t row) {
     cancelPoint();
+    const int y = static_cast<int>(row);
     for (int x = 0; x < w; ++x) {
       const std::size_t mine = id(x, y);
       bool edge = false;
       for (int dy = -1; dy <= 1 && !edge; ++dy)
         for (int dx = -1; dx <= 1 && !edge; ++dx) edge = id(std::clamp(x + dx, 0, w - 1), std::clamp(y + dy, 0, h - 1)) != mine;
-      if (!edge) continue;
-      g.edge[static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)] =
-          static_cast<std::uint32_t>(g.sub.size());
-      g.sub.emplace_back();
+      if (edge) g.edge[row * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)] = 0;
     }
-  }
+  }, {}, options_.threads);
   cancelPoint();
+  std::uint32_t edges = 0;
+  for (std::uint32_t& e : g.edge)
+    if (e != kInterior) e = edges++;
+  g.sub.resize(edges);
   parallelFor(static_cast<std::size_t>(h), [&](std::size_t y) {
     cancelPoint();
     for (int x = 0; x < w; ++x) {
@@ -379,6 +383,9 @@ void CpuRenderer::fillInputs(const ResolvedFrame& resolved, GBuffer& g, const Ca
     in.vertex[0] = tri.x;
     in.vertex[1] = tri.y;
     in.vertex[2] = tri.z;
+    // fused shades the ground in closed form from its shading point alone
+    // (shadeFused), so most of a frame's samples need no slice or angles.
+    if (p.ground && options_.method == RotationMethod::Fused) return;
     const glm::dvec3 n = glm::normalize(in.b[0] * glm::dvec3(mesh.normals[tri.x]) + in.b[1] * glm::dvec3(mesh.normals[tri.y]) +
                                         in.b[2] * glm::dvec3(mesh.normals[tri.z]));
     const glm::dvec3 wo = glm::transpose(resolved.objects[s.hit.object].rotation) * -s.direction;
@@ -598,6 +605,13 @@ std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const RayScen
                                     FusedSlots& slotRecords, const FrameRequest& request, const CameraRays& camera, Frame& frame,
                                     const CancelPoint& cancelPoint) const {
   const auto t0 = Clock::now();
+  // The stage's parts (Frame::parts), each from the mark before it.
+  auto partStart = t0;
+  auto markPart = [&](const char* name) {
+    const auto now = Clock::now();
+    frame.parts.push_back({std::string("fused: ") + name, std::chrono::duration<double>(now - partStart).count()});
+    partStart = now;
+  };
   const ObjectFrames frames(resolved);
   const glm::vec3 eye(camera.origin());
   // The ground's hidden sky on the coarse grid (point_lights.h), from the
@@ -613,6 +627,7 @@ std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const RayScen
       return samplePoint(frames, resolved, c->hit.object, c->input);
     }, options_.threads);
   }
+  markPart("ground sky grid");
   // Each sample's shading point, and the point lights it sees: one shadow
   // ray each (point_lights.h), a pixel row's samples at a time so that each
   // light's rays go in packets. By slot (Shade), for the pass below.
@@ -631,13 +646,16 @@ std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const RayScen
     thread_local std::vector<ShadingPoint> row;
     thread_local std::vector<std::size_t> slots;
     thread_local std::vector<std::uint32_t> masks;
+    thread_local std::vector<std::uint8_t> onGround;
     row.clear();
     slots.clear();
+    onGround.clear();
     auto add = [&](const Sample& s, std::size_t slot) {
       const std::size_t object = s.hit.object;
       points[slot] = samplePoint(frames, resolved, object, s.input);
       row.push_back(points[slot]);
       slots.push_back(slot);
+      onGround.push_back(prepared_.objects[object].ground ? 1 : 0);
       if (occluders.objectSky && !prepared_.objects[object].ground)
         hidden[slot] = hiddenLightOf(objectSkyHidden(rays, points[slot], object, occluders), frames.rotations[object]);
     };
@@ -651,9 +669,10 @@ std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const RayScen
     }
     if (resolved.pointLightDirections.empty()) return;
     masks.resize(row.size());
-    pointLightMasks(rays, row, resolved.pointLightDirections, masks);
+    pointLightMasks(rays, row, resolved.pointLightDirections, masks, GroundRays{occluders.occluders, onGround});
     for (std::size_t j = 0; j < slots.size(); ++j) lightsSeen[slots[j]] = masks[j];
   }, {}, options_.threads);
+  markPart("points and rays");
   // What the pass visited (Frame::passDirections), over the object samples.
   std::atomic<std::size_t> passSamples{0}, passDirections{0}, passDirectionsMax{0};
   auto count = [&](std::size_t directions) {
@@ -700,8 +719,12 @@ std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const RayScen
   };
   std::size_t bytes = 0;
   const std::vector<std::uint8_t>& centreState = slotRecords.centreState;
-  if (options_.smoothSumTolerance > 0.0f) bytes += shadeSmoothSums(g, slotRecords, shadeSample, count, frame.smoothSamples, cancelPoint);
-  else slotRecords.centreState.clear();
+  if (options_.smoothSumTolerance > 0.0f) {
+    bytes += shadeSmoothSums(g, slotRecords, shadeSample, count, frame.smoothSamples, cancelPoint);
+    markPart("sums from neighbours");
+  } else {
+    slotRecords.centreState.clear();
+  }
   bytes += shadePixels(g, request, camera, frame, [&](const Sample& sample, std::size_t slot, std::array<float, 3>& rgb) {
     if (slot < centreState.size() && centreState[slot] != kNotVisited) {
       rgb = slotRecords.shaded[slot];  // shaded in shadeSmoothSums, and counted there
@@ -711,6 +734,7 @@ std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const RayScen
     if (s.pass) count(s.directions);
     return s.bytes;
   }, cancelPoint);
+  markPart("rest");
   frame.stages.push_back({"fused", since(t0)});
   frame.passSamples = passSamples.load();
   frame.passDirections = passDirections.load();

@@ -87,11 +87,17 @@ std::uint32_t VulkanRenderer::Impl::computeShadowMasks(const render::ResolvedFra
     // faces no light) cast none.
     thread_local std::vector<render::ShadingPoint> points;
     thread_local std::vector<std::uint32_t> lightMasks;
+    thread_local std::vector<std::uint8_t> onGround;
     points.resize(end - begin);
-    for (std::size_t s = begin; s < end; ++s)
-      points[s - begin] = sh[s].object < objectCount ? pointOf(sh[s]) : render::ShadingPoint{{}, glm::vec3(0.0f), 0.0f};
+    onGround.resize(end - begin);
+    for (std::size_t s = begin; s < end; ++s) {
+      const bool object = sh[s].object < objectCount;
+      points[s - begin] = object ? pointOf(sh[s]) : render::ShadingPoint{{}, glm::vec3(0.0f), 0.0f};
+      onGround[s - begin] = object && prepared.objects[sh[s].object].ground ? 1 : 0;
+    }
     lightMasks.resize(points.size());
-    render::pointLightMasks(*rays, points, lightDirections, lightMasks);
+    render::pointLightMasks(*rays, points, lightDirections, lightMasks,
+                            render::GroundRays{resolved.skyOccluders.occluders, onGround});
     for (std::size_t s = begin; s < end; ++s) {
       const ShadeSample& sample = sh[s];
       if (sample.object >= objectCount) {

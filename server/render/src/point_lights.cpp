@@ -42,10 +42,26 @@ std::uint32_t pointLightMask(const RayScene& world, const ShadingPoint& p, std::
   return mask;
 }
 
+bool missesSpheres(const glm::vec3& origin, const glm::vec3& direction, std::span<const glm::vec4> spheres) {
+  const float length2 = glm::dot(direction, direction);
+  for (const glm::vec4& s : spheres) {
+    const glm::vec3 toCentre = glm::vec3(s) - origin;
+    const float r = s.w * 1.001f;
+    const float distance2 = glm::dot(toCentre, toCentre);
+    if (distance2 <= r * r) return false;  // the origin inside: anything may block
+    const float along = glm::dot(toCentre, direction);
+    if (along <= 0.0f) continue;  // the sphere behind the origin
+    // The squared distance from the centre to the line, |c − o|² − (c−o·d)²/|d|².
+    if (distance2 - along * along / length2 <= r * r) return false;
+  }
+  return true;
+}
+
 void pointLightMasks(const RayScene& world, std::span<const ShadingPoint> points, std::span<const glm::vec3> directions,
-                     std::span<std::uint32_t> masks) {
+                     std::span<std::uint32_t> masks, const GroundRays& ground) {
   HC_CHECK_LE(directions.size(), std::size_t{32});
   HC_CHECK_EQ(points.size(), masks.size());
+  if (!ground.onGround.empty()) HC_CHECK_EQ(ground.onGround.size(), points.size());
   std::fill(masks.begin(), masks.end(), 0u);
   // Per thread, kept across calls: no allocation per row.
   thread_local std::vector<glm::vec3> origins;
@@ -57,7 +73,12 @@ void pointLightMasks(const RayScene& world, std::span<const ShadingPoint> points
     for (std::size_t i = 0; i < points.size(); ++i) {
       const ShadingPoint& p = points[i];
       if (!(glm::dot(p.normal, directions[k]) > 0.0f)) continue;  // below the shading horizon, as pointLightMask
-      origins.push_back(p.position + p.normal * p.shift);
+      const glm::vec3 origin = p.position + p.normal * p.shift;
+      if (!ground.onGround.empty() && ground.onGround[i] && missesSpheres(origin, directions[k], ground.blockers)) {
+        masks[i] |= 1u << k;
+        continue;
+      }
+      origins.push_back(origin);
       which.push_back(static_cast<std::uint32_t>(i));
     }
     blocked.resize(origins.size());

@@ -112,6 +112,51 @@ TEST(RayPackets, PointLightMasksAreEachPointsMask) {
   }
 }
 
+// A ground point's rays that miss every object's bounding sphere are not
+// traced: the masks are the traced ones bit for bit, and most rays from the
+// open plane are let through untraced (so the test sees both answers).
+TEST(RayPackets, AGroundPointsRaysThatMissTheObjectsSpheresAreLitUntraced) {
+  const World w;
+  // The two spheres' instances as posed (unit sphere, centre 0, radius 1 before the pose).
+  const std::vector<glm::vec4> blockers{{-0.6f, 0.5f, 0.0f, 0.5f}, {0.7f, 0.4f, 0.2f, 0.4f}};
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(-1.5f, 1.5f);
+  std::vector<render::ShadingPoint> points(613);
+  std::vector<std::uint8_t> onGround(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    // Every third point a sphere's (its own sphere may block it: traced).
+    if (i % 3 == 2) {
+      const glm::vec3 n = glm::normalize(glm::vec3(u(rng), u(rng), u(rng)));
+      points[i] = {glm::vec3(-0.6f, 0.5f, 0.0f) + 0.5f * n, n, 1e-3f};
+    } else {
+      points[i] = {glm::vec3(u(rng), 0.0f, u(rng)), glm::vec3(0.0f, 1.0f, 0.0f), 1e-3f};
+      onGround[i] = 1;
+    }
+  }
+  const std::vector<glm::vec3> lights{glm::normalize(glm::vec3(0.3f, 1.0f, 0.2f)), glm::normalize(glm::vec3(-1.0f, 0.3f, 0.0f)),
+                                      glm::normalize(glm::vec3(0.9f, 0.15f, -0.4f))};
+  std::vector<std::uint32_t> traced(points.size()), culled(points.size());
+  render::pointLightMasks(w.rays, points, lights, traced);
+  render::pointLightMasks(w.rays, points, lights, culled, render::GroundRays{blockers, onGround});
+  std::size_t untraced = 0, shadowed = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    ASSERT_EQ(culled[i], traced[i]) << "point " << i;
+    for (std::size_t k = 0; k < lights.size() && onGround[i]; ++k) {
+      const glm::vec3 origin = points[i].position + points[i].normal * points[i].shift;
+      if (render::missesSpheres(origin, lights[k], blockers)) ++untraced;
+      else if (!((traced[i] >> k) & 1u)) ++shadowed;
+    }
+  }
+  EXPECT_GT(untraced, points.size());  // most of the ground's rays
+  EXPECT_GT(shadowed, 10u);            // and shadows on it, traced
+  // A ray through a sphere, one that starts inside it, one that points away.
+  EXPECT_FALSE(render::missesSpheres({-0.6f, 0.0f, 2.0f}, {0.0f, 0.0f, -1.0f}, blockers));
+  EXPECT_FALSE(render::missesSpheres({-0.6f, 0.5f, 0.3f}, {0.0f, 1.0f, 0.0f}, blockers));
+  EXPECT_TRUE(render::missesSpheres({-0.6f, 0.5f, 2.0f}, {0.0f, 0.0f, 1.0f}, blockers));
+  // Grazing: the ray's closest approach just inside the radius is not let through.
+  EXPECT_FALSE(render::missesSpheres({-0.6f + 0.4995f, 0.5f, 2.0f}, {0.0f, 0.0f, -1.0f}, blockers));
+}
+
 // Fills `bytes` of the stack below the caller with `value`: what a deeper
 // call that ran earlier on this thread may have left there. volatile, so the
 // stores are made; noinline, so the frame lies where the next call's will.

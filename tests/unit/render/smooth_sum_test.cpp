@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -202,6 +203,19 @@ TEST(CpuBackend, ASmoothSumTakesAQuarterOfThePixelsAndEachStaysNearTheFullSum) {
     }
   }
   EXPECT_LE(differ, taken.smoothSamples) << "a pixel summed in full differs from the full frame's";
+  // The fused stage's parts (Frame::parts), in order, add up to it.
+  std::vector<std::string> names;
+  double parts = 0.0, stage = -1.0;
+  for (const StageTime& p : taken.parts) {
+    names.push_back(p.name);
+    EXPECT_GE(p.seconds, 0.0) << p.name;
+    parts += p.seconds;
+  }
+  for (const StageTime& st : taken.stages)
+    if (st.name == "fused") stage = st.seconds;
+  EXPECT_EQ(names, (std::vector<std::string>{"fused: ground sky grid", "fused: points and rays", "fused: sums from neighbours",
+                                             "fused: rest"}));
+  EXPECT_NEAR(parts, stage, 1e-3 * stage + 1e-5);
   // A step between two parents errs by half of 4ε at most; the curve's
   // estimate is no bound, so twice that is allowed.
   EXPECT_LE(worst, 4.0 * tolerance);

@@ -132,6 +132,11 @@ struct FusedScratch {
   std::vector<float> blended;     // the θₒ-blended slice, when the blend weight is not 0
   std::size_t blendedRows = 0;    // rows of `blended` that may be non-zero
   CellScratch cells;               // the adaptive pass's
+  // The point lights a sample sees (at most 32, padded by a vector):
+  // directions, index, ρ by channel (fused_kernel.h pointRho).
+  std::array<float, 48> lightX{}, lightY{}, lightZ{};
+  std::array<std::uint32_t, 32> lightIndex{};
+  std::array<float, 3 * 48> lightRho{};
   // The last fusedShade's pass: the map directions it visited, its rows × M
   // (shared::passRows), or by cells one per coarse cell and 16 per fine
   // one; 0 where the lobe path took all.

@@ -48,11 +48,25 @@ ShadingPoint shadingPoint(const Mesh& mesh, const glm::uvec3& triangle, const fl
 // Bit k set when the point sees direction k (world frame, unit): n·d_k > 0
 // and the ray from position + shift·n toward d_k escapes. At most 32 directions.
 std::uint32_t pointLightMask(const RayScene& world, const ShadingPoint& p, std::span<const glm::vec3> directions);
+// What can block a ground point's light: the ground is a plane, and a ray
+// leaving it upward (n·d > 0) cannot come back to it, so only the objects
+// can, each inside its bounding sphere (SkyOccluders::occluders). A ray that
+// misses every sphere escapes, and needs no trace; on the open ground of a
+// frame that is most of them.
+struct GroundRays {
+  std::span<const glm::vec4> blockers;     // world bounding spheres (centre, radius) of every object but the ground
+  std::span<const std::uint8_t> onGround;  // per point: 1 on the ground (empty: none is)
+};
+// Whether the ray origin + t·direction, t > 0, misses every sphere: a
+// conservative test (each radius widened by 10⁻³ of itself for the float
+// rounding), so a ray it lets through would have met nothing inside them.
+bool missesSpheres(const glm::vec3& origin, const glm::vec3& direction, std::span<const glm::vec4> spheres);
 // pointLightMask of many points at once, the same bits: each light's rays
 // in packets of 16 neighbouring points (RayScene::occludedToward), which
-// share their traversal. masks[i] is points[i]'s.
+// share their traversal; a ground point's ray that misses `ground`'s
+// blockers is not traced. masks[i] is points[i]'s.
 void pointLightMasks(const RayScene& world, std::span<const ShadingPoint> points, std::span<const glm::vec3> directions,
-                     std::span<std::uint32_t> masks);
+                     std::span<std::uint32_t> masks, const GroundRays& ground = {});
 
 // shared::kLobeSeenBit when the ray from the point along the mirror
 // direction of the eye escapes (the lobe path's visibility, fused.h: a lobe

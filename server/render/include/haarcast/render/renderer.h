@@ -94,10 +94,11 @@ struct Frame {
   std::vector<std::uint8_t> rgba8;    // tonemapped, row 0 at the top, 4 bytes per pixel
   std::vector<std::uint8_t> objectMask;  // 1 where an object was hit (with the linear image; may be empty without)
   std::vector<StageTime> stages;      // in pipeline order
-  // What a stage's device time went to, where the backend marks it (Vulkan
-  // with timestamps): "stage: part", each from the mark before it in its
-  // stage, "stage: rest" to the stage's end. For profiles (bench-frame
-  // --json); the stages above are the frame's account.
+  // What a stage's time went to, where the backend marks it (Vulkan with
+  // timestamps; the CPU backend's `fused` stage by the clock): "stage:
+  // part", each from the mark before it in its stage, "stage: rest" to the
+  // stage's end. For profiles (bench-frame --json); the stages above are the
+  // frame's account.
   std::vector<StageTime> parts;
   double seconds = 0.0;               // wall time of render()
   std::size_t coefficientBytes = 0;   // coefficient data read this frame (slices, light, visibility, method tables)
