@@ -2,6 +2,7 @@
 #include "haarcast/render/point_lights.h"
 
 #include <algorithm>
+#include <bit>
 #include <atomic>
 #include <cmath>
 #include <optional>
@@ -42,19 +43,26 @@ std::uint32_t pointLightMask(const RayScene& world, const ShadingPoint& p, std::
   return mask;
 }
 
-bool missesSpheres(const glm::vec3& origin, const glm::vec3& direction, std::span<const glm::vec4> spheres) {
-  const float length2 = glm::dot(direction, direction);
+std::uint32_t raysMissingSpheres(const glm::vec3& origin, std::span<const glm::vec3> directions, std::span<const glm::vec4> spheres) {
+  HC_CHECK_LE(directions.size(), std::size_t{32});
+  std::uint32_t open = directions.size() == 32 ? ~0u : (1u << directions.size()) - 1u;
+  // Sphere by sphere, the origin's offset once, then each ray still open.
   for (const glm::vec4& s : spheres) {
     const glm::vec3 toCentre = glm::vec3(s) - origin;
-    const float r = s.w * 1.001f;
+    const float r2 = (s.w * 1.001f) * (s.w * 1.001f);
     const float distance2 = glm::dot(toCentre, toCentre);
-    if (distance2 <= r * r) return false;  // the origin inside: anything may block
-    const float along = glm::dot(toCentre, direction);
-    if (along <= 0.0f) continue;  // the sphere behind the origin
-    // The squared distance from the centre to the line, |c − o|² − (c−o·d)²/|d|².
-    if (distance2 - along * along / length2 <= r * r) return false;
+    if (distance2 <= r2) return 0u;  // the origin inside: anything may block
+    for (std::uint32_t left = open; left != 0u; left &= left - 1u) {
+      const int k = std::countr_zero(left);
+      const glm::vec3& d = directions[static_cast<std::size_t>(k)];
+      const float along = glm::dot(toCentre, d);
+      // In front of the origin, and the centre's squared distance to the
+      // line, |c − o|² − ((c − o)·d)²/|d|², within the radius.
+      if (along > 0.0f && distance2 - along * along / glm::dot(d, d) <= r2) open &= ~(1u << k);
+    }
+    if (open == 0u) return 0u;
   }
-  return true;
+  return open;
 }
 
 void pointLightMasks(const RayScene& world, std::span<const ShadingPoint> points, std::span<const glm::vec3> directions,
@@ -67,18 +75,23 @@ void pointLightMasks(const RayScene& world, std::span<const ShadingPoint> points
   thread_local std::vector<glm::vec3> origins;
   thread_local std::vector<std::uint32_t> which;
   thread_local std::vector<std::uint8_t> blocked;
+  thread_local std::vector<std::uint32_t> untraced;  // per point, the rays that miss every blocker
+  untraced.assign(points.size(), 0u);
+  for (std::size_t i = 0; i < points.size() && !ground.onGround.empty(); ++i) {
+    const ShadingPoint& p = points[i];
+    if (ground.onGround[i]) untraced[i] = raysMissingSpheres(p.position + p.normal * p.shift, directions, ground.blockers);
+  }
   for (std::size_t k = 0; k < directions.size(); ++k) {
     origins.clear();
     which.clear();
     for (std::size_t i = 0; i < points.size(); ++i) {
       const ShadingPoint& p = points[i];
       if (!(glm::dot(p.normal, directions[k]) > 0.0f)) continue;  // below the shading horizon, as pointLightMask
-      const glm::vec3 origin = p.position + p.normal * p.shift;
-      if (!ground.onGround.empty() && ground.onGround[i] && missesSpheres(origin, directions[k], ground.blockers)) {
+      if ((untraced[i] >> k) & 1u) {
         masks[i] |= 1u << k;
         continue;
       }
-      origins.push_back(origin);
+      origins.push_back(p.position + p.normal * p.shift);
       which.push_back(static_cast<std::uint32_t>(i));
     }
     blocked.resize(origins.size());

@@ -141,20 +141,24 @@ TEST(RayPackets, AGroundPointsRaysThatMissTheObjectsSpheresAreLitUntraced) {
   std::size_t untraced = 0, shadowed = 0;
   for (std::size_t i = 0; i < points.size(); ++i) {
     ASSERT_EQ(culled[i], traced[i]) << "point " << i;
-    for (std::size_t k = 0; k < lights.size() && onGround[i]; ++k) {
-      const glm::vec3 origin = points[i].position + points[i].normal * points[i].shift;
-      if (render::missesSpheres(origin, lights[k], blockers)) ++untraced;
+    if (!onGround[i]) continue;
+    const std::uint32_t open =
+        render::raysMissingSpheres(points[i].position + points[i].normal * points[i].shift, lights, blockers);
+    for (std::size_t k = 0; k < lights.size(); ++k) {
+      if ((open >> k) & 1u) ++untraced;
       else if (!((traced[i] >> k) & 1u)) ++shadowed;
     }
   }
   EXPECT_GT(untraced, points.size());  // most of the ground's rays
   EXPECT_GT(shadowed, 10u);            // and shadows on it, traced
-  // A ray through a sphere, one that starts inside it, one that points away.
-  EXPECT_FALSE(render::missesSpheres({-0.6f, 0.0f, 2.0f}, {0.0f, 0.0f, -1.0f}, blockers));
-  EXPECT_FALSE(render::missesSpheres({-0.6f, 0.5f, 0.3f}, {0.0f, 1.0f, 0.0f}, blockers));
-  EXPECT_TRUE(render::missesSpheres({-0.6f, 0.5f, 2.0f}, {0.0f, 0.0f, 1.0f}, blockers));
-  // Grazing: the ray's closest approach just inside the radius is not let through.
-  EXPECT_FALSE(render::missesSpheres({-0.6f + 0.4995f, 0.5f, 2.0f}, {0.0f, 0.0f, -1.0f}, blockers));
+  // Rays through a sphere, from inside one, away from both; grazing: the
+  // closest approach just inside the radius is not let through.
+  const std::vector<glm::vec3> along{{0.0f, 0.0f, -1.0f}, {0.0f, 0.0f, 1.0f}};
+  EXPECT_EQ(render::raysMissingSpheres({-0.6f, 0.0f, 2.0f}, along, blockers), 0b10u);
+  EXPECT_EQ(render::raysMissingSpheres({-0.6f, 0.5f, 0.3f}, along, blockers), 0u);
+  EXPECT_EQ(render::raysMissingSpheres({-0.6f, 0.5f, 2.0f}, along, blockers), 0b10u);
+  EXPECT_EQ(render::raysMissingSpheres({-0.6f + 0.4995f, 0.5f, 2.0f}, along, blockers), 0b10u);
+  EXPECT_EQ(render::raysMissingSpheres({-0.6f + 0.4995f, 0.5f, -2.0f}, along, blockers), 0b01u);
 }
 
 // Fills `bytes` of the stack below the caller with `value`: what a deeper

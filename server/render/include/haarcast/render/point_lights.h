@@ -57,10 +57,12 @@ struct GroundRays {
   std::span<const glm::vec4> blockers;     // world bounding spheres (centre, radius) of every object but the ground
   std::span<const std::uint8_t> onGround;  // per point: 1 on the ground (empty: none is)
 };
-// Whether the ray origin + t·direction, t > 0, misses every sphere: a
-// conservative test (each radius widened by 10⁻³ of itself for the float
-// rounding), so a ray it lets through would have met nothing inside them.
-bool missesSpheres(const glm::vec3& origin, const glm::vec3& direction, std::span<const glm::vec4> spheres);
+// Bit k set when the ray origin + t·directions[k], t > 0, misses every
+// sphere: a conservative test (each radius widened by 10⁻³ of itself for the
+// float rounding), so a ray it lets through would have met nothing inside
+// them. At most 32 directions.
+std::uint32_t raysMissingSpheres(const glm::vec3& origin, std::span<const glm::vec3> directions,
+                                 std::span<const glm::vec4> spheres);
 // pointLightMask of many points at once, the same bits: each light's rays
 // in packets of 16 neighbouring points (RayScene::occludedToward), which
 // share their traversal; a ground point's ray that misses `ground`'s
