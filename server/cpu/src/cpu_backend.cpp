@@ -409,6 +409,7 @@ void CpuRenderer::fillInputs(const ResolvedFrame& resolved, GBuffer& g, const Ca
 std::size_t CpuRenderer::shadePixels(const GBuffer& g, const FrameRequest& request, const CameraRays& camera,
                                      Frame& frame, const Shade& shade, const CancelPoint& cancelPoint) const {
   const int w = frame.width, h = frame.height;
+  const glm::mat3 toEnvironment(glm::transpose(lightRotationOf(prepared_, request)));  // the backdrop's, as the tonemap stage's
   std::atomic<std::size_t> total{0};
   parallelFor(static_cast<std::size_t>(h), [&](std::size_t y) {
     cancelPoint();
@@ -430,8 +431,8 @@ std::size_t CpuRenderer::shadePixels(const GBuffer& g, const FrameRequest& reque
           rowBytes += shade(*s, g.centre.size() + g.edge[i] * shared::kSubsamples + k, rgb);
           sum += glm::dvec3(rgb[0], rgb[1], rgb[2]);
         } else if (options_.environmentBackground) {
-          sum += backgroundRadiance(prepared_.background, lightRotationOf(prepared_, request),
-                                    camera.subsampleDirection(x, static_cast<int>(y), k));
+          sum += glm::dvec3(backdropRadiance(prepared_.background, toEnvironment,
+                                             glm::vec3(camera.subsampleDirection(x, static_cast<int>(y), k))));
         }
       }
       sum /= static_cast<double>(shared::kSubsamples);
@@ -511,13 +512,13 @@ Frame CpuRenderer::renderFrame(const FrameRequest& request, const CancelPoint& c
   t0 = Clock::now();
   enterFrameStage(request, "tonemap", options_.environmentBackground ? rows : 0);
   if (options_.environmentBackground) {
-    const glm::dmat3 lightRotation = lightRotationOf(prepared_, request);  // once, not per pixel
+    const glm::mat3 toEnvironment(glm::transpose(lightRotationOf(prepared_, request)));  // once, not per pixel
     parallelFor(static_cast<std::size_t>(h), [&](std::size_t y) {
       cancelPoint();
       for (int x = 0; x < w; ++x) {
         const std::size_t i = y * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
         if (frame.objectMask[i] || g.edge[i] != kInterior) continue;  // drawn by the shading
-        const glm::dvec3 L = backgroundRadiance(prepared_.background, lightRotation, camera.direction(x, static_cast<int>(y)));
+        const glm::vec3 L = backdropRadiance(prepared_.background, toEnvironment, glm::vec3(camera.direction(x, static_cast<int>(y))));
         for (int c = 0; c < 3; ++c) frame.image.at(static_cast<int>(y), x, c) = static_cast<float>(L[c]);
       }
     }, {}, options_.threads);

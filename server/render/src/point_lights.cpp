@@ -387,13 +387,12 @@ void GroundSkyGrid::compute(const RayScene& world, const SkyOccluders& sky,
   fineTraced_ = traced.load();
 }
 
-float GroundSkyGrid::at(std::size_t pixel, const std::function<float()>& direct) const {
+std::optional<float> GroundSkyGrid::blended(std::size_t pixel) const {
   const int x = static_cast<int>(pixel % static_cast<std::size_t>(width_));
   const int y = static_cast<int>(pixel / static_cast<std::size_t>(width_));
   HC_CHECK_LT(y, height_);
-  if (const std::optional<float> v = blendCell(value_, columns_, step_, width_, height_, x, y)) return *v;
-  if (const std::optional<float> v = blendCell(fine_, fineColumns_, fineStep_, width_, height_, x, y)) return *v;
-  return direct();
+  if (const std::optional<float> v = blendCell(value_, columns_, step_, width_, height_, x, y)) return v;
+  return blendCell(fine_, fineColumns_, fineStep_, width_, height_, x, y);
 }
 
 std::uint32_t withGroundOcclusion(std::uint32_t lightBits, float occlusion) {

@@ -153,8 +153,16 @@ class GroundSkyGrid {
   // centre, or nullopt (not the ground, an edge pixel, nothing).
   void compute(const RayScene& world, const SkyOccluders& sky,
                const std::function<std::optional<ShadingPoint>(std::size_t pixel)>& point, unsigned threads);
-  // The occlusion for a ground sample of pixel y·width + x.
-  float at(std::size_t pixel, const std::function<float()>& direct) const;
+  // The occlusion for a ground sample of pixel y·width + x: the grids'
+  // blend, or direct() (the sample's own rays) where neither covers it.
+  // A template, so the call per ground sample wraps nothing on the heap.
+  template <class Direct>
+  float at(std::size_t pixel, const Direct& direct) const {
+    const std::optional<float> v = blended(pixel);
+    return v ? *v : direct();
+  }
+  // The grids' blend alone (nullopt: the sample's own rays are needed).
+  std::optional<float> blended(std::size_t pixel) const;
   // Fine grid points traced by the last compute (what the refinement costs).
   std::size_t finePointsTraced() const { return fineTraced_; }
 

@@ -315,6 +315,10 @@ RotationInput rotationInput(const glm::dvec3& normal, const glm::dvec3& towardEy
 // by lightRotation: bilinear (sphere_map.h's bilinearTaps) in the maps.
 glm::dvec3 backgroundRadiance(const std::array<SphereMap, 3>& background, const glm::dmat3& lightRotation,
                               const glm::dvec3& direction);
+// The same in float, as the device's resolve pass takes it, for a frame's
+// backdrop pixels (a fifth of their double's cost): `toEnvironment` is
+// lightRotationᵀ; the same taps (shared::latLongTaps), to float rounding.
+glm::vec3 backdropRadiance(const std::array<SphereMap, 3>& background, const glm::mat3& toEnvironment, const glm::vec3& direction);
 
 // Throws std::invalid_argument naming the problem.
 void checkFrameRequest(const FrameRequest& request, std::size_t objectCount);
