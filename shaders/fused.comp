@@ -31,10 +31,11 @@
 //      subgroup, SUBGROUP_REDUCE; else in invocation order through shared
 //      memory, with barriers); invocation 0 puts
 //      the lobe's energy back (× ∫ρ / Σ ΔΩ·ρ, the second sum of step 1:
-//      core fused.cpp energyKept), adds the point lights whose bit is set,
-//      in light order, each with ρ read at the light's direction from the
-//      point slices by Catmull-Rom (pointRhoAt: core fused.cpp pointRhoAt),
-//      and adds the lobe path's core; radiance[pixel] = Σ.
+//      core fused.cpp energyKept), takes off the sky other objects hide
+//      (lessHiddenSky), adds the point lights whose bit is set, in light
+//      order, each with ρ read at the light's direction from the point
+//      slices by Catmull-Rom (pointRhoAt: core point_rho_kernel.cpp), and
+//      adds the lobe path's core; radiance[pixel] = Σ.
 // An object with a lobe path (shared_layout.h, "The lobe path") leaves the
 // directions within its core angle of the lobe's axis to it (rhoAt reads
 // ρ = 0 there, and the pass's energy is the lobe's less the core's); when
@@ -218,7 +219,7 @@ vec3 rhoAt(const bool blended, PixelSetup p, vec3 w0) {
 // ρ_c at the object-frame direction w0 for a point light: slicePosition at
 // the point slices' level, then Catmull-Rom over 4 × 4 taps of the point
 // slices (rows clamped, columns wrapped), each tap blended between the two
-// slices (core fused.cpp pointRhoAt; shared_layout.h catmullRomWeights).
+// slices (core point_rho_kernel.cpp; shared_layout.h catmullRomWeights).
 vec3 pointRhoAt(PixelSetup p, vec3 w0) {
   vec2 pos;
   if (!slicePosition(p, w0, p.pointM, p.pointFraction, pos)) return vec3(0.0);
@@ -308,21 +309,27 @@ vec3 addPointLights(PixelSetup p, uint object, uint count, uint seen, vec3 sum) 
   return sum;
 }
 
+// The pass's sum less the sky other objects hide from sample s, taken off
+// as a light (fusedShade's `hidden`): the sum a pixel keeps for its
+// children (FusedSum), so one that takes its parents' takes theirs less
+// their hidden sky and reads none of its own.
+vec3 lessHiddenSky(ObjectInfo o, uint s, vec3 energy, vec3 sum) {
+  if ((o.flags & kObjectSkyHidden) != 0u) {
+    const HiddenLight h = hidden[s];
+    if (h.power.r > 0.0 || h.power.g > 0.0 || h.power.b > 0.0) sum -= h.power * energy / kPiF;
+  }
+  return sum;
+}
+
 // The radiance from the pixel's sum (the pass's with the lobe's energy put
-// back, or its parents': FusedSum): the point lights, the hidden sky and the
-// lobe path added as fusedShade adds them.
-vec3 finishSum(PixelSetup p, ObjectInfo o, RotationSample rs, SliceBlend blend, uint s, uint seen, vec3 energy,
-               vec3 sum, bool lobePath) {
+// back and the hidden sky taken off, or its parents': FusedSum): the point
+// lights and the lobe path added as fusedShade adds them, the whole kept ≥ 0
+// before the lobe path.
+vec3 finishSum(PixelSetup p, ObjectInfo o, RotationSample rs, SliceBlend blend, uint seen, vec3 sum, bool lobePath) {
   if ((seen & 0xFFFFu) != 0u) {
     sum = addPointLights(p, p.sh.object, o.pointLights, seen, sum);
   }
-  // The sky other objects hide from it, taken off as a light (fusedShade's `hidden`).
-  if ((o.flags & kObjectSkyHidden) != 0u) {
-    const HiddenLight h = hidden[s];
-    if (h.power.r > 0.0 || h.power.g > 0.0 || h.power.b > 0.0) {
-      sum = max(sum - h.power * energy / kPiF, vec3(0.0));
-    }
-  }
+  sum = max(sum, vec3(0.0));
   if (lobePath) sum += lobeShade(o, rs, blend, seen);
   return sum;
 }
@@ -424,7 +431,7 @@ void shadePixel(uint s) {
   if (visited && smoothTaken(sh, o, mirror, given)) {
     if (lid == 0u) {
       atomicAdd(sliceCounts[kSliceCountsPerObject * sh.object + 6u], 1u);
-      radiance[sh.pixel] = vec4(finishSum(p, o, rs, blend, s, seen, energy, given, lobePath), 1.0);
+      radiance[sh.pixel] = vec4(finishSum(p, o, rs, blend, seen, given, lobePath), 1.0);
       smoothData[2u * sh.pixel] = vec4(given, uintBitsToFloat(sh.object + 1u));
       smoothData[2u * sh.pixel + 1u] = vec4(mirror, 0.0);
     }
@@ -483,11 +490,12 @@ void shadePixel(uint s) {
     for (int c = 0; c < 3; ++c) {
       if (sampled[c] > 0.0) sum[c] *= energy[c] / sampled[c];
     }
+    sum = lessHiddenSky(o, s, energy, sum);
     if (visited) {
       smoothData[2u * sh.pixel] = vec4(sum, uintBitsToFloat(sh.object + 1u));
       smoothData[2u * sh.pixel + 1u] = vec4(mirror, 0.0);
     }
-    radiance[sh.pixel] = vec4(finishSum(p, o, rs, blend, s, seen, energy, sum, lobePath), 1.0);
+    radiance[sh.pixel] = vec4(finishSum(p, o, rs, blend, seen, sum, lobePath), 1.0);
   }
   if (SUBGROUP_REDUCE == 0u) sync();  // `partial` is reused by the next sample
 }

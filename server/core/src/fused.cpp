@@ -405,7 +405,16 @@ std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBl
   } else {
     out = energyKept(pass, energy);
   }
-  if (sum && !given) sum->value = out;
+  if (!given) {
+    // The sky other objects hide, taken off before the sum is kept: what a
+    // pixel's neighbours give it is their sum less their hidden sky, which
+    // changes as smoothly across a surface (core/shared_smooth.h), so a
+    // pixel that takes its parents' needs no hidden-sky rays of its own.
+    if (hidden) {
+      for (std::size_t c = 0; c < 3; ++c) out[c] -= (*hidden)[c] * energy[c] / static_cast<float>(kPi);
+    }
+    if (sum) sum->value = out;
+  }
   // The point lights it sees: ρ at each one's direction, a vector of them at
   // a time (point_rho_kernel.cpp), at the point slices' level.
   static_assert(std::tuple_size_v<decltype(scratch.lightX)> == detail::kPointRhoStride);
@@ -433,10 +442,8 @@ std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBl
     for (std::size_t j = 0; j < seen; ++j)
       for (std::size_t c = 0; c < 3; ++c) out[c] += lights[scratch.lightIndex[j]].power[c] * scratch.lightRho[c * detail::kPointRhoStride + j];
   }
-  if (hidden) {
-    for (std::size_t c = 0; c < 3; ++c)
-      out[c] = std::max(0.0f, out[c] - (*hidden)[c] * energy[c] / static_cast<float>(kPi));
-  }
+  // The hidden sky taken off may leave less than nothing; the sum is kept ≥ 0.
+  for (std::size_t c = 0; c < 3; ++c) out[c] = std::max(0.0f, out[c]);
   if (lobe) {
     const std::array<float, 3> inCore = lobeShade(*lobe, blend, r, visibleLights);
     for (std::size_t c = 0; c < 3; ++c) out[c] += inCore[c];

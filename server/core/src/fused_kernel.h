@@ -71,7 +71,7 @@ struct FusedCellPass {
 };
 // out as fusedSample's, over the cells of rows firstRow … endRow − 1.
 void fusedSampleCells(const FusedCellPass& pass, CellScratch& scratch, float out[6], CellCounts& counts);
-// ρ_c at point lights' directions (object frame), fused.cpp's pointRhoAt
+// ρ_c at point lights' directions (object frame), fused.comp's pointRhoAt
 // for a vector of lights at a time (point_rho_kernel.cpp): the pass's turn,
 // cut and core, then Catmull-Rom over 4 × 4 taps of the point slices.
 struct PointRhoPass {

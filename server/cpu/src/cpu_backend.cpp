@@ -187,7 +187,6 @@ class CpuRenderer final : public Renderer {
   struct FusedSlots {
     std::vector<ShadingPoint> points;
     std::vector<std::uint32_t> lightsSeen;     // the point lights each sees
-    std::vector<shared::HiddenLight> hidden;   // the sky other objects hide from it
     // By pixel, with a smooth-sum tolerance (core/shared_smooth.h): the centre
     // sample's sum and radiance, and whether it was summed or taken.
     std::vector<std::array<float, 3>> sums, shaded;
@@ -631,17 +630,14 @@ std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const RayScen
   markPart("ground sky grid");
   // Each sample's shading point, and the point lights it sees: one shadow
   // ray each (point_lights.h), a pixel row's samples at a time so that each
-  // light's rays go in packets. By slot (Shade), for the pass below.
+  // light's rays go in packets. By slot (Shade), for the pass below, which
+  // casts the hidden sky's rays of the samples that sum their own.
   const std::size_t slotCount = g.centre.size() + g.sub.size() * shared::kSubsamples;
   std::vector<ShadingPoint>& points = slotRecords.points;
   std::vector<std::uint32_t>& lightsSeen = slotRecords.lightsSeen;
   points.resize(slotCount);  // each slot a sample takes is written below
   lightsSeen.assign(slotCount, 0u);
-  // The sky other objects hide from each object sample (point_lights.h),
-  // packed as the Vulkan backend reads it.
   const SkyOccluders& occluders = resolved.skyOccluders;
-  std::vector<shared::HiddenLight>& hidden = slotRecords.hidden;
-  hidden.assign(occluders.objectSky ? slotCount : 0, shared::HiddenLight{});
   parallelFor(g.height, [&](std::size_t y) {
     cancelPoint();
     thread_local std::vector<ShadingPoint> row;
@@ -657,8 +653,6 @@ std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const RayScen
       row.push_back(points[slot]);
       slots.push_back(slot);
       onGround.push_back(prepared_.objects[object].ground ? 1 : 0);
-      if (occluders.objectSky && !prepared_.objects[object].ground)
-        hidden[slot] = hiddenLightOf(objectSkyHidden(rays, points[slot], object, occluders), frames.rotations[object]);
     };
     for (std::size_t i = y * g.width; i < (y + 1) * g.width; ++i) {
       if (g.edge[i] == kInterior) {
@@ -710,7 +704,12 @@ std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const RayScen
                                                           static_cast<shared::uint>(slices.thetaSamples()),
                                                           options_.interpolateSlices ? 1u : 0u);
     const LobePath lobe{&prepared_.lobeLight, p.lobes, o.toLight, p.lobeCore};
-    const std::optional<std::array<float, 3>> hiddenSky = hidden.empty() ? std::nullopt : hiddenIrradiance(hidden[slot]);
+    // The sky other objects hide from it (point_lights.h), packed as the
+    // Vulkan backend reads it: only where the sample sums its own (a sum
+    // taken from its neighbours is theirs less their hidden sky, FusedSum).
+    std::optional<std::array<float, 3>> hiddenSky;
+    if (occluders.objectSky && !(sum && sum->given))
+      hiddenSky = hiddenIrradiance(hiddenLightOf(objectSkyHidden(rays, point, object, occluders), frames.rotations[object]));
     rgb = fusedShade(slices, blend, in.rotation.euler, o.fusedLight, vis, o.pointLights, seen, scratch,
                      p.lobePath ? &lobe : nullptr, hiddenSky ? &*hiddenSky : nullptr, sum);
     const bool summed = !(sum && sum->given);

@@ -3,7 +3,10 @@
 // against the Haar-list path it replaces, a point light against the BRDF at
 // its direction, and the light split's bookkeeping.
 #include <gtest/gtest.h>
+#include <glm/geometric.hpp>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -113,6 +116,57 @@ TEST(FusedBits, EqualsTheListPathWithEveryCoefficientKept) {
 struct LobeSweep {
   double thetaSpan, thetaStep, phiSpan, phiStep;
 };
+
+// The sky other objects hide is taken off the sum a pixel keeps (FusedSum),
+// before the point lights: a pixel given its parents' sum takes their
+// hidden sky with it and reads none of its own, and one that sums its own
+// shows what it showed before, max(0, S + lights − power·E/π).
+TEST(FusedBits, TheHiddenSkyIsTakenOffTheSumAPixelKeeps) {
+  std::mt19937 rng(17);
+  const int level = 4;
+  const BrdfSliceTable table = randomTable(level, 3, rng);
+  const PixelSlices slices = PixelSlices::synthesize(table);
+  std::array<SphereMap, 3> weighted;
+  std::uniform_real_distribution<double> l(0.0, 0.2);
+  for (auto& m : weighted) {
+    m = SphereMap(level);
+    for (float& x : m.values()) x = static_cast<float>(l(rng));
+  }
+  const FusedLight light = FusedLight::fromWeightedMaps(weighted);
+  const VisibilityBits bits = randomBits(level, 3, rng);
+  const std::array<WeightedBits, 3> wb = {WeightedBits{bits.point(0).data(), 0.2f}, WeightedBits{bits.point(1).data(), 0.3f},
+                                          WeightedBits{bits.point(2).data(), 0.5f}};
+  FusedPointLight sun;
+  sun.direction = glm::normalize(glm::vec3(0.2f, 1.0f, 0.1f));
+  sun.power = {0.3f, 0.2f, 0.1f};
+  const shared::SliceBlend blend{1u, 2u, 0.25f};
+  const EulerYXY r{0.3, 0.4, -0.7};
+  FusedScratch scratch;
+  FusedSum open, less;
+  const auto plain = fusedShade(slices, blend, r, light, wb, std::span(&sun, 1), 1u, scratch, nullptr, nullptr, &open);
+  const std::array<float, 3> hidden = {0.05f, 0.02f, 0.01f};
+  const auto shaded = fusedShade(slices, blend, r, light, wb, std::span(&sun, 1), 1u, scratch, nullptr, &hidden, &less);
+  for (std::size_t c = 0; c < 3; ++c) {
+    const float e = slices.energy(1)[c] + 0.25f * (slices.energy(2)[c] - slices.energy(1)[c]);
+    const float off = hidden[c] * e / static_cast<float>(kPi);
+    ASSERT_GT(off, 1e-4f * plain[c]) << "channel " << c;
+    EXPECT_NEAR(less.value[c], open.value[c] - off, 1e-6f * (1.0f + open.value[c])) << "channel " << c;
+    EXPECT_NEAR(shaded[c], std::max(0.0f, plain[c] - off), 1e-6f * (1.0f + plain[c])) << "channel " << c;
+  }
+  // Given that sum, the pixel reads no hidden sky of its own (a different
+  // one changes nothing) and shows what summing it showed.
+  const std::array<float, 3> other = {5.0f, 5.0f, 5.0f};
+  FusedSum given{less.value, true};
+  const auto taken = fusedShade(slices, blend, r, light, wb, std::span(&sun, 1), 1u, scratch, nullptr, &other, &given);
+  for (std::size_t c = 0; c < 3; ++c) EXPECT_EQ(taken[c], shaded[c]) << "channel " << c;
+  // A sky hidden past the sum leaves a negative kept sum and nothing below zero shown.
+  FusedSum dark;
+  const auto none = fusedShade(slices, blend, r, light, wb, std::span(&sun, 1), 0u, scratch, nullptr, &other, &dark);
+  for (std::size_t c = 0; c < 3; ++c) {
+    EXPECT_LT(dark.value[c], 0.0f) << "channel " << c;
+    EXPECT_EQ(none[c], 0.0f) << "channel " << c;
+  }
+}
 
 // The relative L2 against the BRDF itself of a point light's ρ over a
 // sweep of the lobe, the slices at `level` and their point slices at

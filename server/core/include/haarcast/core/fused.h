@@ -164,11 +164,12 @@ std::array<float, 3> lobeShade(const LobePath& path, const shared::SliceBlend& b
                                std::uint32_t word);
 
 // The pass's sum of a pixel, the part of fusedShade that is smooth across a
-// surface (the light's rest × V × ρ, the energy put back): given, fusedShade
-// takes it instead of summing (no slice blend, no pass), and everything
-// else (point lights, hidden sky, lobe path) is the pixel's own; not given,
-// fusedShade sums it and writes it here. core/shared_smooth.h takes it from a
-// pixel's neighbours where they agree.
+// surface (the light's rest × V × ρ, the energy put back, less the hidden
+// sky): given, fusedShade takes it instead of summing (no slice blend, no
+// pass, no hidden sky: `hidden` is not read), and everything else (point
+// lights, lobe path) is the pixel's own; not given, fusedShade sums it and
+// writes it here. core/shared_smooth.h takes it from a pixel's neighbours
+// where they agree.
 struct FusedSum {
   std::array<float, 3> value{};
   bool given = false;
@@ -183,7 +184,8 @@ struct FusedSum {
 // when the path takes all. `hidden`, when given, is the sky other objects
 // hide from the pixel (shared_rays.h HiddenLight): its power, the
 // irradiance hidden, is taken off as a diffuse surface of the pass's
-// albedo E_c would lose it, I_c −= power_c·E_c/π, the sum kept ≥ 0.
+// albedo E_c would lose it, I_c −= power_c·E_c/π (from the pass's sum,
+// before the point lights), the whole kept ≥ 0.
 std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBlend& blend, const EulerYXY& r,
                                 const FusedLight& light, std::span<const WeightedBits> visibility,
                                 std::span<const FusedPointLight> lights, std::uint32_t visibleLights,
