@@ -18,6 +18,7 @@
 
 #include "haarcast/net/render_service.h"
 #include "haarcast/net/left_behind.h"
+#include "settled_left_behind.h"
 #include "haarcast/render/frame_stage.h"
 
 namespace haarcast::net {
@@ -310,7 +311,7 @@ TEST(FrameDeadline, AnAbandonedFrameThatReturnsIsDroppedAndItsDeviceRecovers) {
   const auto renderer = stuckOn("gpu0", "tonemap", gate);
   // The process's count of threads left behind (net/left_behind.h): one
   // more while the abandoned render is out, back once it has returned.
-  const std::size_t leftBefore = threadsLeftBehind();
+  const std::size_t leftBefore = settledThreadsLeftBehind();
   service.submit(job(renderer, outcomes, "stuck"));
   ASSERT_TRUE(waitUntil([&] { return !outcomes.of("stuck").empty(); }));
   ASSERT_FALSE(service.devices().at(0).healthy);

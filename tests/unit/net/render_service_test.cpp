@@ -14,6 +14,8 @@
 
 #include <gtest/gtest.h>
 
+#include "settled_left_behind.h"
+
 namespace haarcast::net {
 namespace {
 
@@ -192,7 +194,7 @@ TEST(RenderService, ABuildPastTheStopGraceIsLeftBehindAndCountedUntilItReturns) 
     open.wait();
     return std::make_shared<PreparedRenderer>();
   }, options, metrics);
-  const std::size_t before = threadsLeftBehind();
+  const std::size_t before = settledThreadsLeftBehind();
   service.prepare(config(4), [](std::shared_ptr<PreparedRenderer>, std::string) {});
   for (int i = 0; i < 2000 && !building; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   ASSERT_TRUE(building.load());
