@@ -43,6 +43,17 @@ BrdfSliceTable randomTable(int level, int thetaSamples, std::mt19937& rng) {
   return BrdfSliceTable::fromSlices(thetaOutLayout(thetaSamples), std::move(slices));
 }
 
+// A light of random texels in [0, 0.2) per channel, as fused reads it.
+FusedLight randomLight(int level, std::mt19937& rng) {
+  std::array<SphereMap, 3> weighted;
+  std::uniform_real_distribution<double> l(0.0, 0.2);
+  for (auto& m : weighted) {
+    m = SphereMap(level);
+    for (float& x : m.values()) x = static_cast<float>(l(rng));
+  }
+  return FusedLight::fromWeightedMaps(weighted);
+}
+
 VisibilityBits randomBits(int level, std::size_t points, std::mt19937& rng) {
   VisibilityBits bits(level, points);
   std::bernoulli_distribution coin(0.6);
@@ -51,6 +62,23 @@ VisibilityBits randomBits(int level, std::size_t points, std::mt19937& rng) {
       if (coin(rng)) bits.point(p)[i / 32] |= 1u << (i % 32);
   return bits;
 }
+
+// One pixel's random inputs at level 4: three θₒ slices, a light, three
+// vertices' bits.
+struct RandomPixel {
+  explicit RandomPixel(unsigned seed)
+      : rng(seed),
+        table(randomTable(kLevel, 3, rng)),
+        slices(PixelSlices::synthesize(table)),
+        light(randomLight(kLevel, rng)),
+        bits(randomBits(kLevel, 3, rng)) {}
+  static constexpr int kLevel = 4;
+  std::mt19937 rng;
+  BrdfSliceTable table;
+  PixelSlices slices;
+  FusedLight light;
+  VisibilityBits bits;
+};
 
 TEST(VisibilityBits, BlendIsTheWeightedSumOfTheBits) {
   std::mt19937 rng(3);
@@ -83,18 +111,10 @@ TEST(VisibilityBits, AssignRefusesStrayBitsAndWrongSizes) {
 // The bits path is the list path with nothing truncated: each vertex's bits
 // Haar-coded whole give the same V, so the same sum.
 TEST(FusedBits, EqualsTheListPathWithEveryCoefficientKept) {
-  std::mt19937 rng(7);
-  const int level = 4;
-  const BrdfSliceTable table = randomTable(level, 3, rng);
-  const PixelSlices slices = PixelSlices::synthesize(table);
-  std::array<SphereMap, 3> weighted;
-  std::uniform_real_distribution<double> l(0.0, 0.2);
-  for (auto& m : weighted) {
-    m = SphereMap(level);
-    for (float& x : m.values()) x = static_cast<float>(l(rng));
-  }
-  const FusedLight light = FusedLight::fromWeightedMaps(weighted);
-  const VisibilityBits bits = randomBits(level, 3, rng);
+  const RandomPixel pixel(7);
+  const PixelSlices& slices = pixel.slices;
+  const FusedLight& light = pixel.light;
+  const VisibilityBits& bits = pixel.bits;
   std::array<SparseHaar, 3> lists;
   for (std::size_t v = 0; v < 3; ++v) lists[v] = keepLargest(forwardHaar(bits.map(v)), bits.directions());
   const std::array<float, 3> b = {0.25f, 0.35f, 0.4f};
@@ -122,18 +142,10 @@ struct LobeSweep {
 // hidden sky with it and reads none of its own, and one that sums its own
 // shows what it showed before, max(0, S + lights − power·E/π).
 TEST(FusedBits, TheHiddenSkyIsTakenOffTheSumAPixelKeeps) {
-  std::mt19937 rng(17);
-  const int level = 4;
-  const BrdfSliceTable table = randomTable(level, 3, rng);
-  const PixelSlices slices = PixelSlices::synthesize(table);
-  std::array<SphereMap, 3> weighted;
-  std::uniform_real_distribution<double> l(0.0, 0.2);
-  for (auto& m : weighted) {
-    m = SphereMap(level);
-    for (float& x : m.values()) x = static_cast<float>(l(rng));
-  }
-  const FusedLight light = FusedLight::fromWeightedMaps(weighted);
-  const VisibilityBits bits = randomBits(level, 3, rng);
+  const RandomPixel pixel(17);
+  const PixelSlices& slices = pixel.slices;
+  const FusedLight& light = pixel.light;
+  const VisibilityBits& bits = pixel.bits;
   const std::array<WeightedBits, 3> wb = {WeightedBits{bits.point(0).data(), 0.2f}, WeightedBits{bits.point(1).data(), 0.3f},
                                           WeightedBits{bits.point(2).data(), 0.5f}};
   FusedPointLight sun;
