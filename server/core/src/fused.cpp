@@ -417,9 +417,7 @@ std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBl
   }
   // The point lights it sees: ρ at each one's direction, a vector of them at
   // a time (point_rho_kernel.cpp), at the point slices' level.
-  static_assert(std::tuple_size_v<decltype(scratch.lightX)> == detail::kPointRhoStride);
-  static_assert(std::tuple_size_v<decltype(scratch.lightRho)> == 3 * detail::kPointRhoStride);
-  HC_CHECK_LE(lights.size(), detail::kPointRhoLights);  // one bit of visibleLights each
+  HC_CHECK_LE(lights.size(), std::size_t{shared::kMaxPointLights});
   std::size_t seen = 0;
   for (std::size_t k = 0; k < lights.size(); ++k) {
     if (((visibleLights >> k) & 1u) == 0) continue;
@@ -440,7 +438,7 @@ std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBl
     points.weight = blend.weight;
     detail::pointRho(points, scratch.lightX.data(), scratch.lightY.data(), scratch.lightZ.data(), seen, scratch.lightRho.data());
     for (std::size_t j = 0; j < seen; ++j)
-      for (std::size_t c = 0; c < 3; ++c) out[c] += lights[scratch.lightIndex[j]].power[c] * scratch.lightRho[c * detail::kPointRhoStride + j];
+      for (std::size_t c = 0; c < 3; ++c) out[c] += lights[scratch.lightIndex[j]].power[c] * scratch.lightRho[c * kPointLightLanes + j];
   }
   // The hidden sky taken off may leave less than nothing; the sum is kept ≥ 0.
   for (std::size_t c = 0; c < 3; ++c) out[c] = std::max(0.0f, out[c]);

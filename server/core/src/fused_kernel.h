@@ -83,11 +83,9 @@ struct PointRhoPass {
   const float* second = nullptr;
   float weight = 0.0f;
 };
-// At most kPointRhoLights; x, y, z hold kPointRhoStride floats each (whole
-// vectors are read; what lies past n is ignored), rho three planes of
-// kPointRhoStride (R, then G, then B; light j at j).
-inline constexpr std::size_t kPointRhoLights = 32;  // one bit of a visibility word each
-inline constexpr std::size_t kPointRhoStride = kPointRhoLights + 16;  // and a vector of the widest target
+// At most shared::kMaxPointLights; x, y, z hold kPointLightLanes floats
+// each (fused.h: whole vectors are read, what lies past n is ignored), rho
+// three planes of kPointLightLanes (R, then G, then B; light j at j).
 void pointRho(const PointRhoPass& pass, const float* x, const float* y, const float* z, std::size_t n, float* rho);
 const char* fusedTarget();
 // The target's float lanes: the pass forms V from the bits only where a

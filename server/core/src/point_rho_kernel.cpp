@@ -14,6 +14,7 @@
 #include <hwy/highway.h>
 
 #include "fused_kernel.h"
+#include "haarcast/core/fused.h"
 #include "fused_lookup-inl.h"
 #include "haarcast/core/shared_layout.h"
 
@@ -54,12 +55,13 @@ void PointRho(const PointRhoPass& p, const float* HWY_RESTRICT x, const float* H
   const VF colFraction = hn::Set(d, p.columnFraction);
   const VI colMask = hn::Set(di, m - 1), colShift = hn::Set(di, p.columnShift);
   const bool blend = p.weight != 0.0f && p.second != p.first;
-  HWY_ALIGN int32_t row0[kPointRhoStride], col0[kPointRhoStride];
-  HWY_ALIGN float rowWeight[4][kPointRhoStride], colWeight[4][kPointRhoStride], reads[kPointRhoStride];
-  HWY_DASSERT(n <= kPointRhoLights);
+  HWY_ALIGN int32_t row0[kPointLightLanes], col0[kPointLightLanes];
+  HWY_ALIGN float rowWeight[4][kPointLightLanes], colWeight[4][kPointLightLanes], reads[kPointLightLanes];
+  static_assert(HWY_MAX_BYTES / sizeof(float) <= kPointLightLanes - shared::kMaxPointLights, "a vector past the last light");
+  HWY_DASSERT(n <= shared::kMaxPointLights);
   for (std::size_t i = 0; i < n; i += lanes) {
     const std::size_t count = std::min(lanes, n - i);
-    // Whole vectors: the arrays hold kPointRhoStride (fused_kernel.h).
+    // Whole vectors: the arrays hold kPointLightLanes (fused.h).
     const VF x0 = hn::LoadU(d, x + i), y0 = hn::LoadU(d, y + i), z0 = hn::LoadU(d, z + i);
     const VF x1 = hn::NegMulAdd(sinA, z0, hn::Mul(cosA, x0));  // R_y(−α)
     const VF z1 = hn::MulAdd(sinA, x0, hn::Mul(cosA, z0));
@@ -114,7 +116,7 @@ void PointRho(const PointRhoPass& p, const float* HWY_RESTRICT x, const float* H
     for (int c = 0; c < 3; ++c) {
       const float v = blend ? rgb[0][c] + p.weight * (rgb[1][c] - rgb[0][c]) : rgb[0][c];
       // The cubic overshoots below zero beside a steep lobe; ρ never is.
-      rho[static_cast<std::size_t>(c) * kPointRhoStride + j] = std::max(v, 0.0f);
+      rho[static_cast<std::size_t>(c) * kPointLightLanes + j] = std::max(v, 0.0f);
     }
   }
 }

@@ -238,25 +238,6 @@ RotationInput rotationInput(const glm::dvec3& normal, const glm::dvec3& towardEy
   return in;
 }
 
-glm::dvec3 backgroundRadiance(const std::array<SphereMap, 3>& background, const glm::dmat3& lightRotation,
-                              const glm::dvec3& direction) {
-  // L'(ω) = L(Rᵀω).
-  const Spherical s = directionToSpherical(glm::transpose(lightRotation) * direction);
-  const int level = background[0].level();
-  const BilinearTaps taps = bilinearTaps(level, s.theta, s.phi);
-  glm::dvec3 out(0.0);
-  for (int a = 0; a < 2; ++a) {
-    for (int b = 0; b < 2; ++b) {
-      const double w = taps.weight(a, b);
-      for (int c = 0; c < 3; ++c) {
-        out[c] += w * background[static_cast<std::size_t>(c)].at(taps.row[static_cast<std::size_t>(a)],
-                                                                  taps.col[static_cast<std::size_t>(b)]);
-      }
-    }
-  }
-  return out;
-}
-
 glm::vec3 backdropRadiance(const std::array<SphereMap, 3>& background, const glm::mat3& toEnvironment, const glm::vec3& direction) {
   const glm::vec3 e = toEnvironment * direction;
   const float y = std::clamp(e.y / glm::length(e), -1.0f, 1.0f);

@@ -300,7 +300,7 @@ TEST_P(TonemapPass, BackdropAndEncodingMatchTheCpuDefinitions) {
   radBuf.download(std::span<glm::vec4>(linear));
   rgbaBuf.read(rgba.data(), rgba.size());
 
-  // The CPU's image: covered pixels as given, the rest from backgroundRadiance.
+  // The CPU's image: covered pixels as given, the rest from backdropRadiance.
   const render::CameraRays rays(camera, w, h);
   io::RgbImage image = io::makeImage(w, h);
   double worstBackdrop = 0.0;
@@ -308,14 +308,15 @@ TEST_P(TonemapPass, BackdropAndEncodingMatchTheCpuDefinitions) {
     for (int x = 0; x < w; ++x) {
       const std::size_t p = static_cast<std::size_t>(y) * w + x;
       const glm::dvec3 expected = ids[p].x ? glm::dvec3(radiance[p])
-                                           : render::backgroundRadiance(background, lightRotation, rays.direction(x, y));
+                                           : glm::dvec3(render::backdropRadiance(background, glm::mat3(glm::transpose(lightRotation)),
+                                                                                 glm::vec3(rays.direction(x, y))));
       for (int c = 0; c < 3; ++c) {
         image.at(y, x, c) = static_cast<float>(expected[c]);
         worstBackdrop = std::max(worstBackdrop, std::abs(linear[p][c] - expected[c]) / 2.0);
       }
     }
   }
-  EXPECT_LT(worstBackdrop, 1e-5) << "backdrop differs from render::backgroundRadiance";
+  EXPECT_LT(worstBackdrop, 1e-5) << "backdrop differs from render::backdropRadiance";
   const std::vector<std::uint8_t> expected = render::tonemapRgba8(image, exposure, tone);
   ASSERT_EQ(expected.size(), rgba.size());
   std::size_t differ = 0;

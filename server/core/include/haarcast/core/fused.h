@@ -126,17 +126,22 @@ struct WeightedVisibility {
 
 // Per-thread working memory: sized on first use, reused after (no allocation
 // per pixel).
+// Room for a sample's point lights (shared::kMaxPointLights) and a vector
+// of the widest SIMD target past them, which the point lights' kernel reads
+// whole (fused_kernel.h pointRho).
+inline constexpr std::size_t kPointLightLanes = shared::kMaxPointLights + 16;
+
 struct FusedScratch {
   std::vector<float> visibility;  // merged coefficients, then V in pixel form
   std::vector<float> synthesis;   // one inverse-Haar step
   std::vector<float> blended;     // the θₒ-blended slice, when the blend weight is not 0
   std::size_t blendedRows = 0;    // rows of `blended` that may be non-zero
   CellScratch cells;               // the adaptive pass's
-  // The point lights a sample sees (at most 32, padded by a vector):
-  // directions, index, ρ by channel (fused_kernel.h pointRho).
-  std::array<float, 48> lightX{}, lightY{}, lightZ{};
-  std::array<std::uint32_t, 32> lightIndex{};
-  std::array<float, 3 * 48> lightRho{};
+  // The point lights a sample sees (at most shared::kMaxPointLights, padded
+  // by a vector): directions, index, ρ by channel (fused_kernel.h pointRho).
+  std::array<float, kPointLightLanes> lightX{}, lightY{}, lightZ{};
+  std::array<std::uint32_t, shared::kMaxPointLights> lightIndex{};
+  std::array<float, 3 * kPointLightLanes> lightRho{};
   // The last fusedShade's pass: the map directions it visited, its rows × M
   // (shared::passRows), or by cells one per coarse cell and 16 per fine
   // one; 0 where the lobe path took all.

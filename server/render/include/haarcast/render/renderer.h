@@ -312,12 +312,9 @@ RotationInput rotationInput(const glm::dvec3& normal, const glm::dvec3& towardEy
 RotationInput rotationInput(const glm::dvec3& normal, const glm::dvec3& towardEye);
 
 // The backdrop seen along a world direction when the environment is turned
-// by lightRotation: bilinear (sphere_map.h's bilinearTaps) in the maps.
-glm::dvec3 backgroundRadiance(const std::array<SphereMap, 3>& background, const glm::dmat3& lightRotation,
-                              const glm::dvec3& direction);
-// The same in float, as the device's resolve pass takes it, for a frame's
-// backdrop pixels (a fifth of their double's cost): `toEnvironment` is
-// lightRotationᵀ; the same taps (shared::latLongTaps), to float rounding.
+// by lightRotation (`toEnvironment` is lightRotationᵀ): bilinear in the maps
+// (shared::latLongTaps, sphere_map.h's bilinearTaps in float), in float as
+// the device's resolve pass takes it.
 glm::vec3 backdropRadiance(const std::array<SphereMap, 3>& background, const glm::mat3& toEnvironment, const glm::vec3& direction);
 
 // Throws std::invalid_argument naming the problem.
