@@ -3,7 +3,7 @@
 // `radiance` for the exposure and encoding passes and for EXR output.
 //   - an uncovered interior pixel shows the backdrop: bilinear in the
 //     level-backgroundLevel maps at lightRotationᵀ·direction, as
-//     render::backgroundRadiance, or black;
+//     render::backdropRadiance, or black;
 //   - an edge pixel (frame.antialias, `edges` from rotation_input.comp) is
 //     the mean of its kSubsamples sub-samples: a covered one's shaded
 //     radiance (slot subsampleSlot), an uncovered one the backdrop in its own
