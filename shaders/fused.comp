@@ -146,6 +146,7 @@ struct PixelSetup {
   vec3 axis;               // the lobe's axis before R_y(−γ), and the lobe path's core (fused.cpp setCore)
   float coreCos;
   float coreCellCos;       // by cells: a cell whose turned centre is nearer the axis is summed fine
+  float reachCut;          // by cells: one whose turned centre is below this adds nothing (cellReachCut)
   float tolerance;         // by cells: the detail above which a cell is summed fine
   uint detail0, detail1;   // the two slices' detail maps
 };
@@ -403,6 +404,7 @@ void shadePixel(uint s) {
   p.axis = vec3(0.0, 1.0, 0.0);
   p.coreCos = 2.0;
   p.coreCellCos = 2.0;
+  p.reachCut = cellReachCut(p.m, p.skipBelowY);
   p.tolerance = o.sumTolerance;
   p.detail0 = (o.sliceBase + blend.first) * kCellDetailStride;
   p.detail1 = (o.sliceBase + (blend.weight != 0.0 ? blend.second : blend.first)) * kCellDetailStride;

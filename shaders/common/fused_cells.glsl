@@ -28,6 +28,7 @@ uint coarseCell(const bool blended, PixelSetup p, uint q, uvec3 bits, inout vec3
   const float v = cellVisibility(bits.x, bits.y, bits.z, p.sh.b[0], p.sh.b[1], p.sh.b[2]);
   const vec4 centre = texelFetch(directions, int(p.directionBase + cellCentreTexel(p.m, q)));  // xyz, and w = Ω_C
   const vec3 t = turned(p, centre.xyz);
+  if (t.y < p.reachCut) return kCellDone;  // wholly below the cut: it adds nothing
   const vec2 pos = positionOf(t, p.m, p.fraction);
   const uint texel = detailTexel(p.m, pos.x, pos.y, p.shift);
   const float detail = max(texelFetch(details, int(p.detail0 + texel)).r, texelFetch(details, int(p.detail1 + texel)).r);

@@ -393,10 +393,20 @@ std::array<float, 3> fusedShade(const PixelSlices& slices, const shared::SliceBl
     cells.detail[0] = slices.detail(static_cast<int>(blend.first));
     cells.detail[1] = slices.detail(static_cast<int>(blend.weight != 0.0f ? blend.second : blend.first));
     cells.tolerance = light.sumTolerance;
-    if (lobe) {
-      const float reach = shared::cellReach(static_cast<shared::uint>(mapSize(level)));
-      cells.coreCellCos = std::cos(std::min(lobe->coreAngle + reach, static_cast<float>(kPi)));
+    cells.cellMaskWords = cellMaskWords(level);
+    for (std::size_t v = 0; v < 3; ++v) {
+      if (visibility[v].cells) {
+        cells.cellMasks[v] = visibility[v].cells;
+        continue;
+      }
+      scratch.cells.masks.resize(6 * cells.cellMaskWords);
+      std::uint32_t* masks = scratch.cells.masks.data() + 2 * v * cells.cellMaskWords;
+      cellMasks(visibility[v].words, level, masks);
+      cells.cellMasks[v] = masks;
     }
+    const shared::uint m = static_cast<shared::uint>(mapSize(level));
+    if (lobe) cells.coreCellCos = std::cos(std::min(lobe->coreAngle + shared::cellReach(m), static_cast<float>(kPi)));
+    cells.reachCut = shared::cellReachCut(m, pass.skipBelowY);
     float sums[6] = {};
     scratch.cellCounts = {};
     detail::fusedSampleCells(cells, scratch.cells, sums, scratch.cellCounts);

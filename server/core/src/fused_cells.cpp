@@ -15,6 +15,7 @@
 #include "haarcast/core/shared_cells.h"
 #include "haarcast/core/shared_layout.h"
 #include "haarcast/core/sphere_map.h"
+#include "haarcast/core/visibility_bits.h"
 
 namespace haarcast {
 namespace {
@@ -103,6 +104,40 @@ CellLight CellLight::fromPlanes(int level, std::span<const float> rowMajorPlanes
     out.centroidZ[q] = static_cast<float>(at.z);
   }
   return out;
+}
+
+std::size_t cellMaskWords(int level) {
+  checkCellLevel(level);
+  return cellCount(level) / 32 + 1;
+}
+
+void cellMasks(const std::uint32_t* words, int level, std::uint32_t* out) {
+  const std::size_t setWords = cellMaskWords(level);
+  const std::uint32_t m = static_cast<std::uint32_t>(mapSize(level));
+  std::uint32_t* whole = out;
+  std::uint32_t* any = out + setWords;
+  std::fill(out, out + 2 * setWords, 0u);
+  for (std::uint32_t q = 0; q < cellCount(level); ++q) {
+    const std::uint32_t bits = shared::cellBits(words[shared::cellWordIndex(m, q, 0)], words[shared::cellWordIndex(m, q, 1)],
+                                                words[shared::cellWordIndex(m, q, 2)], words[shared::cellWordIndex(m, q, 3)],
+                                                shared::cellShift(m, q));
+    if (bits == shared::kCellAll) whole[q / 32] |= 1u << (q % 32);
+    if (bits != 0u) any[q / 32] |= 1u << (q % 32);
+  }
+}
+
+CellVisibility CellVisibility::fromBits(const VisibilityBits& bits) {
+  CellVisibility out;
+  out.points_ = bits.pointCount();
+  out.wordsPerPoint_ = 2 * cellMaskWords(bits.level());
+  out.masks_.resize(out.points_ * out.wordsPerPoint_);
+  for (std::size_t p = 0; p < out.points_; ++p) cellMasks(bits.point(p).data(), bits.level(), out.masks_.data() + p * out.wordsPerPoint_);
+  return out;
+}
+
+const std::uint32_t* CellVisibility::point(std::size_t p) const {
+  HC_CHECK_LT(p, points_);
+  return masks_.data() + p * wordsPerPoint_;
 }
 
 namespace {

@@ -1,10 +1,10 @@
 // The adaptive pass of `fused` (shared_cells.h, fused_kernel.h
 // fusedSampleCells), compiled for every SIMD target as fused_kernel.cpp is.
 //
-//   1. Each cell of the pass's rows gets V_C from the three vertices' bits,
-//      four rows' words at a time (a word's AND says which of its 8 cells a
-//      vertex sees whole, its OR which it sees none of), or −1 where mixed.
-//   2. Vectors of cells: ρ at each cell's turned centre gives the sampled
+//   1. The cells whose directions can reach the slice's non-zero cap (the
+//      others add zero), compacted with their V_C from the three vertices'
+//      cell masks (fused_cells.h), or −1 where mixed.
+//   2. Vectors of them: ρ at each cell's turned centre gives the sampled
 //      energy Ω_C·ρ and the slice's detail there; a cell that is not mixed,
 //      not detailed and clear of the lobe path's core is coarse, and a lit
 //      coarse cell adds V_C·P_c·ρ_c at its light's centroid. The rest are
@@ -25,31 +25,6 @@ HWY_BEFORE_NAMESPACE();
 namespace haarcast::detail {
 namespace HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
-
-// Step 1 for the cell rows [r0, r1): V_C, or −1, at visibility[q].
-void ClassifyCells(const FusedPass& p, std::uint32_t r0, std::uint32_t r1, float* visibility) {
-  const std::uint32_t m = 1u << p.level, across = m / shared::kCellSide, words = m / 32u;
-  for (std::uint32_t row = r0; row < r1; ++row) {
-    for (std::uint32_t w = 0; w < words; ++w) {
-      std::uint32_t all[3], any[3];
-      for (std::size_t v = 0; v < 3; ++v) {
-        const std::uint32_t* b = p.bits[v] + row * shared::kCellSide * words + w;
-        all[v] = b[0] & b[words] & b[2 * words] & b[3 * words];
-        any[v] = b[0] | b[words] | b[2 * words] | b[3 * words];
-      }
-      for (std::uint32_t j = 0; j < 32u / shared::kCellSide; ++j) {
-        const std::uint32_t shift = j * shared::kCellSide;
-        // A vertex's 16 bits as cellVisibility reads them: all, none, or some.
-        auto bits = [&](std::size_t v) -> std::uint32_t {
-          if (((all[v] >> shift) & 15u) == 15u) return shared::kCellAll;
-          return ((any[v] >> shift) & 15u) == 0u ? 0u : 1u;
-        };
-        visibility[row * across + w * (32u / shared::kCellSide) + j] =
-            shared::cellVisibility(bits(0), bits(1), bits(2), p.bitWeight[0], p.bitWeight[1], p.bitWeight[2]);
-      }
-    }
-  }
-}
 
 template <bool kCore>
 void CellSampleWith(const FusedCellPass& c, CellScratch& scratch, float* HWY_RESTRICT out, CellCounts& counts) {
@@ -77,10 +52,8 @@ void CellSampleWith(const FusedCellPass& c, CellScratch& scratch, float* HWY_RES
 
   const std::uint32_t r0 = static_cast<std::uint32_t>(p.firstRow) / shared::kCellSide;
   const std::uint32_t r1 = std::min(across, (static_cast<std::uint32_t>(p.endRow) + shared::kCellSide - 1) / shared::kCellSide);
-  scratch.visibility.resize(cells + lanes);
   scratch.fine.resize(cells + lanes);
   scratch.mixed.resize(cells + lanes);
-  ClassifyCells(p, r0, r1, scratch.visibility.data());
   const std::size_t q0 = static_cast<std::size_t>(r0) * across, q1 = static_cast<std::size_t>(r1) * across;
 
   PassSums<decltype(d)> sums(d);
@@ -92,13 +65,76 @@ void CellSampleWith(const FusedCellPass& c, CellScratch& scratch, float* HWY_RES
   VF& sumB = sums.sumB;
   auto coreTest = [&](const Turned<VF>& t) { return hn::MulAdd(t.x1, axisX, hn::MulAdd(t.y2, axisY, hn::Mul(t.z2, axisZ))); };
 
-  // Step 2. The cell arrays are padded by 16 past the last cell, so the last
+  // Step 1. The cells that can reach the cut, compacted with what step 2
+  // reads of them (a cell below reachCut adds exactly zero: ρ is zero at
+  // its centre, at its light's centroids and at each of its directions).
+  // The cell arrays are padded by 16 past the last cell, so the last
   // vector's loads stay inside them; its lanes past q1 are masked off.
-  std::size_t fineCount = 0, mixedCount = 0;
+  enum Plane : std::size_t { kX, kY, kZ, kOmega, kV, kPowerR, kPowerG, kPowerB, kCentroidX, kCentroidY, kCentroidZ, kPlanes };
+  const std::size_t stride = cells + lanes;
+  scratch.reaching.resize(stride);
+  scratch.reachingData.resize(kPlanes * stride);
+  std::uint32_t* HWY_RESTRICT reaching = scratch.reaching.data();
+  float* HWY_RESTRICT plane[kPlanes];
+  for (std::size_t k = 0; k < kPlanes; ++k) plane[k] = scratch.reachingData.data() + k * stride;
+  const VF reachCut = hn::Set(d, c.reachCut);
+  const VI laneBit = hn::Shl(hn::Set(di, 1), hn::Iota(di, 0));
+  const VF bitWeight[3] = {hn::Set(d, p.bitWeight[0]), hn::Set(d, p.bitWeight[1]), hn::Set(d, p.bitWeight[2])};
+  // V_C of cells q … q + lanes − 1: Σ_v b_v·whole_v, or −1 where a vertex
+  // of non-zero weight sees part of a cell (shared::cellVisibility, its
+  // sums in its order).
+  auto cellVisibility = [&](std::size_t q) {
+    auto window = [&](const std::uint32_t* set) {
+      const std::uint64_t pair = set[q / 32] | (static_cast<std::uint64_t>(set[q / 32 + 1]) << 32);
+      return hn::RebindMask(d, hn::TestBit(hn::Set(di, static_cast<int32_t>(static_cast<std::uint32_t>(pair >> (q % 32)))), laneBit));
+    };
+    VF v = zero;
+    auto mixed = hn::Lt(v, zero);  // none
+    for (std::size_t k = 0; k < 3; ++k) {
+      const auto whole = window(c.cellMasks[k]);
+      v = hn::Add(v, hn::IfThenElseZero(whole, bitWeight[k]));
+      if (p.bitWeight[k] != 0.0f) mixed = hn::Or(mixed, hn::AndNot(whole, window(c.cellMasks[k] + c.cellMaskWords)));
+    }
+    return hn::IfThenElse(mixed, hn::Set(d, -1.0f), v);
+  };
+  std::size_t reached = 0;
   for (std::size_t q = q0; q < q1; q += lanes) {
     const auto valid = hn::RebindMask(d, hn::Lt(hn::Iota(di, static_cast<int32_t>(q)), hn::Set(di, static_cast<int32_t>(q1))));
     const Turned<VF> t = look.Turn(hn::LoadU(d, dirs.centreX.data() + q), hn::LoadU(d, dirs.centreY.data() + q),
                                    hn::LoadU(d, dirs.centreZ.data() + q));
+    const auto keep = hn::And(valid, hn::Ge(t.y2, reachCut));
+    if (hn::AllFalse(d, keep)) continue;
+    // Compressed in registers and stored whole (the arrays have a vector's
+    // room past the last cell): cheaper than a compressing store on some cores.
+    auto put = [&](VF v, Plane k) { hn::StoreU(hn::Compress(v, keep), d, plane[k] + reached); };
+    put(t.x1, kX);
+    put(t.y2, kY);
+    put(t.z2, kZ);
+    put(hn::LoadU(d, dirs.cellSolidAngle.data() + q), kOmega);
+    put(cellVisibility(q), kV);
+    put(hn::LoadU(d, light.power.data() + q), kPowerR);
+    put(hn::LoadU(d, light.power.data() + light.stride + q), kPowerG);
+    put(hn::LoadU(d, light.power.data() + 2 * light.stride + q), kPowerB);
+    put(hn::LoadU(d, light.centroidX.data() + q), kCentroidX);
+    put(hn::LoadU(d, light.centroidY.data() + q), kCentroidY);
+    put(hn::LoadU(d, light.centroidZ.data() + q), kCentroidZ);
+    hn::StoreU(hn::Compress(hn::Iota(di, static_cast<int32_t>(q)), hn::RebindMask(di, keep)), di,
+               reinterpret_cast<int32_t*>(reaching) + reached);
+    reached += hn::CountTrue(d, keep);
+  }
+  // The last vector's lanes past `reached`: a direction the lookup reads
+  // inside the slice (their sums are masked off below).
+  for (std::size_t j = reached; j < (reached + lanes - 1) / lanes * lanes; ++j) {
+    for (std::size_t k = 0; k < kPlanes; ++k) plane[k][j] = 0.0f;
+    plane[kY][j] = plane[kCentroidY][j] = 1.0f;
+    reaching[j] = 0;
+  }
+
+  // Step 2. Vectors of reaching cells.
+  std::size_t fineCount = 0, mixedCount = 0;
+  for (std::size_t j = 0; j < reached; j += lanes) {
+    const auto valid = hn::RebindMask(d, hn::Lt(hn::Iota(di, static_cast<int32_t>(j)), hn::Set(di, static_cast<int32_t>(reached))));
+    const Turned<VF> t{hn::LoadU(d, plane[kX] + j), hn::LoadU(d, plane[kY] + j), hn::LoadU(d, plane[kZ] + j)};
     VF rowPos, colPos, rhoR, rhoG, rhoB;
     look.Position(t, rowPos, colPos);
     look.Rho(rowPos, colPos, rhoR, rhoG, rhoB);
@@ -107,41 +143,42 @@ void CellSampleWith(const FusedCellPass& c, CellScratch& scratch, float* HWY_RES
     const VI detailCol = hn::ShiftRight<2>(hn::And(hn::Sub(hn::ConvertTo(di, hn::Floor(hn::Add(colPos, half))), colShift), colMask));
     const VI detailIndex = hn::Or(hn::ShiftLeftSame(detailRow, p.level - 2), detailCol);  // row·(M/4) + column
     const VF detail = hn::Max(hn::GatherIndex(d, c.detail[0], detailIndex), hn::GatherIndex(d, c.detail[1], detailIndex));
-    const VF v = hn::LoadU(d, scratch.visibility.data() + q);
+    const VF v = hn::LoadU(d, plane[kV] + j);
     auto fine = hn::Gt(detail, tolerance);
     if constexpr (kCore) fine = hn::Or(fine, hn::Gt(coreTest(t), coreCellCos));
     fine = hn::And(fine, valid);
     const auto coarse = hn::AndNot(fine, valid);
-    const VF omega = hn::LoadU(d, dirs.cellSolidAngle.data() + q);
+    const VF omega = hn::LoadU(d, plane[kOmega] + j);
     sumR = hn::MulAdd(hn::IfThenElseZero(coarse, omega), rhoR, sumR);
     sumG = hn::MulAdd(hn::IfThenElseZero(coarse, omega), rhoG, sumG);
     sumB = hn::MulAdd(hn::IfThenElseZero(coarse, omega), rhoB, sumB);
     counts.coarse += hn::CountTrue(d, coarse);
     const auto lit = hn::And(coarse, hn::Gt(v, zero));
     if (!hn::AllFalse(d, lit)) {
-      const Turned<VF> tc = look.Turn(hn::LoadU(d, light.centroidX.data() + q), hn::LoadU(d, light.centroidY.data() + q),
-                                      hn::LoadU(d, light.centroidZ.data() + q));
+      const Turned<VF> tc = look.Turn(hn::LoadU(d, plane[kCentroidX] + j), hn::LoadU(d, plane[kCentroidY] + j),
+                                      hn::LoadU(d, plane[kCentroidZ] + j));
       VF cRow, cCol, cR, cG, cB;
       look.Position(tc, cRow, cCol);
       look.Rho(cRow, cCol, cR, cG, cB);
       const VF w = hn::IfThenElseZero(lit, v);
-      accR = hn::MulAdd(hn::Mul(hn::LoadU(d, light.power.data() + q), w), cR, accR);
-      accG = hn::MulAdd(hn::Mul(hn::LoadU(d, light.power.data() + light.stride + q), w), cG, accG);
-      accB = hn::MulAdd(hn::Mul(hn::LoadU(d, light.power.data() + 2 * light.stride + q), w), cB, accB);
+      accR = hn::MulAdd(hn::Mul(hn::LoadU(d, plane[kPowerR] + j), w), cR, accR);
+      accG = hn::MulAdd(hn::Mul(hn::LoadU(d, plane[kPowerG] + j), w), cG, accG);
+      accB = hn::MulAdd(hn::Mul(hn::LoadU(d, plane[kPowerB] + j), w), cB, accB);
     }
     const auto mixed = hn::And(coarse, hn::Lt(v, zero));
-    const VI index = hn::Iota(di, static_cast<int32_t>(q));
+    const VI index = hn::LoadU(di, reinterpret_cast<const int32_t*>(reaching) + j);
     if (!hn::AllFalse(d, mixed)) {
-      mixedCount += hn::CompressStore(index, hn::RebindMask(di, mixed), di, reinterpret_cast<int32_t*>(scratch.mixed.data()) + mixedCount);
+      hn::StoreU(hn::Compress(index, hn::RebindMask(di, mixed)), di, reinterpret_cast<int32_t*>(scratch.mixed.data()) + mixedCount);
+      mixedCount += hn::CountTrue(d, mixed);
     }
     if (!hn::AllFalse(d, fine)) {
-      fineCount += hn::CompressStore(index, hn::RebindMask(di, fine), di, reinterpret_cast<int32_t*>(scratch.fine.data()) + fineCount);
+      hn::StoreU(hn::Compress(index, hn::RebindMask(di, fine)), di, reinterpret_cast<int32_t*>(scratch.fine.data()) + fineCount);
+      fineCount += hn::CountTrue(d, fine);
     }
   }
   counts.fine += fineCount;
   counts.mixed += mixedCount;
 
-  const VI laneBit = hn::Shl(hn::Set(di, 1), hn::Iota(di, 0));
   const VF bitWeight0 = hn::Set(d, p.bitWeight[0]), bitWeight1 = hn::Set(d, p.bitWeight[1]);
   const VF bitWeight2 = hn::Set(d, p.bitWeight[2]);
   // V = ((0 + b₀·bit₀) + b₁·bit₁) + b₂·bit₂ over directions k … k + lanes − 1

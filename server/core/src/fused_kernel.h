@@ -64,10 +64,16 @@ struct FusedCellPass {
   const CellDirections* cells = nullptr;
   const CellLight* light = nullptr;
   const float* detail[2] = {nullptr, nullptr};  // the blend's two slices' detail maps
+  // The three vertices' cell masks (fused_cells.h cellMasks): V_C per cell.
+  const std::uint32_t* cellMasks[3] = {nullptr, nullptr, nullptr};
+  std::size_t cellMaskWords = 0;  // per set
   float tolerance = 0.0f;
   // cos(core angle + cellReach): a cell whose turned centre is nearer the
   // lobe's axis may hold core directions and is summed fine; > 1: no core.
   float coreCellCos = 2.0f;
+  // shared::cellReachCut: a cell whose turned centre has y below it adds
+  // nothing and is not visited.
+  float reachCut = -2.0f;
 };
 // out as fusedSample's, over the cells of rows firstRow … endRow − 1.
 void fusedSampleCells(const FusedCellPass& pass, CellScratch& scratch, float out[6], CellCounts& counts);

@@ -698,7 +698,9 @@ std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const RayScen
       return Shaded{};
     }
     std::array<WeightedBits, 3> vis;
-    for (std::size_t v = 0; v < 3; ++v) vis[v] = {p.visibilityBits.point(in.vertex[v]).data(), static_cast<float>(in.b[v])};
+    for (std::size_t v = 0; v < 3; ++v)
+      vis[v] = {p.visibilityBits.point(in.vertex[v]).data(), static_cast<float>(in.b[v]),
+                p.cellVisibility.empty() ? nullptr : p.cellVisibility.point(in.vertex[v])};
     const PixelSlices& slices = pixelSlices_[object];
     const shared::SliceBlend blend = shared::sliceBlendAt(static_cast<float>(in.rotation.thetaOut),
                                                           static_cast<shared::uint>(slices.thetaSamples()),

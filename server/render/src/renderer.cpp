@@ -10,6 +10,7 @@
 #include <glm/geometric.hpp>
 
 #include "haarcast/core/lobe.h"
+#include "haarcast/core/shared_cells.h"
 #include "haarcast/core/splitsum.h"
 #include "haarcast/io/slice_cache.h"
 #include "haarcast/render/build_plan.h"
@@ -134,6 +135,8 @@ PreparedScene prepareScene(const Scene& scene, const RenderOptions& options, con
         p.mesh = std::make_shared<const Mesh>(std::move(r.mesh));
         p.visibilityBits = std::move(r.bits);
       }
+      if (shared::sumsByCells(static_cast<shared::uint>(p.level), p.sumTolerance))
+        p.cellVisibility = CellVisibility::fromBits(p.visibilityBits);
     } else {
       p.visibility = loadOrComputeVertexVisibility(*p.mesh, vis, options.cacheDir, visibilityProgress);
     }

@@ -38,6 +38,51 @@ TEST(SharedCells, CellBitsAreTheRowMajorBitsOfTheCellsDirections) {
   }
 }
 
+// A point's cell masks say which cells its bits see whole and which any
+// of, against the cell's 16 bits; the word past each set stays zero (the
+// pass reads the 32 cells from any cell as two words).
+TEST(SharedCells, CellMasksAreWhichCellsAPointSeesWholeAndWhichAny) {
+  std::mt19937 rng(11);
+  for (int level : {5, 6, 7}) {
+    const shared::uint m = 1u << level;
+    const std::size_t cells = shared::cellsAcross(m) * shared::cellsAcross(m);
+    VisibilityBits bits(level, 2);
+    for (std::size_t p = 0; p < 2; ++p) {
+      // Whole, empty and mixed cells alike: most are one of the first two.
+      const std::span<std::uint32_t> w = bits.point(p);
+      for (shared::uint q = 0; q < cells; ++q) {
+        const std::uint32_t r = static_cast<std::uint32_t>(rng());
+        const std::uint32_t pattern = (r & 3u) == 0u ? static_cast<std::uint32_t>(rng()) : ((r & 4u) ? 0xFFFFu : 0u);
+        for (shared::uint k = 0; k < shared::kCellDirections; ++k) {
+          const shared::uint i = shared::cellDirection(m, q, k);
+          if ((pattern >> k) & 1u) w[i / 32] |= 1u << (i % 32);
+        }
+      }
+    }
+    const CellVisibility masks = CellVisibility::fromBits(bits);
+    const std::size_t words = cellMaskWords(level);
+    ASSERT_EQ(words, cells / 32 + 1);
+    std::size_t whole = 0, none = 0;
+    for (std::size_t p = 0; p < 2; ++p) {
+      const std::span<const std::uint32_t> w = bits.point(p);
+      const std::uint32_t* set = masks.point(p);
+      for (shared::uint q = 0; q < cells; ++q) {
+        const shared::uint b = shared::cellBits(w[shared::cellWordIndex(m, q, 0)], w[shared::cellWordIndex(m, q, 1)],
+                                                w[shared::cellWordIndex(m, q, 2)], w[shared::cellWordIndex(m, q, 3)], shared::cellShift(m, q));
+        ASSERT_EQ((set[q / 32] >> (q % 32)) & 1u, b == shared::kCellAll ? 1u : 0u) << "level " << level << " cell " << q;
+        ASSERT_EQ((set[words + q / 32] >> (q % 32)) & 1u, b != 0u ? 1u : 0u) << "level " << level << " cell " << q;
+        whole += b == shared::kCellAll;
+        none += b == 0u;
+      }
+      EXPECT_EQ(set[words - 1], 0u);
+      EXPECT_EQ(set[2 * words - 1], 0u);
+    }
+    EXPECT_GT(whole, cells / 4);
+    EXPECT_GT(none, cells / 4);
+    EXPECT_LT(whole + none, 2 * cells);
+  }
+}
+
 // The cells tile the sphere, and cellReach bounds (tightly) how far a
 // cell's directions lie from its centre: the lobe path's core test and the
 // error bound rest on it.

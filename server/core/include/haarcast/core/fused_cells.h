@@ -10,6 +10,8 @@
 
 namespace haarcast {
 
+class VisibilityBits;
+
 // A level's map directions in cell order (direction k of cell q at
 // q·16 + k, shared::cellDirection), and per cell its centre: the
 // ΔΩ-weighted mean of its 16 directions, normalised, and Ω_C = Σ ΔΩ.
@@ -38,14 +40,43 @@ struct CellLight {
   static CellLight fromPlanes(int level, std::span<const float> rowMajorPlanes);
 };
 
+// Which cells of a point's map it sees whole, and which it sees any of
+// (shared_cells.h: what V_C is made of): two sets of K bits, cell q at bit
+// q % 32 of word q / 32, the "whole" set first. Each set has one zero word
+// past its last, so that the 32 cells from any cell on are two of its words.
+std::size_t cellMaskWords(int level);  // per set: K/32 + 1
+// From one point's visibility words (core VisibilityBits) into `out`
+// (2·cellMaskWords(level) words).
+void cellMasks(const std::uint32_t* words, int level, std::uint32_t* out);
+// Every point's masks, built once from its bits (as WeightedBits::cells
+// reads them).
+class CellVisibility {
+ public:
+  CellVisibility() = default;
+  static CellVisibility fromBits(const VisibilityBits& bits);
+  bool empty() const { return masks_.empty(); }
+  const std::uint32_t* point(std::size_t p) const;
+
+ private:
+  std::size_t points_ = 0;
+  std::size_t wordsPerPoint_ = 0;
+  std::vector<std::uint32_t> masks_;
+};
+
 // Per-thread working memory of the adaptive pass (in FusedScratch).
 struct CellScratch {
-  std::vector<float> visibility;     // per cell: V_C, or −1 where mixed
+  // The three vertices' masks where the caller gave none (cellMasks).
+  std::vector<std::uint32_t> masks;
   std::vector<std::uint32_t> fine;   // the cells summed fine
   std::vector<std::uint32_t> mixed;  // the mixed cells summed coarse
   // Per mixed cell: Σ V·L_c·ΔΩ (three planes) and the centroid of its
   // directions weighted by V·(L_R + L_G + L_B)·ΔΩ.
   std::vector<float> mixedPower, mixedX, mixedY, mixedZ;
+  // The cells that can reach the slice's non-zero cap, in order: their
+  // indices, and per cell (planes of the same stride) the turned centre,
+  // Ω_C, V_C, P_c and the light's centroid (fused_cells_kernel.cpp).
+  std::vector<std::uint32_t> reaching;
+  std::vector<float> reachingData;
 };
 // What one adaptive pass did.
 struct CellCounts {

@@ -92,6 +92,17 @@ HC_FUNCTION float cellVisibility(uint bits0, uint bits1, uint bits2, float b0, f
 // centre's pull toward the cell's wider rows (SharedCells.CellReach measures it).
 HC_FUNCTION float cellReach(uint m) { return 10.6f / float(m); }
 
+// The y below which a cell's turned centre puts the whole cell below the
+// pass's cut skipBelowY (core fused_kernel.h FusedPass): every direction
+// within cellReach of the centre, and so every centroid of them, then reads
+// only zero texels, and the cell adds nothing. A cut below the equator
+// only (skipBelowY < 0: a centroid of directions below it is below it
+// too); −2 where there is none: every cell is visited.
+HC_FUNCTION float cellReachCut(uint m, float skipBelowY) {
+  if (!(skipBelowY < 0.0f && skipBelowY > -1.0f)) return -2.0f;
+  return HC_SIN(1.57079632679f - min(HC_ACOS(skipBelowY) + cellReach(m), 3.14159265f));
+}
+
 // The Vulkan backend keeps every slice's detail map at a stride of the
 // most cells a map has (M/4 × M/4 at shared::kFusedMaxLevel = 7): global
 // slice s's at s·kCellDetailStride.

@@ -62,6 +62,9 @@ std::size_t visibilityWordsPerPoint(int level);
 struct WeightedBits {
   const std::uint32_t* words = nullptr;
   float weight = 0.0f;
+  // The point's cell masks (fused_cells.h CellVisibility) where they were
+  // built, for `fused`'s sum by cells; null: formed from `words` per pixel.
+  const std::uint32_t* cells = nullptr;
 };
 void blendVisibility(std::span<const WeightedBits> points, int level, std::span<float> out);
 

@@ -177,6 +177,8 @@ struct PreparedObject {
   // fused), and fused's bits at map resolution (empty for the others).
   std::vector<SparseHaar> visibility;
   VisibilityBits visibilityBits;
+  // `fused` by cells: each vertex's cell masks, from visibilityBits.
+  CellVisibility cellVisibility;
   Pose pose;                           // the scene's pose
   bool ground = false;                 // the scene's ground (SceneObject::ground)
   // `fused`: RenderOptions::sumTolerance where the object is summed by cells
