@@ -45,7 +45,9 @@ bool smoothTaken(ShadeSample sh, ObjectInfo o, vec3 mirror, out vec3 sum) {
     if (!smoothParent(p.at2, sh.object, mirror, cosLimit, s2) || !smoothParent(p.at3, sh.object, mirror, cosLimit, s3))
       return false;
   } else if (p.outer != 0u) {
-    if (!smoothParent(p.at2, sh.object, mirror, cosLimit, s2) || !smoothParent(p.at3, sh.object, mirror, cosLimit, s3))
+    // The outer pair only measures the curve: on the object and visited
+    // suffices (any mirror is near at a limit of −2).
+    if (!smoothParent(p.at2, sh.object, mirror, -2.0, s2) || !smoothParent(p.at3, sh.object, mirror, -2.0, s3))
       p.outer = 0u;
   }
   const float brightness = smoothBrightness(p, radiance[p.at0].rgb, radiance[p.at1].rgb, radiance[p.at2].rgb,

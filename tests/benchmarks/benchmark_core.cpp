@@ -37,6 +37,8 @@
 #include "haarcast/core/brdf.h"
 #include "haarcast/core/brdf_slices.h"
 #include "haarcast/core/fused.h"
+#include "haarcast/core/fused_cells.h"
+#include "haarcast/core/shared_cells.h"
 #include "haarcast/core/haar.h"
 #include "haarcast/core/rotate_haar.h"
 #include "haarcast/core/rotation.h"
@@ -270,6 +272,10 @@ struct PixelInputs {
   std::unique_ptr<RgbHaarRotator> rgb;                     // lean
   PixelSlices pixelSlices;                                 // fused
   FusedLight fusedLight;
+  // fused by cells (shared_cells.h): the slices with their detail maps, the
+  // light by cells at the default tolerance (levels ≥ kCellMinLevel).
+  PixelSlices cellSlices;
+  FusedLight cellLight;
   std::array<SparseHaar, 3> light;
   std::array<PreparedLight, 3> preparedLight;
   std::vector<std::array<SparseHaar, 3>> triangles;  // per-vertex visibility
@@ -298,14 +304,19 @@ const PixelInputs& pixelInputs(int level) {
     std::vector<HaarMap> all;
     for (std::size_t t = 0; t < slices[0].size(); ++t) thetaOut.push_back((static_cast<double>(t) + 0.5) * (kPi / 2.0) / static_cast<double>(slices[0].size()));
     for (const auto& channel : slices) all.insert(all.end(), channel.begin(), channel.end());
-    in.pixelSlices = PixelSlices::synthesize(BrdfSliceTable::fromSlices(thetaOut, std::move(all)));
+    const BrdfSliceTable table = BrdfSliceTable::fromSlices(thetaOut, std::move(all));
+    in.pixelSlices = PixelSlices::synthesize(table);
+    if (level >= static_cast<int>(shared::kCellMinLevel)) in.cellSlices = PixelSlices::synthesize(table, nullptr, true);
   }
   const std::array<SphereMap, 3> env = assets::proceduralEnvironment(level, 4);
+  std::array<SphereMap, 3> weighted;
   for (std::size_t c = 0; c < 3; ++c) {
-    in.light[c] = keepLargest(forwardHaar(env[c].weightedBySolidAngle()), 256);
+    weighted[c] = env[c].weightedBySolidAngle();
+    in.light[c] = keepLargest(forwardHaar(weighted[c]), 256);
     in.preparedLight[c].assign(in.light[c]);
   }
   in.fusedLight = FusedLight::synthesize(in.light);
+  if (level >= static_cast<int>(shared::kCellMinLevel)) in.cellLight = FusedLight::fromWeightedMaps(weighted, shared::kDefaultSumTolerance);
   // Each vertex near a wall: a slanted horizon and a cone-shaped occluder
   // whose direction and size vary from vertex to vertex.
   std::mt19937 rng(77);
@@ -376,15 +387,28 @@ BENCHMARK_CAPTURE(BM_HaarPixel, lean, true)->DenseRange(4, 5)->Unit(benchmark::k
 // the three channels, θₒ blend of two slices, the same inputs. Compare with
 // BM_HaarPixel on the same run. `bits`: the visibility as the renderer holds
 // it, each vertex's bits blended inside the pass (BM_FusedPixelBits); else
-// the vertices' Haar lists merged and synthesised per pixel.
-void fusedPixel(benchmark::State& state, bool bits) {
+// the vertices' Haar lists merged and synthesised per pixel. `cells`: with
+// bits, summed by cells as the renderer sums its objects by default
+// (BM_FusedPixelCells; each vertex's cell masks built once, as the renderer
+// keeps them).
+void fusedPixel(benchmark::State& state, bool bits, bool cells = false) {
   const int level = static_cast<int>(state.range(0));
   const PixelInputs& in = pixelInputs(level);
   const std::vector<EulerYXY>& rs = rotations();
   const auto slices = static_cast<shared::uint>(in.pixelSlices.thetaSamples());
   FusedScratch scratch;
+  // Per triangle, its vertices' cell masks (fused_cells.h cellMasks).
+  std::vector<std::array<std::vector<std::uint32_t>, 3>> masks(kTriangleCount);
+  if (cells) {
+    for (std::size_t t = 0; t < kTriangleCount; ++t) {
+      for (std::size_t v = 0; v < 3; ++v) {
+        masks[t][v].resize(2 * cellMaskWords(level));
+        cellMasks(in.triangleBits[t][v].data(), level, masks[t][v].data());
+      }
+    }
+  }
   float radiance = 0.0f;
-  std::size_t i = 0;
+  std::size_t i = 0, directions = 0;
   for (auto _ : state) {
     const EulerYXY& r = rs[i & (kRotationCount - 1)];
     const std::size_t t = i & (kTriangleCount - 1);
@@ -394,10 +418,16 @@ void fusedPixel(benchmark::State& state, bool bits) {
     std::array<float, 3> rgb{};
     if (bits) {
       const auto& words = in.triangleBits[t];
-      const std::array<WeightedBits, 3> vis{WeightedBits{words[0].data(), static_cast<float>(b[0])},
-                                            WeightedBits{words[1].data(), static_cast<float>(b[1])},
-                                            WeightedBits{words[2].data(), static_cast<float>(b[2])}};
-      rgb = fusedShade(in.pixelSlices, blend, r, in.fusedLight, vis, {}, 0u, scratch);
+      std::array<WeightedBits, 3> vis{WeightedBits{words[0].data(), static_cast<float>(b[0])},
+                                      WeightedBits{words[1].data(), static_cast<float>(b[1])},
+                                      WeightedBits{words[2].data(), static_cast<float>(b[2])}};
+      if (cells) {
+        for (std::size_t v = 0; v < 3; ++v) vis[v].cells = masks[t][v].data();
+        rgb = fusedShade(in.cellSlices, blend, r, in.cellLight, vis, {}, 0u, scratch);
+      } else {
+        rgb = fusedShade(in.pixelSlices, blend, r, in.fusedLight, vis, {}, 0u, scratch);
+      }
+      directions += scratch.passDirections;
     } else {
       const std::array<SparseHaar, 3>& v = in.triangles[t];
       const std::array<WeightedVisibility, 3> vis{WeightedVisibility{&v[0], static_cast<float>(b[0])},
@@ -410,12 +440,15 @@ void fusedPixel(benchmark::State& state, bool bits) {
     ++i;
   }
   setCounters(state, level);
+  if (bits) state.counters["directions"] = benchmark::Counter(static_cast<double>(directions) / static_cast<double>(std::max<std::size_t>(i, 1)));
   state.SetLabel(fusedTargetName());
 }
 void BM_FusedPixel(benchmark::State& state) { fusedPixel(state, false); }
 void BM_FusedPixelBits(benchmark::State& state) { fusedPixel(state, true); }
+void BM_FusedPixelCells(benchmark::State& state) { fusedPixel(state, true, true); }
 BENCHMARK(BM_FusedPixel)->DenseRange(4, 7)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_FusedPixelBits)->DenseRange(4, 7)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_FusedPixelCells)->DenseRange(5, 7)->Unit(benchmark::kMicrosecond);
 
 // The lean pixel's parts on their own: where its time goes (merge_visibility
 // includes preparing the merged list, once per pixel).

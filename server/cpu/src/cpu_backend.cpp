@@ -793,18 +793,19 @@ std::size_t CpuRenderer::shadeSmoothSums(const GBuffer& g, FusedSlots& slots, co
         slots.mirrors[i] = shared::smoothMirror(static_cast<float>(in.euler.alpha), static_cast<float>(in.euler.beta),
                                                 static_cast<float>(in.euler.gamma), static_cast<float>(in.thetaOut));
         // Its parents, where each is on this object, visited, and its
-        // mirror direction near the pixel's; where A' or B' is not, the
-        // outer pair is dropped and A and B decide alone.
+        // mirror direction near the pixel's; the outer pair A', B' (which
+        // only measures the curve) where each is on this object and
+        // visited, else dropped, and A and B decide alone.
         const std::array<shared::uint, 4> at{parents.at0, parents.at1, parents.at2, parents.at3};
         const float cosLimit = cosLimits[*object];
-        auto usable = [&](shared::uint q) {
+        auto usable = [&](shared::uint q, float limit) {
           return state[q] != kNotVisited && g.centre[q]->hit.object == *object &&
-                 shared::smoothMirrorNear(slots.mirrors[i], slots.mirrors[q], cosLimit);
+                 shared::smoothMirrorNear(slots.mirrors[i], slots.mirrors[q], limit);
         };
         bool fromParents = parents.count > 0;
         const std::size_t near = parents.count == 4 ? 4 : 2;
-        for (std::size_t k = 0; k < near && fromParents; ++k) fromParents = usable(at[k]);
-        if (fromParents && parents.outer != 0u && !(usable(at[2]) && usable(at[3]))) parents.outer = 0u;
+        for (std::size_t k = 0; k < near && fromParents; ++k) fromParents = usable(at[k], cosLimit);
+        if (fromParents && parents.outer != 0u && !(usable(at[2], -2.0f) && usable(at[3], -2.0f))) parents.outer = 0u;
         FusedSum sum;
         if (fromParents) {
           std::array<glm::vec3, 4> sums{}, shown{};

@@ -21,7 +21,9 @@
 //     the map's directions, changes from pixel to pixel more than its
 //     neighbours' agreement can show), and
 //   - their sums agree (smoothSumsAgree) within the tolerance of what they
-//     show,
+//     show (Edges' outer pair A', B', which only measures the curve, need
+//     only be on the object and visited: the error's bound, half the near
+//     parents' spread, rests on A and B alone),
 // and is summed where not. A parent outside the frame, on another object or
 // not summed (the ground, an edge pixel's sub-samples) makes the pixel sum.
 // What slips through is a feature of the sum narrower than the spacing whose
