@@ -5,6 +5,7 @@
 #include "haarcast/render/renderer.h"
 
 #include <algorithm>
+#include <limits>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -192,6 +193,10 @@ class CpuRenderer final : public Renderer {
     std::vector<std::array<float, 3>> sums, shaded;
     std::vector<glm::vec3> mirrors;  // shared::smoothMirror
     std::vector<std::uint8_t> centreState;
+    // The object whose sum each pixel's centre takes part in, or −1
+    // (shadeSmoothSums): what its stages read of the G-buffer, two bytes a
+    // pixel rather than a sample's.
+    std::vector<std::int16_t> visitObject;
   };
   struct FrameWork {
     std::unique_ptr<RayScene> rays;
@@ -756,14 +761,20 @@ std::size_t CpuRenderer::shadeSmoothSums(const GBuffer& g, FusedSlots& slots, co
   state.assign(pixels, kNotVisited);
   // A pixel whose sum the pass computes: an interior pixel's centre on an
   // object the pass sums (not the ground, not the lobe path alone), as
-  // fused.comp's smoothVisited.
-  auto objectOf = [&](std::size_t i) -> std::optional<std::size_t> {
-    if (g.edge[i] != kInterior || !g.centre[i]) return std::nullopt;
-    const std::size_t object = g.centre[i]->hit.object;
-    const PreparedObject& p = prepared_.objects[object];
-    if (p.ground || (p.lobePath && p.lobeCore >= static_cast<float>(kPi))) return std::nullopt;
-    return object;
-  };
+  // fused.comp's smoothVisited; once, row by row.
+  HC_CHECK_LT(prepared_.objects.size(), std::size_t{std::numeric_limits<std::int16_t>::max()});
+  std::vector<std::int16_t>& objectAt = slots.visitObject;
+  objectAt.resize(pixels);
+  parallelFor(g.height, [&](std::size_t y) {
+    for (std::size_t i = y * g.width; i < (y + 1) * g.width; ++i) {
+      objectAt[i] = -1;
+      if (g.edge[i] != kInterior || !g.centre[i]) continue;
+      const std::size_t object = g.centre[i]->hit.object;
+      const PreparedObject& p = prepared_.objects[object];
+      if (p.ground || (p.lobePath && p.lobeCore >= static_cast<float>(kPi))) continue;
+      objectAt[i] = static_cast<std::int16_t>(object);
+    }
+  }, {}, options_.threads);
   const float tolerance = options_.smoothSumTolerance;
   // Each object's limit between mirror directions, once (as scene_upload.cpp puts it in ObjectInfo).
   std::vector<float> cosLimits;
@@ -787,8 +798,8 @@ std::size_t CpuRenderer::shadeSmoothSums(const GBuffer& g, FusedSlots& slots, co
         shared::SmoothParents parents = shared::smoothParents(stage, x, y, w, h);
         HC_CHECK_NE(parents.count, -2);  // smoothRowFirst visits the stage's pixels only
         const std::size_t i = static_cast<std::size_t>(y) * g.width + static_cast<std::size_t>(x);
-        const std::optional<std::size_t> object = objectOf(i);
-        if (!object) continue;
+        if (objectAt[i] < 0) continue;
+        const std::size_t object = static_cast<std::size_t>(objectAt[i]);
         const RotationInput& in = g.centre[i]->input.rotation;
         slots.mirrors[i] = shared::smoothMirror(static_cast<float>(in.euler.alpha), static_cast<float>(in.euler.beta),
                                                 static_cast<float>(in.euler.gamma), static_cast<float>(in.thetaOut));
@@ -797,9 +808,9 @@ std::size_t CpuRenderer::shadeSmoothSums(const GBuffer& g, FusedSlots& slots, co
         // only measures the curve) where each is on this object and
         // visited, else dropped, and A and B decide alone.
         const std::array<shared::uint, 4> at{parents.at0, parents.at1, parents.at2, parents.at3};
-        const float cosLimit = cosLimits[*object];
+        const float cosLimit = cosLimits[object];
         auto usable = [&](shared::uint q, float limit) {
-          return state[q] != kNotVisited && g.centre[q]->hit.object == *object &&
+          return state[q] != kNotVisited && objectAt[q] == objectAt[i] &&
                  shared::smoothMirrorNear(slots.mirrors[i], slots.mirrors[q], limit);
         };
         bool fromParents = parents.count > 0;
