@@ -5,6 +5,7 @@
 #include "haarcast/render/renderer.h"
 
 #include <algorithm>
+#include <bit>
 #include <limits>
 #include <atomic>
 #include <chrono>
@@ -696,10 +697,14 @@ std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const RayScen
       // The word the Vulkan backend reads too: bits, then the sky's occlusion.
       seen = withGroundOcclusion(seen, sky.at(sample.pixel, [&] { return groundSkyOcclusion(rays, point, resolved.skyOccluders); }));
       const float kept = shared::groundSkyKept(seen);
-      for (std::size_t c = 0; c < 3; ++c) rgb[c] = kept * o.groundFlat[c];
-      for (std::size_t k = 0; k < o.pointLights.size(); ++k)
-        if ((seen >> k) & 1u)
-          for (std::size_t c = 0; c < 3; ++c) rgb[c] += o.pointLights[k].power[c];
+      // In registers, over the lights it sees, in order.
+      glm::vec3 sum = kept * glm::vec3(o.groundFlat[0], o.groundFlat[1], o.groundFlat[2]);
+      const std::uint32_t lights = (1u << o.pointLights.size()) - 1u;  // at most kMaxPointLights < 32
+      for (std::uint32_t bits = seen & lights; bits != 0u; bits &= bits - 1u) {
+        const FusedPointLight& light = o.pointLights[static_cast<std::size_t>(std::countr_zero(bits))];
+        sum += glm::vec3(light.power[0], light.power[1], light.power[2]);
+      }
+      rgb = {sum.x, sum.y, sum.z};
       return Shaded{};
     }
     std::array<WeightedBits, 3> vis;
