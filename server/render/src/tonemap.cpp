@@ -121,8 +121,19 @@ std::vector<std::uint8_t> tonemapRgba8(const io::RgbImage& image, double exposur
   std::vector<std::uint8_t> out(pixels * 4);
   constexpr std::size_t kBand = std::size_t{1} << 16;  // pixels a task
   parallelFor((pixels + kBand - 1) / kBand, [&](std::size_t b) {
+    // Each channel's last code, kept where the next value lies in its
+    // bracket (most neighbours do): the code is the one k with
+    // threshold[k] ≤ value < threshold[k + 1] (k = 0: below threshold[1];
+    // NaN takes 0 as the search gives it), so the bytes are the search's.
+    std::array<std::uint32_t, 3> last{0u, 0u, 0u};
     for (std::size_t p = b * kBand; p < std::min(pixels, (b + 1) * kBand); ++p) {
-      for (std::size_t c = 0; c < 3; ++c) out[4 * p + c] = tonemapByte(image.rgb[3 * p + c], thresholds);
+      for (std::size_t c = 0; c < 3; ++c) {
+        const float value = image.rgb[3 * p + c];
+        const std::uint32_t k = last[c];
+        const bool inBracket = (k == 0u || value >= thresholds[k]) && (k + 1u == shared::kToneCodes || !(value >= thresholds[k + 1u]));
+        if (!inBracket) last[c] = shared::tonemapCode(value, thresholds);
+        out[4 * p + c] = static_cast<std::uint8_t>(last[c]);
+      }
       out[4 * p + 3] = 255;
     }
   }, {}, threads);

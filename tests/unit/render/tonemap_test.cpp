@@ -6,7 +6,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
+#include <vector>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -127,6 +129,44 @@ TEST(Tonemap, RgbaIsEachChannelAndOpaqueAlpha) {
   for (std::size_t p = 0; p < 2; ++p) {
     for (std::size_t c = 0; c < 3; ++c) EXPECT_EQ(rgba[4 * p + c], tonemapByte(image.rgb[3 * p + c], t));
     EXPECT_EQ(rgba[4 * p + 3], 255);
+  }
+}
+
+// The image's bytes keep a channel's last code where the next value is in
+// its bracket: still each value's own search, along runs of equal values,
+// slow ramps, steps, the bracket's very edges, values past the white, zero,
+// negative, infinite and NaN ones, for each curve.
+TEST(Tonemap, RgbaKeepsEachValuesOwnCodeAlongRunsRampsAndSteps) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  for (const ToneCurve curve : kToneCurves) {
+    const ToneThresholds t = tonemapThresholds(-0.5, curve);
+    std::vector<float> values;
+    for (int run = 0; run < 400; ++run) {
+      const float v = 4.0f * u(rng) * u(rng);
+      switch (run % 5) {
+        case 0: values.insert(values.end(), 7, v); break;                                 // a run
+        case 1: for (int k = 0; k < 9; ++k) values.push_back(v * (1.0f + 0.002f * k)); break;  // a ramp
+        case 2: {  // each side of a code's boundary
+          const float edge = t[1 + rng() % (shared::kToneCodes - 1)];
+          if (std::isfinite(edge)) values.insert(values.end(), {edge, std::nextafter(edge, 0.0f), edge, std::nextafter(edge, 1e30f)});
+          break;
+        }
+        case 3: values.insert(values.end(), {0.0f, -1.0f, 50.0f, std::numeric_limits<float>::infinity(), v}); break;
+        default: values.insert(values.end(), {std::numeric_limits<float>::quiet_NaN(), v, std::numeric_limits<float>::quiet_NaN()}); break;
+      }
+    }
+    // Each value a pixel's red, its green the previous value's, its blue
+    // a constant: every channel sees the sequence's neighbours in turn.
+    io::RgbImage image = io::makeImage(static_cast<int>(values.size()), 1);
+    for (std::size_t p = 0; p < values.size(); ++p) {
+      image.rgb[3 * p] = values[p];
+      image.rgb[3 * p + 1] = values[p > 0 ? p - 1 : 0];
+      image.rgb[3 * p + 2] = 0.25f;
+    }
+    const auto rgba = tonemapRgba8(image, -0.5, curve);
+    for (std::size_t i = 0; i < image.rgb.size(); ++i)
+      ASSERT_EQ(rgba[4 * (i / 3) + i % 3], tonemapByte(image.rgb[i], t)) << "value " << image.rgb[i] << " at " << i;
   }
 }
 
