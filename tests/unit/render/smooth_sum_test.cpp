@@ -99,14 +99,21 @@ TEST(SmoothSum, ALineIsTakenAndABumpOrAStepIsNot) {
   auto agree = [&](const SmoothParents& p, float a, float b, float outerA, float outerB, float brightness = 100.0f) {
     return shared::smoothSumsAgree(p, grey(a), grey(b), grey(outerA), grey(outerB), brightness, tolerance);
   };
-  // A line, whatever its slope within the step limit 4ε.
+  // A line, whatever its slope within the slope guard 16ε.
   EXPECT_TRUE(agree(across, 10, 13, 7, 16));
   EXPECT_EQ(shared::smoothParentsSum(across, grey(10), grey(13), grey(7), grey(16)).x, 11.5f);
+  EXPECT_TRUE(agree(across, 10, 26, -6, 42));
+  EXPECT_FALSE(agree(across, 10, 27, -7, 44));
   // A bump: |A' − A − B + B'|/16 = 20/16 > 1.
   EXPECT_FALSE(agree(across, 10, 10, 0, 0));
   EXPECT_TRUE(agree(across, 10, 10, 2, 2));  // 16/16
-  // A step the outer pair cannot see: its size alone, at most 4ε.
+  // A step between A and B, which the curve does not see: its third
+  // difference |A' − 3A + 3B − B'|/2 is its size, at most 1.5ε.
   EXPECT_FALSE(agree(across, 10, 15, 10, 15));
+  EXPECT_FALSE(agree(across, 10, 12, 10, 12));
+  EXPECT_TRUE(agree(across, 10, 11.4f, 10, 11.4f));
+  // On a quadratic the third difference is zero: only the bend decides.
+  EXPECT_TRUE(agree(across, 8, 12, 12, 24));  // 9 + 2x + x² at x = ∓1, ∓3: bend 16/16
   // Without the outer pair, the spread at most ε.
   SmoothParents near = across;
   near.outer = 0u;

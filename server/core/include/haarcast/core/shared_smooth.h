@@ -165,15 +165,28 @@ HC_FUNCTION float smoothBrightness(SmoothParents p, vec3 shown0, vec3 shown1, ve
 // ε = tolerance × brightness in each channel:
 // - how far their mean is from a curve through them: Edges with outer,
 //   |A' − A − B + B'|/16 (the cubic through the four at the middle less the
-//   line: exact for a quadratic); Centres, the across and the down means'
-//   difference, halved; each at most ε;
-// - and the near parents' spread, max − min, at most 4ε (ε for Edges
-//   without outer): a step between two parents the curve cannot see errs
-//   by half of it at most.
+//   line: the line's error, h²f''/2, for a quadratic); Centres, the across
+//   and the down means' difference, halved; each at most ε;
+// - a step between A and B, which the curve cannot see: Edges with outer,
+//   where A', A, B, B' lie 2h apart, by their third difference
+//   |A' − 3A + 3B − B'|/2, zero on a quadratic and S for a step S between
+//   A and B (A' = A, B = B'), at most kSmoothStepLimit·ε, so that the mean
+//   errs by at most 0.75ε there; and their spread B − A, a slope, at most
+//   kSmoothSlopeLimit·ε (a guard: a line's midpoint is exact, the bend
+//   measures the rest). Centres, whose parents are one step apart, and
+//   Edges without outer, by the near parents' spread, max − min, at most
+//   4ε (ε for Edges without outer): a step errs by half of it at most.
+HC_CONST float kSmoothStepLimit = 1.5f;
+HC_CONST float kSmoothSlopeLimit = 16.0f;
 HC_FUNCTION bool smoothSumsAgree(SmoothParents p, vec3 s0, vec3 s1, vec3 s2, vec3 s3, float brightness, float tolerance) {
   const float epsilon = tolerance * brightness;
   const bool curve = p.count == 4 || p.outer != 0u;
-  const float stepLimit = curve ? 4.0f * epsilon : epsilon;
+  const bool outer = p.count == 2 && p.outer != 0u;
+  if (outer) {
+    const vec3 third = 0.5f * abs(s2 - 3.0f * s0 + 3.0f * s1 - s3);
+    if (!(max(max(third.x, third.y), third.z) <= kSmoothStepLimit * epsilon)) return false;
+  }
+  const float spreadLimit = outer ? kSmoothSlopeLimit * epsilon : (curve ? 4.0f * epsilon : epsilon);
   vec3 lo = min(s0, s1);
   vec3 hi = max(s0, s1);
   if (p.count == 4) {
@@ -181,7 +194,7 @@ HC_FUNCTION bool smoothSumsAgree(SmoothParents p, vec3 s0, vec3 s1, vec3 s2, vec
     hi = max(hi, max(s2, s3));
   }
   const vec3 spread = hi - lo;
-  if (!(max(max(spread.x, spread.y), spread.z) <= stepLimit)) return false;
+  if (!(max(max(spread.x, spread.y), spread.z) <= spreadLimit)) return false;
   if (!curve) return true;
   const vec3 bend = p.count == 4 ? 0.25f * abs(s0 + s1 - s2 - s3) : abs(s2 - s0 - s1 + s3) / 16.0f;
   return max(max(bend.x, bend.y), bend.z) <= epsilon;
