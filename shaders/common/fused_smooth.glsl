@@ -38,21 +38,24 @@ bool smoothTaken(ShadeSample sh, ObjectInfo o, vec3 mirror, out vec3 sum) {
   SmoothParents p = smoothParents(push.stage, x, y, int(push.width), int(push.height));
   if (p.count <= 0) return false;
   const float cosLimit = o.lobeCore.y;
-  vec3 s0, s1, s2 = vec3(0.0), s3 = vec3(0.0);
+  vec3 s0, s1, s2 = vec3(0.0), s3 = vec3(0.0), s4 = vec3(0.0), s5 = vec3(0.0), s6 = vec3(0.0), s7 = vec3(0.0);
   if (!smoothParent(p.at0, sh.object, mirror, cosLimit, s0) || !smoothParent(p.at1, sh.object, mirror, cosLimit, s1))
     return false;
+  // The outer parents only measure the curve: on the object and visited
+  // suffices (any mirror is near at a limit of −2).
   if (p.count == 4) {
     if (!smoothParent(p.at2, sh.object, mirror, cosLimit, s2) || !smoothParent(p.at3, sh.object, mirror, cosLimit, s3))
       return false;
+    if (p.outer != 0u && !(smoothParent(p.at4, sh.object, mirror, -2.0, s4) && smoothParent(p.at5, sh.object, mirror, -2.0, s5) &&
+                           smoothParent(p.at6, sh.object, mirror, -2.0, s6) && smoothParent(p.at7, sh.object, mirror, -2.0, s7)))
+      p.outer = 0u;
   } else if (p.outer != 0u) {
-    // The outer pair only measures the curve: on the object and visited
-    // suffices (any mirror is near at a limit of −2).
     if (!smoothParent(p.at2, sh.object, mirror, -2.0, s2) || !smoothParent(p.at3, sh.object, mirror, -2.0, s3))
       p.outer = 0u;
   }
   const float brightness = smoothBrightness(p, radiance[p.at0].rgb, radiance[p.at1].rgb, radiance[p.at2].rgb,
                                             radiance[p.at3].rgb);
-  if (!smoothSumsAgree(p, s0, s1, s2, s3, brightness, push.tolerance)) return false;
+  if (!smoothSumsAgree(p, s0, s1, s2, s3, s4, s5, s6, s7, brightness, push.tolerance)) return false;
   sum = smoothParentsSum(p, s0, s1, s2, s3);
   return true;
 }

@@ -809,10 +809,11 @@ std::size_t CpuRenderer::shadeSmoothSums(const GBuffer& g, FusedSlots& slots, co
         slots.mirrors[i] = shared::smoothMirror(static_cast<float>(in.euler.alpha), static_cast<float>(in.euler.beta),
                                                 static_cast<float>(in.euler.gamma), static_cast<float>(in.thetaOut));
         // Its parents, where each is on this object, visited, and its
-        // mirror direction near the pixel's; the outer pair A', B' (which
-        // only measures the curve) where each is on this object and
-        // visited, else dropped, and A and B decide alone.
-        const std::array<shared::uint, 4> at{parents.at0, parents.at1, parents.at2, parents.at3};
+        // mirror direction near the pixel's; the outer ones (which only
+        // measure the curve) where each is on this object and visited,
+        // else dropped, and the near ones decide alone.
+        const std::array<shared::uint, 8> at{parents.at0, parents.at1, parents.at2, parents.at3,
+                                             parents.at4, parents.at5, parents.at6, parents.at7};
         const float cosLimit = cosLimits[object];
         auto usable = [&](shared::uint q, float limit) {
           return state[q] != kNotVisited && objectAt[q] == objectAt[i] &&
@@ -821,16 +822,20 @@ std::size_t CpuRenderer::shadeSmoothSums(const GBuffer& g, FusedSlots& slots, co
         bool fromParents = parents.count > 0;
         const std::size_t near = parents.count == 4 ? 4 : 2;
         for (std::size_t k = 0; k < near && fromParents; ++k) fromParents = usable(at[k], cosLimit);
-        if (fromParents && parents.outer != 0u && !(usable(at[2], -2.0f) && usable(at[3], -2.0f))) parents.outer = 0u;
+        const std::size_t parentCount = parents.outer != 0u ? near + (parents.count == 4 ? 4 : 2) : near;
+        for (std::size_t k = near; k < parentCount && fromParents && parents.outer != 0u; ++k)
+          if (!usable(at[k], -2.0f)) parents.outer = 0u;
         FusedSum sum;
         if (fromParents) {
-          std::array<glm::vec3, 4> sums{}, shown{};
-          for (std::size_t k = 0; k < (parents.count == 4 || parents.outer != 0u ? 4u : 2u); ++k) {
+          std::array<glm::vec3, 8> sums{};
+          std::array<glm::vec3, 4> shown{};
+          for (std::size_t k = 0; k < (parents.outer != 0u ? parentCount : near); ++k)
             sums[k] = glm::vec3(slots.sums[at[k]][0], slots.sums[at[k]][1], slots.sums[at[k]][2]);
+          for (std::size_t k = 0; k < near; ++k)
             shown[k] = glm::vec3(slots.shaded[at[k]][0], slots.shaded[at[k]][1], slots.shaded[at[k]][2]);
-          }
           const float brightness = shared::smoothBrightness(parents, shown[0], shown[1], shown[2], shown[3]);
-          if (shared::smoothSumsAgree(parents, sums[0], sums[1], sums[2], sums[3], brightness, tolerance)) {
+          if (shared::smoothSumsAgree(parents, sums[0], sums[1], sums[2], sums[3], sums[4], sums[5], sums[6], sums[7],
+                                      brightness, tolerance)) {
             const glm::vec3 mean = shared::smoothParentsSum(parents, sums[0], sums[1], sums[2], sums[3]);
             sum = {{mean.x, mean.y, mean.z}, true};
             shade(*g.centre[i], i, slots.shaded[i], &sum);

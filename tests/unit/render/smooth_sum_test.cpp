@@ -86,6 +86,14 @@ TEST(SmoothSum, ParentsAreTheGridNeighboursAtTheStagesStep) {
   ASSERT_EQ(p.count, 4);
   EXPECT_EQ(p.at0, at(4, 7));
   EXPECT_EQ(p.at3, at(5, 8));
+  ASSERT_EQ(p.outer, 1u);  // ±3 across and down, each visited by stage 3 as the midpoints were
+  EXPECT_EQ(p.at4, at(2, 7));
+  EXPECT_EQ(p.at5, at(8, 7));
+  EXPECT_EQ(p.at6, at(5, 4));
+  EXPECT_EQ(p.at7, at(5, 10));
+  for (const shared::uint q : {p.at4, p.at5, p.at6, p.at7})
+    EXPECT_EQ(shared::smoothParents(3, static_cast<int>(q % w), static_cast<int>(q / w), w, h).count, 2) << q;
+  EXPECT_EQ(shared::smoothParents(4, 1, 7, w, h).outer, 0u);  // no column −2
   EXPECT_EQ(shared::smoothParents(1, 18, 0, w, h).count, -1);  // x + 2 = 20 is outside
 }
 
@@ -95,9 +103,15 @@ glm::vec3 grey(float v) { return glm::vec3(v); }
 TEST(SmoothSum, ALineIsTakenAndABumpOrAStepIsNot) {
   const float shown = 100.0f;  // the parents' dimmest brightest channel
   const float tolerance = 0.01f;
-  SmoothParents across{2, 1u, 0u, 0u, 0u, 0u};
+  SmoothParents across{2, 1u, 0u, 0u, 0u, 0u, 0u, 0u, 0u, 0u};
+  // s0 … s7 as smoothSumsAgree takes them (the missing ones black).
+  auto agreeRgb = [&](const SmoothParents& p, std::vector<glm::vec3> s) {
+    s.resize(8, grey(0));
+    return shared::smoothSumsAgree(p, s[0], s[1], s[2], s[3], s[4], s[5], s[6], s[7], shown, tolerance);
+  };
   auto agree = [&](const SmoothParents& p, float a, float b, float outerA, float outerB, float brightness = 100.0f) {
-    return shared::smoothSumsAgree(p, grey(a), grey(b), grey(outerA), grey(outerB), brightness, tolerance);
+    return shared::smoothSumsAgree(p, grey(a), grey(b), grey(outerA), grey(outerB), grey(0), grey(0), grey(0), grey(0),
+                                   brightness, tolerance);
   };
   // A line, whatever its slope within the slope guard 16ε.
   EXPECT_TRUE(agree(across, 10, 13, 7, 16));
@@ -120,11 +134,24 @@ TEST(SmoothSum, ALineIsTakenAndABumpOrAStepIsNot) {
   EXPECT_FALSE(agree(near, 10, 12, 0, 0));
   EXPECT_TRUE(agree(near, 10, 11, 0, 0));
   // One channel is enough to refuse.
-  EXPECT_FALSE(shared::smoothSumsAgree(near, grey(10), glm::vec3(11, 11, 13), grey(0), grey(0), shown, tolerance));
-  // The square's centre: the across and the down means agree within 2ε.
-  const SmoothParents centre{4, 0u, 0u, 0u, 0u, 0u};
-  EXPECT_TRUE(shared::smoothSumsAgree(centre, grey(10), grey(10), grey(12), grey(12), shown, tolerance));
-  EXPECT_FALSE(shared::smoothSumsAgree(centre, grey(10), grey(10), grey(13), grey(13), shown, tolerance));
+  EXPECT_FALSE(agreeRgb(near, {grey(10), glm::vec3(11, 11, 13), grey(0), grey(0)}));
+  // The square's centre: the across and the down means agree within 2ε,
+  // and without outer parents the four's spread is at most 4ε.
+  const SmoothParents centre{4, 0u, 0u, 0u, 0u, 0u, 0u, 0u, 0u, 0u};
+  EXPECT_TRUE(agreeRgb(centre, {grey(10), grey(10), grey(12), grey(12)}));
+  EXPECT_FALSE(agreeRgb(centre, {grey(10), grey(10), grey(13), grey(13)}));
+  EXPECT_FALSE(agreeRgb(centre, {grey(10), grey(18), grey(10), grey(18)}));  // a slope of 8ε: spread 8
+  // With outer parents (at ±3h across, then down) each line is judged as
+  // an edge's: the same slope is taken …
+  SmoothParents wide = centre;
+  wide.outer = 1u;
+  EXPECT_TRUE(agreeRgb(wide, {grey(10), grey(18), grey(10), grey(18), grey(2), grey(26), grey(2), grey(26)}));
+  // … a step across between the near pair is not (third difference 8ε),
+  EXPECT_FALSE(agreeRgb(wide, {grey(10), grey(18), grey(14), grey(14), grey(10), grey(18), grey(14), grey(14)}));
+  // nor a bend down of more than ε (|A' − A − B + B'|/16 = 32/16),
+  EXPECT_FALSE(agreeRgb(wide, {grey(14), grey(14), grey(14), grey(14), grey(14), grey(14), grey(30), grey(30)}));
+  // nor a saddle neither line shows: the across and the down means 4ε apart.
+  EXPECT_FALSE(agreeRgb(wide, {grey(12), grey(12), grey(8), grey(8), grey(12), grey(12), grey(8), grey(8)}));
   EXPECT_EQ(shared::smoothParentsSum(centre, grey(10), grey(11), grey(12), grey(13)).x, 11.5f);
   // Brighter point lights shown allow more: the tolerance is of what the parents show…
   EXPECT_TRUE(agree(near, 10, 12, 0, 0, 200.0f));

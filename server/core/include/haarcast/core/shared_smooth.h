@@ -62,11 +62,14 @@ HC_FUNCTION uint smoothStageStep(uint stage) { return stage == 0u ? kSmoothSumSp
 struct SmoothParents {
   // 0: a Grid pixel (summed); 2: Edges, A and B at ±h across or down, then
   // A' and B' at ±3h beyond them where `outer` is 1; 4: Centres, the
-  // midpoints left, right, above and below; −1: a parent outside the
-  // frame; −2: the pixel is not in this stage.
+  // midpoints left, right, above and below, then where `outer` is 1 the
+  // pixels at ±3h beyond them (at4, at5 across; at6, at7 down: the stage
+  // before visited them, as it did the midpoints); −1: a parent outside
+  // the frame; −2: the pixel is not in this stage.
   int count;
   uint outer;
   uint at0, at1, at2, at3;
+  uint at4, at5, at6, at7;
 };
 
 HC_FUNCTION SmoothParents smoothParents(uint stage, int x, int y, int width, int height) {
@@ -77,6 +80,10 @@ HC_FUNCTION SmoothParents smoothParents(uint stage, int x, int y, int width, int
   p.at1 = 0u;
   p.at2 = 0u;
   p.at3 = 0u;
+  p.at4 = 0u;
+  p.at5 = 0u;
+  p.at6 = 0u;
+  p.at7 = 0u;
   const int h = int(smoothStageStep(stage));
   const uint kind = smoothStageKind(stage);
   if (kind == kSmoothGrid) {
@@ -101,6 +108,13 @@ HC_FUNCTION SmoothParents smoothParents(uint stage, int x, int y, int width, int
     p.at1 = uint(y * width + x + h);
     p.at2 = uint((y - h) * width + x);
     p.at3 = uint((y + h) * width + x);
+    if (x - 3 * h >= 0 && y - 3 * h >= 0 && x + 3 * h < width && y + 3 * h < height) {
+      p.outer = 1u;
+      p.at4 = uint(y * width + x - 3 * h);
+      p.at5 = uint(y * width + x + 3 * h);
+      p.at6 = uint((y - 3 * h) * width + x);
+      p.at7 = uint((y + 3 * h) * width + x);
+    }
     return p;
   }
   // x − h·dx and y − h·dy are ≥ 0: x or y is ≥ h where its remainder is h.
@@ -161,43 +175,42 @@ HC_FUNCTION float smoothBrightness(SmoothParents p, vec3 shown0, vec3 shown1, ve
   return dimmest;
 }
 
-// Whether the parents' sums may stand for the pixel's, measured against
-// ε = tolerance × brightness in each channel:
-// - how far their mean is from a curve through them: Edges with outer,
-//   |A' − A − B + B'|/16 (the cubic through the four at the middle less the
-//   line: the line's error, h²f''/2, for a quadratic); Centres, the across
-//   and the down means' difference, halved; each at most ε;
-// - a step between A and B, which the curve cannot see: Edges with outer,
-//   where A', A, B, B' lie 2h apart, by their third difference
-//   |A' − 3A + 3B − B'|/2, zero on a quadratic and S for a step S between
-//   A and B (A' = A, B = B'), at most kSmoothStepLimit·ε, so that the mean
-//   errs by at most 0.75ε there; and their spread B − A, a slope, at most
-//   kSmoothSlopeLimit·ε (a guard: a line's midpoint is exact, the bend
-//   measures the rest). Centres, whose parents are one step apart, and
-//   Edges without outer, by the near parents' spread, max − min, at most
-//   4ε (ε for Edges without outer): a step errs by half of it at most.
+// Whether a line of four parents 2h apart, A' A B B' with the pixel midway
+// between A and B, may give the pixel A and B's mean, against ε:
+// - the curve through them: |A' − A − B + B'|/16, the cubic at the middle
+//   less the line (the line's error, h²f''/2, for a quadratic), at most ε;
+// - a step between A and B, which the curve cannot see, by their third
+//   difference |A' − 3A + 3B − B'|/2: zero on a quadratic and S for a step
+//   S between A and B (A' = A, B = B'), at most kSmoothStepLimit·ε, so
+//   that the mean errs by at most 0.75ε there;
+// - their spread |B − A|, a slope, at most kSmoothSlopeLimit·ε: a guard (a
+//   line's midpoint is exact, and the bend measures the rest).
 HC_CONST float kSmoothStepLimit = 1.5f;
 HC_CONST float kSmoothSlopeLimit = 16.0f;
-HC_FUNCTION bool smoothSumsAgree(SmoothParents p, vec3 s0, vec3 s1, vec3 s2, vec3 s3, float brightness, float tolerance) {
+HC_FUNCTION float smoothLargest(vec3 v) { return max(max(v.x, v.y), v.z); }
+HC_FUNCTION bool smoothLineAgrees(vec3 outerA, vec3 a, vec3 b, vec3 outerB, float epsilon) {
+  if (!(smoothLargest(0.5f * abs(outerA - 3.0f * a + 3.0f * b - outerB)) <= kSmoothStepLimit * epsilon)) return false;
+  if (!(smoothLargest(abs(b - a)) <= kSmoothSlopeLimit * epsilon)) return false;
+  return smoothLargest(abs(outerA - a - b + outerB)) / 16.0f <= epsilon;
+}
+
+// Whether the parents' sums may stand for the pixel's, measured against
+// ε = tolerance × brightness in each channel (s0 … s3 at at0 … at3, s4 …
+// s7 at at4 … at7):
+// - Edges with outer: their line agrees (smoothLineAgrees);
+// - Centres: the across and the down means within 2ε of each other (a
+//   saddle, which neither line shows), and with outer each line agrees,
+//   across (at4, at0, at1, at5) and down (at6, at2, at3, at7); without,
+//   the four's spread, max − min, at most 4ε (a step errs by half of it);
+// - Edges without outer: A and B within ε.
+HC_FUNCTION bool smoothSumsAgree(SmoothParents p, vec3 s0, vec3 s1, vec3 s2, vec3 s3, vec3 s4, vec3 s5, vec3 s6, vec3 s7,
+                                 float brightness, float tolerance) {
   const float epsilon = tolerance * brightness;
-  const bool curve = p.count == 4 || p.outer != 0u;
-  const bool outer = p.count == 2 && p.outer != 0u;
-  if (outer) {
-    const vec3 third = 0.5f * abs(s2 - 3.0f * s0 + 3.0f * s1 - s3);
-    if (!(max(max(third.x, third.y), third.z) <= kSmoothStepLimit * epsilon)) return false;
-  }
-  const float spreadLimit = outer ? kSmoothSlopeLimit * epsilon : (curve ? 4.0f * epsilon : epsilon);
-  vec3 lo = min(s0, s1);
-  vec3 hi = max(s0, s1);
-  if (p.count == 4) {
-    lo = min(lo, min(s2, s3));
-    hi = max(hi, max(s2, s3));
-  }
-  const vec3 spread = hi - lo;
-  if (!(max(max(spread.x, spread.y), spread.z) <= spreadLimit)) return false;
-  if (!curve) return true;
-  const vec3 bend = p.count == 4 ? 0.25f * abs(s0 + s1 - s2 - s3) : abs(s2 - s0 - s1 + s3) / 16.0f;
-  return max(max(bend.x, bend.y), bend.z) <= epsilon;
+  if (p.count == 2) return p.outer != 0u ? smoothLineAgrees(s2, s0, s1, s3, epsilon) : smoothLargest(abs(s1 - s0)) <= epsilon;
+  if (!(smoothLargest(0.25f * abs(s0 + s1 - s2 - s3)) <= epsilon)) return false;
+  if (p.outer != 0u) return smoothLineAgrees(s4, s0, s1, s5, epsilon) && smoothLineAgrees(s6, s2, s3, s7, epsilon);
+  const vec3 spread = max(max(s0, s1), max(s2, s3)) - min(min(s0, s1), min(s2, s3));
+  return smoothLargest(spread) <= 4.0f * epsilon;
 }
 
 // The sum the pixel takes: the mean of A and B, or of the four midpoints.
