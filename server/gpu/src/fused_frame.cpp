@@ -126,7 +126,7 @@ std::uint32_t VulkanRenderer::Impl::computeShadowMasks(const render::ResolvedFra
 
 // The smooth sum's stages as bench-frame's profile names them (Frame::parts).
 constexpr std::array<const char*, shared::kSmoothSumStages> kSmoothStageParts{
-    "grid sums", "step 2 edges", "step 2 centres", "step 1 edges", "step 1 centres"};
+    "grid sums", "step 4 edges", "step 4 centres", "step 2 edges", "step 2 centres", "step 1 edges", "step 1 centres"};
 
 render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& request) {
   const auto start = RendererClock::now();

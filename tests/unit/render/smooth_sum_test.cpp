@@ -34,8 +34,8 @@ TEST(SmoothSum, EveryPixelIsVisitedOnceAfterItsParents) {
           const std::size_t i = static_cast<std::size_t>(y * w + x);
           EXPECT_EQ(visited[i], -1) << w << "×" << h << " (" << x << ", " << y << ") twice";
           visited[i] = static_cast<int>(k);
-          const std::array<shared::uint, 4> at{p.at0, p.at1, p.at2, p.at3};
-          const int n = p.count == 2 && p.outer != 0u ? 4 : std::max(p.count, 0);
+          const std::array<shared::uint, 8> at{p.at0, p.at1, p.at2, p.at3, p.at4, p.at5, p.at6, p.at7};
+          const int n = p.outer != 0u ? 2 * p.count : std::max(p.count, 0);
           for (int j = 0; j < n; ++j) {
             ASSERT_LT(at[static_cast<std::size_t>(j)], static_cast<shared::uint>(w * h));
             const int parent = visited[at[static_cast<std::size_t>(j)]];
@@ -61,28 +61,30 @@ TEST(SmoothSum, EveryPixelIsVisitedOnceAfterItsParents) {
 }
 
 TEST(SmoothSum, ParentsAreTheGridNeighboursAtTheStagesStep) {
-  ASSERT_EQ(shared::kSmoothSumSpacing, 4u);
-  // grid 4, edges 2, centres 2, edges 1, centres 1
-  EXPECT_EQ(shared::smoothStageStep(0), 4u);
-  EXPECT_EQ(shared::smoothStageStep(1), 2u);
-  EXPECT_EQ(shared::smoothStageKind(2), shared::kSmoothCentres);
-  EXPECT_EQ(shared::smoothStageStep(3), 1u);
-  EXPECT_EQ(shared::smoothStageKind(4), shared::kSmoothCentres);
+  ASSERT_EQ(shared::kSmoothSumSpacing, 8u);
+  // grid 8, edges 4, centres 4, edges 2, centres 2, edges 1, centres 1
+  ASSERT_EQ(shared::kSmoothSumStages, 7u);
+  EXPECT_EQ(shared::smoothStageStep(0), 8u);
+  EXPECT_EQ(shared::smoothStageKind(0), shared::kSmoothGrid);
+  for (shared::uint k = 1; k < shared::kSmoothSumStages; ++k) {
+    EXPECT_EQ(shared::smoothStageStep(k), 8u >> ((k + 1) / 2)) << k;
+    EXPECT_EQ(shared::smoothStageKind(k), k % 2 == 1 ? shared::kSmoothEdges : shared::kSmoothCentres) << k;
+  }
   const int w = 20, h = 20;
   auto at = [&](int x, int y) { return static_cast<shared::uint>(y * w + x); };
-  SmoothParents p = shared::smoothParents(1, 10, 8, w, h);  // across, step 2
+  SmoothParents p = shared::smoothParents(3, 10, 8, w, h);  // across, step 2
   ASSERT_EQ(p.count, 2);
   EXPECT_EQ(p.at0, at(8, 8));
   EXPECT_EQ(p.at1, at(12, 8));
   ASSERT_EQ(p.outer, 1u);
   EXPECT_EQ(p.at2, at(4, 8));
   EXPECT_EQ(p.at3, at(16, 8));
-  p = shared::smoothParents(1, 4, 2, w, h);  // down, step 2: no row -4
+  p = shared::smoothParents(3, 4, 2, w, h);  // down, step 2: no row -4
   ASSERT_EQ(p.count, 2);
   EXPECT_EQ(p.at0, at(4, 0));
   EXPECT_EQ(p.at1, at(4, 4));
   EXPECT_EQ(p.outer, 0u);
-  p = shared::smoothParents(4, 5, 7, w, h);  // a square's centre, step 1
+  p = shared::smoothParents(6, 5, 7, w, h);  // a square's centre, step 1
   ASSERT_EQ(p.count, 4);
   EXPECT_EQ(p.at0, at(4, 7));
   EXPECT_EQ(p.at3, at(5, 8));
@@ -92,9 +94,14 @@ TEST(SmoothSum, ParentsAreTheGridNeighboursAtTheStagesStep) {
   EXPECT_EQ(p.at6, at(5, 4));
   EXPECT_EQ(p.at7, at(5, 10));
   for (const shared::uint q : {p.at4, p.at5, p.at6, p.at7})
-    EXPECT_EQ(shared::smoothParents(3, static_cast<int>(q % w), static_cast<int>(q / w), w, h).count, 2) << q;
-  EXPECT_EQ(shared::smoothParents(4, 1, 7, w, h).outer, 0u);  // no column −2
-  EXPECT_EQ(shared::smoothParents(1, 18, 0, w, h).count, -1);  // x + 2 = 20 is outside
+    EXPECT_EQ(shared::smoothParents(5, static_cast<int>(q % w), static_cast<int>(q / w), w, h).count, 2) << q;
+  EXPECT_EQ(shared::smoothParents(6, 1, 7, w, h).outer, 0u);  // no column −2
+  EXPECT_EQ(shared::smoothParents(3, 18, 0, w, h).count, -1);  // x + 2 = 20 is outside
+  p = shared::smoothParents(1, 12, 0, w, h);  // across, step 4
+  ASSERT_EQ(p.count, 2);
+  EXPECT_EQ(p.at0, at(8, 0));
+  EXPECT_EQ(p.at1, at(16, 0));
+  EXPECT_EQ(p.outer, 0u);  // no column −12
 }
 
 glm::vec3 grey(float v) { return glm::vec3(v); }

@@ -37,10 +37,10 @@
 namespace haarcast::shared {
 #endif
 
-// The coarsest grid: every 4th pixel of every 4th row is summed.
-HC_CONST uint kSmoothSumSpacing = 4u;
-// Grid, then Edges and Centres at steps 2 and 1.
-HC_CONST uint kSmoothSumStages = 5u;
+// The coarsest grid: every 8th pixel of every 8th row is summed.
+HC_CONST uint kSmoothSumSpacing = 8u;
+// Grid, then Edges and Centres at steps 4, 2 and 1.
+HC_CONST uint kSmoothSumStages = 7u;
 // RenderOptions::smoothSumTolerance's default (`render`, `serve`,
 // `bench-frame`; RenderOptions keeps 0).
 HC_CONST float kDefaultSmoothSumTolerance = 0.01f;
