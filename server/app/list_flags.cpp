@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "haarcast/core/shared_smooth.h"
 #include "haarcast/render/renderer.h"
 
 namespace haarcast::app {
@@ -83,7 +84,8 @@ std::string sumToleranceHelp() {
 std::string smoothSumHelp() {
   return "fused: take a pixel's sum (the light's rest × visibility × BRDF) from its neighbours where their mirror "
          "directions are within half the lobe and their sums agree within this fraction of what they show, coarse to "
-         "fine from every 4th pixel; point lights, shadows between objects and mirror cores stay each pixel's own "
+         "fine from every " + std::to_string(shared::kSmoothSumSpacing) +
+         "th pixel; point lights, shadows between objects and mirror cores stay each pixel's own "
          "(0 = sum every pixel; docs/design.md)";
 }
 

@@ -211,7 +211,7 @@ TEST_P(FusedCellsFrame, VulkanMatchesTheCpuBackend) {
 INSTANTIATE_TEST_SUITE_P(Levels, FusedCellsFrame, ::testing::Combine(::testing::Values(5, 6), ::testing::Bool()));
 
 // The sum from a pixel's neighbours (RenderOptions::smoothSumTolerance,
-// core/shared_smooth.h) on both backends: the device's five dispatches,
+// core/shared_smooth.h) on both backends: the device's dispatches, one a stage,
 // coarse to fine, take the same pixels' sums as the CPU's pass and make the
 // same frame; a Lambert sphere (whose sum is smooth) beside the GGX torus.
 TEST(FusedSmoothFrame, VulkanTakesTheSameSumsAsTheCpuBackend) {
@@ -219,7 +219,7 @@ TEST(FusedSmoothFrame, VulkanTakesTheSameSumsAsTheCpuBackend) {
   render::Scene scene = render::defaultScene();
   scene.objects[0].material = render::materialFromSpec("lambert");
   render::RenderOptions o = frameOptions(RotationMethod::Fused, true);
-  o.width = o.height = 128;  // the sphere wide enough for its sum to be smooth over 4 pixels
+  o.width = o.height = 128;  // the sphere wide enough for its sum to be smooth over the grid's spacing
   o.level = 5;
   o.sumTolerance = shared::kDefaultSumTolerance;
   o.smoothSumTolerance = shared::kDefaultSmoothSumTolerance;
