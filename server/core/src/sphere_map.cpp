@@ -4,6 +4,8 @@
 #include <stdexcept>
 #include <string>
 
+#include <glm/geometric.hpp>
+
 namespace haarcast {
 
 void checkLevel(int level, const char* what) {
@@ -116,6 +118,21 @@ SphereMap SphereMap::weightedBySolidAngle() const {
     for (int j = 0; j < m; ++j) out.at(i, j) = static_cast<float>(at(i, j) * w);
   }
   return out;
+}
+
+shared::LatLongTaps latLongTapsToward(int level, const glm::vec3& direction) {
+  const float y = std::clamp(direction.y / glm::length(direction), -1.0f, 1.0f);
+  float phi = std::atan2(direction.x, direction.z);
+  if (phi < 0.0f) phi += shared::kTwoPiF;
+  return shared::latLongTaps(static_cast<shared::uint>(level), std::acos(y), phi);
+}
+
+float valueAt(const SphereMap& map, const shared::LatLongTaps& t) {
+  const float top = (1.0f - t.tCol) * map.at(static_cast<int>(t.row0), static_cast<int>(t.col0)) +
+                    t.tCol * map.at(static_cast<int>(t.row0), static_cast<int>(t.col1));
+  const float bottom = (1.0f - t.tCol) * map.at(static_cast<int>(t.row1), static_cast<int>(t.col0)) +
+                       t.tCol * map.at(static_cast<int>(t.row1), static_cast<int>(t.col1));
+  return (1.0f - t.tRow) * top + t.tRow * bottom;
 }
 
 }  // namespace haarcast

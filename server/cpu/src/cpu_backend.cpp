@@ -698,13 +698,13 @@ std::size_t CpuRenderer::shadeFused(const ResolvedFrame& resolved, const RayScen
       seen = withGroundOcclusion(seen, sky.at(sample.pixel, [&] { return groundSkyOcclusion(rays, point, resolved.skyOccluders); }));
       const float kept = shared::groundSkyKept(seen);
       // In registers, over the lights it sees, in order.
-      glm::vec3 sum = kept * glm::vec3(o.groundFlat[0], o.groundFlat[1], o.groundFlat[2]);
+      glm::vec3 radiance = kept * glm::vec3(o.groundFlat[0], o.groundFlat[1], o.groundFlat[2]);
       const std::uint32_t lights = (1u << o.pointLights.size()) - 1u;  // at most kMaxPointLights < 32
       for (std::uint32_t bits = seen & lights; bits != 0u; bits &= bits - 1u) {
         const FusedPointLight& light = o.pointLights[static_cast<std::size_t>(std::countr_zero(bits))];
-        sum += glm::vec3(light.power[0], light.power[1], light.power[2]);
+        radiance += glm::vec3(light.power[0], light.power[1], light.power[2]);
       }
-      rgb = {sum.x, sum.y, sum.z};
+      rgb = {radiance.x, radiance.y, radiance.z};
       return Shaded{};
     }
     std::array<WeightedBits, 3> vis;
@@ -820,16 +820,15 @@ std::size_t CpuRenderer::shadeSmoothSums(const GBuffer& g, FusedSlots& slots, co
                  shared::smoothMirrorNear(slots.mirrors[i], slots.mirrors[q], limit);
         };
         bool fromParents = parents.count > 0;
-        const std::size_t near = parents.count == 4 ? 4 : 2;
+        const std::size_t near = parents.count == 4 ? 4 : 2;  // then as many outer ones
         for (std::size_t k = 0; k < near && fromParents; ++k) fromParents = usable(at[k], cosLimit);
-        const std::size_t parentCount = parents.outer != 0u ? near + (parents.count == 4 ? 4 : 2) : near;
-        for (std::size_t k = near; k < parentCount && fromParents && parents.outer != 0u; ++k)
+        for (std::size_t k = near; k < 2 * near && fromParents && parents.outer != 0u; ++k)
           if (!usable(at[k], -2.0f)) parents.outer = 0u;
         FusedSum sum;
         if (fromParents) {
           std::array<glm::vec3, 8> sums{};
           std::array<glm::vec3, 4> shown{};
-          for (std::size_t k = 0; k < (parents.outer != 0u ? parentCount : near); ++k)
+          for (std::size_t k = 0; k < (parents.outer != 0u ? 2 * near : near); ++k)
             sums[k] = glm::vec3(slots.sums[at[k]][0], slots.sums[at[k]][1], slots.sums[at[k]][2]);
           for (std::size_t k = 0; k < near; ++k)
             shown[k] = glm::vec3(slots.shaded[at[k]][0], slots.shaded[at[k]][1], slots.shaded[at[k]][2]);

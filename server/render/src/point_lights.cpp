@@ -192,19 +192,7 @@ void coneRays(const glm::vec3& origin, const glm::vec3& normal, const SkyOcclude
 // (In double through directionToSpherical and SphereMap::sampleBilinear,
 // the lookups of the blocked rays cost a tenth of a 256² frame.)
 shared::LatLongTaps skyTaps(const SkyOccluders& sky, const glm::vec3& world) {
-  const glm::vec3 e = sky.toEnvironment * world;
-  const float y = std::clamp(e.y / glm::length(e), -1.0f, 1.0f);
-  float phi = std::atan2(e.x, e.z);
-  if (phi < 0.0f) phi += shared::kTwoPiF;
-  return shared::latLongTaps(static_cast<shared::uint>(sky.luminance->level()), std::acos(y), phi);
-}
-
-float tapAt(const SphereMap& map, const shared::LatLongTaps& t) {
-  const float top = (1.0f - t.tCol) * map.at(static_cast<int>(t.row0), static_cast<int>(t.col0)) +
-                    t.tCol * map.at(static_cast<int>(t.row0), static_cast<int>(t.col1));
-  const float bottom = (1.0f - t.tCol) * map.at(static_cast<int>(t.row1), static_cast<int>(t.col0)) +
-                       t.tCol * map.at(static_cast<int>(t.row1), static_cast<int>(t.col1));
-  return (1.0f - t.tRow) * top + t.tRow * bottom;
+  return latLongTapsToward(sky.luminance->level(), sky.toEnvironment * world);
 }
 
 }  // namespace
@@ -226,7 +214,7 @@ float groundSkyOcclusion(const RayScene& world, const ShadingPoint& p, const Sky
   for (std::size_t i = 0; i < rays.size(); ++i) {
     if (!blocked[i]) continue;
     // Each blocked direction takes its share of Σ luminance·cos·ΔΩ.
-    hidden += tapAt(*sky.luminance, skyTaps(sky, rays[i].direction)) * rays[i].cosine * rays[i].weight;
+    hidden += valueAt(*sky.luminance, skyTaps(sky, rays[i].direction)) * rays[i].cosine * rays[i].weight;
   }
   return static_cast<float>(std::clamp(hidden / sky.total, 0.0, 1.0));
 }
@@ -263,8 +251,8 @@ SkyHidden objectSkyHidden(const RayScene& world, const ShadingPoint& p, std::siz
   for (std::size_t i = 0; i < rays.size(); ++i) {
     if (own[i]) continue;
     const shared::LatLongTaps t = skyTaps(sky, rays[i].direction);
-    const glm::vec3 colour(tapAt((*sky.colour)[0], t), tapAt((*sky.colour)[1], t), tapAt((*sky.colour)[2], t));
-    mean += tapAt(*sky.luminance, t) * rays[i].weight * rays[i].direction;
+    const glm::vec3 colour(valueAt((*sky.colour)[0], t), valueAt((*sky.colour)[1], t), valueAt((*sky.colour)[2], t));
+    mean += valueAt(*sky.luminance, t) * rays[i].weight * rays[i].direction;
     sum += colour * (rays[i].cosine * rays[i].weight);
   }
   const float length = glm::length(mean);

@@ -242,21 +242,8 @@ RotationInput rotationInput(const glm::dvec3& normal, const glm::dvec3& towardEy
 }
 
 glm::vec3 backdropRadiance(const std::array<SphereMap, 3>& background, const glm::mat3& toEnvironment, const glm::vec3& direction) {
-  const glm::vec3 e = toEnvironment * direction;
-  const float y = std::clamp(e.y / glm::length(e), -1.0f, 1.0f);
-  float phi = std::atan2(e.x, e.z);
-  if (phi < 0.0f) phi += shared::kTwoPiF;
-  const shared::LatLongTaps t = shared::latLongTaps(static_cast<shared::uint>(background[0].level()), std::acos(y), phi);
-  glm::vec3 out;
-  for (std::size_t c = 0; c < 3; ++c) {
-    const SphereMap& map = background[c];
-    const float top = (1.0f - t.tCol) * map.at(static_cast<int>(t.row0), static_cast<int>(t.col0)) +
-                      t.tCol * map.at(static_cast<int>(t.row0), static_cast<int>(t.col1));
-    const float bottom = (1.0f - t.tCol) * map.at(static_cast<int>(t.row1), static_cast<int>(t.col0)) +
-                         t.tCol * map.at(static_cast<int>(t.row1), static_cast<int>(t.col1));
-    out[static_cast<int>(c)] = (1.0f - t.tRow) * top + t.tRow * bottom;
-  }
-  return out;
+  const shared::LatLongTaps t = latLongTapsToward(background[0].level(), toEnvironment * direction);
+  return {valueAt(background[0], t), valueAt(background[1], t), valueAt(background[2], t)};
 }
 
 void checkFrameRequest(const FrameRequest& r, std::size_t objectCount) {

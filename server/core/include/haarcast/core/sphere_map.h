@@ -116,4 +116,11 @@ class SphereMap {
   std::vector<float> values_{0.0f};
 };
 
+// The float lookup the device's passes make (shared::latLongTaps): the taps
+// toward a direction of any length, and a map's value at them, bilinear,
+// the columns blended first. One definition for the CPU's backdrop and its
+// sky rays (render/renderer.h backdropRadiance, render/point_lights.cpp).
+shared::LatLongTaps latLongTapsToward(int level, const glm::vec3& direction);
+float valueAt(const SphereMap& map, const shared::LatLongTaps& taps);
+
 }  // namespace haarcast
