@@ -85,10 +85,15 @@ void VulkanRenderer::Impl::ensureDeviceRayBuffers() {
   // The coarse grid's points, then the fine grid's (shared_rays.h).
   const int step = render::groundSkyStep(width, height);
   const int fine = static_cast<int>(shared::groundSkyFineStep(static_cast<std::uint32_t>(step)));
-  const std::size_t gridPoints = static_cast<std::size_t>((width - 1) / step + 2) * static_cast<std::size_t>((height - 1) / step + 2) +
-                                 static_cast<std::size_t>((width - 1) / fine + 2) * static_cast<std::size_t>((height - 1) / fine + 2);
+  const std::size_t finePoints = static_cast<std::size_t>((width - 1) / fine + 2) * static_cast<std::size_t>((height - 1) / fine + 2);
+  const std::size_t gridPoints = static_cast<std::size_t>((width - 1) / step + 2) * static_cast<std::size_t>((height - 1) / step + 2) + finePoints;
   pixelSample = Buffer(context, pixels * sizeof(std::uint32_t), kStorageUsage, MemoryUse::DeviceOnly);
   skyGrid = Buffer(context, gridPoints * sizeof(float), kStorageUsage, MemoryUse::DeviceOnly);
+  // The sky jobs: none without the ground's hidden sky (a one-job list, never filled).
+  const bool groundSky = fused && prepared.ground;
+  skyJobCapacity = static_cast<std::uint32_t>(!groundSky ? 1 : limits.skyJobs > 0 ? limits.skyJobs : finePoints);
+  skyJobs = Buffer(context, 4 * sizeof(std::uint32_t) + skyJobCapacity * sizeof(shared::SkyJob), kStorageUsage, MemoryUse::DeviceOnly);
+  skyPartials = Buffer(context, std::size_t{skyJobCapacity} * shared::kSkyLanes * sizeof(float), kStorageUsage, MemoryUse::DeviceOnly);
   shadowRays->bind({{shared::kRaysShadeBinding, &shade},
                     {shared::kRaysCounterBinding, &counter},
                     {shared::kRaysPositionsBinding, &positions},
@@ -99,7 +104,9 @@ void VulkanRenderer::Impl::ensureDeviceRayBuffers() {
                     {shared::kRaysPixelSampleBinding, &pixelSample},
                     {shared::kRaysGridBinding, &skyGrid},
                     {shared::kRaysMasksBinding, &masks},
-                    {shared::kRaysHiddenBinding, &hidden}},
+                    {shared::kRaysHiddenBinding, &hidden},
+                    {shared::kRaysSkyJobsBinding, &skyJobs},
+                    {shared::kRaysSkyPartialsBinding, &skyPartials}},
                    accelerationStructures->topLevel());
 }
 
@@ -147,6 +154,7 @@ void VulkanRenderer::Impl::writeRays(const render::ResolvedFrame& resolved, cons
   f.antialias = options.antialias ? 1u : 0u;
   f.groundSky = groundSky ? 1u : 0u;
   f.objectSky = hides ? 1u : 0u;
+  f.skyJobCapacity = skyJobCapacity;
   if (groundSky || hides) {
     const render::SkyOccluders& sky = resolved.skyOccluders;
     f.sky = glm::vec4(sky.normal, static_cast<float>(sky.total));
@@ -158,6 +166,29 @@ void VulkanRenderer::Impl::writeRays(const render::ResolvedFrame& resolved, cons
 
   posesData.resize(objectCount);
   for (std::size_t i = 0; i < objectCount; ++i) posesData[i] = glm::mat4(resolved.objects[i].objectToWorld);
+}
+
+// Sky jobs: the launch that lists them (`phase`, across × down; the
+// frame's part `listed`), their rays over kSkyLanes invocations a job, then
+// their lanes' sums (part `traced`).
+void VulkanRenderer::Impl::recordSkyJobs(VkCommandBuffer cb, std::uint32_t phase, std::uint32_t across,
+                                         std::uint32_t down, const char* listed, const char* traced) {
+  vkCmdFillBuffer(cb, skyJobs.handle(), 0, sizeof(std::uint32_t), 0u);  // the list's count
+  rayTracingBarrier(cb);
+  RaysPush push{phase};
+  shadowRays->trace(cb, across, down, &push, sizeof push);
+  rayTracingBarrier(cb);
+  markPart(cb, listed);
+  // Every job's lanes at once up to kSkyJobsInFlight; beyond, each invocation takes further jobs.
+  const std::uint32_t inFlight = std::min(skyJobCapacity, shared::kSkyJobsInFlight);
+  push.phase = shared::kRaysPhaseSkyRays;
+  shadowRays->trace(cb, shared::kSkyLanes * shared::kSkyJobsAcross, groupsOf(inFlight, shared::kSkyJobsAcross), &push,
+                    sizeof push);
+  rayTracingBarrier(cb);
+  push.phase = shared::kRaysPhaseSkySums;
+  shadowRays->trace(cb, kRaysLaunchWidth, groupsOf(skyJobCapacity, kRaysLaunchWidth), &push, sizeof push);
+  rayTracingBarrier(cb);
+  markPart(cb, traced);
 }
 
 void VulkanRenderer::Impl::recordDeviceRays(VkCommandBuffer cb) {
@@ -173,18 +204,18 @@ void VulkanRenderer::Impl::recordDeviceRays(VkCommandBuffer cb) {
   if (rayFrameData.groundSky) {
     vkCmdFillBuffer(cb, pixelSample.handle(), 0, VK_WHOLE_SIZE, ~0u);
     rayTracingBarrier(cb);
-    RaysPush push{shared::kRaysPhaseCentres};
+    const RaysPush push{shared::kRaysPhaseCentres};
     shadowRays->trace(cb, kRaysLaunchWidth, rows, &push, sizeof push);
     rayTracingBarrier(cb);
     markPart(cb, "ground centres");
-    push.phase = shared::kRaysPhaseGrid;
-    shadowRays->trace(cb, rayFrameData.gridColumns, rayFrameData.gridRows, &push, sizeof push);
-    rayTracingBarrier(cb);
-    markPart(cb, "ground grid");
-    push.phase = shared::kRaysPhaseFineGrid;  // reads the coarse grid: after it
-    shadowRays->trace(cb, rayFrameData.fineColumns, rayFrameData.fineRows, &push, sizeof push);
-    rayTracingBarrier(cb);
-    markPart(cb, "ground fine grid");
+    recordSkyJobs(cb, shared::kRaysPhaseGrid, rayFrameData.gridColumns, rayFrameData.gridRows, "ground grid points",
+                  "ground grid rays");
+    // Reads the coarse grid: after its sums.
+    recordSkyJobs(cb, shared::kRaysPhaseFineGrid, rayFrameData.fineColumns, rayFrameData.fineRows,
+                  "ground fine grid points", "ground fine grid rays");
+    // The samples' words; the ground's samples that no grid cell blends take sky jobs of their own.
+    recordSkyJobs(cb, shared::kRaysPhaseMasks, kRaysLaunchWidth, rows, "masks", "ground's own sky rays");
+    return;
   }
   const RaysPush push{shared::kRaysPhaseMasks};
   shadowRays->trace(cb, kRaysLaunchWidth, rows, &push, sizeof push);

@@ -90,6 +90,7 @@ void VulkanRenderer::Impl::releaseResolution() {
   hiddenUpload = BufferUpload();
   for (Buffer* b : {&gbufIds, &gbufNormals, &gbufPositions, &samples, &shade, &counter, &counterOut, &shadeOut, &radiance,
                     &rgba8, &rotated, &radianceOut, &idsOut, &batchArgs, &subIds, &subNormals, &edges, &masks, &hidden, &pixelSample, &skyGrid,
+                    &skyJobs, &skyPartials,
                     &smoothSums}) {
     *b = Buffer();
   }

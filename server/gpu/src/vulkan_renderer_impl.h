@@ -118,10 +118,12 @@ struct VulkanRenderer::Impl {
   // The device's: a bottom level per mesh and the frame's top level, the
   // ray-generation pipeline, per frame the objects' and the frame's records
   // (core/shared_rays.h); the map light, rgb and luminance (the hidden
-  // sky); per pixel its centre sample and the coarse grid's values.
+  // sky); per pixel its centre sample and the coarse grid's values; the
+  // sky jobs' list and their lanes' sums (shared_rays.h), skyJobCapacity jobs.
   std::unique_ptr<AccelerationStructures> accelerationStructures;
   std::unique_ptr<RayTracingPipeline> shadowRays;
-  Buffer rayObjects, rayFrame, skyLight, pixelSample, skyGrid;
+  Buffer rayObjects, rayFrame, skyLight, pixelSample, skyGrid, skyJobs, skyPartials;
+  std::uint32_t skyJobCapacity = 0;
   BufferUpload rayObjectsUpload, rayFrameUpload;
   std::vector<RayObject> rayObjectData;
   RayFrame rayFrameData{};
@@ -310,6 +312,8 @@ struct VulkanRenderer::Impl {
   // The "shadow-rays" stage on the device: the uploads, the top level, the
   // four launches (core/shared_rays.h), ending with the masks fused reads.
   void recordDeviceRays(VkCommandBuffer cb);
+  void recordSkyJobs(VkCommandBuffer cb, std::uint32_t phase, std::uint32_t across, std::uint32_t down,
+                     const char* listed, const char* traced);
 
   // rotating_frame.cpp
   render::Frame renderRotating(const render::FrameRequest& request);

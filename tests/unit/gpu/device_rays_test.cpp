@@ -245,6 +245,41 @@ INSTANTIATE_TEST_SUITE_P(Cases, DeviceRays,
                            return name;
                          });
 
+// The ground's hidden sky as sky jobs (each job's rays over kSkyLanes
+// invocations, shared_rays.h) against a list of one job, where every other
+// job traces its rays in the invocation it arose in: the same rays, added
+// in another order, so the same words but for a share that rounds to the
+// next step. Antialiased, so that sub-samples take jobs of their own too.
+GPU_TEST(DeviceRays, ASkyJobsLanesTraceWhatOneInvocationDoes) {
+  HAARCAST_REQUIRE_RAY_TRACING();
+  const render::Scene scene = render::defaultScene();
+  render::RenderOptions o = frameOptions(RotationMethod::Fused, true);
+  o.width = 96;
+  o.height = 72;
+  o.antialias = true;
+  VulkanRendererLimits oneJob = raysOn(render::RayMode::Device);
+  oneJob.skyJobs = 1;
+  VulkanRenderer inOne(scene, o, testing::testOptions(), {}, oneJob);
+  VulkanRenderer lanes(scene, o, testing::testOptions(), {}, raysOn(render::RayMode::Device));
+  render::FrameRequest request = requestFor(scene, o.width, o.height);
+  request.poses = testing::scenePoses(scene);
+  request.poses[1].rotateDegrees += glm::dvec3(10.0, 25.0, -5.0);
+  const render::Frame a = inOne.render(request);
+  const render::Frame b = lanes.render(request);
+  const WordDiff d = diffWords(inOne, lanes, true);
+  const Comparison image = compare(a, b);
+  std::printf("%zu ground samples (%zu occluded), worst %.5f apart; image %.1f dB\n", d.groundSamples, d.groundOccluded,
+              d.groundWorst, image.psnr);
+  EXPECT_GT(d.groundOccluded, 1000u);
+  EXPECT_EQ(d.lightFlipped, 0u);
+  EXPECT_EQ(d.lobeFlipped, 0u);
+  EXPECT_EQ(d.hiddenOff + d.hiddenTurned, 0u);
+  EXPECT_LE(d.groundWorst, 1.0 / shared::kGroundOcclusionSteps + 1e-9);
+  EXPECT_GE(image.psnr, 90.0);
+  EXPECT_EQ(image.mismatched, 0u);
+  testing::expectNoValidationMessages(lanes.context());
+}
+
 // With the rays on the device a frame is one submission; with the host's,
 // three (the first part, the covered samples' copy read back, and after the
 // host's rays the second part with the words' upload). Counted

@@ -466,7 +466,9 @@ static_assert(sizeof(ObjectInfo) == 192 && offsetof(ObjectInfo, toLight) == 96 &
 static_assert(sizeof(PointLight) == 32);
 static_assert(sizeof(RayObject) == 144 && offsetof(RayObject, sphere) == 112 && offsetof(RayObject, occluder) == 140);
 static_assert(sizeof(RayFrame) == 400 && offsetof(RayFrame, eye) == 256 && offsetof(RayFrame, toEnvironment) == 288 &&
-              offsetof(RayFrame, lights) == 336 && offsetof(RayFrame, objectSky) == 380 && offsetof(RayFrame, fineRows) == 392);
+              offsetof(RayFrame, lights) == 336 && offsetof(RayFrame, objectSky) == 380 && offsetof(RayFrame, fineRows) == 392 &&
+              offsetof(RayFrame, skyJobCapacity) == 396);
+static_assert(sizeof(SkyJob) == 8);
 static_assert(sizeof(HiddenLight) == 16 && offsetof(HiddenLight, direction) == 12);
 static_assert(sizeof(SliceLobe) == 48 + 16 * kLobeSamples && offsetof(SliceLobe, median) == 16 &&
               offsetof(SliceLobe, core) == 32 && offsetof(SliceLobe, samples) == 48);

@@ -6,15 +6,25 @@
 // The rays are the host's (render/point_lights.h) for the same samples:
 // each sample's point-light rays, the lobe ray, and the ground's hidden-sky
 // rays, on the same coarse grid, from the same shading points. The pass
-// runs in four launches of one pipeline, told apart by RaysPush::phase:
+// runs in launches of one pipeline, told apart by RaysPush::phase:
 //   kRaysPhaseCentres  per covered sample: a pixel's centre sample into
 //                      pixelSample[pixel] (cleared to ~0 before);
 //   kRaysPhaseGrid     per grid point (RayFrame::gridColumns × gridRows):
-//                      the hidden sky of an interior ground pixel, or −1;
+//                      −1 unless an interior ground pixel, whose hidden
+//                      sky is a sky job (below);
 //   kRaysPhaseFineGrid per fine grid point (fineColumns × fineRows): the
 //                      same, where a coarse cell an outline crosses uses it;
 //   kRaysPhaseMasks    per covered sample: its shadow word (fused.comp's
-//                      `masks`), the ground's occlusion blended from the grid.
+//                      `masks`), the ground's occlusion blended from the
+//                      grid, or, where the grid cannot, a sky job of its own;
+//   kRaysPhaseSkyRays  each sky job's cone rays, over kSkyLanes invocations;
+//   kRaysPhaseSkySums  per sky job: its lanes' sums, written to its grid
+//                      point or into its sample's word.
+// A ground point's hidden sky is up to 256 rays per occluder. Traced in
+// one invocation, the few thousand grid points left a GPU nearly empty
+// while each walked its rays one after another, at every frame size; a sky
+// job spreads them over kSkyLanes invocations instead, so the grid, the
+// fine grid and the samples' own rays are each one short chain of rays.
 #ifndef HAARCAST_CORE_SHARED_RAYS_H
 #define HAARCAST_CORE_SHARED_RAYS_H
 
@@ -22,6 +32,27 @@ HC_CONST uint kRaysPhaseCentres = 0u;
 HC_CONST uint kRaysPhaseGrid = 1u;
 HC_CONST uint kRaysPhaseMasks = 2u;
 HC_CONST uint kRaysPhaseFineGrid = 3u;
+HC_CONST uint kRaysPhaseSkyRays = 4u;
+HC_CONST uint kRaysPhaseSkySums = 5u;
+
+// A sky job: the hidden sky of the shading point of covered sample
+// `from`, for `target`: a point of `grid` (coarse, then fine), or, with
+// kSkyJobWord, that sample's shadow word. Lane l of a job traces the rays
+// whose index over all its cones (occluder, ring, sector, in the host's
+// order) is l modulo kSkyLanes, and writes their sum to partials[job·kSkyLanes + l];
+// kRaysPhaseSkySums adds the lanes in order. Jobs past the list's capacity
+// (RayFrame::skyJobCapacity) are traced where they arise, in one invocation.
+HC_CONST uint kSkyLanes = 32u;
+HC_CONST uint kSkyJobWord = 0x80000000u;
+// The kRaysPhaseSkyRays launch: kSkyJobsAcross jobs a row of kSkyLanes·kSkyJobsAcross
+// invocations, at most kSkyJobsInFlight jobs at once (each invocation
+// takes its job, then every one so many further on).
+HC_CONST uint kSkyJobsAcross = 64u;
+HC_CONST uint kSkyJobsInFlight = 4096u;
+struct SkyJob {
+  uint from;
+  uint target;
+};
 
 // The ground grid's refinement (render::GroundSkyGrid): a coarse cell that
 // an object's outline crosses (a corner off the ground) is read from a grid
@@ -131,7 +162,7 @@ struct RayFrame {
   uint fineStep;          // groundSkyFineStep(gridStep); the fine points follow the coarse ones in `grid`
   uint fineColumns;       // (width − 1)/fineStep + 2
   uint fineRows;
-  uint framePad;
+  uint skyJobCapacity;   // the sky jobs the list holds (kRaysSkyJobsBinding)
 };
 
 // Object i's instance mask in the top level: a bit of its own while there

@@ -88,6 +88,12 @@ struct VulkanRendererLimits {
   // (render/backend_names.h): `device` needs a device with ray tracing
   // (context.h, RayTracingSupport) and is refused elsewhere.
   render::RayMode rays = render::RayMode::Auto;
+  // With the device's rays and a ground: the most sky jobs (a ground
+  // point's hidden-sky rays spread over shared::kSkyLanes invocations,
+  // core/shared_rays.h) one launch's list holds; a job past it traces its
+  // rays in one invocation. 0 = the fine grid's points (every grid point
+  // fits; a sample's own rays past it are rare). Memory: kSkyLanes + 2 words a job.
+  std::size_t skyJobs = 0;
   // On a CPU device each stage is a submission of its own, timed on the host
   // (lavapipe's timestamps do not wait for compute); true records the frame
   // into one submission there too, reported as one stage, "device".
