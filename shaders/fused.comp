@@ -14,7 +14,8 @@
 // by the rotation-input pass's indirect arguments. With a smooth-sum
 // tolerance (push.stage ≠ kSmoothSumOff; core/shared_smooth.h) the pass is
 // dispatched once per stage, coarse to fine: each visits its stage's pixels
-// (and stage 0 every sample the smooth sum does not visit), and a pixel
+// (and stage 0 every sample the smooth sum does not visit), from the lists
+// a dispatch before them writes (listStages), and a pixel
 // whose parents allow takes their mean sum instead of steps 1–2. Per sample:
 //   1. the invocations stride over the directions: Rᵀω with R = Ry(α)Rx(β)Ry(γ)
 //      (γ only offsets the source column), θ', φ' with the CPU kernel's
@@ -114,6 +115,9 @@ layout(set = 0, binding = kFusedDetailTexelsBinding) uniform textureBuffer detai
 // 2q, its mirror direction at 2q + 1, written where it is visited; the
 // stage this dispatch visits, the frame's size and the tolerance.
 layout(std430, set = 0, binding = kFusedSmoothBinding) buffer Smooth { vec4 smoothData[]; };
+// The smooth sum's stage lists (shared_smooth.h smoothListOffset): counts,
+// indirect dispatches, samples.
+layout(std430, set = 0, binding = kFusedStageListsBinding) buffer StageLists { uint stageLists[]; };
 layout(push_constant) uniform Push { FusedPush push; };
 
 shared vec3 partial[LOCAL];
@@ -502,9 +506,33 @@ void shadePixel(uint s) {
   if (SUBGROUP_REDUCE == 0u) sync();  // `partial` is reused by the next sample
 }
 
-void main() {
+// Each covered sample into its stage's list, an invocation a sample: stage
+// 0 takes every sample the smooth sum does not visit. A stage's dispatch
+// then takes min(its count, push.groups) workgroups.
+void listStages() {
   const uint count = counter.covered;
-  for (uint s = gl_WorkGroupID.x; s < count; s += gl_NumWorkGroups.x) {
-    if (shadesNow(s)) shadePixel(s);
+  for (uint s = gl_GlobalInvocationID.x; s < count; s += gl_NumWorkGroups.x * LOCAL) {
+    const ShadeSample sh = shade[s];
+    const uint stage = smoothVisited(sh, objects[sh.object])
+                           ? smoothStageOf(int(sh.pixel % push.width), int(sh.pixel / push.width), int(push.width), int(push.height))
+                           : 0u;
+    const uint i = atomicAdd(stageLists[stage], 1u);
+    stageLists[smoothListOffset(stage, push.width, push.height) + i] = s;
+    if (i < push.groups) atomicMax(stageLists[kSmoothListArgs + 4u * stage], i + 1u);
   }
+}
+
+void main() {
+  if (push.stage == kSmoothSumList) {
+    listStages();
+    return;
+  }
+  if (push.stage == kSmoothSumOff) {
+    const uint count = counter.covered;
+    for (uint s = gl_WorkGroupID.x; s < count; s += gl_NumWorkGroups.x) shadePixel(s);
+    return;
+  }
+  // A stage: its own samples, from its list.
+  const uint count = stageLists[push.stage], first = smoothListOffset(push.stage, push.width, push.height);
+  for (uint i = gl_WorkGroupID.x; i < count; i += gl_NumWorkGroups.x) shadePixel(stageLists[first + i]);
 }

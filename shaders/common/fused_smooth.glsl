@@ -1,6 +1,7 @@
 // `fused`'s sum from a pixel's neighbours (core/shared_smooth.h; the CPU's
-// cpu_backend.cpp shadeSmoothSums): which samples a dispatch shades, and
-// the sum a pixel takes from its parents. Included by fused.comp after what
+// cpu_backend.cpp shadeSmoothSums): which samples the smooth sum visits
+// (each in the stage smoothStageOf names: fused.comp listStages), and the
+// sum a pixel takes from its parents. Included by fused.comp after what
 // it reads: the push block and the shade, objects, radiance and smoothData
 // bindings.
 #ifndef HAARCAST_FUSED_SMOOTH_GLSL
@@ -12,16 +13,6 @@
 bool smoothVisited(ShadeSample sh, ObjectInfo o) {
   return sh.pixel < push.width * push.height && (o.flags & kObjectGround) == 0u &&
          !((o.flags & kObjectLobePath) != 0u && o.lobeCore.x <= -1.0);
-}
-// Whether this dispatch shades sample s: every sample without a smooth
-// sum; with one, each visited sample in its stage and every other sample
-// in stage 0.
-bool shadesNow(uint s) {
-  if (push.stage == kSmoothSumOff) return true;
-  const ShadeSample sh = shade[s];
-  if (!smoothVisited(sh, objects[sh.object])) return push.stage == 0u;
-  const int x = int(sh.pixel % push.width), y = int(sh.pixel / push.width);
-  return smoothParents(push.stage, x, y, int(push.width), int(push.height)).count != -2;
 }
 // A parent's sum and mirror, where it is on `object` and visited.
 bool smoothParent(uint q, uint object, vec3 mirror, float cosLimit, out vec3 sum) {

@@ -3,6 +3,8 @@
 
 #include <algorithm>
 
+#include "haarcast/core/shared_smooth.h"
+
 #include "vulkan_renderer_impl.h"
 
 namespace haarcast::gpu {
@@ -91,7 +93,7 @@ void VulkanRenderer::Impl::releaseResolution() {
   for (Buffer* b : {&gbufIds, &gbufNormals, &gbufPositions, &samples, &shade, &counter, &counterOut, &shadeOut, &radiance,
                     &rgba8, &rotated, &radianceOut, &idsOut, &batchArgs, &subIds, &subNormals, &edges, &masks, &hidden, &pixelSample, &skyGrid,
                     &skyJobs, &skyPartials,
-                    &smoothSums}) {
+                    &smoothSums, &smoothLists}) {
     *b = Buffer();
   }
   width = height = 0;
@@ -137,6 +139,11 @@ void VulkanRenderer::Impl::ensureResolution(int w, int h) {
                     kStorageUsage, MemoryUse::DeviceOnly);
   // fused's smooth sum: pixel q's sum and object, then its mirror direction.
   smoothSums = Buffer(context, (fused ? 2 * pixels : 1) * sizeof(glm::vec4), kStorageUsage, MemoryUse::DeviceOnly);
+  // fused's stage lists (shared_smooth.h): the header, every stage's pixels after the grid's, then stage 0's
+  // samples, as many as can be covered; read as indirect dispatches too.
+  smoothLists = Buffer(context,
+                       (fused ? shared::smoothListOffset(0u, uw, uh) + sampleCapacity : 1) * sizeof(std::uint32_t),
+                       kStorageUsage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, MemoryUse::DeviceOnly);
   // The one image every frame reads back, written once by the tonemap pass.
   rgba8 = Buffer(context, pixels * sizeof(std::uint32_t), kStorageUsage, MemoryUse::Readback);
   radianceOut = Buffer(context, pixels * sizeof(glm::vec4), kStorageUsage, MemoryUse::Readback);
@@ -216,7 +223,8 @@ void VulkanRenderer::Impl::ensureResolution(int w, int h) {
                      {kFusedDetailTexelsBinding, &detailTexels},
                      {kFusedSliceCountsBinding, &sliceCounts},
                      {kFusedHiddenBinding, &hidden},
-                     {kFusedSmoothBinding, &smoothSums}});
+                     {kFusedSmoothBinding, &smoothSums},
+                     {kFusedStageListsBinding, &smoothLists}});
     return;
   }
 

@@ -188,6 +188,9 @@ struct VulkanRenderer::Impl {
   // `fused`'s smooth sum (shared_smooth.h): two vec4 per pixel, cleared
   // each frame that takes sums from neighbours (RenderOptions::smoothSumTolerance).
   Buffer smoothSums;
+  // Its stage lists: per stage the samples its dispatch shades, and that
+  // dispatch's arguments (shared_smooth.h smoothListOffset).
+  Buffer smoothLists;
   std::vector<HiddenLight> hiddenData;
   // Antialiasing: the sub-samples' ids and normals (else 4-byte stand-ins),
   // and each pixel's edge word (shared_layout.h kEdgeFlag).
@@ -311,7 +314,10 @@ struct VulkanRenderer::Impl {
   void writeRays(const render::ResolvedFrame& resolved, const glm::vec3& eye);
   // The "shadow-rays" stage on the device: the uploads, the top level, the
   // four launches (core/shared_rays.h), ending with the masks fused reads.
+  shared::FusedPush fusedPush(shared::uint stage, float tolerance) const;
+  void recordSmoothStages(VkCommandBuffer cb);
   void recordDeviceRays(VkCommandBuffer cb);
+
   void recordSkyJobs(VkCommandBuffer cb, std::uint32_t phase, std::uint32_t across, std::uint32_t down,
                      const char* listed, const char* traced);
 

@@ -258,6 +258,7 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
   Buffer detailBuf = upload(&noDetail, sizeof noDetail);
   const TexelView detailView(context, detailBuf, VK_FORMAT_R32_SFLOAT, sizeof(float));
   Buffer smoothBuf(context, sizeof(glm::vec4));
+  Buffer stageListsBuf(context, sizeof(std::uint32_t));
   ComputePipeline p(context, "fused.comp", fusedBindings(), sizeof(shared::FusedPush),
                     {{shared::kSpecLocalSize, shared::kLocalSize},
                      {shared::kSpecInterpolate, pc.interpolate ? 1u : 0u},
@@ -267,9 +268,12 @@ TEST_P(FusedPass, MatchesCoreFusedShade) {
   Buffer sliceCountBuf = upload(sliceCounts.data(), sliceCounts.size() * sizeof(std::uint32_t));
   p.bind({&sampleBuf, &shadeBuf, &objectBuf, &texelView, &lightView, &bitsView, &dirView, &pointBuf, &radiance,
           &counterBuf, &maskBuf, &energyBuf, &lobeBuf, &prefilterView, &pointTexelView, &sliceCountBuf, &hiddenBuf,
-          &detailView, &smoothBuf});
+          &detailView, &smoothBuf, &stageListsBuf});
   // Every sample shaded in one dispatch: no sum from neighbours (its own test: FusedFrame).
-  const shared::FusedPush push{shared::kSmoothSumOff, static_cast<std::uint32_t>(kPixels), 1u, 0.0f};
+  shared::FusedPush push{};
+  push.stage = shared::kSmoothSumOff;
+  push.width = static_cast<std::uint32_t>(kPixels);
+  push.height = 1u;
   context.submit([&](VkCommandBuffer cb) { p.dispatch(cb, {kGroups, 1, 1}, &push, sizeof push); });
   std::vector<glm::vec4> got(kPixels);
   radiance.read(got.data(), got.size() * sizeof(glm::vec4));

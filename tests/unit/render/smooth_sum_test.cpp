@@ -60,6 +60,35 @@ TEST(SmoothSum, EveryPixelIsVisitedOnceAfterItsParents) {
   }
 }
 
+// fused.comp's stage lists: a pixel's stage is the one that visits it, a
+// stage's list is as long as its pixels, and the lists lie one after
+// another (stage 0 last, open-ended: it also takes the samples not visited).
+TEST(SmoothSum, EachStagesListHoldsItsPixelsAndNoOtherStages) {
+  for (const auto& [w, h] : {std::pair{13, 9}, {16, 16}, {1, 1}, {5, 1}, {1, 7}, {33, 20}, {1280, 720}, {97, 1}}) {
+    const auto uw = static_cast<shared::uint>(w), uh = static_cast<shared::uint>(h);
+    std::array<shared::uint, shared::kSmoothSumStages> pixels{};
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) {
+        const shared::uint k = shared::smoothStageOf(x, y, w, h);
+        ASSERT_LT(k, shared::kSmoothSumStages);
+        EXPECT_NE(shared::smoothParents(k, x, y, w, h).count, -2) << "(" << x << ", " << y << ") of " << w << "×" << h;
+        ++pixels[k];
+      }
+    }
+    shared::uint offset = shared::kSmoothListHeader;
+    for (shared::uint k = 1; k < shared::kSmoothSumStages; ++k) {
+      EXPECT_EQ(shared::smoothStagePixels(k, uw, uh), pixels[k]) << "stage " << k << " of " << w << "×" << h;
+      EXPECT_EQ(shared::smoothListOffset(k, uw, uh), offset) << "stage " << k << " of " << w << "×" << h;
+      offset += pixels[k];
+    }
+    EXPECT_EQ(shared::smoothStagePixels(0, uw, uh), pixels[0]);
+    EXPECT_EQ(shared::smoothListOffset(0, uw, uh), offset) << w << "×" << h << ": stage 0 after the others";
+  }
+  // The header: a count per stage, then each stage's dispatch (x, y, z, pad).
+  EXPECT_GE(shared::kSmoothListArgs, shared::kSmoothSumStages);
+  EXPECT_EQ(shared::kSmoothListHeader, shared::kSmoothListArgs + 4 * shared::kSmoothSumStages);
+}
+
 TEST(SmoothSum, ParentsAreTheGridNeighboursAtTheStagesStep) {
   ASSERT_EQ(shared::kSmoothSumSpacing, 8u);
   // grid 8, edges 4, centres 4, edges 2, centres 2, edges 1, centres 1

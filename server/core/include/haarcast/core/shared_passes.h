@@ -207,16 +207,22 @@ HC_CONST uint kFusedDetailTexelsBinding = 17u;  // the slices' detail maps (shar
 // pixel's sum (rgb) and 1 + its object as the bits of w, 0 until it is
 // visited; its mirror direction (xyz).
 HC_CONST uint kFusedSmoothBinding = 18u;
-HC_CONST uint kFusedBindings = 19u;
+HC_CONST uint kFusedStageListsBinding = 19u;  // the smooth sum's stage lists (shared_smooth.h)
+HC_CONST uint kFusedBindings = 20u;
 
 // fused.comp's push block: the smooth sum's stage this dispatch
-// (shared_smooth.h; kSmoothSumOff: one dispatch shades every sample), the
-// frame's size and the tolerance.
+// (shared_smooth.h; kSmoothSumOff: one dispatch shades every sample;
+// kSmoothSumList: the stages' lists are written), the frame's size, the
+// tolerance, and the most workgroups a stage's dispatch takes.
 struct FusedPush {
   uint stage;
   uint width;
   uint height;
   float tolerance;
+  uint groups;
+  uint pushPad0;
+  uint pushPad1;
+  uint pushPad2;
 };
 
 // splitsum.comp; kSplitsumLobeLightTexelsBinding is a uniform texel

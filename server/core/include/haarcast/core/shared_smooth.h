@@ -148,6 +148,47 @@ HC_FUNCTION int smoothRowFirst(uint stage, int y, HC_OUT(int) stride) {
   return ry == h ? h : -1;
 }
 
+// The stage that visits pixel (x, y): the one whose smoothParents is not −2
+// (every pixel has exactly one: SmoothSum.EveryPixelIsVisitedOnceAfterItsParents).
+HC_FUNCTION uint smoothStageOf(int x, int y, int width, int height) {
+  for (uint stage = 1u; stage < kSmoothSumStages; ++stage) {
+    if (smoothParents(stage, x, y, width, height).count != -2) return stage;
+  }
+  return 0u;
+}
+
+// How many of a width × height frame's pixels stage `stage` visits: those
+// with x ≡ rx (mod 2h) and y ≡ ry, for the stage's remainders (rx, ry) at
+// its step h (the grid's: both ≡ 0 mod h).
+HC_FUNCTION uint smoothCountOf(uint extent, uint remainder, uint modulus) {
+  return extent > remainder ? (extent - remainder + modulus - 1u) / modulus : 0u;
+}
+HC_FUNCTION uint smoothStagePixels(uint stage, uint width, uint height) {
+  const uint h = smoothStageStep(stage);
+  const uint kind = smoothStageKind(stage);
+  if (kind == kSmoothGrid) return smoothCountOf(width, 0u, h) * smoothCountOf(height, 0u, h);
+  if (kind == kSmoothCentres) return smoothCountOf(width, h, 2u * h) * smoothCountOf(height, h, 2u * h);
+  return smoothCountOf(width, h, 2u * h) * smoothCountOf(height, 0u, 2u * h) +
+         smoothCountOf(width, 0u, 2u * h) * smoothCountOf(height, h, 2u * h);
+}
+
+// fused.comp's stage lists (push stage kSmoothSumList writes them, so that a
+// stage's dispatch visits its own samples, not every covered sample): in
+// words, stage k's count at k, its indirect dispatch (x, 1, 1) at
+// kSmoothListArgs + 4k, and its samples from smoothListOffset(k): stages 1
+// and on first, each as long as it has pixels, then stage 0, which also
+// takes every sample the smooth sum does not visit (as long as the
+// covered samples can be).
+HC_CONST uint kSmoothSumList = 0xFFFFFFFEu;
+HC_CONST uint kSmoothListArgs = 8u;
+HC_CONST uint kSmoothListHeader = kSmoothListArgs + 4u * kSmoothSumStages;
+HC_FUNCTION uint smoothListOffset(uint stage, uint width, uint height) {
+  uint offset = kSmoothListHeader;
+  const uint end = stage == 0u ? kSmoothSumStages : stage;
+  for (uint k = 1u; k < end; ++k) offset += smoothStagePixels(k, width, height);
+  return offset;
+}
+
 // The mirror direction of the view in the object's frame: the slice frame's
 // (0, cos θₒ, −sin θₒ) (the view is at φ = 0, shared_frame.h shadingFrame)
 // turned by R = R_y(α) R_x(β) R_y(γ).
