@@ -339,24 +339,26 @@ vec3 finishSum(PixelSetup p, ObjectInfo o, RotationSample rs, SliceBlend blend, 
   return sum;
 }
 
+// The ground: its map light is the same at every point (closed form on the
+// host) less the share the objects hide (the word's upper half); the point
+// lights' shadow bits vary. One invocation's work.
+void shadeGround(ShadeSample sh, ObjectInfo o, uint seen) {
+  atomicAdd(sliceCounts[kSliceCountsPerObject * sh.object], 1u);  // read no slice: counted so that every sample is
+  vec3 sum = groundSkyKept(seen) * o.groundRadiance.rgb;
+  for (uint k = 0u; k < o.pointLights; ++k) {
+    if (((seen >> k) & 1u) != 0u) sum += pointLights[sh.object * kMaxPointLights + k].power.rgb;
+  }
+  radiance[sh.pixel] = vec4(sum, 1.0);
+}
+
 void shadePixel(uint s) {
   const uint lid = gl_LocalInvocationID.x;
   const ShadeSample sh = shade[s];
   const ObjectInfo o = objects[sh.object];
   const uint seen = masks[s];
 
-  // The ground: its map light is the same at every point (closed form on
-  // the host) less the share the objects hide (the word's upper half); the
-  // point lights' shadow bits vary.
   if ((o.flags & kObjectGround) != 0u) {
-    if (lid == 0u) {
-      atomicAdd(sliceCounts[kSliceCountsPerObject * sh.object], 1u);  // read no slice: counted so that every sample is
-      vec3 sum = groundSkyKept(seen) * o.groundRadiance.rgb;
-      for (uint k = 0u; k < o.pointLights; ++k) {
-        if (((seen >> k) & 1u) != 0u) sum += pointLights[sh.object * kMaxPointLights + k].power.rgb;
-      }
-      radiance[sh.pixel] = vec4(sum, 1.0);
-    }
+    if (lid == 0u) shadeGround(sh, o, seen);
     return;  // uniform over the workgroup: no barrier skipped by some invocations only
   }
 
@@ -507,13 +509,20 @@ void shadePixel(uint s) {
 }
 
 // Each covered sample into its stage's list, an invocation a sample: stage
-// 0 takes every sample the smooth sum does not visit. A stage's dispatch
-// then takes min(its count, push.groups) workgroups.
+// 0 takes every sample the smooth sum does not visit but the ground's,
+// which are shaded here, an invocation each, rather than a workgroup each
+// in stage 0. A stage's dispatch then takes min(its count, push.groups)
+// workgroups.
 void listStages() {
   const uint count = counter.covered;
   for (uint s = gl_GlobalInvocationID.x; s < count; s += gl_NumWorkGroups.x * LOCAL) {
     const ShadeSample sh = shade[s];
-    const uint stage = smoothVisited(sh, objects[sh.object])
+    const ObjectInfo o = objects[sh.object];
+    if ((o.flags & kObjectGround) != 0u) {
+      shadeGround(sh, o, masks[s]);
+      continue;
+    }
+    const uint stage = smoothVisited(sh, o)
                            ? smoothStageOf(int(sh.pixel % push.width), int(sh.pixel / push.width), int(push.width), int(push.height))
                            : 0u;
     const uint i = atomicAdd(stageLists[stage], 1u);
