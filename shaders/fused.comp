@@ -15,7 +15,9 @@
 // tolerance (push.stage ≠ kSmoothSumOff; core/shared_smooth.h) the pass is
 // dispatched once per stage, coarse to fine: each visits its stage's pixels
 // (and stage 0 every sample the smooth sum does not visit), from the lists
-// a dispatch before them writes (listStages), and a pixel
+// a dispatch before them writes (listStages), in two dispatches: an
+// invocation a sample decides (decideStage), a workgroup a sample sums
+// what it could not take; a pixel
 // whose parents allow takes their mean sum instead of steps 1–2. Per sample:
 //   1. the invocations stride over the directions: Rᵀω with R = Ry(α)Rx(β)Ry(γ)
 //      (γ only offsets the source column), θ', φ' with the CPU kernel's
@@ -351,15 +353,27 @@ void shadeGround(ShadeSample sh, ObjectInfo o, uint seen) {
   radiance[sh.pixel] = vec4(sum, 1.0);
 }
 
-void shadePixel(uint s) {
+// How shadePixel takes sample s: the whole workgroup's, deciding and
+// summing (kPixelWhole); one invocation's, shading it where it needs no
+// sum of its own (the ground, a whole lobe path, a sum taken from its
+// parents) and returning false where it does (kPixelDecide); the
+// workgroup's, summing it, already decided (kPixelSum).
+const uint kPixelWhole = 0u;
+const uint kPixelDecide = 1u;
+const uint kPixelSum = 2u;
+
+// Returns false only where `how` is kPixelDecide and the sample sums its own.
+bool shadePixel(uint s, uint how) {
   const uint lid = gl_LocalInvocationID.x;
+  const bool alone = how == kPixelDecide;  // one invocation's: no workgroup-wide step before it returns
+  const bool writer = alone || lid == 0u;
   const ShadeSample sh = shade[s];
   const ObjectInfo o = objects[sh.object];
   const uint seen = masks[s];
 
   if ((o.flags & kObjectGround) != 0u) {
-    if (lid == 0u) shadeGround(sh, o, seen);
-    return;  // uniform over the workgroup: no barrier skipped by some invocations only
+    if (writer) shadeGround(sh, o, seen);
+    return true;  // uniform over the workgroup: no barrier skipped by some invocations only
   }
 
   const RotationSample rs = samples[s];
@@ -373,11 +387,11 @@ void shadePixel(uint s) {
   // its core, with the pass over the rest.
   const bool lobePath = (o.flags & kObjectLobePath) != 0u;
   if (lobePath && o.lobeCore.x <= -1.0) {
-    if (lid == 0u) {
+    if (writer) {
       atomicAdd(sliceCounts[sliceWord], 1u);
       radiance[sh.pixel] = vec4(lobeShade(o, rs, blend, seen), 1.0);
     }
-    return;  // uniform over the workgroup
+    return true;  // uniform over the workgroup
   }
   PixelSetup p;
   p.sh = sh;
@@ -436,15 +450,16 @@ void shadePixel(uint s) {
   const bool visited = push.stage != kSmoothSumOff && smoothVisited(sh, o);
   const vec3 mirror = visited ? smoothMirror(rs.alpha, rs.beta, rs.gamma, rs.thetaOut) : vec3(0.0);
   vec3 given;
-  if (visited && smoothTaken(sh, o, mirror, given)) {
-    if (lid == 0u) {
+  if (visited && how != kPixelSum && smoothTaken(sh, o, mirror, given)) {
+    if (writer) {
       atomicAdd(sliceCounts[kSliceCountsPerObject * sh.object + 6u], 1u);
       radiance[sh.pixel] = vec4(finishSum(p, o, rs, blend, seen, given, lobePath), 1.0);
       smoothData[2u * sh.pixel] = vec4(given, uintBitsToFloat(sh.object + 1u));
       smoothData[2u * sh.pixel + 1u] = vec4(mirror, 0.0);
     }
-    return;  // uniform over the workgroup
+    return true;  // uniform over the workgroup
   }
+  if (alone) return false;
   if (lid == 0u) atomicAdd(sliceCounts[sliceWord], 1u);
 
   // Only rows that can reach the slice's non-zero cap (shared_layout.h
@@ -506,13 +521,14 @@ void shadePixel(uint s) {
     radiance[sh.pixel] = vec4(finishSum(p, o, rs, blend, seen, sum, lobePath), 1.0);
   }
   if (SUBGROUP_REDUCE == 0u) sync();  // `partial` is reused by the next sample
+  return true;
 }
 
 // Each covered sample into its stage's list, an invocation a sample: stage
 // 0 takes every sample the smooth sum does not visit but the ground's,
-// which are shaded here, an invocation each, rather than a workgroup each
-// in stage 0. A stage's dispatch then takes min(its count, push.groups)
-// workgroups.
+// which are shaded here, an invocation each, rather than a workgroup each.
+// A stage's deciding dispatch then takes ⌈count / LOCAL⌉ workgroups (at
+// most push.groups).
 void listStages() {
   const uint count = counter.covered;
   for (uint s = gl_GlobalInvocationID.x; s < count; s += gl_NumWorkGroups.x * LOCAL) {
@@ -527,7 +543,21 @@ void listStages() {
                            : 0u;
     const uint i = atomicAdd(stageLists[stage], 1u);
     stageLists[smoothListOffset(stage, push.width, push.height) + i] = s;
-    if (i < push.groups) atomicMax(stageLists[kSmoothListArgs + 4u * stage], i + 1u);
+    if (i % LOCAL == 0u && i / LOCAL < push.groups) atomicMax(stageLists[kSmoothDecideArgs + 4u * stage], i / LOCAL + 1u);
+  }
+}
+
+// A stage's samples, an invocation each: those that take their parents'
+// sum (or need none) shaded, the rest into the stage's list of its own
+// sums, whose dispatch takes a workgroup a sample (at most push.groups).
+void decideStage() {
+  const uint count = stageLists[push.stage], first = smoothListOffset(push.stage, push.width, push.height);
+  for (uint i = gl_GlobalInvocationID.x; i < count; i += gl_NumWorkGroups.x * LOCAL) {
+    const uint s = stageLists[first + i];
+    if (shadePixel(s, kPixelDecide)) continue;
+    const uint j = atomicAdd(stageLists[kSmoothSumCounts + push.stage], 1u);
+    stageLists[push.ownLists + first + j] = s;
+    if (j < push.groups) atomicMax(stageLists[kSmoothSumArgs + 4u * push.stage], j + 1u);
   }
 }
 
@@ -538,10 +568,15 @@ void main() {
   }
   if (push.stage == kSmoothSumOff) {
     const uint count = counter.covered;
-    for (uint s = gl_WorkGroupID.x; s < count; s += gl_NumWorkGroups.x) shadePixel(s);
+    for (uint s = gl_WorkGroupID.x; s < count; s += gl_NumWorkGroups.x) shadePixel(s, kPixelWhole);
     return;
   }
-  // A stage: its own samples, from its list.
-  const uint count = stageLists[push.stage], first = smoothListOffset(push.stage, push.width, push.height);
-  for (uint i = gl_WorkGroupID.x; i < count; i += gl_NumWorkGroups.x) shadePixel(stageLists[first + i]);
+  if (push.part == kSmoothPartDecide) {
+    decideStage();
+    return;
+  }
+  // A stage's own sums, a workgroup each.
+  const uint count = stageLists[kSmoothSumCounts + push.stage];
+  const uint first = push.ownLists + smoothListOffset(push.stage, push.width, push.height);
+  for (uint i = gl_WorkGroupID.x; i < count; i += gl_NumWorkGroups.x) shadePixel(stageLists[first + i], kPixelSum);
 }

@@ -100,6 +100,11 @@ void VulkanRenderer::Impl::releaseResolution() {
   batch = maxBatches = sampleCapacity = 0;
 }
 
+shared::uint VulkanRenderer::Impl::smoothOwnLists() const {
+  return shared::smoothListOffset(0u, static_cast<shared::uint>(width), static_cast<shared::uint>(height)) +
+         static_cast<shared::uint>(sampleCapacity);
+}
+
 void VulkanRenderer::Impl::ensureResolution(int w, int h) {
   if (w == width && h == height) return;
   releaseResolution();
@@ -140,9 +145,9 @@ void VulkanRenderer::Impl::ensureResolution(int w, int h) {
   // fused's smooth sum: pixel q's sum and object, then its mirror direction.
   smoothSums = Buffer(context, (fused ? 2 * pixels : 1) * sizeof(glm::vec4), kStorageUsage, MemoryUse::DeviceOnly);
   // fused's stage lists (shared_smooth.h): the header, every stage's pixels after the grid's, then stage 0's
-  // samples, as many as can be covered; read as indirect dispatches too.
-  smoothLists = Buffer(context,
-                       (fused ? shared::smoothListOffset(0u, uw, uh) + sampleCapacity : 1) * sizeof(std::uint32_t),
+  // samples, as many as can be covered; then as much again for each stage's samples that sum their own.
+  // Read as indirect dispatches too.
+  smoothLists = Buffer(context, (fused ? 2 * smoothOwnLists() : 1) * sizeof(std::uint32_t),
                        kStorageUsage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, MemoryUse::DeviceOnly);
   // The one image every frame reads back, written once by the tonemap pass.
   rgba8 = Buffer(context, pixels * sizeof(std::uint32_t), kStorageUsage, MemoryUse::Readback);

@@ -128,37 +128,45 @@ std::uint32_t VulkanRenderer::Impl::computeShadowMasks(const render::ResolvedFra
 constexpr std::array<const char*, shared::kSmoothSumStages> kSmoothStageParts{
     "grid sums", "step 4 edges", "step 4 centres", "step 2 edges", "step 2 centres", "step 1 edges", "step 1 centres"};
 
-shared::FusedPush VulkanRenderer::Impl::fusedPush(shared::uint stage, float tolerance) const {
+shared::FusedPush VulkanRenderer::Impl::fusedPush(shared::uint stage, shared::uint part, float tolerance) const {
   shared::FusedPush push{};
   push.stage = stage;
   push.width = static_cast<shared::uint>(width);
   push.height = static_cast<shared::uint>(height);
   push.tolerance = tolerance;
   push.groups = fusedGroups;
+  push.part = part;
+  push.ownLists = smoothOwnLists();
   return push;
 }
 
 // The smooth sum's stages, coarse to fine, each reading the ones before:
 // first every covered sample into its stage's list, so that each stage's
-// dispatch takes its own samples (min(their count, fusedGroups) workgroups)
-// rather than every workgroup passing over every sample to find them.
+// dispatches take its own samples rather than every workgroup passing over
+// every sample to find them; then per stage one invocation a sample decides
+// (a sum taken from the parents is shaded there), and a workgroup a sample
+// sums the rest (shared_smooth.h).
 void VulkanRenderer::Impl::recordSmoothStages(VkCommandBuffer cb) {
   vkCmdFillBuffer(cb, smoothSums.handle(), 0, VK_WHOLE_SIZE, 0u);
   std::array<std::uint32_t, shared::kSmoothListHeader> header{};  // counts 0; each dispatch (0, 1, 1)
   for (shared::uint stage = 0; stage < shared::kSmoothSumStages; ++stage) {
-    header[shared::kSmoothListArgs + 4 * stage + 1] = 1;
-    header[shared::kSmoothListArgs + 4 * stage + 2] = 1;
+    for (const shared::uint args : {shared::kSmoothDecideArgs, shared::kSmoothSumArgs}) {
+      header[args + 4 * stage + 1] = 1;
+      header[args + 4 * stage + 2] = 1;
+    }
   }
   vkCmdUpdateBuffer(cb, smoothLists.handle(), 0, sizeof header, header.data());
   computeBarrier(cb);
-  const shared::FusedPush list = fusedPush(shared::kSmoothSumList, 0.0f);
+  const shared::FusedPush list = fusedPush(shared::kSmoothSumList, 0, 0.0f);
   fusedPass->dispatchIndirect(cb, counter, offsetof(CoverageCounter, groups), &list, sizeof list);
   markPart(cb, "stage lists");
   for (shared::uint stage = 0; stage < shared::kSmoothSumStages; ++stage) {
-    computeBarrier(cb);  // the lists and their dispatches; then each stage's sums, for the next
-    const shared::FusedPush push = fusedPush(stage, options.smoothSumTolerance);
-    fusedPass->dispatchIndirect(cb, smoothLists, (shared::kSmoothListArgs + 4 * stage) * sizeof(std::uint32_t), &push,
-                                sizeof push);
+    for (const shared::uint part : {shared::kSmoothPartDecide, shared::kSmoothPartSum}) {
+      computeBarrier(cb);  // the lists and their dispatches; each stage's sums, for the next
+      const shared::FusedPush push = fusedPush(stage, part, options.smoothSumTolerance);
+      const shared::uint args = part == shared::kSmoothPartDecide ? shared::kSmoothDecideArgs : shared::kSmoothSumArgs;
+      fusedPass->dispatchIndirect(cb, smoothLists, (args + 4 * stage) * sizeof(std::uint32_t), &push, sizeof push);
+    }
     markPart(cb, kSmoothStageParts[stage]);
   }
 }
@@ -234,7 +242,7 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
                                if (!fused) {
                                  fusedPass->dispatchIndirect(cb, counter, offsetof(CoverageCounter, groups));
                                } else if (!(options.smoothSumTolerance > 0.0f)) {
-                                 const shared::FusedPush push = fusedPush(shared::kSmoothSumOff, 0.0f);
+                                 const shared::FusedPush push = fusedPush(shared::kSmoothSumOff, 0, 0.0f);
                                  fusedPass->dispatchIndirect(cb, counter, offsetof(CoverageCounter, groups), &push, sizeof push);
                                } else {
                                  recordSmoothStages(cb);

@@ -314,7 +314,9 @@ struct VulkanRenderer::Impl {
   void writeRays(const render::ResolvedFrame& resolved, const glm::vec3& eye);
   // The "shadow-rays" stage on the device: the uploads, the top level, the
   // four launches (core/shared_rays.h), ending with the masks fused reads.
-  shared::FusedPush fusedPush(shared::uint stage, float tolerance) const;
+  shared::FusedPush fusedPush(shared::uint stage, shared::uint part, float tolerance) const;
+  // Where the stages' lists of their own sums start in smoothLists, in words.
+  shared::uint smoothOwnLists() const;
   void recordSmoothStages(VkCommandBuffer cb);
   void recordDeviceRays(VkCommandBuffer cb);
 

@@ -84,9 +84,12 @@ TEST(SmoothSum, EachStagesListHoldsItsPixelsAndNoOtherStages) {
     EXPECT_EQ(shared::smoothStagePixels(0, uw, uh), pixels[0]);
     EXPECT_EQ(shared::smoothListOffset(0, uw, uh), offset) << w << "×" << h << ": stage 0 after the others";
   }
-  // The header: a count per stage, then each stage's dispatch (x, y, z, pad).
-  EXPECT_GE(shared::kSmoothListArgs, shared::kSmoothSumStages);
-  EXPECT_EQ(shared::kSmoothListHeader, shared::kSmoothListArgs + 4 * shared::kSmoothSumStages);
+  // The header: a count per stage, of its samples and of those that sum
+  // their own, then each stage's two dispatches (x, y, z, pad), apart.
+  EXPECT_GE(shared::kSmoothSumCounts, shared::kSmoothSumStages);
+  EXPECT_GE(shared::kSmoothDecideArgs, shared::kSmoothSumCounts + shared::kSmoothSumStages);
+  EXPECT_EQ(shared::kSmoothSumArgs, shared::kSmoothDecideArgs + 4 * shared::kSmoothSumStages);
+  EXPECT_EQ(shared::kSmoothListHeader, shared::kSmoothSumArgs + 4 * shared::kSmoothSumStages);
 }
 
 TEST(SmoothSum, ParentsAreTheGridNeighboursAtTheStagesStep) {

@@ -212,17 +212,19 @@ HC_CONST uint kFusedBindings = 20u;
 
 // fused.comp's push block: the smooth sum's stage this dispatch
 // (shared_smooth.h; kSmoothSumOff: one dispatch shades every sample;
-// kSmoothSumList: the stages' lists are written), the frame's size, the
-// tolerance, and the most workgroups a stage's dispatch takes.
+// kSmoothSumList: the stages' lists are written) and its part
+// (kSmoothPartDecide, kSmoothPartSum), the frame's size, the tolerance, the
+// most workgroups a stage's dispatch takes, and where the stages' lists of
+// their own sums start (words past the stages' lists).
 struct FusedPush {
   uint stage;
   uint width;
   uint height;
   float tolerance;
   uint groups;
-  uint pushPad0;
-  uint pushPad1;
-  uint pushPad2;
+  uint part;
+  uint ownLists;
+  uint pushPad;
 };
 
 // splitsum.comp; kSplitsumLobeLightTexelsBinding is a uniform texel

@@ -173,15 +173,23 @@ HC_FUNCTION uint smoothStagePixels(uint stage, uint width, uint height) {
 }
 
 // fused.comp's stage lists (push stage kSmoothSumList writes them, so that a
-// stage's dispatch visits its own samples, not every covered sample): in
-// words, stage k's count at k, its indirect dispatch (x, 1, 1) at
-// kSmoothListArgs + 4k, and its samples from smoothListOffset(k): stages 1
-// and on first, each as long as it has pixels, then stage 0, which also
-// takes every sample the smooth sum does not visit (as long as the
-// covered samples can be).
+// stage's dispatches visit its own samples, not every covered sample): in
+// words, stage k's count at k; its samples from smoothListOffset(k):
+// stages 1 and on first, each as long as it has pixels, then stage 0, which
+// also takes every sample the smooth sum does not visit (as long as the
+// covered samples can be). Each stage is two dispatches: the first
+// (kSmoothPartDecide, an invocation a sample, its indirect dispatch (x, 1,
+// 1) at kSmoothDecideArgs + 4k) shades the samples that take their
+// parents' sum and lists the others, FusedPush::ownLists words further on,
+// counted at kSmoothSumCounts + k; the second (kSmoothPartSum, a workgroup
+// a sample, at kSmoothSumArgs + 4k) sums those.
 HC_CONST uint kSmoothSumList = 0xFFFFFFFEu;
-HC_CONST uint kSmoothListArgs = 8u;
-HC_CONST uint kSmoothListHeader = kSmoothListArgs + 4u * kSmoothSumStages;
+HC_CONST uint kSmoothPartDecide = 0u;
+HC_CONST uint kSmoothPartSum = 1u;
+HC_CONST uint kSmoothSumCounts = 8u;
+HC_CONST uint kSmoothDecideArgs = 16u;
+HC_CONST uint kSmoothSumArgs = kSmoothDecideArgs + 4u * kSmoothSumStages;
+HC_CONST uint kSmoothListHeader = kSmoothSumArgs + 4u * kSmoothSumStages;
 HC_FUNCTION uint smoothListOffset(uint stage, uint width, uint height) {
   uint offset = kSmoothListHeader;
   const uint end = stage == 0u ? kSmoothSumStages : stage;
