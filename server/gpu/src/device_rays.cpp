@@ -11,6 +11,7 @@
 #include <string>
 
 #include "haarcast/core/check.h"
+#include "haarcast/core/shared_smooth.h"
 #include "haarcast/render/point_lights.h"
 
 #include "vulkan_renderer_impl.h"
@@ -106,7 +107,8 @@ void VulkanRenderer::Impl::ensureDeviceRayBuffers() {
                     {shared::kRaysMasksBinding, &masks},
                     {shared::kRaysHiddenBinding, &hidden},
                     {shared::kRaysSkyJobsBinding, &skyJobs},
-                    {shared::kRaysSkyPartialsBinding, &skyPartials}},
+                    {shared::kRaysSkyPartialsBinding, &skyPartials},
+                    {shared::kRaysStageListsBinding, &smoothLists}},
                    accelerationStructures->topLevel());
 }
 
@@ -168,6 +170,29 @@ void VulkanRenderer::Impl::writeRays(const render::ResolvedFrame& resolved, cons
   for (std::size_t i = 0; i < objectCount; ++i) posesData[i] = glm::mat4(resolved.objects[i].objectToWorld);
 }
 
+bool VulkanRenderer::Impl::hiddenPerStage() const {
+  return deviceRays && objectSky() && options.smoothSumTolerance > 0.0f;
+}
+
+RaysPush VulkanRenderer::Impl::raysPush(shared::uint phase, shared::uint stage) const {
+  RaysPush push{};
+  push.phase = phase;
+  push.stagedHidden = hiddenPerStage() ? 1u : 0u;
+  push.stage = stage;
+  push.ownLists = smoothOwnLists();
+  return push;
+}
+
+// The hidden sky of the samples smooth-sum stage `stage` sums itself, between
+// its two `fused` dispatches (after its first, before its second).
+void VulkanRenderer::Impl::recordStageHidden(VkCommandBuffer cb, shared::uint stage) {
+  rayTracingBarrier(cb);
+  const RaysPush push = raysPush(shared::kRaysPhaseHidden, stage);
+  const auto entries = shared::smoothStagePixels(stage, static_cast<shared::uint>(width), static_cast<shared::uint>(height));
+  shadowRays->trace(cb, kRaysLaunchWidth, groupsOf(entries, kRaysLaunchWidth), &push, sizeof push);
+  rayTracingBarrier(cb);
+}
+
 // Sky jobs: the launch that lists them (`phase`, across × down; the
 // frame's part `listed`), their rays over kSkyLanes invocations a job, then
 // their lanes' sums (part `traced`).
@@ -175,7 +200,7 @@ void VulkanRenderer::Impl::recordSkyJobs(VkCommandBuffer cb, std::uint32_t phase
                                          std::uint32_t down, const char* listed, const char* traced) {
   vkCmdFillBuffer(cb, skyJobs.handle(), 0, sizeof(std::uint32_t), 0u);  // the list's count
   rayTracingBarrier(cb);
-  RaysPush push{phase};
+  RaysPush push = raysPush(phase);
   shadowRays->trace(cb, across, down, &push, sizeof push);
   rayTracingBarrier(cb);
   markPart(cb, listed);
@@ -204,7 +229,7 @@ void VulkanRenderer::Impl::recordDeviceRays(VkCommandBuffer cb) {
   if (rayFrameData.groundSky) {
     vkCmdFillBuffer(cb, pixelSample.handle(), 0, VK_WHOLE_SIZE, ~0u);
     rayTracingBarrier(cb);
-    const RaysPush push{shared::kRaysPhaseCentres};
+    const RaysPush push = raysPush(shared::kRaysPhaseCentres);
     shadowRays->trace(cb, kRaysLaunchWidth, rows, &push, sizeof push);
     rayTracingBarrier(cb);
     markPart(cb, "ground centres");
@@ -217,7 +242,7 @@ void VulkanRenderer::Impl::recordDeviceRays(VkCommandBuffer cb) {
     recordSkyJobs(cb, shared::kRaysPhaseMasks, kRaysLaunchWidth, rows, "masks", "ground's own sky rays");
     return;
   }
-  const RaysPush push{shared::kRaysPhaseMasks};
+  const RaysPush push = raysPush(shared::kRaysPhaseMasks);
   shadowRays->trace(cb, kRaysLaunchWidth, rows, &push, sizeof push);
   rayTracingBarrier(cb);
   markPart(cb, "masks");

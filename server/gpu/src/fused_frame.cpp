@@ -163,6 +163,8 @@ void VulkanRenderer::Impl::recordSmoothStages(VkCommandBuffer cb) {
   for (shared::uint stage = 0; stage < shared::kSmoothSumStages; ++stage) {
     for (const shared::uint part : {shared::kSmoothPartDecide, shared::kSmoothPartSum}) {
       computeBarrier(cb);  // the lists and their dispatches; each stage's sums, for the next
+      // The hidden sky of the samples the stage sums itself, traced now (stage 0's with the masks).
+      if (part == shared::kSmoothPartSum && stage > 0 && hiddenPerStage()) recordStageHidden(cb, stage);
       const shared::FusedPush push = fusedPush(stage, part, options.smoothSumTolerance);
       const shared::uint args = part == shared::kSmoothPartDecide ? shared::kSmoothDecideArgs : shared::kSmoothSumArgs;
       fusedPass->dispatchIndirect(cb, smoothLists, (args + 4 * stage) * sizeof(std::uint32_t), &push, sizeof push);

@@ -319,6 +319,11 @@ struct VulkanRenderer::Impl {
   shared::uint smoothOwnLists() const;
   void recordSmoothStages(VkCommandBuffer cb);
   void recordDeviceRays(VkCommandBuffer cb);
+  // The device traces the objects' hidden sky per smooth-sum stage, only for
+  // the samples a stage sums itself (shared_rays.h RaysPush::stagedHidden).
+  bool hiddenPerStage() const;
+  RaysPush raysPush(shared::uint phase, shared::uint stage = 0) const;
+  void recordStageHidden(VkCommandBuffer cb, shared::uint stage);
 
   void recordSkyJobs(VkCommandBuffer cb, std::uint32_t phase, std::uint32_t across, std::uint32_t down,
                      const char* listed, const char* traced);

@@ -28,6 +28,7 @@
 #include "haarcast/core/brdf.h"
 #include "haarcast/core/rotation.h"
 #include "haarcast/core/shared_layout.h"
+#include "haarcast/core/shared_smooth.h"
 #include "haarcast/gpu/vulkan_renderer.h"
 #include "haarcast/render/renderer.h"
 
@@ -278,6 +279,59 @@ GPU_TEST(DeviceRays, ASkyJobsLanesTraceWhatOneInvocationDoes) {
   EXPECT_GE(image.psnr, 90.0);
   EXPECT_EQ(image.mismatched, 0u);
   testing::expectNoValidationMessages(lanes.context());
+}
+
+// With sums from neighbours the device traces the sky other objects hide
+// from a sample of the smooth sum's stages 1 and on only where that stage
+// sums it itself (shared_rays.h kRaysPhaseHidden); the host traces every
+// sample's. The frames agree as with every other ray; the device's hidden
+// lights are the host's where traced, and none where the sum came from the
+// parents, which reads none.
+GPU_TEST(DeviceRays, ASmoothStageTracesTheHiddenSkyOfWhatItSumsItself) {
+  HAARCAST_REQUIRE_RAY_TRACING();
+  const render::Scene scene = render::defaultScene();
+  render::RenderOptions o = frameOptions(RotationMethod::Fused, true);
+  o.width = 96;
+  o.height = 72;
+  o.smoothSumTolerance = shared::kDefaultSmoothSumTolerance;
+  VulkanRenderer host(scene, o, testing::testOptions(), {}, raysOn(render::RayMode::Host));
+  VulkanRenderer device(scene, o, testing::testOptions(), {}, raysOn(render::RayMode::Device));
+  render::FrameRequest request = requestFor(scene, o.width, o.height);
+  request.poses = testing::scenePoses(scene);
+  request.poses[1].rotateDegrees += glm::dvec3(10.0, 25.0, -5.0);
+  const render::Frame a = host.render(request);
+  const render::Frame b = device.render(request);
+  const Comparison image = compare(a, b);
+  const std::vector<ShadeSample> hs = host.shadeSamples(), ds = device.shadeSamples();
+  const std::vector<HiddenLight> hh = host.hiddenLights(), dh = device.hiddenLights();
+  ASSERT_EQ(hs.size(), hh.size());
+  ASSERT_EQ(ds.size(), dh.size());
+  std::map<std::uint32_t, std::size_t> hostAt;
+  for (std::size_t s = 0; s < hs.size(); ++s) hostAt[hs[s].pixel] = s;
+  double largest = 0.0;
+  for (const HiddenLight& l : hh) largest = std::max(largest, static_cast<double>(l.power.x));
+  std::size_t onHost = 0, traced = 0, left = 0, off = 0;
+  for (std::size_t s = 0; s < ds.size(); ++s) {
+    const HiddenLight& x = hh[hostAt.at(ds[s].pixel)];
+    const HiddenLight& y = dh[s];
+    if (!(x.power.x > 0.0f)) continue;
+    ++onHost;
+    if (y.power.x > 0.0f) {
+      ++traced;
+      if (std::abs(x.power.x - y.power.x) > kHiddenSlack * largest) ++off;
+    } else {
+      ++left;
+    }
+  }
+  std::printf("hidden sky on %zu samples on the host; the device traced %zu (%zu off), left %zu to their parents' sums; "
+              "image %.1f dB\n", onHost, traced, off, left, image.psnr);
+  EXPECT_GT(onHost, 100u);
+  EXPECT_GE(traced * 2, onHost) << "the stages' own sums trace theirs";
+  EXPECT_GT(left, 0u) << "a sum taken from the parents traces none";
+  EXPECT_LE(off * 500, onHost);
+  EXPECT_GE(image.psnr, 60.0);
+  EXPECT_EQ(image.mismatched, 0u);
+  testing::expectNoValidationMessages(device.context());
 }
 
 // With the rays on the device a frame is one submission; with the host's,

@@ -42,8 +42,9 @@ HC_CONST uint kRaysMasksBinding = 9u;
 HC_CONST uint kRaysHiddenBinding = 10u;
 HC_CONST uint kRaysSkyJobsBinding = 11u;      // uint count, then SkyJob[skyJobCapacity]
 HC_CONST uint kRaysSkyPartialsBinding = 12u;  // float per job and lane
-HC_CONST uint kRaysSceneBinding = 13u;
-HC_CONST uint kRaysStorageBindings = 13u;
+HC_CONST uint kRaysStageListsBinding = 13u;   // fused's stage lists (shared_smooth.h), read
+HC_CONST uint kRaysSceneBinding = 14u;
+HC_CONST uint kRaysStorageBindings = 14u;
 
 // ---- Specialization constants: the ids the shaders declare them at
 // (layout(constant_id = …)) and the host sets them by (gpu::SpecConstant).

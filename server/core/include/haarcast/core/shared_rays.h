@@ -19,7 +19,9 @@
 //                      grid, or, where the grid cannot, a sky job of its own;
 //   kRaysPhaseSkyRays  each sky job's cone rays, over kSkyLanes invocations;
 //   kRaysPhaseSkySums  per sky job: its lanes' sums, written to its grid
-//                      point or into its sample's word.
+//                      point or into its sample's word;
+//   kRaysPhaseHidden   per sample a smooth-sum stage sums itself: the sky
+//                      other objects hide from it (RaysPush::stagedHidden).
 // A ground point's hidden sky is up to 256 rays per occluder. Traced in
 // one invocation, the few thousand grid points left a GPU nearly empty
 // while each walked its rays one after another, at every frame size; a sky
@@ -34,6 +36,9 @@ HC_CONST uint kRaysPhaseMasks = 2u;
 HC_CONST uint kRaysPhaseFineGrid = 3u;
 HC_CONST uint kRaysPhaseSkyRays = 4u;
 HC_CONST uint kRaysPhaseSkySums = 5u;
+// Between a smooth-sum stage's two `fused` dispatches: the HiddenLight of
+// each sample the stage sums itself (its list of own sums).
+HC_CONST uint kRaysPhaseHidden = 6u;
 
 // A sky job: the hidden sky of the shading point of covered sample
 // `from`, for `target`: a point of `grid` (coarse, then fine), or, with
@@ -173,6 +178,13 @@ HC_FUNCTION uint rayMaskOf(uint object) { return 1u << (object & 7u); }
 
 struct RaysPush {
   uint phase;
+  // 1 where `fused` takes sums from neighbours and objects hide sky from
+  // each other: the samples of the smooth sum's stages 1 and on
+  // (shared_smooth.h) get their HiddenLight from kRaysPhaseHidden, only
+  // where they sum their own (a sum taken from the parents reads none).
+  uint stagedHidden;
+  uint stage;     // kRaysPhaseHidden: the smooth sum's stage
+  uint ownLists;  // kRaysPhaseHidden: FusedPush::ownLists
 };
 
 #endif  // HAARCAST_CORE_SHARED_RAYS_H
