@@ -24,8 +24,8 @@
 # profile: the device, the GPU tests of HAARCAST_GPU_TEST_FILTER (default
 # all), then bench-frame's JSON with each stage's parts (render::Frame::parts:
 # device timestamps within the stages) for the service's frame (1280×720,
-# level 4, antialiased; again without the sky the objects hide from each
-# other) and 1920×1080 at levels auto and 6, and frames in flight on one
+# level 4, antialiased; again with fused's workgroups of 64 and 128, and
+# without the sky the objects hide from each other) and 1920×1080 at levels auto and 6, and frames in flight on one
 # queue and on every queue at 256² and 1280×720.
 #
 # OUT_DIR receives device.txt, vulkaninfo.txt, gpu_tests.log, one JSON file
@@ -104,6 +104,12 @@ frames="${HAARCAST_GPU_FRAMES:-20}"
 if [[ "$mode" == profile ]]; then
   bench profile_720_service 60 --backend vulkan --method fused --sizes 1280x720 --levels 4 --antialias on --frames "$frames"
   bench profile_1080 60 --backend vulkan --method fused --sizes 1920x1080 --levels auto,6 --frames "$frames"
+  # fused's workgroup: 256 invocations a pixel by default on a GPU; fewer may
+  # fit a pixel's directions now that cells and the reach cut leave fewer.
+  for local in 64 128; do
+    bench "profile_720_local$local" 60 --backend vulkan --method fused --sizes 1280x720 --levels 4 --antialias on \
+      --fused-local-size "$local" --frames "$frames"
+  done
   # What the sky the objects hide from each other costs the rays and the pass.
   bench profile_720_no_object_sky 60 --backend vulkan --method fused --sizes 1280x720 --levels 4 --antialias on \
     --object-sky 0 --frames "$frames"

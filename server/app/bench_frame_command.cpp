@@ -82,6 +82,7 @@ struct BenchArgs {
   // as that many threads rendering at once on one renderer of as many slots.
   std::string inFlight;
   std::uint32_t queues = 1;  // Vulkan: the most device queues (0: all its family offers)
+  std::uint32_t fusedLocalSize = 0;  // Vulkan: fused's workgroup size (0: the device's default)
   int frames = 3;
   int warmup = 1;
   bool json = false;
@@ -289,9 +290,10 @@ int run(const BenchArgs& a) {
         if (vulkan) {
           // Timing: validation layers would dominate.
           gpuRenderer = backends::makeRenderer(render::kVulkanBackend, scene, options,
-                                               {a.device, false, slots, rays, a.queues}, progress.callback());
+                                               {a.device, false, slots, rays, a.queues, a.fusedLocalSize}, progress.callback());
           out["vulkan_device"] = gpuRenderer->deviceName();
           out["vulkan_rays"] = gpuRenderer->rays();
+          out["vulkan_fused_local_size"] = a.fusedLocalSize;
         }
         if (cpuRenderer) out["cpu_device"] = cpuRenderer->deviceName();
         // Each object's level: the choice's, or under `auto` each one's own.
@@ -444,6 +446,11 @@ std::function<int()> addBenchFrameCommand(CLI::App& app) {
                 "Vulkan: the most queues the device is opened with (0: every queue its family offers, at most 16; 1: "
                 "every frame on one queue, the default)")
       ->check(CLI::Range(0, 16))
+      ->capture_default_str();
+  c->add_option("--fused-local-size", args->fusedLocalSize,
+                "Vulkan, fused: the workgroup size, a power of two up to 1024 (one workgroup sums a pixel's directions; 0: "
+                "the device's default, 256 on a GPU, the subgroup on a CPU device)")
+      ->check(CLI::IsMember({0u, 1u, 2u, 4u, 8u, 16u, 32u, 64u, 128u, 256u, 512u, 1024u}))
       ->capture_default_str();
   c->add_option("--sum-tolerance", args->sumTolerances,
                 sumToleranceHelp() + "; comma-separated, one run each: e.g. 0,0.1 times both")

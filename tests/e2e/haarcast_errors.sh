@@ -46,6 +46,8 @@ expect "bench-frame level cap outside the range" '--levels: "auto:9" is not N (2
 expect "bench-frame sum tolerance outside 0..1" '--sum-tolerance: "2" is not a number in 0..1' -- "$bin" bench-frame --backend cpu --sum-tolerance 0,2
 expect "bench-frame smooth-sum tolerance outside 0..1" '--smooth-sum: "2" is not a number in 0..1' -- "$bin" bench-frame --backend cpu --smooth-sum 0,2
 expect "bench-frame frames in flight outside 1..16" '--in-flight: "0" is not a count of frames in 1..16' -- "$bin" bench-frame --backend vulkan --in-flight 1,0
+expect "bench-frame fused workgroup size not a power of two" "--fused-local-size: 48 not in {0,1,2,4" -- \
+  "$bin" bench-frame --backend vulkan --fused-local-size 48
 expect "bench-frame frames in flight on the CPU backend" "--in-flight measures the Vulkan backend's frames in flight" -- \
   "$bin" bench-frame --backend cpu --in-flight 2
 expect "serve queues over 16" "--vulkan-queues: Value 17 not in range 0 to 16" -- "$bin" serve --vulkan-queues 17

@@ -60,6 +60,7 @@ std::unique_ptr<render::Renderer> makeRenderer(std::string_view backend, const r
   vulkan.queues = device.queues;
   gpu::VulkanRendererLimits limits;
   limits.framesInFlight = device.framesInFlight;
+  limits.fusedLocalSize = device.fusedLocalSize;
   limits.rays = device.rays;
   return gpu::makeVulkanRenderer(scene, options, vulkan, progress, limits);
 #else

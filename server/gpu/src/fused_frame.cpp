@@ -157,8 +157,11 @@ void VulkanRenderer::Impl::recordSmoothStages(VkCommandBuffer cb) {
   }
   vkCmdUpdateBuffer(cb, smoothLists.handle(), 0, sizeof header, header.data());
   computeBarrier(cb);
+  // An invocation a sample: as many workgroups as the samples that can be
+  // covered fill (at most fusedGroups; the invocations past the covered
+  // count return at once), not the shading dispatch's workgroup a sample.
   const shared::FusedPush list = fusedPush(shared::kSmoothSumList, 0, 0.0f);
-  fusedPass->dispatchIndirect(cb, counter, offsetof(CoverageCounter, groups), &list, sizeof list);
+  fusedPass->dispatch(cb, {std::min(groupsOf(sampleCapacity, fusedLocal), fusedGroups), 1, 1}, &list, sizeof list);
   markPart(cb, "stage lists");
   for (shared::uint stage = 0; stage < shared::kSmoothSumStages; ++stage) {
     for (const shared::uint part : {shared::kSmoothPartDecide, shared::kSmoothPartSum}) {

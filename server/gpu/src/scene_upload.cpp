@@ -307,6 +307,12 @@ void VulkanRenderer::Impl::createFusedPipeline(std::uint32_t local) {
   // samples took 0.21 CPU-s per frame on lavapipe where one group per sample
   // took 0.25 (default scene, 256², level 5; docs/gpu.md).
   fusedLocal = limits.fusedLocalSize ? limits.fusedLocalSize : local;
+  const VkPhysicalDeviceLimits& device = context.properties().limits;
+  const std::uint32_t largest = std::min(device.maxComputeWorkGroupSize[0], device.maxComputeWorkGroupInvocations);
+  if (fusedLocal == 0 || (fusedLocal & (fusedLocal - 1)) != 0 || fusedLocal > largest) {
+    throw std::invalid_argument("fused workgroup size " + std::to_string(fusedLocal) + ": " + context.info().name +
+                                " takes a power of two from 1 to " + std::to_string(largest));
+  }
   // A workgroup of one subgroup reduces with subgroupAdd: no barrier, which
   // lavapipe would compile into coroutines (shared_passes.h, kSpecSubgroupReduce).
   const bool subgroupReduce = fusedLocal == context.subgroupSize() && context.subgroupArithmetic();

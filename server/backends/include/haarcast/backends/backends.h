@@ -40,6 +40,9 @@ struct DeviceOptions {
   // Vulkan: the most queues the device is opened with (gpu::VulkanOptions::queues;
   // 0 = all its family offers, at most 16); the first renderer on it decides.
   std::uint32_t queues = 1;
+  // Vulkan: `fused`'s workgroup size (gpu::VulkanRendererLimits::fusedLocalSize;
+  // 0 = the device's default).
+  std::uint32_t fusedLocalSize = 0;
 };
 
 // True when this build has `name` (one of render::kBackendNames).
