@@ -148,6 +148,15 @@ WordDiff diffWords(const VulkanRenderer& host, const VulkanRenderer& device, boo
   return d;
 }
 
+// A request of the scene at o's size with its second object turned: shadows
+// between the objects that the scene's own poses do not line up.
+render::FrameRequest turnedRequest(const render::Scene& scene, const render::RenderOptions& o) {
+  render::FrameRequest request = requestFor(scene, o.width, o.height);
+  request.poses = testing::scenePoses(scene);
+  request.poses[1].rotateDegrees += glm::dvec3(10.0, 25.0, -5.0);
+  return request;
+}
+
 struct RaysCase {
   const char* name;
   RotationMethod method;
@@ -198,9 +207,7 @@ TEST_P(DeviceRays, ShadowWordsMatchTheHostsRays) {
   VulkanRenderer device(scene, o, testing::testOptions(), {}, raysOn(render::RayMode::Device));
   EXPECT_EQ(host.rays(), "host");
   EXPECT_EQ(device.rays(), "device");
-  render::FrameRequest request = requestFor(scene, o.width, o.height);
-  request.poses = testing::scenePoses(scene);
-  request.poses[1].rotateDegrees += glm::dvec3(10.0, 25.0, -5.0);
+  render::FrameRequest request = turnedRequest(scene, o);
   request.lightRotation = rotationMatrix({0.3, -0.4, 0.1});
   const render::Frame a = host.render(request);
   const render::Frame b = device.render(request);
@@ -262,9 +269,7 @@ GPU_TEST(DeviceRays, ASkyJobsLanesTraceWhatOneInvocationDoes) {
   oneJob.skyJobs = 1;
   VulkanRenderer inOne(scene, o, testing::testOptions(), {}, oneJob);
   VulkanRenderer lanes(scene, o, testing::testOptions(), {}, raysOn(render::RayMode::Device));
-  render::FrameRequest request = requestFor(scene, o.width, o.height);
-  request.poses = testing::scenePoses(scene);
-  request.poses[1].rotateDegrees += glm::dvec3(10.0, 25.0, -5.0);
+  render::FrameRequest request = turnedRequest(scene, o);
   const render::Frame a = inOne.render(request);
   const render::Frame b = lanes.render(request);
   const WordDiff d = diffWords(inOne, lanes, true);
@@ -296,9 +301,7 @@ GPU_TEST(DeviceRays, ASmoothStageTracesTheHiddenSkyOfWhatItSumsItself) {
   o.smoothSumTolerance = shared::kDefaultSmoothSumTolerance;
   VulkanRenderer host(scene, o, testing::testOptions(), {}, raysOn(render::RayMode::Host));
   VulkanRenderer device(scene, o, testing::testOptions(), {}, raysOn(render::RayMode::Device));
-  render::FrameRequest request = requestFor(scene, o.width, o.height);
-  request.poses = testing::scenePoses(scene);
-  request.poses[1].rotateDegrees += glm::dvec3(10.0, 25.0, -5.0);
+  render::FrameRequest request = turnedRequest(scene, o);
   const render::Frame a = host.render(request);
   const render::Frame b = device.render(request);
   const Comparison image = compare(a, b);
