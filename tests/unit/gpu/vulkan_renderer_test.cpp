@@ -214,12 +214,17 @@ INSTANTIATE_TEST_SUITE_P(Levels, FusedCellsFrame, ::testing::Combine(::testing::
 // core/shared_smooth.h) on both backends: the device's dispatches, one a stage,
 // coarse to fine, take the same pixels' sums as the CPU's pass and make the
 // same frame; a Lambert sphere (whose sum is smooth) beside the GGX torus.
-TEST(FusedSmoothFrame, VulkanTakesTheSameSumsAsTheCpuBackend) {
+// Antialiased too: the edge pixels' sub-samples, which the rule does not
+// visit, are summed in stage 0 beside the grid's pixels (fused.comp's lists).
+class FusedSmoothFrame : public testing::GpuTestWithParam<bool> {};
+
+TEST_P(FusedSmoothFrame, VulkanTakesTheSameSumsAsTheCpuBackend) {
   HAARCAST_REQUIRE_VULKAN();
   render::Scene scene = render::defaultScene();
   scene.objects[0].material = render::materialFromSpec("lambert");
   render::RenderOptions o = frameOptions(RotationMethod::Fused, true);
   o.width = o.height = 128;  // the sphere wide enough for its sum to be smooth over the grid's spacing
+  o.antialias = GetParam();
   o.level = 5;
   o.sumTolerance = shared::kDefaultSumTolerance;
   o.smoothSumTolerance = shared::kDefaultSmoothSumTolerance;
@@ -228,17 +233,34 @@ TEST(FusedSmoothFrame, VulkanTakesTheSameSumsAsTheCpuBackend) {
   const render::Frame& a = p.cpu;
   const render::Frame& b = p.vulkan;
   std::printf("  sums from neighbours: cpu %zu, vulkan %zu of %zu\n", a.smoothSamples, b.smoothSamples, a.passSamples);
-  EXPECT_GE(p.c.psnr, testing::fusedPsnrFloor(gpu.context()));
   EXPECT_EQ(p.c.mismatched, 0u);
-  EXPECT_EQ(a.passSamples, b.passSamples);
+  if (o.antialias) {
+    // The raster and Embree may cover an edge's sub-sample differently
+    // (AntialiasFrame: a couple of edges); at 128² one sample does, and the
+    // frames are 101.7 dB apart summing every pixel as with the sums from
+    // neighbours.
+    EXPECT_GE(p.c.psnr, 95.0);
+    EXPECT_NEAR(static_cast<double>(b.passSamples), static_cast<double>(a.passSamples), 2.0);
+  } else {
+    EXPECT_GE(p.c.psnr, testing::fusedPsnrFloor(gpu.context()));
+    EXPECT_EQ(a.passSamples, b.passSamples);
+  }
   EXPECT_GT(a.smoothSamples, a.passSamples / 10) << "the test must see sums taken";
   // A decision on a threshold may round the other way: a few in a thousand.
   EXPECT_NEAR(static_cast<double>(b.smoothSamples), static_cast<double>(a.smoothSamples), 3e-3 * a.passSamples + 1.0);
   EXPECT_NEAR(static_cast<double>(b.passDirections), static_cast<double>(a.passDirections), 5e-3 * a.passDirections);
-  // A sample that takes its sum reads no slice of the pass: counted alike.
-  EXPECT_EQ(b.coefficientBytes, a.coefficientBytes);
+  // A sample that takes its sum reads no slice of the pass: counted alike
+  // (but for the sub-samples the backends cover differently).
+  if (o.antialias) {
+    EXPECT_NEAR(static_cast<double>(b.coefficientBytes), static_cast<double>(a.coefficientBytes), 1e-3 * a.coefficientBytes);
+  } else {
+    EXPECT_EQ(b.coefficientBytes, a.coefficientBytes);
+  }
   testing::expectNoValidationMessages(gpu.context());
 }
+
+INSTANTIATE_TEST_SUITE_P(Edges, FusedSmoothFrame, ::testing::Bool(),
+                         [](const ::testing::TestParamInfo<bool>& param) { return param.param ? "antialiased" : "aliased"; });
 
 // Each object at its own level (RenderOptions::automaticLevel): the default
 // scene with a Lambert sphere (the floor, 5) beside its GGX torus (6) and
