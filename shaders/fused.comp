@@ -542,6 +542,6 @@ void main() {
   }
   // A stage's own sums, a workgroup each.
   const uint count = stageLists[kSmoothSumCounts + push.stage];
-  const uint first = push.ownLists + smoothListOffset(push.stage, push.width, push.height);
+  const uint first = push.ownLists + stageLists[kSmoothListOffsets + push.stage];
   for (uint i = gl_WorkGroupID.x; i < count; i += gl_NumWorkGroups.x) shadePixel(stageLists[first + i], kPixelSum);
 }

@@ -25,7 +25,7 @@ void listStages() {
                            ? smoothStageOf(int(sh.pixel % push.width), int(sh.pixel / push.width), int(push.width), int(push.height))
                            : 0u;
     const uint i = atomicAdd(stageLists[stage], 1u);
-    stageLists[smoothListOffset(stage, push.width, push.height) + i] = s;
+    stageLists[stageLists[kSmoothListOffsets + stage] + i] = s;
     if (i % LOCAL == 0u && i / LOCAL < push.groups) atomicMax(stageLists[kSmoothDecideArgs + 4u * stage], i / LOCAL + 1u);
   }
 }
@@ -34,7 +34,7 @@ void listStages() {
 // sum (or need none) shaded, the rest into the stage's list of its own
 // sums, whose dispatch takes a workgroup a sample (at most push.groups).
 void decideStage() {
-  const uint count = stageLists[push.stage], first = smoothListOffset(push.stage, push.width, push.height);
+  const uint count = stageLists[push.stage], first = stageLists[kSmoothListOffsets + push.stage];
   for (uint i = gl_GlobalInvocationID.x; i < count; i += gl_NumWorkGroups.x * LOCAL) {
     const uint s = stageLists[first + i];
     if (shadePixel(s, kPixelDecide)) continue;

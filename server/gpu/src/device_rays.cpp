@@ -66,7 +66,7 @@ void VulkanRenderer::Impl::setUpDeviceRays() {
   rayFrameUpload = BufferUpload(context, rayFrame);
   // The map light, rgb and luminance per texel, for the sky the objects
   // hide (SkyOccluders::colour, ::luminance).
-  const bool skyRays = fused && (prepared.ground || objectSky());
+  const bool skyRays = groundSky() || objectSky();
   std::vector<glm::vec4> texels(1, glm::vec4(0.0f));
   if (skyRays) {
     const SphereMap& luminance = prepared.restLuminance;
@@ -91,8 +91,7 @@ void VulkanRenderer::Impl::ensureDeviceRayBuffers() {
   pixelSample = Buffer(context, pixels * sizeof(std::uint32_t), kStorageUsage, MemoryUse::DeviceOnly);
   skyGrid = Buffer(context, gridPoints * sizeof(float), kStorageUsage, MemoryUse::DeviceOnly);
   // The sky jobs: none without the ground's hidden sky (a one-job list, never filled).
-  const bool groundSky = fused && prepared.ground;
-  skyJobCapacity = static_cast<std::uint32_t>(!groundSky ? 1 : limits.skyJobs > 0 ? limits.skyJobs : finePoints);
+  skyJobCapacity = static_cast<std::uint32_t>(!groundSky() ? 1 : limits.skyJobs > 0 ? limits.skyJobs : finePoints);
   skyJobs = Buffer(context, 4 * sizeof(std::uint32_t) + skyJobCapacity * sizeof(shared::SkyJob), kStorageUsage, MemoryUse::DeviceOnly);
   skyPartials = Buffer(context, std::size_t{skyJobCapacity} * shared::kSkyLanes * sizeof(float), kStorageUsage, MemoryUse::DeviceOnly);
   shadowRays->bind({{shared::kRaysShadeBinding, &shade},
@@ -115,7 +114,7 @@ void VulkanRenderer::Impl::ensureDeviceRayBuffers() {
 void VulkanRenderer::Impl::writeRays(const render::ResolvedFrame& resolved, const glm::vec3& eye) {
   const std::size_t objectCount = prepared.objects.size();
   HC_CHECK_EQ(resolved.objects.size(), objectCount);
-  const bool groundSky = fused && prepared.ground;
+  const bool groundSky = this->groundSky();
   const bool hides = objectSky();
   std::size_t occluder = 0;  // SkyOccluders::occluders: every object but the ground, in order
   for (std::size_t i = 0; i < objectCount; ++i) {

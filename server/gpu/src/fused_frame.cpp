@@ -61,7 +61,7 @@ std::uint32_t VulkanRenderer::Impl::computeShadowMasks(const render::ResolvedFra
   const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
   render::GroundSkyGrid sky(static_cast<int>(width), static_cast<int>(height));
   // splitsum shades its ground as any object (core/splitsum.h): no hidden sky.
-  const bool groundSky = fused && prepared.ground;
+  const bool groundSky = this->groundSky();
   if (groundSky) {
     std::vector<std::uint32_t> centreOf(pixels, ~0u);
     for (std::size_t s = 0; s < covered; ++s)
@@ -148,8 +148,11 @@ shared::FusedPush VulkanRenderer::Impl::fusedPush(shared::uint stage, shared::ui
 // sums the rest (shared_smooth.h).
 void VulkanRenderer::Impl::recordSmoothStages(VkCommandBuffer cb) {
   vkCmdFillBuffer(cb, smoothSums.handle(), 0, VK_WHOLE_SIZE, 0u);
-  std::array<std::uint32_t, shared::kSmoothListHeader> header{};  // counts 0; each dispatch (0, 1, 1)
+  // Counts 0; where each stage's list starts; each dispatch (0, 1, 1).
+  std::array<std::uint32_t, shared::kSmoothListHeader> header{};
   for (shared::uint stage = 0; stage < shared::kSmoothSumStages; ++stage) {
+    header[shared::kSmoothListOffsets + stage] =
+        shared::smoothListOffset(stage, static_cast<shared::uint>(width), static_cast<shared::uint>(height));
     for (const shared::uint args : {shared::kSmoothDecideArgs, shared::kSmoothSumArgs}) {
       header[args + 4 * stage + 1] = 1;
       header[args + 4 * stage + 2] = 1;

@@ -95,6 +95,8 @@ struct VulkanRenderer::Impl {
   bool splitsum = false;
   // `fused` whose objects hide sky from each other (kObjectSkyHidden).
   bool objectSky() const { return fused && options.objectSky && prepared.standingObjects() >= 2; }
+  // `fused` on a ground: the ground's hidden sky (its grid, its sky jobs).
+  bool groundSky() const { return fused && prepared.ground; }
   Buffer directions, pointLights, pointSlices;
   // `fused` by cells (RenderOptions::sumTolerance): every slice's detail map
   // (shared::kCellDetailStride apart); the light's cells follow each

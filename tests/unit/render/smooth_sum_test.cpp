@@ -85,9 +85,11 @@ TEST(SmoothSum, EachStagesListHoldsItsPixelsAndNoOtherStages) {
     EXPECT_EQ(shared::smoothListOffset(0, uw, uh), offset) << w << "×" << h << ": stage 0 after the others";
   }
   // The header: a count per stage, of its samples and of those that sum
-  // their own, then each stage's two dispatches (x, y, z, pad), apart.
+  // their own, where each stage's list starts, then each stage's two
+  // dispatches (x, y, z, pad), apart.
   EXPECT_GE(shared::kSmoothSumCounts, shared::kSmoothSumStages);
-  EXPECT_GE(shared::kSmoothDecideArgs, shared::kSmoothSumCounts + shared::kSmoothSumStages);
+  EXPECT_GE(shared::kSmoothListOffsets, shared::kSmoothSumCounts + shared::kSmoothSumStages);
+  EXPECT_GE(shared::kSmoothDecideArgs, shared::kSmoothListOffsets + shared::kSmoothSumStages);
   EXPECT_EQ(shared::kSmoothSumArgs, shared::kSmoothDecideArgs + 4 * shared::kSmoothSumStages);
   EXPECT_EQ(shared::kSmoothListHeader, shared::kSmoothSumArgs + 4 * shared::kSmoothSumStages);
 }

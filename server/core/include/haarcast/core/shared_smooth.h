@@ -174,10 +174,11 @@ HC_FUNCTION uint smoothStagePixels(uint stage, uint width, uint height) {
 
 // fused.comp's stage lists (push stage kSmoothSumList writes them, so that a
 // stage's dispatches visit its own samples, not every covered sample): in
-// words, stage k's count at k; its samples from smoothListOffset(k):
-// stages 1 and on first, each as long as it has pixels, then stage 0, which
-// also takes every sample the smooth sum does not visit (as long as the
-// covered samples can be). Each stage is two dispatches: the first
+// words, stage k's count at k; its samples from smoothListOffset(k), which
+// the host writes at kSmoothListOffsets + k once a frame: stages 1 and on
+// first, each as long as it has pixels, then stage 0, which also takes
+// every sample the smooth sum does not visit (as long as the covered
+// samples can be). Each stage is two dispatches: the first
 // (kSmoothPartDecide, an invocation a sample, its indirect dispatch (x, 1,
 // 1) at kSmoothDecideArgs + 4k) shades the samples that take their
 // parents' sum and lists the others, FusedPush::ownLists words further on,
@@ -187,7 +188,8 @@ HC_CONST uint kSmoothSumList = 0xFFFFFFFEu;
 HC_CONST uint kSmoothPartDecide = 0u;
 HC_CONST uint kSmoothPartSum = 1u;
 HC_CONST uint kSmoothSumCounts = 8u;
-HC_CONST uint kSmoothDecideArgs = 16u;
+HC_CONST uint kSmoothListOffsets = 16u;
+HC_CONST uint kSmoothDecideArgs = 24u;
 HC_CONST uint kSmoothSumArgs = kSmoothDecideArgs + 4u * kSmoothSumStages;
 HC_CONST uint kSmoothListHeader = kSmoothSumArgs + 4u * kSmoothSumStages;
 HC_FUNCTION uint smoothListOffset(uint stage, uint width, uint height) {
