@@ -185,11 +185,11 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
   frame.width = request.width;
   frame.height = request.height;
 
-  // ---- light (host): resolveFrame, as the CPU backend; its pixel form and
-  // point lights uploaded, the ground's closed form in its ObjectInfo
-  auto t0 = RendererClock::now();
-  render::enterFrameStage(request, "light");
-  const render::ResolvedFrame resolved = render::resolveFrame(prepared, options, request);
+  // ---- What the host resolves: poses, camera and point lights, one number
+  // per object or light (render::resolveFrame, which checks the request),
+  // written into the frame's records. The map light itself is the device's
+  // first stage ("light", fused_light.cpp).
+  const render::ResolvedFrame resolved = render::resolveFrame(prepared, options, request, render::FusedMapLight::Device);
   ensureResolution(request.width, request.height);
   const std::size_t objectCount = prepared.objects.size();
   const std::size_t lightCount = resolved.pointLightDirections.size();
@@ -197,20 +197,11 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
   for (std::size_t i = 0; i < objectCount; ++i) {
     const render::ResolvedObject& o = resolved.objects[i];
     ObjectInfo& info = objectInfo[i];
-    if (fused) {
-      const std::size_t n = o.fusedLight.planes.size() / 3;  // N at the object's level
-      fusedLightTexels(o.fusedLight.planes, std::span<glm::vec4>(lightTexelData).subspan(info.lightBase, n));
-      // By cells: the two agree on which objects (scene_upload.cpp, resolveFusedLight).
-      HC_CHECK_EQ(o.fusedLight.sumsByCells(), info.sumTolerance > 0.0f);
-      if (info.sumTolerance > 0.0f) {
-        fusedCellLightTexels(o.fusedLight.cells, std::span<glm::vec4>(lightTexelData).subspan(info.lightBase + n, 2 * n / shared::kCellDirections));
-      }
-    }
     for (int c = 0; c < 3; ++c) info.rotation[c] = glm::vec4(glm::vec3(o.rotation[c]), 0.0f);
     for (int c = 0; c < 3; ++c) info.toLight[c] = glm::vec4(o.toLight[c], 0.0f);
     HC_CHECK_EQ(o.pointLights.size(), lightCount);
     info.pointLights = static_cast<std::uint32_t>(lightCount);
-    info.groundRadiance = glm::vec4(o.groundFlat[0], o.groundFlat[1], o.groundFlat[2], 0.0f);
+    info.groundRadiance = glm::vec4(0.0f);  // the ground's: the light stage's
     for (std::size_t k = 0; k < lightCount; ++k) {
       const FusedPointLight& l = o.pointLights[k];
       PointLight& out = pointLightData[i * shared::kMaxPointLights + k];
@@ -218,17 +209,18 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
       out.power = glm::vec4(l.power[0], l.power[1], l.power[2], 0.0f);
     }
   }
-  if (fused) {
-    lightUpload.write(lightTexelData.data(), lightTexelData.size() * sizeof(glm::vec4));
-    pointLightUpload.write(pointLightData.data(), pointLightData.size() * sizeof(PointLight));
-  }
+  if (fused) pointLightUpload.write(pointLightData.data(), pointLightData.size() * sizeof(PointLight));
   objects.write(objectInfo.data(), objectInfo.size() * sizeof(ObjectInfo));
   uploadFrameUniforms(request, resolved);
-  frame.stages.push_back({"light", secondsSince(t0)});
 
   // ---- the samples to shade, their shadow rays, the pass, the image
   const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
   const glm::vec3 eye(render::CameraRays(request.camera, request.width, request.height).origin());
+  // Where the point lights are staged: their copy into device memory.
+  const FrameStage lightStage{"light", [&](VkCommandBuffer cb) {
+                                pointLightUpload.record(cb);
+                                recordFusedLight(cb, resolved);
+                              }};
   const FrameStage gbufferStage{"gbuffer", [&](VkCommandBuffer cb) { recordGBuffer(cb, resolved); }};
   const FrameStage rotationInputStage{"rotation-input", [&](VkCommandBuffer cb) {
                                         vkCmdFillBuffer(cb, counter.handle(), 0, VK_WHOLE_SIZE, 0u);
@@ -238,15 +230,13 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
                                         recordCounterCopy(cb);
                                       }};
   const FrameStage passStage{splitsum ? "splitsum" : "fused", [&](VkCommandBuffer cb) {
-                               // Where the inputs are staged: their copies into device memory.
-                               if (fused) {
-                                 lightUpload.record(cb);
-                                 pointLightUpload.record(cb);
+                               if (!deviceRays) {
+                                 // Where the host's rays are staged: their copies into device memory.
+                                 maskUpload.record(cb);
+                                 if (objectSky()) hiddenUpload.record(cb);
+                                 computeBarrier(cb);
+                                 markPart(cb, "uploads");
                                }
-                               if (!deviceRays) maskUpload.record(cb);
-                               if (!deviceRays && objectSky()) hiddenUpload.record(cb);
-                               computeBarrier(cb);
-                               markPart(cb, "uploads");
                                if (!fused) {
                                  fusedPass->dispatchIndirect(cb, counter, offsetof(CoverageCounter, groups));
                                } else if (!(options.smoothSumTolerance > 0.0f)) {
@@ -263,25 +253,25 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
                              }};
   const FrameStage tonemapStage{"tonemap", [&](VkCommandBuffer cb) { recordTonemap(cb, request); }};
   std::uint32_t covered = 0;
+  // splitsum keeps no light of its own: it turns its lookup (ObjectInfo::toLight).
+  std::vector<FrameStage> first;
+  if (fused) first.push_back(lightStage);
+  first.insert(first.end(), {gbufferStage, rotationInputStage});
   if (deviceRays) {
     // One submission: the rays traced on the device between rotation-input and the pass.
     writeRays(resolved, eye);
-    runStages({gbufferStage,
-               rotationInputStage,
-               {"shadow-rays", [&](VkCommandBuffer cb) { recordDeviceRays(cb); }},
-               passStage,
-               tonemapStage},
-              request, frame);
+    first.insert(first.end(), {{"shadow-rays", [&](VkCommandBuffer cb) { recordDeviceRays(cb); }}, passStage, tonemapStage});
+    runStages(first, request, frame);
     if (frame.cancelled) return frame;
     covered = coveredSamples();
   } else {
-    runStages({gbufferStage, rotationInputStage}, request, frame);
+    runStages(first, request, frame);
     if (frame.cancelled) return frame;  // stopped between stages: no images
 
     // ---- shadow-rays (host): each covered sample's point-light bits
     frame.cancelled = cancelRequested();
     if (frame.cancelled) return frame;
-    t0 = RendererClock::now();
+    const auto t0 = RendererClock::now();
     render::enterFrameStage(request, "shadow-rays");
     covered = computeShadowMasks(resolved, eye);
     frame.stages.push_back({"shadow-rays", secondsSince(t0)});

@@ -71,15 +71,6 @@ void fusedLightTexels(std::span<const float> planes, std::span<glm::vec4> out) {
   for (std::size_t k = 0; k < n; ++k) out[k] = glm::vec4(planes[k], planes[n + k], planes[2 * n + k], 0.0f);
 }
 
-void fusedCellLightTexels(const CellLight& cells, std::span<glm::vec4> out) {
-  const std::size_t k = cells.stride - kCellPadding;
-  HC_CHECK_EQ(out.size(), 2 * k);
-  for (std::size_t q = 0; q < k; ++q) {
-    out[q] = glm::vec4(cells.power[q], cells.power[cells.stride + q], cells.power[2 * cells.stride + q], 0.0f);
-    out[k + q] = glm::vec4(cells.centroidX[q], cells.centroidY[q], cells.centroidZ[q], 0.0f);
-  }
-}
-
 std::vector<glm::vec4> pixelCentreDirections(int level) {
   const int m = mapSize(level);
   std::vector<glm::vec4> out;

@@ -225,14 +225,15 @@ void VulkanRenderer::Impl::uploadScene() {
     // The mirror rays' scene, as fused's shadow rays' (below), where the host traces them.
     if (!deviceRays) createHostRays();
   }
-  // The light: per object and channel a header and at most (N − 1)/3 blocks;
-  // for `fused` its pixel form, N RGB0 texels per object at its level (fusedLightTexels).
-  // Written every frame, device-local like the other inputs: its upload (and
-  // staging buffer, where there is one) lives as long as the renderer.
-  if (!splitsum) {
-    light = Buffer(context,
-                   fused ? fusedLightTexelCount * sizeof(glm::vec4) : objectCount * 3 * (1 + (n - 1) / 3) * sizeof(glm::uvec4),
-                   fusedUsage, MemoryUse::DeviceInput);
+  // The light: per object and channel a header and at most (N − 1)/3 blocks,
+  // written by the host every frame, device-local like the other inputs: its
+  // upload (and staging buffer, where there is one) lives as long as the
+  // renderer. `fused`'s is its pixel form, N RGB0 texels per object at its
+  // level (then its cells), which the device makes every frame (fused_light.cpp).
+  if (fused) {
+    light = Buffer(context, fusedLightTexelCount * sizeof(glm::vec4), kTexelUsage, MemoryUse::DeviceOnly);
+  } else if (!splitsum) {
+    light = Buffer(context, objectCount * 3 * (1 + (n - 1) / 3) * sizeof(glm::uvec4), kStorageUsage, MemoryUse::DeviceInput);
     lightUpload = BufferUpload(context, light);
   }
   if (fused) {
@@ -270,6 +271,7 @@ void VulkanRenderer::Impl::uploadScene() {
     return;
   }
   if (fused) {
+    createFusedLight();
     // One SIMD group per workgroup on a CPU device: the workgroup's only
     // barriers (the reduction's) then switch no coroutines (docs/gpu.md).
     createFusedPipeline(limits.fusedLocalSize          ? limits.fusedLocalSize
@@ -298,7 +300,6 @@ void VulkanRenderer::Impl::createFusedPipeline(std::uint32_t local) {
   lobeLightTexels = TexelView(context, lobeLight, VK_FORMAT_R32G32B32A32_SFLOAT, sizeof(glm::vec4));
   pointSliceTexels = TexelView(context, pointSlices, VK_FORMAT_R32G32B32A32_SFLOAT, sizeof(glm::vec4));
   detailTexels = TexelView(context, details, VK_FORMAT_R32_SFLOAT, sizeof(float));
-  lightTexelData.resize(fusedLightTexelCount);
 
   // No scratch: a workgroup keeps only its reduction's vec3 per invocation,
   // so the dispatch may have as many groups as the device allows: 65,536 on

@@ -203,6 +203,16 @@ std::vector<HiddenLight> VulkanRenderer::hiddenLights() const {
   const std::uint32_t covered = impl.counterOut.handle() ? impl.coveredSamples() : 0;
   return readAll<HiddenLight>(impl.context, impl.hidden, covered);
 }
+std::vector<glm::vec4> VulkanRenderer::lightTexels() const {
+  Impl& impl = last();
+  if (!impl.fused) return {};
+  return readAll<glm::vec4>(impl.context, impl.light, impl.fusedLightTexelCount);
+}
+std::vector<ObjectInfo> VulkanRenderer::objectInfos() const {
+  Impl& impl = last();
+  if (!impl.fused) return {};
+  return readAll<ObjectInfo>(impl.context, impl.objects, impl.objectInfo.size());
+}
 std::vector<std::uint32_t> VulkanRenderer::edgeWords() const {
   if (!last().options.antialias) return {};
   return readAll<std::uint32_t>(last().context, last().edges, static_cast<std::size_t>(last().width) * static_cast<std::size_t>(last().height));

@@ -80,13 +80,14 @@ struct VulkanRenderer::Impl {
   // frame) and their read-out (exposure_readout.comp), which the tonemap
   // pass reads on the device and the host from its copy in `exposureOut`.
   Buffer exposureHistograms, exposureResult, exposureOut;
-  // The light is device-local (buffer.h); each frame writes it here and
-  // records the copy, where it is staged, ahead of the pass that reads it.
+  // The rotating methods' light is device-local (buffer.h); each frame
+  // writes it here and records the copy, where it is staged, ahead of the
+  // pass that reads it. `fused`'s is made on the device (fused_light.cpp).
   BufferUpload lightUpload;
   // `fused`: the slices in pixel form (texels) and as point values
   // (`pointSlices`, the point lights' lookup), the visibility bits (in
   // `visibility`, every vertex's words in global vertex order), the light in
-  // pixel form per frame (in `light`), the pixel-centre directions; per
+  // pixel form per frame (in `light`, made by the device), the pixel-centre directions; per
   // frame the point lights (PointLight, kMaxPointLights per object).
   bool fused = false;
   // `splitsum`: no slices, light or visibility; per global lobe (`lobes`,
@@ -108,7 +109,13 @@ struct VulkanRenderer::Impl {
   BufferUpload pointLightUpload;
   // fused.comp reads these through texel views (BindingKind::Texels).
   TexelView sliceTexels, lightTexels, directionTexels, visibilityTexels, lobeLightTexels, pointSliceTexels, detailTexels;
-  std::vector<glm::vec4> lightTexelData;  // this frame's light texels, before upload
+  // `fused`'s light, made on the device each frame (fused_light.cpp,
+  // shaders/light.comp) from the rest map at each object's turn level
+  // (once per level, RGB0 texels) and each level's row solid angles; per
+  // object, where its rest map starts and its level.
+  Buffer lightRestMaps, rowSolidAngles;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> lightRestOf;
+  std::unique_ptr<ComputePipeline> lightPass;
   std::vector<PointLight> pointLightData;         // this frame's point lights, before upload
   std::uint32_t fusedGroups = 0;     // the most workgroups of the fused dispatch
   std::uint32_t fusedLocal = 0;      // its local size
@@ -234,6 +241,11 @@ struct VulkanRenderer::Impl {
   void uploadScene();
   void createFusedPipeline(std::uint32_t local);
   void createSplitsumPipeline();
+
+  // fused_light.cpp: `fused`'s "light" stage, the rest maps uploaded once
+  // and each object's light in its frame recorded every frame.
+  void createFusedLight();
+  void recordFusedLight(VkCommandBuffer cb, const render::ResolvedFrame& resolved);
 
   // gbuffer_pass.cpp
   void createGraphicsPipeline();

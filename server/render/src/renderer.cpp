@@ -285,9 +285,32 @@ void checkFrameRequest(const FrameRequest& r, std::size_t objectCount) {
 
 namespace {
 
+// fused's point lights for one object: their directions in its frame, and
+// for the ground its closed form's share of each, ρ·cos θ·power where seen.
+void resolveFusedPointLights(const PreparedScene& prepared, const PreparedObject& object,
+                             const std::vector<glm::vec3>& worldDirections, ResolvedObject& o) {
+  o.pointLights.resize(worldDirections.size());
+  for (std::size_t k = 0; k < worldDirections.size(); ++k) {
+    const glm::dvec3 d = glm::transpose(o.rotation) * glm::dvec3(worldDirections[k]);
+    o.pointLights[k].direction = glm::vec3(d);
+    for (std::size_t c = 0; c < 3; ++c) o.pointLights[k].power[c] = static_cast<float>(prepared.pointLights[k].power[c]);
+  }
+  if (!object.ground) return;
+  // The ground is a Lambert plane with +Y up in its own frame and nothing of
+  // its own above it: ρ·cos θ = albedo/π·max(y, 0) at every point, so each
+  // point light adds a constant where seen (and the map part is one sum per
+  // frame, resolveFusedLight's groundFlat).
+  const glm::dvec3 rho = object.groundAlbedo / kPi;
+  for (FusedPointLight& l : o.pointLights) {
+    const double cosine = std::max(0.0, static_cast<double>(l.direction.y));
+    for (std::size_t c = 0; c < 3; ++c) l.power[c] = static_cast<float>(rho[static_cast<int>(c)] * cosine * l.power[c]);
+  }
+}
+
 // fused's light for one object (ResolvedObject): the rest map in the
 // object's frame, weighted by ΔΩ, zero where the ground hides it; the point
 // lights in the object's frame; and for the ground itself its closed form.
+// shaders/light.comp computes the same map light on the device.
 void resolveFusedLight(const PreparedScene& prepared, const PreparedObject& object, const glm::dmat3& lightRotation,
                        const std::optional<glm::dvec3>& groundNormal, const std::vector<glm::vec3>& worldDirections,
                        ResolvedObject& o) {
@@ -308,16 +331,9 @@ void resolveFusedLight(const PreparedScene& prepared, const PreparedObject& obje
           for (std::size_t c = 0; c < 3; ++c) weighted[c].at(r, col) = 0.0f;
   }
   o.fusedLight = FusedLight::fromWeightedMaps(weighted, object.sumTolerance);
-  o.pointLights.resize(worldDirections.size());
-  for (std::size_t k = 0; k < worldDirections.size(); ++k) {
-    const glm::dvec3 d = glm::transpose(o.rotation) * glm::dvec3(worldDirections[k]);
-    o.pointLights[k].direction = glm::vec3(d);
-    for (std::size_t c = 0; c < 3; ++c) o.pointLights[k].power[c] = static_cast<float>(prepared.pointLights[k].power[c]);
-  }
+  resolveFusedPointLights(prepared, object, worldDirections, o);
   if (!object.ground) return;
-  // The ground is a Lambert plane with +Y up in its own frame and nothing of
-  // its own above it: ρ·cos θ = albedo/π·max(y, 0) at every point, so the map
-  // part is one sum per frame and each point light adds a constant where seen.
+  // The ground's map part: ρ·Σ_{y>0} (L·ΔΩ)·y, one sum per frame.
   const glm::dvec3 rho = object.groundAlbedo / kPi;
   glm::dvec3 flat(0.0);
   for (int r = 0; r < m; ++r) {
@@ -327,10 +343,6 @@ void resolveFusedLight(const PreparedScene& prepared, const PreparedObject& obje
       for (int c = 0; c < 3; ++c) flat[c] += weighted[static_cast<std::size_t>(c)].at(r, col) * y;
   }
   for (int c = 0; c < 3; ++c) o.groundFlat[static_cast<std::size_t>(c)] = static_cast<float>(rho[c] * flat[c]);
-  for (FusedPointLight& l : o.pointLights) {
-    const double cosine = std::max(0.0, static_cast<double>(l.direction.y));
-    for (std::size_t c = 0; c < 3; ++c) l.power[c] = static_cast<float>(rho[static_cast<int>(c)] * cosine * l.power[c]);
-  }
 }
 
 }  // namespace
@@ -367,7 +379,8 @@ glm::dmat3 lightRotationOf(const PreparedScene& prepared, const FrameRequest& re
   return request.lightRotation * prepared.scene.environment.rotation;
 }
 
-ResolvedFrame resolveFrame(const PreparedScene& prepared, const RenderOptions& options, const FrameRequest& request) {
+ResolvedFrame resolveFrame(const PreparedScene& prepared, const RenderOptions& options, const FrameRequest& request,
+                           FusedMapLight mapLight) {
   checkFrameRequest(request, prepared.objects.size());
   ResolvedFrame out;
   const glm::dmat3 light = lightRotationOf(prepared, request);
@@ -434,6 +447,12 @@ ResolvedFrame resolveFrame(const PreparedScene& prepared, const RenderOptions& o
   }
   for (std::size_t i = 0; i < out.objects.size(); ++i) {
     ResolvedObject& o = out.objects[i];
+    if (fused && mapLight == FusedMapLight::Device) {
+      resolveFusedPointLights(prepared, prepared.objects[i], out.pointLightDirections, o);
+      const auto n = static_cast<std::size_t>(mapSize(prepared.objects[i].level));
+      out.lightBytes += 3 * n * n * sizeof(float);  // what the device's light holds: resolveFusedLight's planes
+      continue;
+    }
     if (fused) {
       // Everything resolveFusedLight reads that a request changes.
       const FusedLightCache::Key key{light, o.rotation, groundNormal};

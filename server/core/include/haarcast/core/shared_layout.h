@@ -457,6 +457,9 @@ struct ShadeSample {
 // The passes' workgroup sizes, push blocks and bindings.
 #include "haarcast/core/shared_passes.h"
 
+// `fused`'s light resolved on the device: LightPush, its phases and bindings.
+#include "haarcast/core/shared_light.h"
+
 #ifdef __cplusplus
 static_assert(sizeof(FrameParams) == 128 && offsetof(FrameParams, tanHalf) == 96 &&
               offsetof(FrameParams, fusedGroups) == 124);
@@ -483,6 +486,7 @@ static_assert(sizeof(ExposurePush) == 32 && sizeof(ExposureResult) == 32);
 static_assert(sizeof(GBufferPush) == 80 && offsetof(GBufferPush, objectId) == 64);
 static_assert(sizeof(RotationPush) == 16 && offsetof(RotationPush, count) == 4);
 static_assert(sizeof(BatchArgsPush) == 16 && offsetof(BatchArgsPush, batches) == 4);
+static_assert(sizeof(LightPush) == 48 && offsetof(LightPush, groundUp) == 16 && offsetof(LightPush, albedo) == 32);
 #endif
 
 #ifdef __cplusplus

@@ -31,6 +31,7 @@ using shared::ExposureResult;
 using shared::FrameParams;
 using shared::GBufferPush;
 using shared::HiddenLight;
+using shared::LightPush;
 using shared::ObjectInfo;
 using shared::PointLight;
 using shared::RayFrame;
@@ -75,11 +76,6 @@ struct DirectionTable {
 };
 DirectionTable pixelCentreDirections(std::span<const int> levels);
 
-// An object's light by cells as fused.comp reads it after its N light
-// texels (shared::cellPowerTexel, cellCentroidTexel): K texels of P_c
-// (RGB), then K of the centroid (xyz). `out` has 2K texels.
-void fusedCellLightTexels(const CellLight& cells, std::span<glm::vec4> out);
-
 // The kinds of fused.comp's and splitsum.comp's bindings, from their names
 // (core/shared_passes.h): the *TexelsBinding ones uniform texel buffers
 // (fused: RGBA32F slices, light, directions, prefiltered light, point
@@ -89,7 +85,8 @@ std::vector<BindingKind> splitsumBindings();
 
 // The light of one object as fused.comp reads it: texel k = (L_r, L_g, L_b, 0)
 // at direction k, from the three planes of core FusedLight (ΔΩ folded in),
-// written to out[0 … N).
+// written to out[0 … N). A frame's light is light.comp's (fused_light.cpp);
+// this is how a test hands fused.comp the host's instead.
 void fusedLightTexels(std::span<const float> planes, std::span<glm::vec4> out);
 
 // ObjectInfo's skipBelowY for fused.comp, from the slices' last non-zero row

@@ -1,14 +1,17 @@
 // The Vulkan backend behind render::Renderer (docs/gpu.md): the seed's
 // passes as Vulkan work, each timed on the device with timestamp queries
 // under the shared stage names of renderer.h:
-//   light           host: render::lightInObjectFrame per object, uploaded
+//   light           `fused`: compute, each object's light in its frame (shaders/light.comp,
+//                   fused_light.cpp); the rotating methods: host, render::lightInObjectFrame
+//                   per object (the Haar cut keeps each channel's k largest), uploaded
 //   gbuffer         graphics pipeline, offscreen: normal, ids + barycentrics, position
 //   rotation-input  compute: slice index and Y-X-Y angles per covered pixel, compacted;
 //                   then every batch's indirect arguments (batch_args.comp)
 //   rotation        compute: shaders/rotate_<method>.comp, in batches of covered pixels
 //   triple-product  compute: light × rotated slice × interpolated visibility
-//   shadow-rays     `fused` and `splitsum`, host: the covered samples read back, one
-//                   Embree shadow ray per sample and point light
+//   shadow-rays     `fused` and `splitsum`: on a device that traces rays, its
+//                   ray-generation shader (device_rays.cpp); else on the host, the covered
+//                   samples read back, one Embree shadow ray per sample and point light
 //                   (render::pointLightMask; splitsum: its mirror ray alone), the masks uploaded
 //   fused           `fused` only, in place of rotation and triple-product:
 //                   shaders/fused.comp, one indirect dispatch sized by rotation-input
@@ -25,8 +28,10 @@
 // The rotating methods record their frame as one command buffer (timestamps
 // per stage on GPUs; one submission per stage, host-timed, on CPU devices)
 // and read the covered count back only when the frame is done. `fused`
-// (and `splitsum`) submits twice: [gbuffer, rotation-input], then, after the
-// host's shadow rays for the samples read back, [fused (splitsum), tonemap].
+// (and `splitsum`) with the device's rays is one submission too, from its
+// light to its RGBA8 bytes; with the host's it submits twice: [light,
+// gbuffer, rotation-input], then, after the host's shadow rays for the
+// samples read back, [fused (splitsum), tonemap].
 // Scene data (slices, method data, meshes, visibility, backdrop) is uploaded
 // once, into device-local memory (staged where the host cannot map it);
 // frame buffers are allocated once per resolution and reused, so a frame at
@@ -149,6 +154,12 @@ class VulkanRenderer final : public render::Renderer {
   // With antialiasing, each pixel's edge word (shared_layout.h kEdgeFlag);
   // empty without.
   std::vector<std::uint32_t> edgeWords() const;
+  // `fused`: the light texels the pass read (ObjectInfo::lightBase, N per
+  // object at its level, then by cells its cells' power and centroids:
+  // shaders/light.comp) and the ObjectInfo records (the ground's
+  // groundRadiance as the device made it); else empty.
+  std::vector<glm::vec4> lightTexels() const;
+  std::vector<ObjectInfo> objectInfos() const;
   std::size_t batchSamples() const;  // the batch size in use (0 before the first frame)
   std::size_t batchesLastFrame() const;
 

@@ -351,14 +351,21 @@ struct ResolvedFrame {
   glm::dmat4 viewProjection{1.0};
   std::size_t lightCoefficients = 0;  // k in effect (the Haar methods)
   std::vector<ResolvedObject> objects;
-  std::size_t lightBytes = 0;         // the light lists, index + value per entry
+  std::size_t lightBytes = 0;         // the light lists, index + value per entry; fused: its planes' floats
   std::vector<glm::vec3> pointLightDirections;  // fused: world frame, unit, toward each light
   // The environment's frame → the world this frame (lightRotationOf): what
   // every pass that reads the light or the backdrop turns by.
   glm::dmat3 lightRotation{1.0};
   SkyOccluders skyOccluders;          // fused with a ground or two objects: what their samples' hidden-sky rays need (point_lights.h)
 };
-ResolvedFrame resolveFrame(const PreparedScene& prepared, const RenderOptions& options, const FrameRequest& request);
+// Where `fused`'s map light is made each frame: by resolveFrame on the host
+// (the CPU backend), or on the device (the Vulkan backend's "light" stage,
+// shaders/light.comp, from the same rest maps): then resolveFrame leaves
+// each ResolvedObject's fusedLight empty and groundFlat zero, and resolves
+// only what is one number per object or light (poses, point lights).
+enum class FusedMapLight { Host, Device };
+ResolvedFrame resolveFrame(const PreparedScene& prepared, const RenderOptions& options, const FrameRequest& request,
+                           FusedMapLight mapLight = FusedMapLight::Host);
 // The light's turn this frame: the request's (the wire's light pose) on top
 // of the scene's own (Environment::rotation, a scene file's
 // "environment": {"rotate": …}).

@@ -1,0 +1,93 @@
+// `fused`'s "light" stage on the device (shaders/light.comp,
+// core/shared_light.h): each object's light in its own frame, made every
+// frame inside the frame's one submission from the rest maps uploaded once.
+// The host's share is a push block per object (its rest map, its ground).
+
+#include <map>
+
+#include "haarcast/core/check.h"
+#include "haarcast/core/shared_cells.h"
+#include "haarcast/core/sphere_map.h"
+#include "vulkan_renderer_impl.h"
+
+namespace haarcast::gpu {
+
+void VulkanRenderer::Impl::createFusedLight() {
+  // The rest map at each object's turn level (render::lightTurnLevel), once
+  // per level, RGB0 texels in the map's row-major order.
+  std::vector<glm::vec4> rest;
+  std::map<int, std::uint32_t> baseOf;
+  lightRestOf.clear();
+  for (const render::PreparedObject& p : prepared.objects) {
+    const int turn = render::lightTurnLevel(p.level);
+    auto [at, added] = baseOf.try_emplace(turn, static_cast<std::uint32_t>(rest.size()));
+    if (added) {
+      const std::array<SphereMap, 3>& maps = prepared.restLightAt(turn);
+      for (std::size_t i = 0; i < maps[0].pixelCount(); ++i)
+        rest.emplace_back(maps[0].values()[i], maps[1].values()[i], maps[2].values()[i], 0.0f);
+    }
+    lightRestOf.emplace_back(at->second, static_cast<std::uint32_t>(turn));
+  }
+  std::vector<float> solid(shared::kRowSolidAngles);
+  for (int l = 0; l <= static_cast<int>(shared::kFusedMaxLevel); ++l)
+    for (int row = 0; row < mapSize(l); ++row)
+      solid[shared::rowSolidAngleIndex(static_cast<shared::uint>(l), static_cast<shared::uint>(row))] =
+          static_cast<float>(pixelSolidAngle(l, row));
+  lightRestMaps = Buffer(context, rest.size() * sizeof(glm::vec4), kStorageUsage, MemoryUse::DeviceInput);
+  rowSolidAngles = Buffer(context, solid.size() * sizeof(float), kStorageUsage, MemoryUse::DeviceInput);
+  for (auto [buffer, data, bytes] : {std::tuple{&lightRestMaps, static_cast<const void*>(rest.data()), rest.size() * sizeof(glm::vec4)},
+                                     std::tuple{&rowSolidAngles, static_cast<const void*>(solid.data()), solid.size() * sizeof(float)}}) {
+    BufferUpload up(context, *buffer);
+    up.write(data, bytes);
+    up.submit();
+  }
+  lightPass = std::make_unique<ComputePipeline>(context, "light.comp", shared::kLightBindings, sizeof(LightPush));
+  lightPass->bind({{shared::kLightObjectsBinding, &objects},
+                   {shared::kLightRestBinding, &lightRestMaps},
+                   {shared::kLightSolidAnglesBinding, &rowSolidAngles},
+                   {shared::kLightDirectionsBinding, &directions},
+                   {shared::kLightTexelsBinding, &light}});
+}
+
+void VulkanRenderer::Impl::recordFusedLight(VkCommandBuffer cb, const render::ResolvedFrame& resolved) {
+  const std::size_t objectCount = prepared.objects.size();
+  HC_CHECK_EQ(resolved.objects.size(), objectCount);
+  HC_CHECK_EQ(lightRestOf.size(), objectCount);
+  // The ground's normal in the world (renderer.cpp resolveFrame's).
+  std::optional<glm::dvec3> groundNormal;
+  if (prepared.ground) groundNormal = resolved.objects[*prepared.ground].rotation * glm::dvec3(0.0, 1.0, 0.0);
+  std::vector<LightPush> pushes(objectCount);
+  for (std::size_t i = 0; i < objectCount; ++i) {
+    const render::PreparedObject& p = prepared.objects[i];
+    LightPush& push = pushes[i];
+    push.object = static_cast<std::uint32_t>(i);
+    push.restBase = lightRestOf[i].first;
+    push.restLevel = lightRestOf[i].second;
+    if (groundNormal && !p.ground) {
+      push.groundUp = glm::vec4(glm::vec3(glm::transpose(resolved.objects[i].rotation) * *groundNormal), 1.0f);
+    }
+    if (p.ground) push.albedo = glm::vec4(glm::vec3(p.groundAlbedo / kPi), 0.0f);
+  }
+  // Every object's texels, then what is made from them: the cells' power
+  // and centroids, the ground's flat radiance.
+  for (LightPush& push : pushes) {
+    push.phase = shared::kLightPhaseTexels;
+    const std::size_t m = static_cast<std::size_t>(mapSize(prepared.objects[push.object].level));
+    lightPass->dispatch(cb, {groupsOf(m * m, shared::kLocalSize), 1, 1}, &push, sizeof push);
+  }
+  computeBarrier(cb);
+  for (LightPush& push : pushes) {
+    const render::PreparedObject& p = prepared.objects[push.object];
+    const std::size_t m = static_cast<std::size_t>(mapSize(p.level));
+    if (objectInfo[push.object].sumTolerance > 0.0f) {
+      push.phase = shared::kLightPhaseCells;
+      lightPass->dispatch(cb, {groupsOf(m * m / shared::kCellDirections, shared::kLocalSize), 1, 1}, &push, sizeof push);
+    }
+    if (p.ground) {
+      push.phase = shared::kLightPhaseGround;
+      lightPass->dispatch(cb, {1, 1, 1}, &push, sizeof push);
+    }
+  }
+}
+
+}  // namespace haarcast::gpu
