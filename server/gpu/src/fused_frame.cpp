@@ -253,19 +253,21 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
                              }};
   const FrameStage tonemapStage{"tonemap", [&](VkCommandBuffer cb) { recordTonemap(cb, request); }};
   std::uint32_t covered = 0;
-  // splitsum keeps no light of its own: it turns its lookup (ObjectInfo::toLight).
-  std::vector<FrameStage> first;
-  if (fused) first.push_back(lightStage);
-  first.insert(first.end(), {gbufferStage, rotationInputStage});
+  // The stages up to the shadow rays (splitsum keeps no light of its own:
+  // it turns its lookup, ObjectInfo::toLight), then the rest where the
+  // device traces the rays.
+  std::vector<FrameStage> stages;
+  if (fused) stages.push_back(lightStage);
+  stages.insert(stages.end(), {gbufferStage, rotationInputStage});
   if (deviceRays) {
     // One submission: the rays traced on the device between rotation-input and the pass.
     writeRays(resolved, eye);
-    first.insert(first.end(), {{"shadow-rays", [&](VkCommandBuffer cb) { recordDeviceRays(cb); }}, passStage, tonemapStage});
-    runStages(first, request, frame);
+    stages.insert(stages.end(), {{"shadow-rays", [&](VkCommandBuffer cb) { recordDeviceRays(cb); }}, passStage, tonemapStage});
+    runStages(stages, request, frame);
     if (frame.cancelled) return frame;
     covered = coveredSamples();
   } else {
-    runStages(first, request, frame);
+    runStages(stages, request, frame);
     if (frame.cancelled) return frame;  // stopped between stages: no images
 
     // ---- shadow-rays (host): each covered sample's point-light bits
