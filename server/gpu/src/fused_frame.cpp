@@ -265,10 +265,12 @@ render::Frame VulkanRenderer::Impl::renderFused(const render::FrameRequest& requ
     stages.insert(stages.end(), {{"shadow-rays", [&](VkCommandBuffer cb) { recordDeviceRays(cb); }}, passStage, tonemapStage});
     runStages(stages, request, frame);
     if (frame.cancelled) return frame;
+    if (fused) fusedLightMade();
     covered = coveredSamples();
   } else {
     runStages(stages, request, frame);
     if (frame.cancelled) return frame;  // stopped between stages: no images
+    if (fused) fusedLightMade();
 
     // ---- shadow-rays (host): each covered sample's point-light bits
     frame.cancelled = cancelRequested();

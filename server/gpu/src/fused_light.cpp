@@ -4,6 +4,8 @@
 // The host's share is a push block per object (its rest map, its ground).
 
 #include <map>
+#include <optional>
+#include <utility>
 
 #include "haarcast/core/check.h"
 #include "haarcast/core/shared_cells.h"
@@ -56,8 +58,20 @@ void VulkanRenderer::Impl::recordFusedLight(VkCommandBuffer cb, const render::Re
   // The ground's normal in the world (renderer.cpp resolveFrame's).
   std::optional<glm::dvec3> groundNormal;
   if (prepared.ground) groundNormal = resolved.objects[*prepared.ground].rotation * glm::dvec3(0.0, 1.0, 0.0);
+  lightMadeFor.resize(objectCount);
+  lightMaking.assign(objectCount, std::nullopt);
   std::vector<LightPush> pushes(objectCount);
+  std::vector<bool> make(objectCount);
+  lightsMadeLastFrame = 0;
   for (std::size_t i = 0; i < objectCount; ++i) {
+    // Everything the object's texels depend on that a request changes.
+    const render::FusedLightCache::Key key{resolved.lightRotation, resolved.objects[i].rotation, groundNormal};
+    make[i] = !(lightMadeFor[i] == key);
+    if (make[i]) {
+      lightMadeFor[i].reset();  // until its frame has run: the buffer may hold either light
+      lightMaking[i] = key;
+      ++lightsMadeLastFrame;
+    }
     const render::PreparedObject& p = prepared.objects[i];
     LightPush& push = pushes[i];
     push.object = static_cast<std::uint32_t>(i);
@@ -68,9 +82,11 @@ void VulkanRenderer::Impl::recordFusedLight(VkCommandBuffer cb, const render::Re
     }
     if (p.ground) push.albedo = glm::vec4(glm::vec3(p.groundAlbedo / kPi), 0.0f);
   }
-  // Every object's texels, then what is made from them: the cells' power
-  // and centroids, the ground's flat radiance.
+  // Every turned object's texels, then what is made from them: the cells'
+  // power and centroids, the ground's flat radiance (the ground's every
+  // frame: its ObjectInfo is written by the host each frame).
   for (LightPush& push : pushes) {
+    if (!make[push.object]) continue;
     push.phase = shared::kLightPhaseTexels;
     const std::size_t m = static_cast<std::size_t>(mapSize(prepared.objects[push.object].level));
     lightPass->dispatch(cb, {groupsOf(m * m, shared::kLocalSize), 1, 1}, &push, sizeof push);
@@ -79,7 +95,7 @@ void VulkanRenderer::Impl::recordFusedLight(VkCommandBuffer cb, const render::Re
   for (LightPush& push : pushes) {
     const render::PreparedObject& p = prepared.objects[push.object];
     const std::size_t m = static_cast<std::size_t>(mapSize(p.level));
-    if (objectInfo[push.object].sumTolerance > 0.0f) {
+    if (make[push.object] && objectInfo[push.object].sumTolerance > 0.0f) {
       push.phase = shared::kLightPhaseCells;
       lightPass->dispatch(cb, {groupsOf(m * m / shared::kCellDirections, shared::kLocalSize), 1, 1}, &push, sizeof push);
     }
@@ -88,6 +104,11 @@ void VulkanRenderer::Impl::recordFusedLight(VkCommandBuffer cb, const render::Re
       lightPass->dispatch(cb, {1, 1, 1}, &push, sizeof push);
     }
   }
+}
+
+void VulkanRenderer::Impl::fusedLightMade() {
+  for (std::size_t i = 0; i < lightMaking.size(); ++i)
+    if (lightMaking[i]) lightMadeFor[i] = std::exchange(lightMaking[i], std::nullopt);
 }
 
 }  // namespace haarcast::gpu

@@ -213,6 +213,7 @@ std::vector<ObjectInfo> VulkanRenderer::objectInfos() const {
   if (!impl.fused) return {};
   return readAll<ObjectInfo>(impl.context, impl.objects, impl.objectInfo.size());
 }
+std::size_t VulkanRenderer::lightsMadeLastFrame() const { return last().lightsMadeLastFrame; }
 std::vector<std::uint32_t> VulkanRenderer::edgeWords() const {
   if (!last().options.antialias) return {};
   return readAll<std::uint32_t>(last().context, last().edges, static_cast<std::size_t>(last().width) * static_cast<std::size_t>(last().height));

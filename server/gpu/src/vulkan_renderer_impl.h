@@ -116,6 +116,14 @@ struct VulkanRenderer::Impl {
   Buffer lightRestMaps, rowSolidAngles;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> lightRestOf;
   std::unique_ptr<ComputePipeline> lightPass;
+  // Per object, what its light in `light` was made for (its rotation, the
+  // light's and the ground's, as render::FusedLightCache keys it): a frame
+  // that turns none of them records no texels for it, so an orbiting camera
+  // pays only the ground's sum. Empty while a frame that remakes it is in
+  // flight or was stopped (then the buffer may hold either light);
+  // `lightMaking` is set when its frame's light stage has run.
+  std::vector<std::optional<render::FusedLightCache::Key>> lightMadeFor, lightMaking;
+  std::size_t lightsMadeLastFrame = 0;
   std::vector<PointLight> pointLightData;         // this frame's point lights, before upload
   std::uint32_t fusedGroups = 0;     // the most workgroups of the fused dispatch
   std::uint32_t fusedLocal = 0;      // its local size
@@ -246,6 +254,9 @@ struct VulkanRenderer::Impl {
   // and each object's light in its frame recorded every frame.
   void createFusedLight();
   void recordFusedLight(VkCommandBuffer cb, const render::ResolvedFrame& resolved);
+  // After the submission that held the light stage ran to its end: the
+  // lights it made are what `light` holds.
+  void fusedLightMade();
 
   // gbuffer_pass.cpp
   void createGraphicsPipeline();

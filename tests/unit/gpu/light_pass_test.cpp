@@ -105,7 +105,9 @@ LightDiff diffLight(const VulkanRenderer& gpu, const render::RenderOptions& o, c
 }
 
 // The default scene (a sphere and a torus on a ground): the torus and the
-// light turned, then the sphere and the light turned otherwise.
+// light turned, then the sphere and the light turned otherwise; then the
+// same again (no object's light made afresh), the torus alone turned (its
+// alone), the light alone (every object's).
 TEST_P(LightPass, DeviceMakesTheHostsLight) {
   HAARCAST_REQUIRE_VULKAN();
   const LightCase& c = GetParam();
@@ -126,9 +128,18 @@ TEST_P(LightPass, DeviceMakesTheHostsLight) {
   request.poses[0].rotateDegrees += glm::dvec3(-30.0, 70.0, 15.0);
   request.lightRotation = rotationMatrix({-1.1, 0.7, 2.0});
   requests.push_back(request);
-  for (const render::FrameRequest& r : requests) {
+  requests.push_back(request);
+  request.poses[1].rotateDegrees += glm::dvec3(0.0, 40.0, 0.0);
+  requests.push_back(request);
+  request.lightRotation = rotationMatrix({0.2, 0.1, -0.3});
+  requests.push_back(request);
+  const std::size_t objects = scene.objects.size();
+  const std::vector<std::size_t> made = {objects, objects, 0, 1, objects};  // a turned light turns every object's
+  for (std::size_t f = 0; f < requests.size(); ++f) {
+    const render::FrameRequest& r = requests[f];
     const render::Frame frame = gpu.render(r);
     ASSERT_FALSE(frame.cancelled);
+    EXPECT_EQ(gpu.lightsMadeLastFrame(), made[f]) << "frame " << f;
     const LightDiff d = diffLight(gpu, o, r);
     std::printf("%s: texels off by %.2e of the brightest, %zu zeroed on one side only; %zu cells, power off by %.2e, "
                 "centroids by %.2e rad; ground %.2e\n",
@@ -142,6 +153,44 @@ TEST_P(LightPass, DeviceMakesTheHostsLight) {
       EXPECT_GT(d.cells, 0u);
     }
   }
+  testing::expectNoValidationMessages(gpu.context());
+}
+
+// A frame stopped after its light stage (a CPU device submits stage by
+// stage and polls between them) leaves the buffer with its light while the
+// light's record still names the frame before: the next frame, turned as
+// that one, must make its light again rather than keep the stopped frame's.
+TEST_P(LightPass, AStoppedFrameLeavesNoLightBehind) {
+  HAARCAST_REQUIRE_VULKAN();
+  const LightCase& c = GetParam();
+  const render::Scene scene = render::defaultScene();
+  render::RenderOptions o = testing::frameOptions(RotationMethod::Fused, true);
+  o.width = 48;
+  o.height = 32;
+  o.level = c.level;
+  o.automaticLevel = c.automaticLevel;
+  o.sumTolerance = c.sumTolerance;
+  VulkanRenderer gpu(scene, o, testing::testOptions());
+  render::FrameRequest first = testing::requestFor(scene, o.width, o.height);
+  first.poses = testing::scenePoses(scene);
+  render::FrameRequest turned = first;
+  turned.poses[0].rotateDegrees += glm::dvec3(20.0, -60.0, 5.0);
+  turned.lightRotation = rotationMatrix({0.9, -0.2, 0.4});
+  gpu.render(first);
+  int polls = 0;
+  turned.cancelled = [&] { return ++polls >= 2; };  // after the first stage
+  const render::Frame stopped = gpu.render(turned);
+  if (stopped.cancelled) {
+    ASSERT_FALSE(stopped.stages.empty());
+    EXPECT_EQ(stopped.stages.front().name, "light");
+  }  // else the device took the frame in one submission, polled once before it
+  const render::Frame again = gpu.render(first);
+  ASSERT_FALSE(again.cancelled);
+  const LightDiff d = diffLight(gpu, o, first);
+  EXPECT_LE(d.texels, 2e-5) << "the stopped frame's light kept";
+  EXPECT_EQ(d.zeroed, 0u);
+  EXPECT_LE(d.power, 1e-5);
+  EXPECT_LE(d.ground, 1e-5);
   testing::expectNoValidationMessages(gpu.context());
 }
 

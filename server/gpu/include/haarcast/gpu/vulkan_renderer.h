@@ -160,6 +160,9 @@ class VulkanRenderer final : public render::Renderer {
   // groundRadiance as the device made it); else empty.
   std::vector<glm::vec4> lightTexels() const;
   std::vector<ObjectInfo> objectInfos() const;
+  // `fused`: how many objects' light texels the last frame's light stage
+  // made (the others' were made for the same turns by an earlier frame).
+  std::size_t lightsMadeLastFrame() const;
   std::size_t batchSamples() const;  // the batch size in use (0 before the first frame)
   std::size_t batchesLastFrame() const;
 
