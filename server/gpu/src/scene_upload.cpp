@@ -229,7 +229,7 @@ void VulkanRenderer::Impl::uploadScene() {
   // written by the host every frame, device-local like the other inputs: its
   // upload (and staging buffer, where there is one) lives as long as the
   // renderer. `fused`'s is its pixel form, N RGB0 texels per object at its
-  // level (then its cells), which the device makes every frame (fused_light.cpp).
+  // level (then its cells), which the device makes (fused_light.cpp).
   if (fused) {
     light = Buffer(context, fusedLightTexelCount * sizeof(glm::vec4), kTexelUsage, MemoryUse::DeviceOnly);
   } else if (!splitsum) {

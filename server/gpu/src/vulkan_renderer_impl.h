@@ -87,8 +87,9 @@ struct VulkanRenderer::Impl {
   // `fused`: the slices in pixel form (texels) and as point values
   // (`pointSlices`, the point lights' lookup), the visibility bits (in
   // `visibility`, every vertex's words in global vertex order), the light in
-  // pixel form per frame (in `light`, made by the device), the pixel-centre directions; per
-  // frame the point lights (PointLight, kMaxPointLights per object).
+  // pixel form per frame (in `light`, made by the device), the pixel-centre
+  // directions; per frame the point lights (PointLight, kMaxPointLights per
+  // object).
   bool fused = false;
   // `splitsum`: no slices, light or visibility; per global lobe (`lobes`,
   // ObjectInfo::sliceBase + t) its SliceLobe, and the prefiltered light.
@@ -120,8 +121,9 @@ struct VulkanRenderer::Impl {
   // light's and the ground's, as render::FusedLightCache keys it): a frame
   // that turns none of them records no texels for it, so an orbiting camera
   // pays only the ground's sum. Empty while a frame that remakes it is in
-  // flight or was stopped (then the buffer may hold either light);
-  // `lightMaking` is set when its frame's light stage has run.
+  // flight or was stopped (then the buffer may hold either light).
+  // `lightMaking`: what the frame being recorded makes, moved into
+  // `lightMadeFor` once its submission has run (fusedLightMade).
   std::vector<std::optional<render::FusedLightCache::Key>> lightMadeFor, lightMaking;
   std::size_t lightsMadeLastFrame = 0;
   std::vector<PointLight> pointLightData;         // this frame's point lights, before upload
