@@ -14,18 +14,15 @@ layout(push_constant) uniform Push { LightPush pc; };
 
 layout(std430, set = 0, binding = kLightObjectsBinding) buffer Objects { ObjectInfo objects[]; };
 layout(std430, set = 0, binding = kLightRestBinding) readonly buffer Rest { vec4 rest[]; };
-layout(std430, set = 0, binding = kLightSolidAnglesBinding) readonly buffer SolidAngles { float rowSolidAngle[]; };
+// Per texel of each level in use (the objects' and the turn levels'): its
+// centre's direction (xyz) and solid angle (w).
 layout(std430, set = 0, binding = kLightDirectionsBinding) readonly buffer Directions { vec4 directions[]; };
 layout(std430, set = 0, binding = kLightTexelsBinding) buffer Light { vec4 light[]; };
 
-float solidAngle(uint level, uint row) { return rowSolidAngle[rowSolidAngleIndex(level, row)]; }
-
-// The rest map at the turn level, looked up along M·ω for the fine texel
-// (row, col): SphereMap::sampleBilinear's sum, in its order.
-vec3 turned(mat3 toLight, uint row, uint col) {
-  const float m = float(1u << pc.restLevel);
-  const vec3 omega = sphericalToDirection((float(row) + 0.5) * kPiF / m, (float(col) + 0.5) * kTwoPiF / m);
-  const vec2 src = directionToSpherical(toLight * omega);
+// The rest map at the turn level, looked up along M·ω for its texel k
+// (its centre's direction ω): SphereMap::sampleBilinear's sum, in its order.
+vec3 turned(mat3 toLight, uint k) {
+  const vec2 src = directionToSpherical(toLight * directions[pc.restDirections + k].xyz);
   const Taps t = bilinearTaps(int(pc.restLevel), src.x, src.y);
   const uint width = 1u << pc.restLevel;
   const vec3 a = rest[pc.restBase + uint(t.rc.x) * width + uint(t.rc.z)].rgb;
@@ -44,19 +41,21 @@ void texel(ObjectInfo o, uint k) {
   const uint m = 1u << o.level;
   const uint row = k / m, col = k % m;
   const uint f = 1u << (pc.restLevel - o.level);
+  const uint fineWidth = m * f;
   const mat3 toLight = mat3(o.toLight[0].xyz, o.toLight[1].xyz, o.toLight[2].xyz);
   vec3 sum = vec3(0.0);
   float band = 0.0;
   for (uint di = 0u; di < f; ++di) {
-    const uint fineRow = row * f + di;
+    const uint fine = (row * f + di) * fineWidth + col * f;
     vec3 fineRowSum = vec3(0.0);
-    for (uint dj = 0u; dj < f; ++dj) fineRowSum += turned(toLight, fineRow, col * f + dj);
-    const float omega = solidAngle(pc.restLevel, fineRow);
+    for (uint dj = 0u; dj < f; ++dj) fineRowSum += turned(toLight, fine + dj);
+    const float omega = directions[pc.restDirections + fine].w;  // the fine row's ΔΩ
     sum += fineRowSum * omega;
     band += omega;
   }
-  vec3 value = sum / (band * float(f)) * solidAngle(o.level, row);
-  if (pc.groundUp.w > 0.0 && dot(directions[o.directionBase + k].xyz, pc.groundUp.xyz) < 0.0) value = vec3(0.0);
+  const vec4 centre = directions[o.directionBase + k];
+  vec3 value = sum / (band * float(f)) * centre.w;
+  if (pc.groundUp.w > 0.0 && dot(centre.xyz, pc.groundUp.xyz) < 0.0) value = vec3(0.0);
   light[o.lightBase + k] = vec4(value, 0.0);
 }
 

@@ -14,9 +14,10 @@
 
 namespace haarcast::gpu {
 
-void VulkanRenderer::Impl::createFusedLight() {
+void VulkanRenderer::Impl::createFusedLight(const DirectionTable& directionTable) {
   // The rest map at each object's turn level (render::lightTurnLevel), once
-  // per level, RGB0 texels in the map's row-major order.
+  // per level, RGB0 texels in the map's row-major order; the level's
+  // directions and solid angles are in the direction table.
   std::vector<glm::vec4> rest;
   std::map<int, std::uint32_t> baseOf;
   lightRestOf.clear();
@@ -28,25 +29,18 @@ void VulkanRenderer::Impl::createFusedLight() {
       for (std::size_t i = 0; i < maps[0].pixelCount(); ++i)
         rest.emplace_back(maps[0].values()[i], maps[1].values()[i], maps[2].values()[i], 0.0f);
     }
-    lightRestOf.emplace_back(at->second, static_cast<std::uint32_t>(turn));
+    LightPush& of = lightRestOf.emplace_back();
+    of.restBase = at->second;
+    of.restLevel = static_cast<std::uint32_t>(turn);
+    of.restDirections = directionTable.base[static_cast<std::size_t>(turn)];
   }
-  std::vector<float> solid(shared::kRowSolidAngles);
-  for (int l = 0; l <= static_cast<int>(shared::kFusedMaxLevel); ++l)
-    for (int row = 0; row < mapSize(l); ++row)
-      solid[shared::rowSolidAngleIndex(static_cast<shared::uint>(l), static_cast<shared::uint>(row))] =
-          static_cast<float>(pixelSolidAngle(l, row));
   lightRestMaps = Buffer(context, rest.size() * sizeof(glm::vec4), kStorageUsage, MemoryUse::DeviceInput);
-  rowSolidAngles = Buffer(context, solid.size() * sizeof(float), kStorageUsage, MemoryUse::DeviceInput);
-  for (auto [buffer, data, bytes] : {std::tuple{&lightRestMaps, static_cast<const void*>(rest.data()), rest.size() * sizeof(glm::vec4)},
-                                     std::tuple{&rowSolidAngles, static_cast<const void*>(solid.data()), solid.size() * sizeof(float)}}) {
-    BufferUpload up(context, *buffer);
-    up.write(data, bytes);
-    up.submit();
-  }
+  BufferUpload up(context, lightRestMaps);
+  up.write(rest.data(), rest.size() * sizeof(glm::vec4));
+  up.submit();
   lightPass = std::make_unique<ComputePipeline>(context, "light.comp", shared::kLightBindings, sizeof(LightPush));
   lightPass->bind({{shared::kLightObjectsBinding, &objects},
                    {shared::kLightRestBinding, &lightRestMaps},
-                   {shared::kLightSolidAnglesBinding, &rowSolidAngles},
                    {shared::kLightDirectionsBinding, &directions},
                    {shared::kLightTexelsBinding, &light}});
 }
@@ -74,9 +68,8 @@ void VulkanRenderer::Impl::recordFusedLight(VkCommandBuffer cb, const render::Re
     }
     const render::PreparedObject& p = prepared.objects[i];
     LightPush& push = pushes[i];
+    push = lightRestOf[i];
     push.object = static_cast<std::uint32_t>(i);
-    push.restBase = lightRestOf[i].first;
-    push.restLevel = lightRestOf[i].second;
     if (groundNormal && !p.ground) {
       push.groundUp = glm::vec4(glm::vec3(glm::transpose(resolved.objects[i].rotation) * *groundNormal), 1.0f);
     }

@@ -37,8 +37,10 @@ void VulkanRenderer::Impl::uploadScene() {
   objectInfo.resize(objectCount);
   // fused: each object at its own level (PreparedObject::level), its data
   // at its own bases (ObjectInfo), the directions of every level in use in
-  // one table.
-  const DirectionTable directionTable = fused ? pixelCentreDirections(prepared.objectLevels()) : DirectionTable{};
+  // one table: the objects' and their lights' turn levels (fused_light.cpp).
+  std::vector<int> directionLevels = prepared.objectLevels();
+  for (const render::PreparedObject& p : prepared.objects) directionLevels.push_back(render::lightTurnLevel(p.level));
+  const DirectionTable directionTable = fused ? pixelCentreDirections(directionLevels) : DirectionTable{};
   fusedLightTexelCount = 0;
   for (std::size_t k = 0; k < objectCount; ++k) {
     const render::PreparedObject& p = prepared.objects[k];
@@ -271,7 +273,7 @@ void VulkanRenderer::Impl::uploadScene() {
     return;
   }
   if (fused) {
-    createFusedLight();
+    createFusedLight(directionTable);
     // One SIMD group per workgroup on a CPU device: the workgroup's only
     // barriers (the reduction's) then switch no coroutines (docs/gpu.md).
     createFusedPipeline(limits.fusedLocalSize          ? limits.fusedLocalSize

@@ -112,10 +112,11 @@ struct VulkanRenderer::Impl {
   TexelView sliceTexels, lightTexels, directionTexels, visibilityTexels, lobeLightTexels, pointSliceTexels, detailTexels;
   // `fused`'s light, made on the device each frame (fused_light.cpp,
   // shaders/light.comp) from the rest map at each object's turn level
-  // (once per level, RGB0 texels) and each level's row solid angles; per
-  // object, where its rest map starts and its level.
-  Buffer lightRestMaps, rowSolidAngles;
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> lightRestOf;
+  // (once per level, RGB0 texels) and that level's directions in
+  // `directions`; per object, where its rest map starts, its level and
+  // where its directions start (LightPush).
+  Buffer lightRestMaps;
+  std::vector<LightPush> lightRestOf;
   std::unique_ptr<ComputePipeline> lightPass;
   // Per object, what its light in `light` was made for (its rotation, the
   // light's and the ground's, as render::FusedLightCache keys it): a frame
@@ -254,7 +255,7 @@ struct VulkanRenderer::Impl {
 
   // fused_light.cpp: `fused`'s "light" stage, the rest maps uploaded once
   // and each object's light in its frame recorded every frame.
-  void createFusedLight();
+  void createFusedLight(const DirectionTable& directionTable);
   void recordFusedLight(VkCommandBuffer cb, const render::ResolvedFrame& resolved);
   // After the submission that held the light stage ran to its end: the
   // lights it made are what `light` holds.

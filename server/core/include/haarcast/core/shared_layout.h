@@ -486,7 +486,8 @@ static_assert(sizeof(ExposurePush) == 32 && sizeof(ExposureResult) == 32);
 static_assert(sizeof(GBufferPush) == 80 && offsetof(GBufferPush, objectId) == 64);
 static_assert(sizeof(RotationPush) == 16 && offsetof(RotationPush, count) == 4);
 static_assert(sizeof(BatchArgsPush) == 16 && offsetof(BatchArgsPush, batches) == 4);
-static_assert(sizeof(LightPush) == 48 && offsetof(LightPush, groundUp) == 16 && offsetof(LightPush, albedo) == 32);
+static_assert(sizeof(LightPush) == 64 && offsetof(LightPush, restDirections) == 16 && offsetof(LightPush, groundUp) == 32 &&
+              offsetof(LightPush, albedo) == 48);
 #endif
 
 #ifdef __cplusplus

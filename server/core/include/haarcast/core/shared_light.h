@@ -27,26 +27,25 @@ HC_CONST uint kLightPhaseTexels = 0u;
 HC_CONST uint kLightPhaseCells = 1u;
 HC_CONST uint kLightPhaseGround = 2u;
 
-// Each row's solid angle (core pixelSolidAngle, computed in double on the
-// host) at every level the turn can take, level l's row r at
-// rowSolidAngleIndex(l, r): the device need not recompute a difference of
-// cosines that float loses most of near the poles.
-HC_FUNCTION uint rowSolidAngleIndex(uint level, uint row) { return (1u << level) - 1u + row; }
-HC_CONST uint kRowSolidAngles = (1u << (kFusedMaxLevel + 1u)) - 1u;
-
-// light.comp's bindings, all storage buffers.
-HC_CONST uint kLightObjectsBinding = 0u;      // ObjectInfo[]; the ground's groundRadiance written
-HC_CONST uint kLightRestBinding = 1u;         // vec4: the rest maps (RGB), each turn level's row-major from its base
-HC_CONST uint kLightSolidAnglesBinding = 2u;  // float[kRowSolidAngles]
-HC_CONST uint kLightDirectionsBinding = 3u;   // vec4: fused's direction table (gpu::pixelCentreDirections)
-HC_CONST uint kLightTexelsBinding = 4u;       // vec4: the light texels fused.comp reads, written
-HC_CONST uint kLightBindings = 5u;
+// light.comp's bindings, all storage buffers. The directions are fused's
+// table (gpu::pixelCentreDirections), which holds each object's level and
+// each turn level: a texel's centre (xyz) and solid angle (w), computed in
+// double on the host.
+HC_CONST uint kLightObjectsBinding = 0u;     // ObjectInfo[]; the ground's groundRadiance written
+HC_CONST uint kLightRestBinding = 1u;        // vec4: the rest maps (RGB), each turn level's row-major from its base
+HC_CONST uint kLightDirectionsBinding = 2u;  // vec4: the direction table
+HC_CONST uint kLightTexelsBinding = 3u;      // vec4: the light texels fused.comp reads, written
+HC_CONST uint kLightBindings = 4u;
 
 struct LightPush {
   uint phase;
   uint object;
-  uint restBase;   // the object's turn-level rest map at this vec4 of kLightRestBinding
-  uint restLevel;  // its level (≥ ObjectInfo::level)
+  uint restBase;        // the object's turn-level rest map at this vec4 of kLightRestBinding
+  uint restLevel;       // its level (≥ ObjectInfo::level)
+  uint restDirections;  // that level's direction 0 in the direction table
+  uint pushPad0;
+  uint pushPad1;
+  uint pushPad2;
   // xyz: the ground's normal in the object's frame; w: 1 where the object
   // stands on a ground (its light is zero below that plane), else 0.
   vec4 groundUp;
